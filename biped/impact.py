@@ -1,0 +1,42 @@
+"""Impact of a foot landing flat, eqs. (21)-(24), and the leg swap that follows it.
+
+The landing foot is stopped dead by an impulsive ground wrench I_R; the other foot leaves
+the ground. With D = D(q⁻) and A the contact Jacobian of the landing foot (rows ankle x,
+ankle z, foot angle, as ``Chain.contact_jacobian``):
+
+    D (q̇⁺ - q̇⁻) = Aᵀ I_R,   A q̇⁺ = 0                                   (21), (22)
+    q̇⁺ = [I - D⁻¹Aᵀ (A D⁻¹ Aᵀ)⁻¹ A] q̇⁻                                 (23)
+    I_R = -(A D⁻¹ Aᵀ)⁻¹ A q̇⁻                                           (24)
+
+I_R is the impulse of the ground on the landing foot [N·s, N·s, N·m·s] (Iz > 0 for a foot
+moving down); the printed eq. (24) drops the minus sign of this convention.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def flat_foot_impact(model, q, qd_minus, foot: str = "swing"):
+    """Velocities after the impact q̇⁺ (..., 9) and the ground impulse I_R (..., 3).
+
+    Args:
+        model: a ``biped.Biped``.
+        q: configuration at touchdown (..., 9), the landing foot flat on the ground.
+        qd_minus: velocities just before touchdown (..., 9).
+        foot: the landing foot, ``"swing"`` (end of a step) or ``"stance"``.
+
+    q̇⁺ is in the same labelling as q̇⁻: apply ``biped.kinematics.swap_legs`` to start the
+    next step.
+    """
+    q = np.asarray(q, dtype=float)
+    qd_minus = np.asarray(qd_minus, dtype=float)
+    mass = model.mass_matrix(q)
+    jac = model.contact_jacobian(q, foot)
+    # D⁻¹ Aᵀ through one factorisation of the symmetric positive-definite D.
+    d_inv_jt = np.linalg.solve(mass, np.swapaxes(jac, -1, -2))
+    gram = jac @ d_inv_jt  # A D⁻¹ Aᵀ (..., 3, 3)
+    approach = (jac @ qd_minus[..., None])[..., 0]  # A q̇⁻
+    impulse = -np.linalg.solve(gram, approach[..., None])[..., 0]
+    qd_plus = qd_minus + (d_inv_jt @ impulse[..., None])[..., 0]
+    return qd_plus, impulse

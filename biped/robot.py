@@ -1,0 +1,187 @@
+"""Robot parameters: the single source of truth for masses, lengths and knee radii.
+
+Conventions (used throughout the package, see also ``biped.kinematics``):
+
+- Planar robot in the x-z plane, x forward, z up, ground at z = 0.
+- Every angle is absolute, measured from the vertical, positive counter-clockwise in the
+  x-z plane (from +x towards +z). A segment hanging down from P with angle a ends at
+  P + L (sin a, -cos a); the trunk stands up from the hip and ends at P + L (-sin a, cos a).
+- Centre-of-mass distances are measured from the proximal end of each segment: the hip for
+  thigh and trunk, the knee for the shank, the ankle for the foot (straight below it when
+  the foot is flat).
+- Rolling knee (paper, Fig. 3): the shank ends in a circle of radius ``r1``, the thigh in a
+  circle of radius ``r2``; the two roll without slip. The overall segment lengths ``l1``,
+  ``l2`` include the radii, so both robots have the same height.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import tomllib
+from pathlib import Path
+
+from biped.errors import ParameterError
+
+# Standard gravity [m/s²].
+STANDARD_GRAVITY = 9.81
+
+
+@dataclasses.dataclass(frozen=True)
+class Robot:
+    """Parameters of the seven-link planar biped (paper, Table 1), SI units.
+
+    Symbols of the paper in brackets. Both legs are identical.
+    """
+
+    foot_length: float
+    """[m] Length of the sole, heel to toe (L_p)."""
+    foot_heel: float
+    """[m] Horizontal distance from the heel to the ankle (l_p)."""
+    ankle_height: float
+    """[m] Height of the ankle above the sole (h_p)."""
+    foot_mass: float
+    """[kg] Mass of one foot (m_p)."""
+    foot_inertia: float
+    """[kg·m²] Moment of inertia of one foot about its centre of mass (I_p)."""
+    foot_com: float
+    """[m] Distance of the foot centre of mass below the ankle (s_p)."""
+
+    shank_length: float
+    """[m] Ankle to knee (l_1), the rolling-knee radius r1 included."""
+    shank_mass: float
+    """[kg] (m_1)."""
+    shank_inertia: float
+    """[kg·m²] About the shank centre of mass (I_1)."""
+    shank_com: float
+    """[m] Knee to shank centre of mass (s_1); r1 - s1 from the rolling circle centre C1."""
+
+    thigh_length: float
+    """[m] Knee to hip (l_2), the rolling-knee radius r2 included."""
+    thigh_mass: float
+    """[kg] (m_2)."""
+    thigh_inertia: float
+    """[kg·m²] About the thigh centre of mass (I_2)."""
+    thigh_com: float
+    """[m] Hip to thigh centre of mass (s_2)."""
+
+    trunk_length: float
+    """[m] Hip to top of the head-arms-trunk segment (l_3)."""
+    trunk_mass: float
+    """[kg] (m_3)."""
+    trunk_inertia: float
+    """[kg·m²] About the trunk centre of mass (I_3)."""
+    trunk_com: float
+    """[m] Hip to trunk centre of mass (s_3)."""
+
+    r1: float = 0.05
+    """[m] Radius of the shank's rolling surface (rolling knee only)."""
+    r2: float = 0.05
+    """[m] Radius of the thigh's rolling surface (rolling knee only)."""
+    gravity: float = STANDARD_GRAVITY
+    """[m/s²] Gravitational acceleration."""
+
+    def __post_init__(self):
+        for field in dataclasses.fields(self):
+            value = getattr(self, field.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ParameterError(field.name, value, "a real number")
+            if not math.isfinite(value):
+                raise ParameterError(field.name, value, "a finite number")
+            object.__setattr__(self, field.name, float(value))
+        positive = [f.name for f in dataclasses.fields(self) if f.name not in ("r1", "r2")]
+        for name in positive:
+            if getattr(self, name) <= 0.0:
+                raise ParameterError(name, getattr(self, name), "> 0")
+        for name in ("r1", "r2"):
+            if getattr(self, name) < 0.0:
+                raise ParameterError(name, getattr(self, name), ">= 0")
+        self._check_below("foot_heel", "foot_length", "0 < foot_heel < foot_length")
+        self._check_below("foot_com", "ankle_height", "0 < foot_com <= ankle_height", strict=False)
+        for segment in ("shank", "thigh", "trunk"):
+            self._check_below(
+                f"{segment}_com", f"{segment}_length", f"0 < {segment}_com < {segment}_length"
+            )
+        self._check_below("r1", "shank_length", "0 <= r1 < shank_length")
+        self._check_below("r2", "thigh_length", "0 <= r2 < thigh_length")
+
+    def _check_below(self, name: str, bound: str, allowed: str, strict: bool = True):
+        value, limit = getattr(self, name), getattr(self, bound)
+        if value > limit or (strict and value == limit):
+            raise ParameterError(name, value, f"{allowed} (here {bound} = {limit!r})")
+
+    # ------------------------------------------------------------------ factories
+    @classmethod
+    def paper(cls) -> Robot:
+        """Table 1 of the paper: 70 kg, 1.70 m, knee radii r1 = r2 = 0.05 m."""
+        return cls(
+            foot_length=0.2584,
+            foot_heel=0.0935,
+            ankle_height=0.0663,
+            foot_mass=1.015,
+            foot_inertia=0.001,
+            foot_com=0.0331,
+            shank_length=0.4182,
+            shank_mass=3.2550,
+            shank_inertia=0.0519,
+            shank_com=0.1811,
+            thigh_length=0.4165,
+            thigh_mass=7.00,
+            thigh_inertia=0.1267,
+            thigh_com=0.1803,
+            trunk_length=0.7990,
+            trunk_mass=47.46,
+            trunk_inertia=7.4539,
+            trunk_com=0.5002,
+            r1=0.05,
+            r2=0.05,
+        )
+
+    @classmethod
+    def from_mapping(cls, values: dict, source: str = "mapping") -> Robot:
+        """A robot from a mapping of field names; missing fields take Table 1 values."""
+        if not isinstance(values, dict):
+            raise ParameterError(source, type(values).__name__, "a table of field = value")
+        known = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise ParameterError(unknown[0], values[unknown[0]], f"one of {sorted(known)}")
+        return dataclasses.replace(cls.paper(), **values)
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Robot:
+        """Load a robot from a ``.json`` or ``.toml`` file of field names (SI units).
+
+        Fields left out take their Table 1 value, so ``r1 = 0.08`` alone is a valid file.
+        """
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".json", ".toml"):
+            raise ParameterError("file", str(path), "a .json or .toml file")
+        try:
+            text = path.read_text()
+        except OSError as error:
+            raise ParameterError("file", str(path), f"a readable file ({error.strerror})") from None
+        try:
+            values = json.loads(text) if suffix == ".json" else tomllib.loads(text)
+        except (json.JSONDecodeError, tomllib.TOMLDecodeError) as error:
+            raise ParameterError(
+                "file", str(path), f"valid {suffix[1:].upper()} ({error})"
+            ) from None
+        return cls.from_mapping(values, source=str(path))
+
+    def to_dict(self) -> dict:
+        """Field names to values, for JSON output."""
+        return dataclasses.asdict(self)
+
+    # ------------------------------------------------------------------ derived values
+    @property
+    def total_mass(self) -> float:
+        """[kg] Mass of the whole robot (two feet, two shanks, two thighs, trunk)."""
+        return 2 * (self.foot_mass + self.shank_mass + self.thigh_mass) + self.trunk_mass
+
+    @property
+    def height(self) -> float:
+        """[m] Standing height: ankle height + shank + thigh + trunk."""
+        return self.ankle_height + self.shank_length + self.thigh_length + self.trunk_length

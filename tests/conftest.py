@@ -1,0 +1,39 @@
+"""Shared fixtures: both robots and seeded random motions with the stance foot fixed."""
+
+import numpy as np
+import pytest
+
+import biped
+
+KNEES = biped.KNEES
+
+
+@pytest.fixture(params=KNEES)
+def model(request):
+    """The Table 1 robot with each knee kinematic."""
+    return biped.Biped(biped.Robot.paper(), knee=request.param)
+
+
+def random_state(model, seed, n=16, spread=0.6):
+    """n seeded single-support states (q, q̇, q̈) with the stance foot flat and fixed."""
+    rng = np.random.default_rng(seed)
+    angles = rng.uniform(-spread, spread, (n, 6))
+    return model.stance_state(angles, rng.normal(0, 2, (n, 6)), rng.normal(0, 10, (n, 6)))
+
+
+def smooth_motion(model, seed, t):
+    """A smooth single-support motion (sums of sines) sampled at times t [s]."""
+    rng = np.random.default_rng(seed)
+    amplitude = rng.uniform(0.1, 0.4, (2, 6))
+    omega = rng.uniform(1.0, 6.0, (2, 6))
+    phase = rng.uniform(0, 2 * np.pi, (2, 6))
+    arg = omega[:, None] * np.asarray(t)[None, :, None] + phase[:, None]
+    angles = (amplitude[:, None] * np.sin(arg)).sum(0)
+    rates = (amplitude[:, None] * omega[:, None] * np.cos(arg)).sum(0)
+    accel = -(amplitude[:, None] * omega[:, None] ** 2 * np.sin(arg)).sum(0)
+    return model.stance_state(angles, rates, accel)
+
+
+def complex_step_velocity(model, q, qd, names, h=1e-30):
+    """Exact velocities (..., P, 2) of named points by complex-step differentiation."""
+    return model.points(np.asarray(q) + 1j * h * np.asarray(qd), names).imag / h

@@ -1,0 +1,1 @@
+"""Physics validation of analytical gaits in MuJoCo (models, cross-checks, recordings)."""
