@@ -10,12 +10,17 @@ import sys
 
 import numpy as np
 
+from biped.criteria import CRITERIA
 from biped.dynamics import JOINTS, Biped
 from biped.errors import BipedError
 from biped.kinematics import KNEES
 from biped.robot import Robot
+from biped.sweep import DEFAULT_SPEEDS
 
 EXIT_BAD_INPUT = 2
+DEFAULT_SWEEP = "logs/sweep"
+DEFAULT_FIGURES = "logs/figures"
+ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
 
 
 def _robot(path: str | None) -> Robot:
@@ -61,21 +66,164 @@ def cmd_demo(args) -> int:
     return 0
 
 
+def _speed(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"speed = {text!r} is not a number") from None
+    if not (np.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"speed = {text!r} m/s: allowed > 0")
+    return value
+
+
+def _speeds(text: str) -> np.ndarray:
+    """'0.15:0.45:13' (start:stop:count) or '0.2,0.3' (a list)."""
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            values = np.linspace(float(start), float(stop), int(count))
+        else:
+            values = np.array([float(v) for v in text.split(",")])
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"speeds = {text!r}: allowed START:STOP:COUNT or a comma-separated list"
+        ) from None
+    if values.size == 0 or not np.all(np.isfinite(values) & (values > 0)):
+        raise argparse.ArgumentTypeError(f"speeds = {text!r}: allowed speeds > 0 m/s")
+    return np.round(values, 6)
+
+
+def cmd_optimize(args) -> int:
+    """Find the optimal gait of one robot at one walking speed and write it as JSON.
+
+    Exits 0 with the gait file written when the optimum is feasible on the fine check grid;
+    otherwise names the violated constraints, writes nothing and exits 1.
+    """
+    from biped import gait_file
+    from biped.optimize import check_speed, optimize
+
+    robot = _robot(args.robot)
+    model = Biped(robot, args.knee)
+    check_speed(model, args.speed)
+    print(
+        f"optimizing {args.knee} knee, {args.criterion} criterion, {args.speed} m/s "
+        f"(seed {args.seed})...",
+        file=sys.stderr,
+    )
+    optimum = optimize(model, args.speed, args.criterion, seed=args.seed, **_budget(args))
+    ev = optimum.evaluation
+    print(
+        f"{args.knee} {args.criterion} {args.speed} m/s: criterion {optimum.value:.6g}, "
+        f"sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J, "
+        f"period {optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m, "
+        f"{optimum.evaluations} evaluations in {optimum.seconds:.1f} s"
+    )
+    if not optimum.feasible:
+        worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
+        print(
+            f"biped optimize: infeasible optimum, violated constraints (Ψ < 0): {worst}; "
+            f"no file written",
+            file=sys.stderr,
+        )
+        return 1
+    path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    """Optimal gaits over a range of speeds, both knees and both criteria, on all cores.
+
+    Each point is saved as it completes; run the same command again to resume.
+    """
+    from biped.sweep import run_sweep
+
+    robot = _robot(args.robot)
+    run_sweep(
+        args.out,
+        robot,
+        args.speeds,
+        args.knees,
+        args.criteria,
+        seed=args.seed,
+        jobs=args.jobs,
+        **_budget(args),
+    )
+    print(f"sweep results in {args.out}")
+    return 0
+
+
+def cmd_figures(args) -> int:
+    """PNG figures reproducing the paper's Figs. 4-8 and a comparison table (markdown)."""
+    from biped.figures import make_figures
+
+    for path in make_figures(args.sweep, args.out):
+        print(f"wrote {path}")
+    return 0
+
+
+def _budget(args) -> dict:
+    return {"max_restarts": args.restarts, "evaluations_per_run": args.evaluations}
+
+
+def _add_budget(parser):
+    from biped.optimize import EVALUATIONS_PER_RUN, MAX_RESTARTS
+
+    parser.add_argument("--seed", type=int, default=0, help="orients the restarts (default 0)")
+    parser.add_argument(
+        "--restarts",
+        type=_non_negative,
+        default=MAX_RESTARTS,
+        help=f"Nelder-Mead restarts from the best point at most (default {MAX_RESTARTS})",
+    )
+    parser.add_argument(
+        "--evaluations",
+        type=_positive,
+        default=EVALUATIONS_PER_RUN,
+        metavar="N",
+        help=f"criterion evaluations per Nelder-Mead run (default {EVALUATIONS_PER_RUN})",
+    )
+
+
+def _non_negative(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer >= 0")
+    return value
+
+
+def _positive(text: str) -> int:
+    value = _non_negative(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer >= 1")
+    return value
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2."""
+
+    def error(self, message):
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="biped",
         description="Quasi-optimal gaits of planar bipeds with revolute or rolling knees.",
     )
-    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    commands = parser.add_subparsers(
+        dest="command", required=True, metavar="COMMAND", parser_class=_Parser
+    )
     demo = commands.add_parser(
         "demo",
         help="torques, ground wrench and ZMP of a one-leg posture",
         description=cmd_demo.__doc__,
     )
     demo.add_argument("--knee", choices=KNEES, help="one knee kinematic (default: both)")
-    demo.add_argument(
-        "--robot", metavar="FILE", help="robot parameters, .json or .toml (default: Table 1)"
-    )
+    demo.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     demo.add_argument(
         "--hip-ahead",
         type=float,
@@ -91,6 +239,46 @@ def build_parser() -> argparse.ArgumentParser:
         help="[m] hip above the ground (default 0.86)",
     )
     demo.set_defaults(run=cmd_demo)
+
+    opt = commands.add_parser(
+        "optimize", help="optimal gait at one speed", description=cmd_optimize.__doc__
+    )
+    opt.add_argument("--knee", choices=KNEES, required=True)
+    opt.add_argument("--criterion", choices=CRITERIA, default="sthenic")
+    opt.add_argument("--speed", type=_speed, required=True, metavar="V", help="[m/s] > 0")
+    opt.add_argument("--out", required=True, metavar="FILE", help="gait file to write (JSON)")
+    _add_budget(opt)
+    opt.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    opt.set_defaults(run=cmd_optimize)
+
+    sweep = commands.add_parser(
+        "sweep", help="optimal gaits over speeds, knees, criteria", description=cmd_sweep.__doc__
+    )
+    sweep.add_argument(
+        "--speeds",
+        type=_speeds,
+        default=DEFAULT_SPEEDS,
+        metavar="S",
+        help="START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.15:0.45:13)",
+    )
+    sweep.add_argument("--knees", nargs="+", choices=KNEES, default=list(KNEES))
+    sweep.add_argument("--criteria", nargs="+", choices=CRITERIA, default=list(CRITERIA))
+    sweep.add_argument(
+        "--out", default=DEFAULT_SWEEP, metavar="DIR", help=f"(default {DEFAULT_SWEEP})"
+    )
+    sweep.add_argument(
+        "--jobs", type=_positive, default=None, help="processes (default: all cores)"
+    )
+    _add_budget(sweep)
+    sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    sweep.set_defaults(run=cmd_sweep)
+
+    fig = commands.add_parser(
+        "figures", help="figures and table of the comparison", description=cmd_figures.__doc__
+    )
+    fig.add_argument("--sweep", default=DEFAULT_SWEEP, metavar="DIR", help="sweep results")
+    fig.add_argument("--out", default=DEFAULT_FIGURES, metavar="DIR", help="(default logs/figures)")
+    fig.set_defaults(run=cmd_figures)
     return parser
 
 

@@ -141,6 +141,15 @@ class Chain:
             for key, value in b.items():
                 self.point_b[index[key], j] = value
         self._point_index = {name: j for j, name in enumerate(points)}
+        self._stance_ankle = self.point_a[:, self._point_index["stance_ankle"]].copy()
+        self._reach = (
+            float(np.sqrt(self._reach_squared(np.pi))),
+            float(np.sqrt(self._reach_squared(0.0))),
+        )
+        # Table of the monotone reach |hip - ankle|² over the knee flexion [0, π], to start
+        # the Newton iterations of the inverse geometric model next to the root.
+        self._flexion_table = np.linspace(0.0, np.pi, 1025)
+        self._reach_table = self._reach_squared(self._flexion_table)
 
         self.bodies = tuple(
             Body(f"{side}_{segment}", mass, inertia, f"{side}_{segment}", f"{side}_{segment}_com")
@@ -244,33 +253,30 @@ class Chain:
         stays at x = 0, z = h_p, the ground at z = 0.
         """
         free = np.asarray(angles, dtype=float)
-        zeros = np.zeros(free.shape[:-1] + (1,))
-        rates = np.zeros_like(free) if rates is None else np.asarray(rates, dtype=float)
-        accel = np.zeros_like(free) if accelerations is None else np.asarray(accelerations, float)
-        angles, rates, accel = (np.concatenate([zeros, x], -1) for x in (free, rates, accel))
-        j = self.point_index("stance_ankle")
-        a = self.point_a[:, j]  # the ankle has no u' terms
-        phi, phid, phidd = (x @ self.directions.T for x in (angles, rates, accel))
+        shape = free.shape[:-1] + (NQ,)
+        q, qd, qdd = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+        q[..., 1:7] = free
+        if rates is not None:
+            qd[..., 1:7] = rates
+        if accelerations is not None:
+            qdd[..., 1:7] = accelerations
+        a = self._stance_ankle  # ankle = hip + Σ a u(φ)  =>  hip = ankle - Σ a u(φ)
+        phi = self.direction_angles(q)
+        phid = self.direction_angles(qd)
+        phidd = self.direction_angles(qdd)
         s, c = np.sin(phi), np.cos(phi)
-        # ankle = hip + Σ a u(φ)  =>  hip = ankle - Σ a u(φ)
-        hip = np.stack([-(a * s).sum(-1), self.robot.ankle_height + (a * c).sum(-1)], -1)
-        hip_d = np.stack([-(a * c * phid).sum(-1), -(a * s * phid).sum(-1)], -1)
-        hip_dd = np.stack(
-            [
-                -(a * (c * phidd - s * phid**2)).sum(-1),
-                -(a * (s * phidd + c * phid**2)).sum(-1),
-            ],
-            -1,
-        )
-        return (
-            np.concatenate([angles, hip], -1),
-            np.concatenate([rates, hip_d], -1),
-            np.concatenate([accel, hip_dd], -1),
-        )
+        rate2 = phid * phid
+        q[..., XH] = -(s @ a)
+        q[..., ZH] = self.robot.ankle_height + c @ a
+        qd[..., XH] = -((c * phid) @ a)
+        qd[..., ZH] = -((s * phid) @ a)
+        qdd[..., XH] = -((c * phidd - s * rate2) @ a)
+        qdd[..., ZH] = -((s * phidd + c * rate2) @ a)
+        return q, qd, qdd
 
     def leg_reach(self):
         """[m] Shortest and longest ankle-to-hip distance (knee flexion π and 0)."""
-        return float(np.sqrt(self._reach_squared(np.pi))), float(np.sqrt(self._reach_squared(0.0)))
+        return self._reach
 
     def _reach_squared(self, flexion):
         """|hip - ankle|² as a function of the knee flexion θ = q_thigh - q_shank ≥ 0."""
@@ -320,19 +326,19 @@ class Chain:
             )
         r1, r2 = self.radii
         shank, thigh = self.robot.shank_length - r1, self.robot.thigh_length - r2
-        # Revolute closed form (exact when r1 = r2 = 0), then Newton on the monotone f(θ).
-        l1, l2 = self.robot.shank_length, self.robot.thigh_length
-        flexion = np.arccos(np.clip((dist2 - l1**2 - l2**2) / (2 * l1 * l2), -1.0, 1.0))
-        if r1 + r2 > 0.0:
-            flexion = np.clip(flexion, 1e-9, np.pi)
-            for _ in range(50):
+        if r1 + r2 == 0.0:  # revolute: closed form
+            l1, l2 = self.robot.shank_length, self.robot.thigh_length
+            flexion = np.arccos(np.clip((dist2 - l1**2 - l2**2) / (2 * l1 * l2), -1.0, 1.0))
+        else:  # Newton on the monotone f(θ) from the tabulated inverse
+            flexion = np.interp(dist2, self._reach_table[::-1], self._flexion_table[::-1])
+            for _ in range(20):
                 residual = self._reach_squared(flexion) - dist2
+                if np.all(np.abs(residual) < 1e-13):
+                    break
                 slope = self._reach_squared_derivative(flexion)
                 step = np.where(slope < 0.0, residual / np.where(slope < 0.0, slope, -1.0), 0.0)
                 flexion = np.clip(flexion - step, 0.0, np.pi)
-                if np.all(np.abs(residual) < 1e-15):
-                    break
-            if np.any(np.abs(self._reach_squared(flexion) - dist2) > 1e-12):
+            else:
                 raise UnreachableError("inverse geometric model did not converge")
         link = r1 + r2
         # Leg as a chain hanging from the ankle with shank angle 0: hip = -R(q1) v(θ).

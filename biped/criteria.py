@@ -1,0 +1,158 @@
+"""Constraints Ψ1-Ψ7 (eq. 28) and the sthenic and energy criteria (eqs. 30-31).
+
+    Ψ1 = Fz                    the ground pushes (unilateral contact)
+    Ψ2 = x_ZMP + l_p           ZMP in front of the heel
+    Ψ3 = -x_ZMP + (L_p - l_p)  ZMP behind the toe
+    Ψ4 = q2 - q1               stance knee not inverted
+    Ψ5 = q3 - q4               swing knee not inverted
+    Ψ6 = z of the swing heel   swing foot above the ground
+    Ψ7 = z of the swing toe
+
+    C_Γ = (2/d) ∫₀ᵀ (ΓᵀΓ + k Σ (e^(|Ψ_i| - Ψ_i) - 1)) dt + Err              (30)
+    C_E =       ∫₀ᵀ (Σ |Γ_i θ̇_i| + k Σ (e^(|Ψ_i| - Ψ_i) - 1)) dt + Err      (31)
+
+with k = 10⁶ and d = 2 S (see ``biped.gait``). Integrals use Simpson's rule on each spline
+piece separately: the accelerations, hence the torques, jump at the knot t = T/2.
+Ψ6 and Ψ7 vanish by construction at t = 0 and t = T (both feet on the ground); they are
+checked at the interior samples only.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import simpson
+
+from biped.dynamics import Biped
+from biped.gait import Step, sample
+
+CONSTRAINTS = (
+    "normal_force",
+    "zmp_heel",
+    "zmp_toe",
+    "stance_knee",
+    "swing_knee",
+    "swing_heel",
+    "swing_toe",
+)
+CRITERIA = ("sthenic", "energy")
+PENALTY_WEIGHT = 1e6  # k of eqs. (30)-(31)
+# Err of eqs. (30)-(31) when the parameters give no posture: a large cost growing with the
+# distance [m] by which the hip is out of reach, so that the simplex is led back.
+BUILD_ERROR_COST = 1e12
+BUILD_ERROR_SLOPE = 1e13  # per metre out of reach
+
+
+# Margins δ_i the optimiser keeps from each constraint [N, m, m, rad, rad, m, m]. With an
+# exponential penalty of finite weight, the minimum of the penalised criterion violates an
+# active constraint slightly; asking for Ψ_i >= δ_i there leaves Ψ_i >= 0 with room to spare.
+# The swing-foot margins ramp up from zero over the first and last tenth of the step, where
+# the foot leaves and reaches the ground.
+MARGINS = np.array([1.0, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
+FOOT_MARGIN_RAMP = 0.1  # fraction of the step
+
+
+@functools.cache
+def margin_profile(samples_per_half: int) -> np.ndarray:
+    """δ (N, 7) on the time grid of ``biped.gait.sample``."""
+    t = np.linspace(0.0, 0.5, samples_per_half + 1)
+    t_n = np.concatenate([t, t + 0.5])
+    ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / FOOT_MARGIN_RAMP, 0.0, 1.0)
+    profile = np.tile(MARGINS, (len(t_n), 1))
+    profile[:, 5:] *= ramp[:, None]
+    profile.setflags(write=False)
+    return profile
+
+
+@functools.cache
+def simpson_weights(samples_per_half: int) -> np.ndarray:
+    """Weights w with Σ w f(t_n) = Simpson's rule on both pieces of the normalised grid.
+
+    Simpson's rule is linear in the samples, so scipy's rule applied to the identity gives
+    its weights once for all.
+    """
+    n = samples_per_half + 1
+    half = simpson(np.eye(n), x=np.linspace(0.0, 0.5, n), axis=-1)
+    return np.concatenate([half, half])
+
+
+@dataclass(frozen=True)
+class StepEvaluation:
+    """Everything computed on one step's time grid."""
+
+    t: np.ndarray  # [s] (N,), T/2 twice
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    torques: np.ndarray  # [N·m] (N, 6)
+    wrench: np.ndarray  # (N, 3)
+    zmp: np.ndarray  # [m] (N,)
+    constraints: np.ndarray  # (N, 7) Ψ1..Ψ7, NaN where not checked
+    sthenic: float  # (2/d) ∫ ΓᵀΓ dt [N²·m·s]
+    energy: float  # ∫ Σ |Γ θ̇| dt [J]
+    penalty: float  # ∫ k Σ (e^(|Ψ|-Ψ) - 1) dt [s]
+
+    def cost(self, criterion: str, step_length: float) -> float:
+        """C_Γ or C_E with the penalty (Err = 0: the step was built)."""
+        if criterion == "sthenic":
+            return self.sthenic + self.penalty / step_length
+        return self.energy + self.penalty
+
+    def violations(self) -> dict:
+        """Worst value of each violated constraint (Ψ_i < 0), by name."""
+        worst = np.nanmin(self.constraints, axis=0)
+        return {name: float(w) for name, w in zip(CONSTRAINTS, worst, strict=True) if w < 0.0}
+
+
+def evaluate_step(
+    model: Biped, step: Step, samples_per_half: int, margins: bool = False
+) -> StepEvaluation:
+    """Torques, wrench, ZMP, constraints and criteria of one step.
+
+    Args:
+        margins: penalise Ψ_i - δ_i instead of Ψ_i (``MARGINS``), as the optimiser does.
+    """
+    t, q, qd, qdd = sample(model, step, samples_per_half)
+    torques, wrench = model.inverse_dynamics(q, qd, qdd)
+    robot = model.robot
+    zmp = (torques[:, 0] - robot.ankle_height * wrench[:, 0]) / wrench[:, 1]
+    feet = model.points(q, ["swing_heel", "swing_toe"])[..., 1]
+    feet[[0, -1]] = np.nan  # on the ground by construction
+    psi = np.column_stack(
+        [
+            wrench[:, 1],
+            zmp + robot.foot_heel,
+            robot.foot_length - robot.foot_heel - zmp,
+            q[:, 3] - q[:, 2],
+            q[:, 4] - q[:, 5],
+            feet,
+        ]
+    )
+    if margins:
+        psi_seen = psi - margin_profile(samples_per_half)
+    else:
+        psi_seen = psi
+    barrier = np.expm1(np.abs(psi_seen) - psi_seen)
+    barrier = PENALTY_WEIGHT * np.nansum(barrier, axis=1)
+    power = np.abs(model.joint_angles(qd) * torques).sum(-1)
+    squared = (torques**2).sum(-1)
+    weights = step.period * simpson_weights(samples_per_half)
+
+    def integral(values):
+        return float(weights @ values)
+
+    return StepEvaluation(
+        t=t,
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        torques=torques,
+        wrench=wrench,
+        zmp=zmp,
+        constraints=psi,
+        sthenic=integral(squared) / step.step_length,
+        energy=integral(power),
+        penalty=integral(barrier),
+    )

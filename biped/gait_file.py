@@ -1,0 +1,141 @@
+"""Gait files: one optimal gait as JSON, written atomically, read back with checks.
+
+Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at x = 0):
+
+    knee, criterion, speed [m/s], period [s], step_length [m], feasible,
+    costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]},
+    robot {field: value}, parameters {name: value} (the 21 of ``biped.gait.PARAMETERS``),
+    constraints {name: worst Ψ_i on the samples},
+    impact {impulse [N·s, N·s, N·m·s], qd_minus, qd_plus},
+    optimizer {seed, evaluations, seconds, history},
+    samples {t, q, qd, qdd, torques, wrench, zmp}
+
+The samples run from t = 0 to t = T inclusive on both spline pieces; t = T/2 appears twice,
+left and right limits, because the accelerations (and torques) jump at the knot.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from biped.criteria import CONSTRAINTS
+from biped.errors import BipedError
+from biped.gait import PARAMETERS
+from biped.optimize import Optimum
+from biped.robot import Robot
+
+FORMAT = "biped-gait/1"
+SAMPLE_FIELDS = {"t": 1, "q": 9, "qd": 9, "qdd": 9, "torques": 6, "wrench": 3, "zmp": 1}
+
+
+def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
+    """The JSON-ready content of a gait file."""
+    ev = optimum.evaluation
+    step = optimum.step
+    worst = np.nanmin(ev.constraints, axis=0)
+    return {
+        "format": FORMAT,
+        "knee": optimum.knee,
+        "criterion": optimum.criterion,
+        "speed": optimum.speed,
+        "period": step.period,
+        "step_length": step.step_length,
+        "feasible": optimum.feasible,
+        "costs": {
+            "sthenic": ev.sthenic,
+            "energy": ev.energy,
+            "energy_per_metre": ev.energy / step.step_length,
+        },
+        "robot": robot.to_dict(),
+        "parameters": dict(zip(PARAMETERS, map(float, optimum.parameters), strict=True)),
+        "constraints": dict(zip(CONSTRAINTS, map(float, worst), strict=True)),
+        "impact": {
+            "impulse": step.impulse.tolist(),
+            "qd_minus": step.end[1].tolist(),
+            "qd_plus": step.start[1].tolist(),
+        },
+        "optimizer": {
+            "seed": seed,
+            "evaluations": optimum.evaluations,
+            "seconds": optimum.seconds,
+            "history": list(map(float, optimum.history)),
+        },
+        "samples": {
+            "t": ev.t.tolist(),
+            "q": ev.q.tolist(),
+            "qd": ev.qd.tolist(),
+            "qdd": ev.qdd.tolist(),
+            "torques": ev.torques.tolist(),
+            "wrench": ev.wrench.tolist(),
+            "zmp": ev.zmp.tolist(),
+        },
+    }
+
+
+def write_json(path: str | Path, content: dict) -> Path:
+    """Write JSON atomically: a temporary file in the same folder, then a rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as handle:
+            json.dump(content, handle, indent=1, allow_nan=False)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read(path: str | Path) -> dict:
+    """Read a gait file; samples become numpy arrays. Raises BipedError if it is not one."""
+    path = Path(path)
+    try:
+        content = json.loads(path.read_text())
+    except OSError as error:
+        raise BipedError(f"gait file {str(path)!r} cannot be read: {error.strerror}") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise BipedError(f"gait file {str(path)!r} is not valid JSON: {error}") from None
+
+    def bad(what):
+        return BipedError(f"gait file {str(path)!r} is corrupt: {what}")
+
+    if not isinstance(content, dict) or content.get("format") != FORMAT:
+        raise bad(f"format is not {FORMAT!r}")
+    for key in ("knee", "criterion", "speed", "period", "step_length", "feasible", "costs"):
+        if key not in content:
+            raise bad(f"missing {key!r}")
+    for key in ("speed", "period", "step_length"):
+        value = content[key]
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise bad(f"{key} = {value!r}, allowed a number > 0")
+    try:
+        content["robot"] = Robot.from_mapping(content["robot"], source=str(path))
+        names = set(content["parameters"])
+    except (KeyError, TypeError) as error:
+        raise bad(f"robot or parameters missing ({error})") from None
+    if names != set(PARAMETERS):
+        raise bad(f"parameters are not the {len(PARAMETERS)} of the gait")
+    samples = content.get("samples")
+    if not isinstance(samples, dict):
+        raise bad("missing samples")
+    length = None
+    for key, width in SAMPLE_FIELDS.items():
+        try:
+            array = np.asarray(samples[key], dtype=float)
+        except (KeyError, TypeError, ValueError):
+            raise bad(f"samples.{key} missing or not numeric") from None
+        expected = (array.shape[0],) if width == 1 else (array.shape[0], width)
+        if array.ndim == 0 or array.shape != expected or not np.all(np.isfinite(array)):
+            raise bad(f"samples.{key} has shape {array.shape}, allowed (N,{width})")
+        length = array.shape[0] if length is None else length
+        if array.shape[0] != length:
+            raise bad(f"samples.{key} has {array.shape[0]} rows, others {length}")
+        samples[key] = array
+    return content
