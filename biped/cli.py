@@ -6,6 +6,7 @@ Errors in the input print one line on stderr and exit with status 2.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 
 import numpy as np
@@ -138,6 +139,8 @@ def cmd_sweep(args) -> int:
     """
     from biped.sweep import run_sweep
 
+    # A terminated sweep stops its worker processes too (the pool closes on SystemExit).
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
     robot = _robot(args.robot)
     run_sweep(
         args.out,
@@ -163,11 +166,15 @@ def cmd_figures(args) -> int:
 
 
 def _budget(args) -> dict:
-    return {"max_restarts": args.restarts, "evaluations_per_run": args.evaluations}
+    return {
+        "max_restarts": args.restarts,
+        "evaluations_per_run": args.evaluations,
+        "polish_iterations": args.polish,
+    }
 
 
 def _add_budget(parser):
-    from biped.optimize import EVALUATIONS_PER_RUN, MAX_RESTARTS
+    from biped.optimize import EVALUATIONS_PER_RUN, MAX_RESTARTS, POLISH_ITERATIONS
 
     parser.add_argument("--seed", type=int, default=0, help="orients the restarts (default 0)")
     parser.add_argument(
@@ -182,6 +189,13 @@ def _add_budget(parser):
         default=EVALUATIONS_PER_RUN,
         metavar="N",
         help=f"criterion evaluations per Nelder-Mead run (default {EVALUATIONS_PER_RUN})",
+    )
+    parser.add_argument(
+        "--polish",
+        type=_non_negative,
+        default=POLISH_ITERATIONS,
+        metavar="N",
+        help=f"SLSQP polish iterations at most, 0 for none (default {POLISH_ITERATIONS})",
     )
 
 

@@ -114,11 +114,12 @@ def evaluate_step(
     Args:
         margins: penalise Ψ_i - δ_i instead of Ψ_i (``MARGINS``), as the optimiser does.
     """
-    t, q, qd, qdd = sample(model, step, samples_per_half)
-    torques, wrench = model.inverse_dynamics(q, qd, qdd)
+    t, q, qd, qdd, torques, wrench, feet = sample(
+        model, step, samples_per_half, ("swing_heel", "swing_toe")
+    )
     robot = model.robot
     zmp = (torques[:, 0] - robot.ankle_height * wrench[:, 0]) / wrench[:, 1]
-    feet = model.points(q, ["swing_heel", "swing_toe"])[..., 1]
+    feet = feet[..., 1]
     feet[[0, -1]] = np.nan  # on the ground by construction
     psi = np.column_stack(
         [

@@ -82,8 +82,8 @@ class Biped(Chain):
         self._p = np.zeros((k + 2, NQ))
         self._p[:k, :7] = self.directions
         self._p[k, XH] = self._p[k + 1, ZH] = 1.0
-        ankle = self.point_index("stance_ankle")
-        self._ankle = self.point_a[:, ankle]
+        self._ankle = self.point_a[:, self.point_index("stance_ankle")]
+        self._stance_leg = self.directions[:, [Q1, Q2]]
 
     # ------------------------------------------------------------------ matrices of eq. (19)
     @property
@@ -130,14 +130,15 @@ class Biped(Chain):
 
     def generalized_forces(self, q, qd, qdd):
         """D q̈ + H + Q (..., 9) in one pass (see the module docstring)."""
-        qdd = np.asarray(qdd)
         phi = self.direction_angles(q)
         phid = self.direction_angles(qd)
-        phidd = self.direction_angles(qdd)
-        s, c = np.sin(phi), np.cos(phi)
+        return self._forces(qdd, phid, self.direction_angles(qdd), np.sin(phi), np.cos(phi))
+
+    def _forces(self, qdd, phid, phidd, s, c):
         rate2 = phid * phid
         ax = c * phidd - s * rate2  # d²(sin φ)/dt²
         az = s * phidd + c * rate2  # d²(-cos φ)/dt²
+        qdd = np.asarray(qdd)
         hip_x = qdd[..., XH, None]
         hip_z = qdd[..., ZH, None] + self.gravity
         tau_phi = (
@@ -165,15 +166,16 @@ class Biped(Chain):
         and B has none, so (Fx, Fz) = τ_H; then the swing leg from the foot up, the trunk,
         and the stance leg down to the foot, whose row gives Cy.
         """
-        q = np.asarray(q)
-        tau = self.generalized_forces(q, qd, qdd)
-        fx, fz = tau[..., XH], tau[..., ZH]
         phi = self.direction_angles(q)
+        s, c = np.sin(phi), np.cos(phi)
+        tau = self._forces(qdd, self.direction_angles(qd), self.direction_angles(qdd), s, c)
+        return self._torques_and_wrench(tau, s, c)
+
+    def _torques_and_wrench(self, tau, s, c):
+        fx, fz = tau[..., XH], tau[..., ZH]
         # Stance-ankle Jacobian columns for q1 and q2: ∂(ankle)/∂φ = a u'(φ).
-        weights = (
-            self._ankle * np.cos(phi) * fx[..., None] + self._ankle * np.sin(phi) * fz[..., None]
-        )
-        work = weights @ self.directions[:, [Q1, Q2]]  # F · ∂ankle/∂q1, F · ∂ankle/∂q2
+        weights = self._ankle * (c * fx[..., None] + s * fz[..., None])
+        work = weights @ self._stance_leg  # F · ∂ankle/∂q1, F · ∂ankle/∂q2
         g6 = -tau[..., QP2]
         g5 = g6 - tau[..., Q4]
         g4 = g5 - tau[..., Q3]
@@ -182,6 +184,17 @@ class Biped(Chain):
         g1 = tau[..., Q1] + g2 - work[..., 0]
         cy = tau[..., QP1] + g1
         return np.stack([g1, g2, g3, g4, g5, g6], -1), np.stack([fx, fz, cy], -1)
+
+    def single_support(self, angles, rates, accelerations, points=()):
+        """``stance_state`` then ``inverse_dynamics`` and ``points`` sharing one evaluation
+        of the sines and cosines: the inner loop of the gait criteria.
+
+        Returns:
+            q, q̇, q̈ (..., 9), torques (..., 6), wrench (..., 3), positions (..., P, 2).
+        """
+        q, qd, qdd, phid, phidd, s, c = self._stance_state(angles, rates, accelerations)
+        torques, wrench = self._torques_and_wrench(self._forces(qdd, phid, phidd, s, c), s, c)
+        return q, qd, qdd, torques, wrench, self._points(q, s, c, list(points))
 
     def zmp(self, q, qd, qdd):
         """x of the zero-moment point [m] from the stance ankle, eq. (29): (Γ1 - h_p Fx) / Fz."""

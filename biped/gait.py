@@ -188,14 +188,19 @@ def _basis(samples_per_half: int):
     return np.concatenate([left, right]), bases
 
 
-def sample(model: Biped, step: Step, samples_per_half: int):
-    """t [s], q, q̇, q̈ (2 (n + 1), 9) on both pieces; t = T/2 appears twice (both sides)."""
+def sample(model: Biped, step: Step, samples_per_half: int, points=()):
+    """Motion and inverse dynamics on both pieces; t = T/2 appears twice (both sides).
+
+    Returns:
+        t [s] (N,), q, q̇, q̈ (N, 9), torques (N, 6), wrench (N, 3), positions of ``points``
+        (N, P, 2), N = 2 (n + 1).
+    """
     t_n, (values, rates, accels) = _basis(samples_per_half)
     coefficients = np.concatenate([step.a, step.b], axis=1).T  # (8, 6)
     period = step.period
-    q, qd, qdd = model.stance_state(
+    return (t_n * period,) + model.single_support(
         values @ coefficients,
         (rates @ coefficients) / period,
         (accels @ coefficients) / period**2,
+        points,
     )
-    return t_n * period, q, qd, qdd

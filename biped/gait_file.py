@@ -64,7 +64,7 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
             "seed": seed,
             "evaluations": optimum.evaluations,
             "seconds": optimum.seconds,
-            "history": list(map(float, optimum.history)),
+            "history": [list(map(float, run)) for run in optimum.history],
         },
         "samples": {
             "t": ev.t.tolist(),

@@ -184,10 +184,12 @@ class Chain:
             names: point names (default: all, in ``point_names`` order).
         """
         q = np.asarray(q)
+        phi = self.direction_angles(q)
+        return self._points(q, np.sin(phi), np.cos(phi), names)
+
+    def _points(self, q, s, c, names=None):
         cols = slice(None) if names is None else [self.point_index(name) for name in names]
         a, b = self.point_a[:, cols], self.point_b[:, cols]
-        phi = self.direction_angles(q)
-        s, c = np.sin(phi), np.cos(phi)
         x = q[..., XH, None] + s @ a + c @ b
         z = q[..., ZH, None] - c @ a + s @ b
         return np.stack([x, z], axis=-1)
@@ -252,6 +254,10 @@ class Chain:
         The hip follows from eqs. (1)-(2) (revolute) or (7)-(8) (rolling): the stance ankle
         stays at x = 0, z = h_p, the ground at z = 0.
         """
+        return self._stance_state(angles, rates, accelerations)[:3]
+
+    def _stance_state(self, angles, rates=None, accelerations=None):
+        """``stance_state`` plus φ̇, φ̈, sin φ, cos φ, for callers that go on to dynamics."""
         free = np.asarray(angles, dtype=float)
         shape = free.shape[:-1] + (NQ,)
         q, qd, qdd = np.zeros(shape), np.zeros(shape), np.zeros(shape)
@@ -272,7 +278,7 @@ class Chain:
         qd[..., ZH] = -((s * phid) @ a)
         qdd[..., XH] = -((c * phidd - s * rate2) @ a)
         qdd[..., ZH] = -((s * phidd + c * rate2) @ a)
-        return q, qd, qdd
+        return q, qd, qdd, phid, phidd, s, c
 
     def leg_reach(self):
         """[m] Shortest and longest ankle-to-hip distance (knee flexion π and 0)."""

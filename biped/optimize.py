@@ -244,6 +244,7 @@ def optimize(
     evaluations_per_run: int = EVALUATIONS_PER_RUN,
     starts=None,
     polish_iterations: int = POLISH_ITERATIONS,
+    polish_starts=(),
 ) -> Optimum:
     """Minimise the criterion at walking speed ``speed`` [m/s].
 
@@ -257,6 +258,8 @@ def optimize(
         evaluations_per_run: criterion evaluations per Nelder-Mead run.
         starts: first guesses, each 21 parameters (default: ``initial_parameters``).
         polish_iterations: SLSQP iterations at most (0: no polish).
+        polish_starts: guesses close to an optimum (e.g. the optimum at a neighbouring
+            speed), polished directly without Nelder-Mead.
     """
     speed = check_speed(model, speed)
     criterion = check_criterion(criterion)
@@ -283,6 +286,12 @@ def optimize(
         candidates.append(parameters)
         if polish_iterations > 0:
             polished, count = polish(model, speed, criterion, parameters, polish_iterations)
+            evaluations += count
+            candidates.append(polished)
+    for start in polish_starts:
+        candidates.append(np.asarray(start, float))
+        if polish_iterations > 0:
+            polished, count = polish(model, speed, criterion, start, polish_iterations)
             evaluations += count
             candidates.append(polished)
     best = None

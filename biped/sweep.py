@@ -1,8 +1,15 @@
 """Sweeps of optimal gaits over walking speed, both knees and both criteria.
 
-Each point is one optimisation, run on all cores; its gait file is written atomically as soon
-as it completes, so an interrupted sweep resumes with the points still missing. Infeasible
-points are saved too (``feasible: false``) and are not optimised again.
+Each (knee, criterion) pair is a series over increasing speeds, and the series run in
+parallel on all cores. Every point is optimised from the default first guess (Nelder-Mead,
+then SLSQP) and, by continuation, polished from the optimum of the previous speed (same step
+length, period scaled to the new speed); the better feasible result is kept.
+Nelder-Mead and SLSQP find local minima, and continuation keeps a series in the basin it
+found instead of letting neighbouring speeds fall into unrelated ones.
+
+Each point's gait file is written atomically as soon as it completes, so an interrupted
+sweep resumes with the points still missing (a saved point also seeds the continuation).
+Infeasible points are saved too (``feasible: false``) and are not optimised again.
 """
 
 from __future__ import annotations
@@ -20,8 +27,9 @@ from biped import gait_file
 from biped.criteria import CRITERIA
 from biped.dynamics import Biped
 from biped.errors import BipedError
+from biped.gait import PARAMETERS
 from biped.kinematics import KNEES
-from biped.optimize import optimize
+from biped.optimize import initial_parameters, optimize
 from biped.robot import Robot
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
@@ -37,28 +45,65 @@ class Point:
         return f"{self.knee}-{self.criterion}-{self.speed:.3f}.json"
 
 
-def run_point(point: Point, robot: Robot, seed: int, folder: Path, budget: dict) -> tuple:
-    """Optimise one point and save it; returns (point, value, feasible, seconds)."""
-    model = Biped(robot, point.knee)
-    optimum = optimize(model, point.speed, point.criterion, seed=seed, **budget)
-    gait_file.write_json(folder / point.filename(), gait_file.to_dict(optimum, robot, seed))
-    return point, optimum.value, optimum.feasible, optimum.seconds
+def _saved(path: Path):
+    """The gait saved at ``path``, or None if missing or unreadable."""
+    try:
+        return gait_file.read(path)
+    except BipedError:
+        return None
 
 
-def _run_point(args):
-    return run_point(*args)
+def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.stderr):
+    """Optimise one (knee, criterion) series over increasing speeds; returns points run."""
+    model = Biped(robot, knee)
+    previous = None  # (speed, parameters) of the previous speed's optimum
+    ran = 0
+    for i, speed in enumerate(sorted(speeds), start=1):
+        point = Point(knee, criterion, float(speed))
+        path = Path(folder) / point.filename()
+        saved = _saved(path)
+        if saved is None:
+            warm = []
+            if previous is not None:
+                # Same step length, period scaled to the new speed: the posture stays in reach.
+                last_speed, warm_start = previous
+                warm_start = warm_start.copy()
+                warm_start[-1] *= last_speed / point.speed
+                warm.append(warm_start)
+            optimum = optimize(
+                model,
+                point.speed,
+                criterion,
+                seed=seed,
+                starts=[initial_parameters(model, point.speed)],
+                polish_starts=warm,
+                **budget,
+            )
+            gait_file.write_json(path, gait_file.to_dict(optimum, robot, seed))
+            ran += 1
+            status = "feasible" if optimum.feasible else "INFEASIBLE"
+            print(
+                f"[{knee:8} {criterion:7} {i:2d}/{len(speeds)}] {point.speed:.3f} m/s  "
+                f"C = {optimum.value:12.4f}  {status}  {optimum.seconds:5.1f} s",
+                file=stream,
+                flush=True,
+            )
+            feasible, parameters = optimum.feasible, optimum.parameters
+        else:
+            feasible = saved["feasible"]
+            parameters = np.array([saved["parameters"][name] for name in PARAMETERS])
+        if feasible:
+            previous = (point.speed, parameters)
+    return ran
+
+
+def _run_series(args):
+    return run_series(*args)
 
 
 def pending_points(points, folder: Path):
     """Points whose gait file is missing or unreadable."""
-    todo = []
-    for point in points:
-        path = folder / point.filename()
-        try:
-            gait_file.read(path)
-        except BipedError:
-            todo.append(point)
-    return todo
+    return [point for point in points if _saved(Path(folder) / point.filename()) is None]
 
 
 def run_sweep(
@@ -74,37 +119,35 @@ def run_sweep(
 ) -> list[Point]:
     """Optimise every (knee, criterion, speed) not yet in ``folder``; returns all points.
 
-    ``budget`` goes to ``biped.optimize.optimize`` (``max_restarts``, ``evaluations_per_run``).
+    ``budget`` goes to ``biped.optimize.optimize`` (``max_restarts``, ``evaluations_per_run``,
+    ``polish_iterations``).
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    points = [Point(k, c, float(s)) for c in criteria for k in knees for s in speeds]
+    speeds = sorted(float(s) for s in speeds)
+    points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
     todo = pending_points(points, folder)
-    done = len(points) - len(todo)
     print(
-        f"sweep: {len(points)} points in {folder}, {done} already done, {len(todo)} to run",
+        f"sweep: {len(points)} points in {folder}, {len(points) - len(todo)} already done, "
+        f"{len(todo)} to run",
         file=stream,
+        flush=True,
     )
-    jobs = jobs or os.cpu_count() or 1
+    series = [
+        (k, c)
+        for c in criteria
+        for k in knees
+        if any(p.knee == k and p.criterion == c for p in todo)
+    ]
+    tasks = [(k, c, speeds, robot, seed, folder, budget) for k, c in series]
+    jobs = min(jobs or os.cpu_count() or 1, max(len(tasks), 1))
     began = time.perf_counter()
-    tasks = [(point, robot, seed, folder, budget) for point in todo]
-    if jobs == 1 or len(tasks) <= 1:
-        results = map(_run_point, tasks)
-        pool = None
+    if jobs == 1:
+        for task in tasks:
+            run_series(*task, stream=stream)
     else:
-        pool = multiprocessing.get_context("spawn").Pool(min(jobs, len(tasks)))
-        results = pool.imap_unordered(_run_point, tasks)
-    try:
-        for count, (point, value, feasible, seconds) in enumerate(results, start=1):
-            status = "feasible" if feasible else "INFEASIBLE"
-            print(
-                f"[{done + count:3d}/{len(points)}] {point.knee:8} {point.criterion:7} "
-                f"{point.speed:.3f} m/s  C = {value:12.4f}  {status}  {seconds:5.1f} s  "
-                f"(elapsed {time.perf_counter() - began:6.1f} s)",
-                file=stream,
-                flush=True,
-            )
-    finally:
-        if pool is not None:
-            pool.terminate()
+        with multiprocessing.get_context("spawn").Pool(jobs) as pool:
+            for _ in pool.imap_unordered(_run_series, tasks):
+                pass
+    print(f"sweep: done in {time.perf_counter() - began:.1f} s", file=stream, flush=True)
     return points

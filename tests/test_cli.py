@@ -36,3 +36,80 @@ def test_unknown_knee_exits_2(capsys):
         main(["demo", "--knee", "hinge"])
     assert exit_info.value.code == 2
     assert "hinge" in capsys.readouterr().err
+
+
+FAST = ["--evaluations", "300", "--restarts", "0", "--polish", "30"]
+
+
+def test_optimize_writes_a_complete_gait_file(tmp_path, capsys):
+    """optimize writes every documented field, ≥ 200 samples from t = 0 to T inclusive."""
+    from biped import gait_file
+
+    out = tmp_path / "gait.json"
+    assert main(["optimize", "--knee", "rolling", "--speed", "0.3", "--out", str(out), *FAST]) == 0
+    gait = gait_file.read(out)
+    for key in (
+        "knee",
+        "criterion",
+        "speed",
+        "period",
+        "step_length",
+        "feasible",
+        "costs",
+        "robot",
+        "parameters",
+        "samples",
+    ):
+        assert key in gait
+    assert gait["knee"] == "rolling" and gait["feasible"] is True and gait["speed"] == 0.3
+    assert set(gait["costs"]) >= {"sthenic", "energy"}
+    assert gait["robot"].r1 == 0.05 and len(gait["parameters"]) == 21
+    t = gait["samples"]["t"]
+    assert len(t) >= 200 and t[0] == 0.0 and t[-1] == pytest.approx(gait["period"])
+    assert gait["step_length"] == pytest.approx(gait["speed"] * gait["period"])
+    assert gait["samples"]["q"].shape == (len(t), 9) and gait["samples"]["torques"].shape == (
+        len(t),
+        6,
+    )
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_infeasible_optimum_writes_nothing(tmp_path, capsys):
+    """An infeasible result names the violated constraints, exits 1 and writes no file."""
+    out = tmp_path / "gait.json"
+    argv = ["optimize", "--knee", "revolute", "--speed", "0.3", "--out", str(out)]
+    assert main([*argv, "--evaluations", "1", "--restarts", "0", "--polish", "0"]) == 1
+    err = capsys.readouterr().err
+    assert "infeasible" in err and "swing_toe = -" in err
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["optimize", "--knee", "hinge", "--speed", "0.3", "--out", "x.json"], "hinge"),
+        (["optimize", "--knee", "rolling", "--speed", "0", "--out", "x.json"], "speed = '0'"),
+        (["optimize", "--knee", "rolling", "--speed", "fast", "--out", "x.json"], "fast"),
+        (["optimize", "--knee", "rolling", "--speed", "9", "--out", "x.json"], "speed = 9.0"),
+        (["sweep", "--speeds", "0.3:0.1"], "START:STOP:COUNT"),
+        (["sweep", "--speeds", "0.2,-0.1"], "speeds > 0"),
+        (["sweep", "--jobs", "0"], "'0'"),
+    ],
+)
+def test_bad_arguments_one_line_exit_2(capsys, argv, needle):
+    """Bad arguments: one line on stderr naming the value, exit status 2."""
+    try:
+        code = main(argv)
+    except SystemExit as exit_info:
+        code = exit_info.code
+    assert code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], lines
+
+
+def test_figures_reject_a_corrupt_gait_file(tmp_path, capsys):
+    """A corrupt gait file in the sweep folder is one clear line and exit 2."""
+    (tmp_path / "rolling-sthenic-0.300.json").write_text('{"format": "biped-gait/1", "knee": ')
+    assert main(["figures", "--sweep", str(tmp_path), "--out", str(tmp_path / "fig")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "rolling-sthenic-0.300.json" in lines[0]

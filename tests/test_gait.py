@@ -52,7 +52,7 @@ def test_parameters_are_reproduced(model, step):
 
 def test_swing_foot_flat_on_the_ground_at_both_ends(model, step):
     """qp2 = 0 at 0 and T, q̇p2(T) = 0; heel and toe at z = 0; ankles one step apart."""
-    t, q, qd, _ = sample(model, step, 20)
+    t, q, qd, *_ = sample(model, step, 20)
     for i in (0, -1):
         assert q[i, QP2] == pytest.approx(0.0, abs=1e-12)
         np.testing.assert_allclose(model.point(q[i], "swing_heel")[1], 0.0, atol=1e-12)
@@ -66,7 +66,7 @@ def test_swing_foot_flat_on_the_ground_at_both_ends(model, step):
 
 def test_end_posture_is_the_start_posture_with_legs_swapped(model, step):
     """Thighs and shanks 2T-periodic, trunk and feet T-periodic."""
-    _, q, _, _ = sample(model, step, 20)
+    _, q, *_ = sample(model, step, 20)
     start, end = q[0], q[-1]
     swapped = biped.swap_legs(model, end)
     np.testing.assert_allclose(swapped, start, atol=1e-12)
@@ -84,7 +84,7 @@ def test_spline_is_c1_at_the_knot(step):
 
 def test_start_velocities_are_the_impact_of_the_end_velocities(model, step):
     """q̇(0⁺) = swap(impact(q̇(T⁻))): the gait is periodic through the impact."""
-    _, q, qd, _ = sample(model, step, 20)
+    _, q, qd, *_ = sample(model, step, 20)
     qd_plus, impulse = model.impact(q[-1], qd[-1])
     _, qd_next = biped.swap_legs(model, q[-1], qd_plus)
     np.testing.assert_allclose(qd[0], qd_next, atol=1e-12)
