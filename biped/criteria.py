@@ -100,6 +100,11 @@ class StepEvaluation:
             return self.sthenic + self.penalty / step_length
         return self.energy + self.penalty
 
+    @property
+    def feasible(self) -> bool:
+        """Every constraint holds on the samples: no violation, zero penalty."""
+        return self.penalty == 0.0 and not self.violations()
+
     def violations(self) -> dict:
         """Worst value of each violated constraint (Ψ_i < 0), by name."""
         worst = np.nanmin(self.constraints, axis=0)

@@ -169,22 +169,25 @@ def evaluate(step: Step, t_n, piece: str):
 
 @functools.cache
 def _basis(samples_per_half: int):
-    """Matrices mapping the stacked coefficients [a0..a3, b0..b3] to values, first and second
-    derivatives in normalised time on the grid of ``half_grid`` (both pieces)."""
+    """Matrices mapping the stacked coefficients [a0..a3, b0..b3] (8, 6) to the values and the
+    first and second derivatives in normalised time on both pieces of ``half_grid``.
+
+    Piece (26) is a polynomial in u = 1 - t_n, so d/dt_n = -d/du there.
+    """
     left, right = half_grid(samples_per_half)
-    u = np.concatenate([left, 1.0 - right])
-    powers = u[:, None] ** np.arange(4)
-    d1 = np.column_stack([np.zeros_like(u), np.ones_like(u), 2 * u, 3 * u**2])
-    d2 = np.column_stack([np.zeros_like(u), np.zeros_like(u), 2 * np.ones_like(u), 6 * u])
     n = len(left)
+    u = np.concatenate([left, 1.0 - right])[:, None]
+    zero, one = np.zeros_like(u), np.ones_like(u)
+    value = np.hstack([one, u, u**2, u**3])
+    rate = np.hstack([zero, one, 2 * u, 3 * u**2])
+    accel = np.hstack([zero, zero, 2 * one, 6 * u])
     bases = []
-    for matrix, sign in ((powers, -1.0), (d1, -1.0), (d2, 1.0)):
+    for matrix, sign in ((value, 1.0), (rate, -1.0), (accel, 1.0)):
         block = np.zeros((2 * n, 8))
         block[:n, :4] = matrix[:n]
-        block[n:, 4:] = matrix[n:] * (sign if matrix is d1 else 1.0)
-        bases.append(block)
-    for block in bases:
+        block[n:, 4:] = sign * matrix[n:]
         block.setflags(write=False)
+        bases.append(block)
     return np.concatenate([left, right]), bases
 
 

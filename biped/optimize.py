@@ -123,7 +123,7 @@ class Optimum:
 
     @property
     def feasible(self) -> bool:
-        return self.evaluation.penalty == 0.0 and not self.evaluation.violations()
+        return self.evaluation.feasible
 
     def costs(self) -> dict:
         """Both criteria of the gait (no penalty)."""
@@ -266,7 +266,7 @@ def optimize(
     rng = np.random.default_rng(seed)
     if starts is None:
         starts = [initial_parameters(model, speed)]
-    starts = np.atleast_2d(starts)
+    starts = np.reshape(starts, (-1, N_PARAMETERS))
     began = time.perf_counter()
     candidates = []
     evaluations = 0
@@ -302,8 +302,7 @@ def optimize(
             continue
         evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF)
         value = evaluation.cost(criterion, step.step_length)
-        feasible = evaluation.penalty == 0.0 and not evaluation.violations()
-        rank = (not feasible, value)
+        rank = (not evaluation.feasible, value)
         if best is None or rank < best[0]:
             best = (rank, parameters, step, evaluation, value)
     if best is None:

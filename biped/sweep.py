@@ -1,9 +1,10 @@
 """Sweeps of optimal gaits over walking speed, both knees and both criteria.
 
 Each (knee, criterion) pair is a series over increasing speeds, and the series run in
-parallel on all cores. Every point is optimised from the default first guess (Nelder-Mead,
-then SLSQP) and, by continuation, polished from the optimum of the previous speed (same step
-length, period scaled to the new speed); the better feasible result is kept.
+parallel on all cores. The first speed is optimised from the default first guess
+(Nelder-Mead, then SLSQP); each next one by continuation, polishing the optimum of the
+previous speed (same step length, period scaled to the new speed), and from the default first
+guess too if the continuation ends infeasible.
 Nelder-Mead and SLSQP find local minima, and continuation keeps a series in the basin it
 found instead of letting neighbouring speeds fall into unrelated ones.
 
@@ -70,15 +71,27 @@ def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.
                 warm_start = warm_start.copy()
                 warm_start[-1] *= last_speed / point.speed
                 warm.append(warm_start)
-            optimum = optimize(
-                model,
-                point.speed,
-                criterion,
-                seed=seed,
-                starts=[initial_parameters(model, point.speed)],
-                polish_starts=warm,
-                **budget,
-            )
+            optimum = None
+            if warm:
+                optimum = optimize(
+                    model,
+                    point.speed,
+                    criterion,
+                    seed=seed,
+                    starts=[],
+                    polish_starts=warm,
+                    **budget,
+                )
+            if optimum is None or not optimum.feasible:
+                optimum = optimize(
+                    model,
+                    point.speed,
+                    criterion,
+                    seed=seed,
+                    starts=[initial_parameters(model, point.speed)],
+                    polish_starts=warm,
+                    **budget,
+                )
             gait_file.write_json(path, gait_file.to_dict(optimum, robot, seed))
             ran += 1
             status = "feasible" if optimum.feasible else "INFEASIBLE"
