@@ -125,6 +125,10 @@ class Optimum:
     def feasible(self) -> bool:
         return self.evaluation.feasible
 
+    def rank(self) -> tuple:
+        """Sort key: feasible before infeasible, then lower criterion."""
+        return (not self.feasible, self.value)
+
     def costs(self) -> dict:
         """Both criteria of the gait (no penalty)."""
         return {"sthenic": self.evaluation.sthenic, "energy": self.evaluation.energy}

@@ -4,7 +4,7 @@ Each (knee, criterion) pair is a series over increasing speeds, and the series r
 parallel on all cores. The first speed is optimised from the default first guess
 (Nelder-Mead, then SLSQP); each next one by continuation, polishing the optimum of the
 previous speed (same step length, period scaled to the new speed), and from the default first
-guess too if the continuation ends infeasible.
+guess too if the continuation ends infeasible or with a jump of the criterion.
 Nelder-Mead and SLSQP find local minima, and continuation keeps a series in the basin it
 found instead of letting neighbouring speeds fall into unrelated ones.
 
@@ -57,41 +57,39 @@ def _saved(path: Path):
 def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.stderr):
     """Optimise one (knee, criterion) series over increasing speeds; returns points run."""
     model = Biped(robot, knee)
-    previous = None  # (speed, parameters) of the previous speed's optimum
+    previous = None  # (speed, parameters, criterion) of the previous speed's optimum
     ran = 0
     for i, speed in enumerate(sorted(speeds), start=1):
         point = Point(knee, criterion, float(speed))
         path = Path(folder) / point.filename()
         saved = _saved(path)
         if saved is None:
-            warm = []
+            optimum = None
             if previous is not None:
                 # Same step length, period scaled to the new speed: the posture stays in reach.
-                last_speed, warm_start = previous
-                warm_start = warm_start.copy()
-                warm_start[-1] *= last_speed / point.speed
-                warm.append(warm_start)
-            optimum = None
-            if warm:
+                last_speed, warm, _ = previous
+                warm = warm.copy()
+                warm[-1] *= last_speed / point.speed
                 optimum = optimize(
                     model,
                     point.speed,
                     criterion,
                     seed=seed,
                     starts=[],
-                    polish_starts=warm,
+                    polish_starts=[warm],
                     **budget,
                 )
-            if optimum is None or not optimum.feasible:
-                optimum = optimize(
+            if optimum is None or not _continues(optimum, previous):
+                fresh = optimize(
                     model,
                     point.speed,
                     criterion,
                     seed=seed,
                     starts=[initial_parameters(model, point.speed)],
-                    polish_starts=warm,
                     **budget,
                 )
+                if optimum is None or fresh.rank() < optimum.rank():
+                    optimum = fresh
             gait_file.write_json(path, gait_file.to_dict(optimum, robot, seed))
             ran += 1
             status = "feasible" if optimum.feasible else "INFEASIBLE"
@@ -101,13 +99,24 @@ def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.
                 file=stream,
                 flush=True,
             )
-            feasible, parameters = optimum.feasible, optimum.parameters
+            feasible, parameters, value = optimum.feasible, optimum.parameters, optimum.value
         else:
             feasible = saved["feasible"]
             parameters = np.array([saved["parameters"][name] for name in PARAMETERS])
+            value = saved["costs"][criterion]
         if feasible:
-            previous = (point.speed, parameters)
+            previous = (point.speed, parameters, value)
     return ran
+
+
+# A continued optimum is trusted if feasible and its criterion at most this factor above the
+# previous speed's (the criteria change by tens of percent between grid speeds).
+CONTINUATION_GROWTH = 1.5
+
+
+def _continues(optimum, previous) -> bool:
+    """Whether the continued optimum is plausible: feasible, no jump of the criterion."""
+    return optimum.feasible and optimum.value <= CONTINUATION_GROWTH * previous[2]
 
 
 def _run_series(args):
