@@ -1,0 +1,55 @@
+"""The analytical model against MuJoCo's dynamics of the MJCF: the same robot, to rounding."""
+
+import numpy as np
+import pytest
+
+import biped
+from biped.optimize import initial_parameters, optimize
+from tests.conftest import random_state
+from validate.crosscheck import knee_link_effect, load_model, mujoco_inverse_dynamics
+
+ROBOT = biped.Robot.paper()
+
+
+@pytest.mark.parametrize("stance", ["left", "right"])
+def test_inverse_dynamics_agree_on_random_motions(model, stance):
+    """Torques, ground wrench and ZMP agree with MuJoCo's to 1e-9 on random motions."""
+    q, qd, qdd = random_state(model, seed=40, n=30)
+    torques, wrench = model.inverse_dynamics(q, qd, qdd)
+    result = mujoco_inverse_dynamics(load_model(model, exact=True), model, q, qd, qdd, stance)
+    np.testing.assert_allclose(result.torques, torques, atol=1e-9)
+    np.testing.assert_allclose(result.wrench, wrench, atol=1e-9)
+    np.testing.assert_allclose(result.zmp, model.zmp(q, qd, qdd), atol=1e-12)
+
+
+def test_inverse_dynamics_agree_on_an_optimal_gait(model):
+    """Along a gait produced by the optimiser, MuJoCo reproduces Γ, F_e and the ZMP to 1e-6."""
+    optimum = optimize(
+        model,
+        0.3,
+        "sthenic",
+        starts=initial_parameters(model, 0.3),
+        max_restarts=0,
+        evaluations_per_run=300,
+        polish_iterations=20,
+    )
+    ev = optimum.evaluation
+    result = mujoco_inverse_dynamics(load_model(model, exact=True), model, ev.q, ev.qd, ev.qdd)
+    assert np.abs(result.torques - ev.torques).max() < 1e-6
+    assert np.abs(result.wrench - ev.wrench).max() < 1e-6
+    assert np.abs(result.zmp - ev.zmp).max() < 1e-6
+
+
+def test_rolling_knee_couplings_carry_the_knee_load():
+    """The equality forces of the rolling knee are not zero: the knee links are loaded."""
+    model = biped.Biped(ROBOT, "rolling")
+    q, qd, qdd = random_state(model, seed=41, n=10)
+    result = mujoco_inverse_dynamics(load_model(model, exact=True), model, q, qd, qdd)
+    assert np.abs(result.coupling).max() > 1.0
+
+
+def test_knee_link_mass_is_negligible():
+    """The MJCF's near-massless knee link changes the torques by less than 1e-4 N·m."""
+    model = biped.Biped(ROBOT, "rolling")
+    q, qd, qdd = random_state(model, seed=42, n=20)
+    assert knee_link_effect(model, q, qd, qdd) < 1e-4

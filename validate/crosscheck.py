@@ -1,0 +1,127 @@
+"""Cross-checks of the analytical model against MuJoCo's dynamics of the MJCF.
+
+Inverse dynamics. For each sample (q, q̇, q̈) of a gait, MuJoCo's recursive Newton-Euler
+(``mj_rne``, no constraint forces) gives the generalized forces τ = M q̈ + c of its model.
+In single support they are produced by the six motors, the ground wrench on the stance foot
+and, for the rolling knee, the forces holding the two knee equalities:
+
+    τ = Bᵀ u + J_cᵀ λ + J_eqᵀ μ
+
+with B the actuator moments, J_c the stance ankle's Jacobian (x, z rows; rotation about -y,
+the paper's positive sense) and J_eq the equality rows. The system is square (9 x 9 for the
+revolute knee, 11 x 11 for the rolling knee), so u, λ = [Fx, Fz, Cy] and μ follow uniquely
+and are compared with the analytical Γ and F_e. Both are exact rigid-body models of the same
+robot, so they agree to rounding.
+
+The MJCF carries two things the analytical model does not: armature on the rolling-knee
+hinges (it enters MuJoCo's joint-space mass matrix, though not ``mj_rne``'s body recursion)
+and a near-massless knee link. The cross-check zeroes both in a copy of the model;
+``knee_link_effect`` reports what the link's mass changes.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from biped.dynamics import Biped
+from validate.mapping import Mapping, mapping
+from validate.mjcf import robot_xml
+
+
+def load_model(biped: Biped, exact: bool = False) -> mujoco.MjModel:
+    """Compile the MJCF of ``biped.robot``; ``exact`` zeroes armature and knee-link mass."""
+    model = mujoco.MjModel.from_xml_string(robot_xml(biped.robot, biped.knee))
+    if exact:
+        model = rigid_copy(model)
+    return model
+
+
+def rigid_copy(model: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy without armature and with massless knee links: the analytical robot exactly."""
+    exact = copy.deepcopy(model)
+    exact.dof_armature[:] = 0.0
+    for side in ("left", "right"):
+        name = f"{side}_knee_link"
+        if mujoco.mj_name2id(exact, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
+            body = exact.body(name).id
+            exact.body_mass[body] = 0.0
+            exact.body_inertia[body] = 0.0
+    return exact
+
+
+def actuator_moments(model: mujoco.MjModel) -> np.ndarray:
+    """B (nu, nv): generalized force of each actuator per unit control (constant here)."""
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    moments = np.zeros((model.nu, model.nv))
+    for i in range(model.nu):
+        data.ctrl[:] = 0.0
+        data.ctrl[i] = 1.0
+        mujoco.mj_fwdActuation(model, data)
+        moments[i] = data.qfrc_actuator
+    return moments
+
+
+def equality_jacobian(model: mujoco.MjModel) -> np.ndarray:
+    """J_eq (neq, nv) of the joint equalities joint1 = c0 + c1 joint2 (linear ones)."""
+    rows = np.zeros((model.neq, model.nv))
+    for k in range(model.neq):
+        joint1, joint2 = model.eq_obj1id[k], model.eq_obj2id[k]
+        rows[k, model.jnt_dofadr[joint1]] = 1.0
+        rows[k, model.jnt_dofadr[joint2]] = -model.eq_data[k, 1]
+    return rows
+
+
+@dataclass
+class InverseDynamics:
+    """MuJoCo's torques, ground wrench, ZMP and knee coupling forces along a gait."""
+
+    torques: np.ndarray  # (N, 6) Γ1..Γ6 [N·m]
+    wrench: np.ndarray  # (N, 3) [Fx, Fz, Cy]
+    zmp: np.ndarray  # (N,) [m]
+    coupling: np.ndarray  # (N, neq) equality forces [N·m]
+
+
+def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, stance="left"):
+    """Solve τ = Bᵀu + J_cᵀλ + J_eqᵀμ sample by sample (see the module docstring)."""
+    mapped: Mapping = mapping(model, stance, biped.radii)
+    data = mujoco.MjData(model)
+    moments = actuator_moments(model)
+    j_eq = equality_jacobian(model)
+    site = model.site(f"{stance}_ankle").id
+    jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    qpos, qvel, qacc = (mapped.qpos(x) for x in (q, qd, qdd))
+    n = len(qpos)
+    torques, wrench = np.zeros((n, 6)), np.zeros((n, 3))
+    coupling = np.zeros((n, model.neq))
+    tau = np.zeros(model.nv)
+    for k in range(n):
+        data.qpos[:], data.qvel[:], data.qacc[:] = qpos[k], qvel[k], qacc[k]
+        mujoco.mj_fwdPosition(model, data)
+        mujoco.mj_fwdVelocity(model, data)
+        mujoco.mj_rne(model, data, 1, tau)
+        mujoco.mj_jacSite(model, data, jacp, jacr, site)
+        contact = np.stack([jacp[0], jacp[2], -jacr[1]])
+        system = np.concatenate([moments, contact, j_eq]).T
+        solution = np.linalg.solve(system, tau)
+        torques[k] = solution[: model.nu][mapped.actuator_order]
+        wrench[k] = solution[model.nu : model.nu + 3]
+        coupling[k] = solution[model.nu + 3 :]
+    hp = biped.robot.ankle_height
+    zmp = (torques[:, 0] - hp * wrench[:, 0]) / wrench[:, 1]
+    return InverseDynamics(torques, wrench, zmp, coupling)
+
+
+def knee_link_effect(biped: Biped, q, qd, qdd, stance="left") -> float:
+    """Largest torque change [N·m] that the MJCF's knee-link mass makes along the motion."""
+    model = load_model(biped)
+    with_link = copy.deepcopy(model)
+    with_link.dof_armature[:] = 0.0
+    exact = rigid_copy(model)
+    a = mujoco_inverse_dynamics(with_link, biped, q, qd, qdd, stance).torques
+    b = mujoco_inverse_dynamics(exact, biped, q, qd, qdd, stance).torques
+    return float(np.abs(a - b).max())

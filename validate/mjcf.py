@@ -1,0 +1,223 @@
+"""MJCF models of both bipeds, generated from ``biped.Robot`` (the single source of truth).
+
+    python -m validate.mjcf            # rewrite mjcf/*.xml from Robot.paper()
+
+Layout (mujoco_menagerie style): the trunk is the root body, at the hip, with the planar base
+``rootx``, ``rootz`` (slides, equal to the paper's x_H, z_H) and ``rooty`` (hinge, equal to
+the trunk angle q5). Every hinge turns about "0 -1 0", so a positive angle is
+counter-clockwise in the x-z plane like the paper's angles: a child's absolute angle is its
+parent's plus the joint angle. The legs are ``left`` and ``right``; which one is the stance leg
+changes every step (``validate.mapping``).
+
+Rolling knee: thigh, then a near-massless link of length r1 + r2 between two hinges at the
+centres C2 and C1 of the rolling circles, then the shank. Rolling without slip turns the two
+hinges by r1 θ / l and r2 θ / l for a knee flexion θ, so a joint equality holds
+``knee_lower = (r2 / r1) knee_upper``; a fixed tendon over both hinges measures θ and carries
+the knee motor.
+
+Motors have gear -1: the paper's Γ_i is conjugate to θ_i of eq. (32), which is minus the
+MuJoCo joint angle of the same joint (θ1 = q1 - qp1 = -ankle, θ3 = q5 - q2 = -hip, ...), so a
+motor's control is the paper's torque Γ_i [N·m].
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from biped.kinematics import check_knee
+from biped.robot import Robot
+
+SIDES = ("left", "right")
+# Near-massless knee link of the rolling knee (MuJoCo needs mass on a moving body) [kg, kg·m²].
+KNEE_LINK_MASS = 1e-6
+KNEE_LINK_INERTIA = 1e-10
+# Armature on the rolling-knee hinges [kg·m²]: with a stiff equality, it keeps the coupling
+# tight under load. It enters MuJoCo's mass matrix; the cross-check removes it.
+KNEE_ARMATURE = 1e-3
+# Equality constraint of the rolling knee: stiff and hard (solimp close to 1).
+KNEE_SOLREF = "0.002 1"
+KNEE_SOLIMP = "0.9999 0.99999 0.0001 0.5 2"
+# Foot box: width and sole thickness [m]; friction (sliding, torsional, rolling).
+FOOT_WIDTH = 0.10
+SOLE_THICKNESS = 0.02
+FOOT_FRICTION = "1.0 0.02 0.0001"
+TIMESTEP = 0.001  # [s]
+FOLDER = Path(__file__).resolve().parent.parent / "mjcf"
+
+
+def _f(value: float) -> str:
+    return f"{value:.10g}"
+
+
+def _inertial(pos_z: float, mass: float, inertia: float) -> str:
+    i = _f(inertia)
+    return f'<inertial pos="0 0 {_f(pos_z)}" mass="{_f(mass)}" diaginertia="{i} {i} {i}"/>'
+
+
+def robot_xml(robot: Robot, knee: str) -> str:
+    """The robot's MJCF (no floor), for one knee kinematic."""
+    check_knee(knee)
+    rolling = knee == "rolling"
+    r = robot
+    r1, r2 = (r.r1, r.r2) if rolling else (0.0, 0.0)
+    if rolling and (r1 <= 0.0 or r2 <= 0.0):
+        raise ValueError(f"a rolling-knee MJCF needs r1, r2 > 0 (got r1 = {r1}, r2 = {r2})")
+    shank, thigh, link = r.shank_length - r1, r.thigh_length - r2, r1 + r2
+    sole_x = r.foot_length / 2 - r.foot_heel
+    stand = r.ankle_height + r.shank_length + r.thigh_length
+    lines = [
+        f'<mujoco model="biped_{knee}">',
+        '  <compiler angle="radian" autolimits="true" inertiafromgeom="false"/>',
+        f'  <option timestep="{_f(TIMESTEP)}" integrator="implicitfast"/>',
+        "",
+        "  <default>",
+        '    <joint type="hinge" axis="0 -1 0"/>',
+        '    <motor ctrlrange="-400 400" gear="-1"/>',
+        '    <default class="visual">',
+        '      <geom contype="0" conaffinity="0" group="2" rgba="0.7 0.7 0.75 1"/>',
+        "    </default>",
+        '    <default class="collision">',
+        f'      <geom group="3" friction="{FOOT_FRICTION}" condim="3"/>',
+        "    </default>",
+        '    <site size="0.01" group="4" rgba="1 0.2 0.2 1"/>',
+        "  </default>",
+        "",
+        "  <worldbody>",
+        '    <body name="trunk" pos="0 0 0">',
+        '      <joint name="rootx" type="slide" axis="1 0 0"/>',
+        '      <joint name="rootz" type="slide" axis="0 0 1"/>',
+        '      <joint name="rooty"/>',
+        f"      {_inertial(r.trunk_com, r.trunk_mass, r.trunk_inertia)}",
+        f'      <geom class="visual" type="capsule" size="0.08" fromto="0 0 0.1 0 0 {_f(r.trunk_length - 0.1)}"/>',
+        '      <site name="hip"/>',
+    ]
+    for side in SIDES:
+        pad = "      "
+        lines += [
+            f'{pad}<body name="{side}_thigh">',
+            f'{pad}  <joint name="{side}_hip"/>',
+            f"{pad}  {_inertial(-r.thigh_com, r.thigh_mass, r.thigh_inertia)}",
+            f'{pad}  <geom class="visual" type="capsule" size="0.045" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
+        ]
+        if rolling:
+            lines += [
+                f'{pad}  <geom class="visual" type="cylinder" size="{_f(r2)} 0.03" pos="0 0 {_f(-thigh)}" zaxis="0 1 0"/>',
+                f'{pad}  <body name="{side}_knee_link" pos="0 0 {_f(-thigh)}">',
+                f'{pad}    <joint name="{side}_knee_upper" armature="{_f(KNEE_ARMATURE)}"/>',
+                f"{pad}    {_inertial(-link / 2, KNEE_LINK_MASS, KNEE_LINK_INERTIA)}",
+                f'{pad}    <body name="{side}_shank" pos="0 0 {_f(-link)}">',
+                f'{pad}      <joint name="{side}_knee_lower" armature="{_f(KNEE_ARMATURE)}"/>',
+                f'{pad}      <geom class="visual" type="cylinder" size="{_f(r1)} 0.03" zaxis="0 1 0" rgba="0.5 0.5 0.55 1"/>',
+            ]
+            pad += "    "
+        else:
+            lines += [
+                f'{pad}  <body name="{side}_shank" pos="0 0 {_f(-thigh)}">',
+                f'{pad}    <joint name="{side}_knee"/>',
+            ]
+        lines += [
+            f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia)}",
+            f'{pad}    <geom class="visual" type="capsule" size="0.035" fromto="0 0 0 0 0 {_f(-shank)}"/>',
+            f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
+            f'{pad}      <joint name="{side}_ankle"/>',
+            f"{pad}      {_inertial(-r.foot_com, r.foot_mass, r.foot_inertia)}",
+            f'{pad}      <geom name="{side}_sole" class="collision" type="box" '
+            f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
+            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}"/>',
+            f'{pad}      <geom class="visual" type="box" '
+            f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
+            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}"/>',
+            f'{pad}      <site name="{side}_ankle"/>',
+            f'{pad}      <site name="{side}_heel" pos="{_f(-r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
+            f'{pad}      <site name="{side}_toe" pos="{_f(r.foot_length - r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
+            f"{pad}    </body>",
+            f"{pad}  </body>",
+        ]
+        if rolling:
+            lines += ["        </body>"]
+        lines += ["      </body>"]
+    lines += ["    </body>", "  </worldbody>", ""]
+    if rolling:
+        lines += ["  <equality>"]
+        for side in SIDES:
+            lines += [
+                f'    <joint name="{side}_knee_coupling" joint1="{side}_knee_lower" '
+                f'joint2="{side}_knee_upper" polycoef="0 {_f(r2 / r1)} 0 0 0" '
+                f'solref="{KNEE_SOLREF}" solimp="{KNEE_SOLIMP}"/>'
+            ]
+        lines += ["  </equality>", "", "  <tendon>"]
+        for side in SIDES:
+            lines += [
+                f'    <fixed name="{side}_knee">',
+                f'      <joint joint="{side}_knee_upper" coef="1"/>',
+                f'      <joint joint="{side}_knee_lower" coef="1"/>',
+                "    </fixed>",
+            ]
+        lines += ["  </tendon>", ""]
+    lines += ["  <actuator>"]
+    for side in SIDES:
+        knee_target = f'tendon="{side}_knee"' if rolling else f'joint="{side}_knee"'
+        lines += [
+            f'    <motor name="{side}_hip" joint="{side}_hip"/>',
+            f'    <motor name="{side}_knee" {knee_target}/>',
+            f'    <motor name="{side}_ankle" joint="{side}_ankle"/>',
+        ]
+    lines += ["  </actuator>", "", "  <keyframe>"]
+    nq = 3 + 2 * (4 if rolling else 3)
+    home = ["0", _f(stand)] + ["0"] * (nq - 2)
+    lines += [f'    <key name="home" qpos="{" ".join(home)}"/>', "  </keyframe>", "</mujoco>", ""]
+    return "\n".join(lines)
+
+
+def scene_xml(knee: str) -> str:
+    """A scene that includes the robot file and adds the floor and a light."""
+    return "\n".join(
+        [
+            f'<mujoco model="scene_{knee}">',
+            f'  <include file="biped_{knee}.xml"/>',
+            "",
+            '  <visual><global azimuth="90" elevation="-15"/></visual>',
+            "",
+            "  <asset>",
+            '    <texture name="grid" type="2d" builtin="checker" width="512" height="512" '
+            'rgb1="0.2 0.3 0.4" rgb2="0.3 0.4 0.5"/>',
+            '    <material name="grid" texture="grid" texrepeat="1 1" texuniform="true"/>',
+            "  </asset>",
+            "",
+            "  <worldbody>",
+            '    <light pos="0 -2 3" dir="0 1 -1"/>',
+            '    <geom name="floor" type="plane" size="0 0 0.05" material="grid" '
+            f'friction="{FOOT_FRICTION}"/>',
+            "  </worldbody>",
+            "</mujoco>",
+            "",
+        ]
+    )
+
+
+def model_files(robot: Robot | None = None) -> dict[str, str]:
+    """File name -> content of every committed model."""
+    robot = Robot.paper() if robot is None else robot
+    files = {}
+    for knee in ("revolute", "rolling"):
+        files[f"biped_{knee}.xml"] = robot_xml(robot, knee)
+        files[f"scene_{knee}.xml"] = scene_xml(knee)
+    return files
+
+
+def write_models(folder: Path = FOLDER, robot: Robot | None = None) -> list[Path]:
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, text in model_files(robot).items():
+        path = folder / name
+        tmp = path.with_suffix(".xml.tmp")
+        tmp.write_text(text)
+        tmp.replace(path)
+        paths.append(path)
+    return paths
+
+
+if __name__ == "__main__":
+    for written in write_models():
+        print(f"wrote {written}", file=sys.stderr)
