@@ -6,6 +6,7 @@ Errors in the input print one line on stderr and exit with status 2.
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 
@@ -94,6 +95,20 @@ def _speeds(text: str) -> np.ndarray:
     return np.round(values, 6)
 
 
+def _check_output(path: str) -> None:
+    """Fail before any work if ``path`` cannot become a file."""
+    from pathlib import Path
+
+    target = Path(path)
+    if target.is_dir():
+        raise BipedError(f"--out {path!r} is a folder: allowed a file path")
+    parent = target.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not os.access(parent, os.W_OK):
+        raise BipedError(f"--out {path!r}: folder {str(parent)!r} is not writable")
+
+
 def cmd_optimize(args) -> int:
     """Find the optimal gait of one robot at one walking speed and write it as JSON.
 
@@ -106,6 +121,7 @@ def cmd_optimize(args) -> int:
     robot = _robot(args.robot)
     model = Biped(robot, args.knee)
     check_speed(model, args.speed)
+    _check_output(args.out)
     print(
         f"optimizing {args.knee} knee, {args.criterion} criterion, {args.speed} m/s "
         f"(seed {args.seed})...",
@@ -301,7 +317,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.run(args)
-    except BipedError as error:
+    except (BipedError, OSError) as error:
         print(f"biped {args.command}: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
 

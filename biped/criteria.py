@@ -25,8 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import simpson
 
-from biped.dynamics import Biped
-from biped.gait import Step, sample
+from biped.dynamics import Biped, zmp_from
+from biped.gait import Step, half_grid, sample
+from biped.kinematics import Q1, Q2, Q3, Q4
 
 CONSTRAINTS = (
     "normal_force",
@@ -57,8 +58,7 @@ FOOT_MARGIN_RAMP = 0.1  # fraction of the step
 @functools.cache
 def margin_profile(samples_per_half: int) -> np.ndarray:
     """δ (N, 7) on the time grid of ``biped.gait.sample``."""
-    t = np.linspace(0.0, 0.5, samples_per_half + 1)
-    t_n = np.concatenate([t, t + 0.5])
+    t_n = np.concatenate(half_grid(samples_per_half))
     ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / FOOT_MARGIN_RAMP, 0.0, 1.0)
     profile = np.tile(MARGINS, (len(t_n), 1))
     profile[:, 5:] *= ramp[:, None]
@@ -89,10 +89,10 @@ class StepEvaluation:
     torques: np.ndarray  # [N·m] (N, 6)
     wrench: np.ndarray  # (N, 3)
     zmp: np.ndarray  # [m] (N,)
-    constraints: np.ndarray  # (N, 7) Ψ1..Ψ7, NaN where not checked
+    constraints: np.ndarray  # (N, 7) Ψ1..Ψ7, NaN where not checked (swing foot at 0 and T)
     sthenic: float  # (2/d) ∫ ΓᵀΓ dt [N²·m·s]
     energy: float  # ∫ Σ |Γ θ̇| dt [J]
-    penalty: float  # ∫ k Σ (e^(|Ψ|-Ψ) - 1) dt [s]
+    penalty: float  # ∫ k Σ (e^(|Ψ|-Ψ) - 1) dt [s]; inf if any value is not finite
 
     def cost(self, criterion: str, step_length: float) -> float:
         """C_Γ or C_E with the penalty (Err = 0: the step was built)."""
@@ -105,10 +105,49 @@ class StepEvaluation:
         """Every constraint holds on the samples: no violation, zero penalty."""
         return self.penalty == 0.0 and not self.violations()
 
+    @property
+    def worst(self) -> np.ndarray:
+        """Smallest value of each Ψ_i over the checked samples (7,)."""
+        return np.nanmin(self.constraints, axis=0)
+
     def violations(self) -> dict:
         """Worst value of each violated constraint (Ψ_i < 0), by name."""
-        worst = np.nanmin(self.constraints, axis=0)
-        return {name: float(w) for name, w in zip(CONSTRAINTS, worst, strict=True) if w < 0.0}
+        return {name: float(w) for name, w in zip(CONSTRAINTS, self.worst, strict=True) if w < 0.0}
+
+
+def constraints(robot, q, torques, wrench, swing_feet_z) -> np.ndarray:
+    """Ψ1..Ψ7 (N, 7) of eq. (28) from the samples.
+
+    Args:
+        robot: the parameters (foot geometry).
+        q: (N, 9); torques: (N, 6); wrench: (N, 3).
+        swing_feet_z: (N, 2) heights of the swing heel and toe [m].
+    """
+    zmp = zmp_from(torques, wrench, robot.ankle_height)
+    return np.column_stack(
+        [
+            wrench[:, 1],
+            zmp + robot.foot_heel,
+            robot.foot_length - robot.foot_heel - zmp,
+            q[:, Q2] - q[:, Q1],
+            q[:, Q3] - q[:, Q4],
+            swing_feet_z,
+        ]
+    )
+
+
+def penalty_rate(psi, checked) -> np.ndarray:
+    """k Σ_i (e^(|Ψ_i| - Ψ_i) - 1) per sample (N,), over the ``checked`` entries only."""
+    return PENALTY_WEIGHT * np.where(checked, np.expm1(np.abs(psi) - psi), 0.0).sum(axis=1)
+
+
+@functools.cache
+def checked_mask(samples_per_half: int) -> np.ndarray:
+    """Which Ψ_i are checked at which sample (N, 7): all but the swing foot at t = 0, T."""
+    mask = np.ones((2 * (samples_per_half + 1), len(CONSTRAINTS)), dtype=bool)
+    mask[[0, -1], 5:] = False  # both feet on the ground by construction
+    mask.setflags(write=False)
+    return mask
 
 
 def evaluate_step(
@@ -123,32 +162,13 @@ def evaluate_step(
         model, step, samples_per_half, ("swing_heel", "swing_toe")
     )
     robot = model.robot
-    zmp = (torques[:, 0] - robot.ankle_height * wrench[:, 0]) / wrench[:, 1]
-    feet = feet[..., 1]
-    feet[[0, -1]] = np.nan  # on the ground by construction
-    psi = np.column_stack(
-        [
-            wrench[:, 1],
-            zmp + robot.foot_heel,
-            robot.foot_length - robot.foot_heel - zmp,
-            q[:, 3] - q[:, 2],
-            q[:, 4] - q[:, 5],
-            feet,
-        ]
-    )
-    if margins:
-        psi_seen = psi - margin_profile(samples_per_half)
-    else:
-        psi_seen = psi
-    barrier = np.expm1(np.abs(psi_seen) - psi_seen)
-    barrier = PENALTY_WEIGHT * np.nansum(barrier, axis=1)
+    psi = constraints(robot, q, torques, wrench, feet[..., 1])
+    checked = checked_mask(samples_per_half)
+    seen = psi - margin_profile(samples_per_half) if margins else psi
     power = np.abs(model.joint_angles(qd) * torques).sum(-1)
     squared = (torques**2).sum(-1)
     weights = step.period * simpson_weights(samples_per_half)
-
-    def integral(values):
-        return float(weights @ values)
-
+    finite = bool(np.all(np.isfinite(psi[checked])) and np.all(np.isfinite(squared)))
     return StepEvaluation(
         t=t,
         q=q,
@@ -156,9 +176,9 @@ def evaluate_step(
         qdd=qdd,
         torques=torques,
         wrench=wrench,
-        zmp=zmp,
-        constraints=psi,
-        sthenic=integral(squared) / step.step_length,
-        energy=integral(power),
-        penalty=integral(barrier),
+        zmp=zmp_from(torques, wrench, robot.ankle_height),
+        constraints=np.where(checked, psi, np.nan),
+        sthenic=float(weights @ squared) / step.step_length,
+        energy=float(weights @ power),
+        penalty=float(weights @ penalty_rate(seen, checked)) if finite else float("inf"),
     )

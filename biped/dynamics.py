@@ -51,6 +51,15 @@ for _row, (_plus, _minus) in enumerate(_JOINT_PAIRS):
 JOINT_MATRIX.setflags(write=False)
 
 
+def zmp_from(torques, wrench, ankle_height):
+    """Eq. (29): x_ZMP = (Γ1 - h_p Fx) / Fz [m], from the stance ankle.
+
+    Exact for a flat, fixed stance foot whose centre of mass lies below the ankle: the foot's
+    moment balance about the ankle gives Γ1 = x_ZMP Fz + h_p Fx.
+    """
+    return (torques[..., 0] - ankle_height * wrench[..., 0]) / wrench[..., 1]
+
+
 class Biped(Chain):
     """Geometry and dynamics of one biped, in the paper's coordinates and order.
 
@@ -82,7 +91,6 @@ class Biped(Chain):
         self._p = np.zeros((k + 2, NQ))
         self._p[:k, :7] = self.directions
         self._p[k, XH] = self._p[k + 1, ZH] = 1.0
-        self._ankle = self.point_a[:, self.point_index("stance_ankle")]
         self._stance_leg = self.directions[:, [Q1, Q2]]
 
     # ------------------------------------------------------------------ matrices of eq. (19)
@@ -174,7 +182,7 @@ class Biped(Chain):
     def _torques_and_wrench(self, tau, s, c):
         fx, fz = tau[..., XH], tau[..., ZH]
         # Stance-ankle Jacobian columns for q1 and q2: ∂(ankle)/∂φ = a u'(φ).
-        weights = self._ankle * (c * fx[..., None] + s * fz[..., None])
+        weights = self._stance_ankle * (c * fx[..., None] + s * fz[..., None])
         work = weights @ self._stance_leg  # F · ∂ankle/∂q1, F · ∂ankle/∂q2
         g6 = -tau[..., QP2]
         g5 = g6 - tau[..., Q4]
@@ -197,9 +205,9 @@ class Biped(Chain):
         return q, qd, qdd, torques, wrench, self._points(q, s, c, list(points))
 
     def zmp(self, q, qd, qdd):
-        """x of the zero-moment point [m] from the stance ankle, eq. (29): (Γ1 - h_p Fx) / Fz."""
+        """x of the zero-moment point [m] from the stance ankle, eq. (29)."""
         torques, wrench = self.inverse_dynamics(q, qd, qdd)
-        return (torques[..., 0] - self.robot.ankle_height * wrench[..., 0]) / wrench[..., 1]
+        return zmp_from(torques, wrench, self.robot.ankle_height)
 
     # ------------------------------------------------------------------ energy
     def kinetic_energy(self, q, qd):

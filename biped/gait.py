@@ -91,6 +91,8 @@ def build_step(model: Biped, speed: float, p) -> Step:
     p = np.asarray(p, dtype=float)
     if p.shape != (N_PARAMETERS,):
         raise BipedError(f"gait parameters have shape {p.shape}: allowed ({N_PARAMETERS},)")
+    if not np.all(np.isfinite(p)):
+        raise StepBuildError("gait parameters are not all finite", excess=1.0)
     x_hip, z_hip, trunk = p[0:3]
     end_rates = np.concatenate([[0.0], p[3:8]])
     acc0, acc1 = p[8:14], p[14:20]
@@ -207,3 +209,13 @@ def sample(model: Biped, step: Step, samples_per_half: int, points=()):
         (accels @ coefficients) / period**2,
         points,
     )
+
+
+def angles_at(step: Step, t_n):
+    """Angles, rates, accelerations (..., 6) at normalised times t_n in [0, 1], the left
+    piece up to t_n = 0.5 inclusive, the right piece after."""
+    t_n = np.asarray(t_n, dtype=float)
+    left = evaluate(step, np.minimum(t_n, 0.5), "left")
+    right = evaluate(step, np.maximum(t_n, 0.5), "right")
+    first = (t_n <= 0.5)[..., None]
+    return tuple(np.where(first, a, b) for a, b in zip(left, right, strict=True))

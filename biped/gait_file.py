@@ -6,7 +6,9 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
     costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]},
     robot {field: value}, parameters {name: value} (the 21 of ``biped.gait.PARAMETERS``),
     constraints {name: worst Ψ_i on the samples},
-    impact {impulse [N·s, N·s, N·m·s], qd_minus, qd_plus},
+    impact {impulse [N·s, N·s, N·m·s], trailing_foot_lift [m/s] (heel, toe), consistent
+            (Iz > 0 and the trailing foot lifts: the flat-foot impact model holds), qd_minus,
+            qd_plus},
     optimizer {seed, evaluations, seconds, history},
     samples {t, q, qd, qdd, torques, wrench, zmp}
 
@@ -24,9 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-from biped.criteria import CONSTRAINTS
+from biped.criteria import CONSTRAINTS, CRITERIA
+from biped.dynamics import Biped
 from biped.errors import BipedError
 from biped.gait import PARAMETERS
+from biped.impact import trailing_foot_lift
+from biped.kinematics import KNEES
 from biped.optimize import Optimum
 from biped.robot import Robot
 
@@ -38,7 +43,8 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
     """The JSON-ready content of a gait file."""
     ev = optimum.evaluation
     step = optimum.step
-    worst = np.nanmin(ev.constraints, axis=0)
+    model = Biped(robot, optimum.knee)
+    qd_plus, _ = model.impact(*step.end)
     return {
         "format": FORMAT,
         "knee": optimum.knee,
@@ -54,9 +60,13 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
         },
         "robot": robot.to_dict(),
         "parameters": dict(zip(PARAMETERS, map(float, optimum.parameters), strict=True)),
-        "constraints": dict(zip(CONSTRAINTS, map(float, worst), strict=True)),
+        "constraints": dict(zip(CONSTRAINTS, map(float, ev.worst), strict=True)),
         "impact": {
             "impulse": step.impulse.tolist(),
+            "trailing_foot_lift": trailing_foot_lift(model, step.end[0], qd_plus).tolist(),
+            "consistent": bool(
+                step.impulse[1] > 0 and np.all(trailing_foot_lift(model, step.end[0], qd_plus) >= 0)
+            ),
             "qd_minus": step.end[1].tolist(),
             "qd_plus": step.start[1].tolist(),
         },
@@ -84,13 +94,32 @@ def write_json(path: str | Path, content: dict) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)  # as a plain open() would create it
         with os.fdopen(fd, "w") as handle:
             json.dump(content, handle, indent=1, allow_nan=False)
+            handle.flush()
+            os.fsync(handle.fileno())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def _positive_number(value) -> bool:
+    return (
+        isinstance(value, (int, float))
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+        and value > 0
+    )
+
+
+def parameters(gait: dict) -> np.ndarray:
+    """The 21 parameters (in ``PARAMETERS`` order) of a gait read by ``read``."""
+    return np.array([gait["parameters"][name] for name in PARAMETERS])
 
 
 def read(path: str | Path) -> dict:
@@ -112,16 +141,29 @@ def read(path: str | Path) -> dict:
         if key not in content:
             raise bad(f"missing {key!r}")
     for key in ("speed", "period", "step_length"):
-        value = content[key]
-        if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-            raise bad(f"{key} = {value!r}, allowed a number > 0")
+        if not _positive_number(content[key]):
+            raise bad(f"{key} = {content[key]!r}, allowed a number > 0")
+    if content["knee"] not in KNEES:
+        raise bad(f"knee = {content['knee']!r}, allowed {', '.join(KNEES)}")
+    if content["criterion"] not in CRITERIA:
+        raise bad(f"criterion = {content['criterion']!r}, allowed {', '.join(CRITERIA)}")
+    if not isinstance(content["feasible"], bool):
+        raise bad(f"feasible = {content['feasible']!r}, allowed true or false")
+    costs = content["costs"]
+    if not isinstance(costs, dict) or not all(
+        isinstance(costs.get(name), (int, float)) and math.isfinite(costs[name])
+        for name in CRITERIA
+    ):
+        raise bad(f"costs = {costs!r}, allowed finite numbers for {', '.join(CRITERIA)}")
     try:
         content["robot"] = Robot.from_mapping(content["robot"], source=str(path))
         names = set(content["parameters"])
     except (KeyError, TypeError) as error:
         raise bad(f"robot or parameters missing ({error})") from None
-    if names != set(PARAMETERS):
-        raise bad(f"parameters are not the {len(PARAMETERS)} of the gait")
+    if names != set(PARAMETERS) or not all(
+        isinstance(v, (int, float)) and math.isfinite(v) for v in content["parameters"].values()
+    ):
+        raise bad(f"parameters are not the {len(PARAMETERS)} finite numbers of the gait")
     samples = content.get("samples")
     if not isinstance(samples, dict):
         raise bad("missing samples")

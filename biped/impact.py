@@ -40,3 +40,19 @@ def flat_foot_impact(model, q, qd_minus, foot: str = "swing"):
     impulse = -np.linalg.solve(gram, approach[..., None])[..., 0]
     qd_plus = qd_minus + (d_inv_jt @ impulse[..., None])[..., 0]
     return qd_plus, impulse
+
+
+def trailing_foot_lift(model, q, qd_plus) -> np.ndarray:
+    """Vertical velocities (..., 2) [m/s] of the heel and toe of the foot that leaves the
+    ground (the stance foot before the swap) just after the impact.
+
+    The flat-foot impact model holds only if the landing foot is pushed (I_R,z > 0) and this
+    foot lifts (both velocities >= 0); the paper's constraints do not impose it.
+    """
+    return np.stack(
+        [
+            (model.point_jacobian(q, name)[..., 1, :] * qd_plus).sum(-1)
+            for name in ("stance_heel", "stance_toe")
+        ],
+        axis=-1,
+    )

@@ -321,9 +321,12 @@ class Chain:
             UnreachableError: the distance is outside the leg's reach.
         """
         d = np.asarray(hip_from_ankle, dtype=float)
+        if not np.all(np.isfinite(d)):
+            raise UnreachableError(f"hip position {d.tolist()!r} m: allowed finite numbers")
         dist2 = (d**2).sum(-1)
         low, high = self.leg_reach()
         bad = (dist2 > high**2 * (1 + 1e-12)) | (dist2 < low**2)
+        dist2 = np.minimum(dist2, high**2)  # rounding above the straight leg
         if np.any(bad):
             worst = float(np.sqrt(np.atleast_1d(dist2)[np.atleast_1d(bad)][0]))
             raise UnreachableError(

@@ -26,14 +26,14 @@ from scipy.optimize import minimize
 from biped.criteria import (
     BUILD_ERROR_COST,
     BUILD_ERROR_SLOPE,
-    CONSTRAINTS,
     CRITERIA,
     StepEvaluation,
+    checked_mask,
     evaluate_step,
     margin_profile,
 )
 from biped.dynamics import Biped
-from biped.errors import BipedError
+from biped.errors import BipedError, UnreachableError
 from biped.gait import N_PARAMETERS, Step, StepBuildError, build_step
 
 # Samples per spline piece while optimising and when checking the optimum.
@@ -84,8 +84,9 @@ def initial_parameters(model: Biped, speed: float, period: float = FIRST_GUESS_P
     Args:
         period: duration of the step T [s]; the step length is speed x T.
     """
-    length = speed * period
     leg = model.robot.shank_length + model.robot.thigh_length
+    length = min(speed * period, leg)  # a step the legs can reach at any speed
+    period = length / speed
     height = np.sqrt((0.97 * leg) ** 2 - (length / 2) ** 2) + model.robot.ankle_height
     rate = -speed / leg
     p = np.zeros(N_PARAMETERS)
@@ -101,6 +102,8 @@ def cost(model: Biped, speed: float, criterion: str, p, samples_per_half: int) -
         step = build_step(model, speed, p)
     except StepBuildError as error:
         return BUILD_ERROR_COST + BUILD_ERROR_SLOPE * error.excess
+    except UnreachableError:
+        return BUILD_ERROR_COST
     evaluation = evaluate_step(model, step, samples_per_half, margins=True)
     value = evaluation.cost(criterion, step.step_length)
     return value if np.isfinite(value) else BUILD_ERROR_COST
@@ -145,12 +148,9 @@ class _Polish:
         self.cache: dict = {}
         self.count = 0
         self.reference = None
-        n = 2 * (samples_per_half + 1)
-        margins = margin_profile(samples_per_half)
-        self.mask = np.ones((n, len(CONSTRAINTS)), bool)
-        self.mask[[0, -1], 5:] = False  # swing foot on the ground by construction
-        self.margins = margins[self.mask]
-        self.scales = np.broadcast_to(CONSTRAINT_SCALES, (n, len(CONSTRAINTS)))[self.mask]
+        self.mask = checked_mask(samples_per_half)
+        self.margins = margin_profile(samples_per_half)[self.mask]
+        self.scales = np.broadcast_to(CONSTRAINT_SCALES, self.mask.shape)[self.mask]
 
     def _evaluate(self, z):
         key = z.tobytes()
@@ -165,7 +165,10 @@ class _Polish:
             ev = evaluate_step(self.model, step, self.samples)
             criterion = ev.sthenic if self.criterion == "sthenic" else ev.energy
             psi = (ev.constraints[self.mask] - self.margins) / self.scales
-            value = (criterion, psi)
+            if not np.all(np.isfinite(psi)) or not np.isfinite(criterion):
+                value = (None, -np.ones(self.margins.shape))
+            else:
+                value = (criterion, psi)
         if len(self.cache) > 4 * N_PARAMETERS:
             self.cache.pop(next(iter(self.cache)))
         self.cache[key] = value
@@ -302,7 +305,7 @@ def optimize(
     for parameters in candidates:
         try:
             step = build_step(model, speed, parameters)
-        except StepBuildError:
+        except (StepBuildError, UnreachableError):
             continue
         evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF)
         value = evaluation.cost(criterion, step.step_length)

@@ -55,7 +55,7 @@ class Robot:
     shank_inertia: float
     """[kg·m²] About the shank centre of mass (I_1)."""
     shank_com: float
-    """[m] Knee to shank centre of mass (s_1); r1 - s1 from the rolling circle centre C1."""
+    """[m] Knee to shank centre of mass (s_1); s1 - r1 from the rolling circle centre C1."""
 
     thigh_length: float
     """[m] Knee to hip (l_2), the rolling-knee radius r2 included."""

@@ -28,9 +28,8 @@ from biped import gait_file
 from biped.criteria import CRITERIA
 from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.gait import PARAMETERS
 from biped.kinematics import KNEES
-from biped.optimize import initial_parameters, optimize
+from biped.optimize import check_speed, initial_parameters, optimize
 from biped.robot import Robot
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
@@ -46,12 +45,23 @@ class Point:
         return f"{self.knee}-{self.criterion}-{self.speed:.3f}.json"
 
 
-def _saved(path: Path):
-    """The gait saved at ``path``, or None if missing or unreadable."""
+def _saved(path: Path, point: Point, robot: Robot):
+    """The gait saved for ``point`` at ``path``, or None if missing or unreadable.
+
+    Raises:
+        BipedError: the file holds another robot's or another point's gait.
+    """
     try:
-        return gait_file.read(path)
+        gait = gait_file.read(path)
     except BipedError:
         return None
+    found = (gait["knee"], gait["criterion"], gait["speed"])
+    if found != (point.knee, point.criterion, point.speed) or gait["robot"] != robot:
+        raise BipedError(
+            f"{path} holds a gait of another robot or point ({found[0]}, {found[1]}, "
+            f"{found[2]} m/s): allowed only this sweep's, choose another --out folder"
+        )
+    return gait
 
 
 def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.stderr):
@@ -62,7 +72,7 @@ def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.
     for i, speed in enumerate(sorted(speeds), start=1):
         point = Point(knee, criterion, float(speed))
         path = Path(folder) / point.filename()
-        saved = _saved(path)
+        saved = _saved(path, point, robot)
         if saved is None:
             optimum = None
             if previous is not None:
@@ -102,7 +112,7 @@ def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.
             feasible, parameters, value = optimum.feasible, optimum.parameters, optimum.value
         else:
             feasible = saved["feasible"]
-            parameters = np.array([saved["parameters"][name] for name in PARAMETERS])
+            parameters = gait_file.parameters(saved)
             value = saved["costs"][criterion]
         if feasible:
             previous = (point.speed, parameters, value)
@@ -123,9 +133,23 @@ def _run_series(args):
     return run_series(*args)
 
 
-def pending_points(points, folder: Path):
+def pending_points(points, folder: Path, robot: Robot):
     """Points whose gait file is missing or unreadable."""
-    return [point for point in points if _saved(Path(folder) / point.filename()) is None]
+    return [p for p in points if _saved(Path(folder) / p.filename(), p, robot) is None]
+
+
+def check_speeds(robot: Robot, speeds, knees) -> list[float]:
+    """Sorted speeds, each walkable and with its own file name; raise a clear error if not."""
+    speeds = sorted(float(s) for s in speeds)
+    for knee in knees:
+        model = Biped(robot, knee)
+        for speed in speeds:
+            check_speed(model, speed)
+    names = [f"{s:.3f}" for s in speeds]
+    for a, b in zip(names, names[1:], strict=False):
+        if a == b:
+            raise BipedError(f"speeds {a} m/s appear twice at 1 mm/s resolution: allowed distinct")
+    return speeds
 
 
 def run_sweep(
@@ -144,11 +168,11 @@ def run_sweep(
     ``budget`` goes to ``biped.optimize.optimize`` (``max_restarts``, ``evaluations_per_run``,
     ``polish_iterations``).
     """
+    speeds = check_speeds(robot, speeds, knees)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    speeds = sorted(float(s) for s in speeds)
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
-    todo = pending_points(points, folder)
+    todo = pending_points(points, folder, robot)
     print(
         f"sweep: {len(points)} points in {folder}, {len(points) - len(todo)} already done, "
         f"{len(todo)} to run",

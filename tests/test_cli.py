@@ -62,6 +62,10 @@ def test_optimize_writes_a_complete_gait_file(tmp_path, capsys):
     ):
         assert key in gait
     assert gait["knee"] == "rolling" and gait["feasible"] is True and gait["speed"] == 0.3
+    assert (
+        isinstance(gait["impact"]["consistent"], bool)
+        and len(gait["impact"]["trailing_foot_lift"]) == 2
+    )
     assert set(gait["costs"]) >= {"sthenic", "energy"}
     assert gait["robot"].r1 == 0.05 and len(gait["parameters"]) == 21
     t = gait["samples"]["t"]
@@ -94,6 +98,8 @@ def test_infeasible_optimum_writes_nothing(tmp_path, capsys):
         (["sweep", "--speeds", "0.3:0.1"], "START:STOP:COUNT"),
         (["sweep", "--speeds", "0.2,-0.1"], "speeds > 0"),
         (["sweep", "--jobs", "0"], "'0'"),
+        (["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "."], "is a folder"),
+        (["demo", "--knee", "rolling", "--hip-ahead", "nan"], "allowed finite numbers"),
     ],
 )
 def test_bad_arguments_one_line_exit_2(capsys, argv, needle):

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from biped.criteria import CONSTRAINTS, PENALTY_WEIGHT, evaluate_step
+import biped
+from biped.criteria import CONSTRAINTS, PENALTY_WEIGHT, constraints, evaluate_step, penalty_rate
 from biped.gait import build_step, evaluate
 from biped.optimize import initial_parameters
 
@@ -39,19 +40,54 @@ def test_criteria_match_adaptive_quadrature(model):
     assert ev.energy == pytest.approx(power, rel=1e-4)
 
 
-def test_penalty_counts_only_violations(model):
-    """The penalty integrates k (e^(|Ψ|-Ψ) - 1) over time: zero iff every Ψ_i >= 0."""
+def test_each_constraint_flags_its_own_violation():
+    """Hand-made samples: a ZMP behind the heel or past the toe, a knee bent backwards, a
+    swing foot below the ground each make exactly the matching Ψ_i negative."""
+    robot = biped.Robot.paper()
+    weight = 700.0
+
+    def psi(zmp=0.0, q1=-0.1, q2=0.1, q3=0.1, q4=-0.1, heel=0.02, toe=0.02, fz=weight):
+        q = np.zeros((1, 9))
+        q[0, 2:6] = q1, q2, q3, q4
+        torques = np.zeros((1, 6))
+        torques[0, 0] = zmp * fz  # Γ1 = x_ZMP Fz + h_p Fx with Fx = 0
+        wrench = np.array([[0.0, fz, torques[0, 0]]])
+        return dict(
+            zip(CONSTRAINTS, constraints(robot, q, torques, wrench, [[heel, toe]])[0], strict=True)
+        )
+
+    assert all(v > 0 for v in psi().values())
+    cases = {
+        "zmp_heel": psi(zmp=-0.12),  # heel at -0.0935 m
+        "zmp_toe": psi(zmp=0.18),  # toe at 0.1649 m
+        "stance_knee": psi(q1=0.2, q2=0.1),
+        "swing_knee": psi(q3=-0.2, q4=-0.1),
+        "swing_heel": psi(heel=-0.001),
+        "swing_toe": psi(toe=-0.001),
+        "normal_force": psi(fz=-1.0, zmp=0.0),
+    }
+    for name, values in cases.items():
+        assert [k for k, v in values.items() if v < 0] == [name], name
+    assert psi(zmp=-0.12)["zmp_heel"] == pytest.approx(-0.12 + robot.foot_heel)
+    assert psi(zmp=0.18)["zmp_toe"] == pytest.approx(robot.foot_length - robot.foot_heel - 0.18)
+
+
+def test_penalty_rate_is_the_exponential_barrier():
+    """k (e^(|Ψ|-Ψ) - 1) is 0 for Ψ >= 0 and k (e^(2|Ψ|) - 1) for Ψ < 0; unchecked ignored."""
+    psi = np.array([[0.3, 0.0, -0.01], [-0.5, 2.0, -1.0]])
+    checked = np.array([[True, True, True], [True, True, False]])
+    expected = [PENALTY_WEIGHT * np.expm1(0.02), PENALTY_WEIGHT * np.expm1(1.0)]
+    np.testing.assert_allclose(penalty_rate(psi, checked), expected, rtol=1e-12)
+
+
+def test_infeasible_first_guess_reports_its_violations(model):
+    """The first guess violates constraints: positive penalty, each violation negative."""
     step = build_step(model, SPEED, initial_parameters(model, SPEED))
     ev = evaluate_step(model, step, 100)
-    psi = ev.constraints
-    barrier = PENALTY_WEIGHT * np.nansum(np.expm1(np.abs(psi) - psi), axis=1)
-    expected = sum(np.trapezoid(barrier[i], ev.t[i]) for i in (slice(0, 101), slice(101, None)))
-    assert ev.penalty == pytest.approx(expected, rel=1e-2)
     violated = ev.violations()
-    assert set(violated) <= set(CONSTRAINTS)
-    assert (ev.penalty > 0.0) == bool(violated)
+    assert violated and ev.penalty > 0.0 and not ev.feasible
     for name, worst in violated.items():
-        assert worst == np.nanmin(psi[:, CONSTRAINTS.index(name)]) < 0.0
+        assert worst == np.nanmin(ev.constraints[:, CONSTRAINTS.index(name)]) < 0.0
 
 
 def test_margins_only_make_the_penalty_larger(model):

@@ -114,3 +114,13 @@ def test_next_step_starts_on_the_new_stance_foot(model):
         atol=1e-12,
     )
     assert np.all(new_q[:, XH] != q[:, XH])
+
+
+def test_trailing_foot_lift_is_the_stance_foot_velocity(model):
+    """trailing_foot_lift equals the vertical velocity of the old stance heel and toe."""
+    from biped.impact import trailing_foot_lift
+
+    q, qd = touchdown_state(model, seed=37, n=5)
+    qd_plus, _ = model.impact(q, qd)
+    velocity = complex_step_velocity(model, q, qd_plus, ["stance_heel", "stance_toe"])[..., 1]
+    np.testing.assert_allclose(trailing_foot_lift(model, q, qd_plus), velocity, atol=1e-12)

@@ -66,4 +66,27 @@ def test_figures_and_table(sweep, tmp_path):
     for path in paths:
         assert path.stat().st_size > 1000
     table = (tmp_path / "comparison.md").read_text()
-    assert "~17%" in table and "0.27" in table and "~11%" in table
+    # Our numbers in the table are those of the gait files.
+    best = {}
+    for knee in biped.KNEES:
+        gaits = [gait_file.read(p) for p in folder.glob(f"{knee}-sthenic-*.json")]
+        gaits = [g for g in gaits if g["feasible"]]
+        best[knee] = min(gaits, key=lambda g: g["costs"]["sthenic"])
+    reduction = 1 - best["rolling"]["costs"]["sthenic"] / best["revolute"]["costs"]["sthenic"]
+    assert f"| ~17% | {reduction:.1%} |" in table
+    assert f"| 0.27 | {best['revolute']['speed']:.3f} |" in table
+
+
+def test_sweep_refuses_another_robots_folder(sweep):
+    """Resuming into a folder of another robot's gaits is an error, not a silent mix."""
+    folder, _ = sweep
+    other = biped.Robot.from_mapping({"r1": 0.08})
+    with pytest.raises(biped.BipedError, match="another robot or point"):
+        run_sweep(folder, other, SPEEDS, jobs=1, stream=io.StringIO(), **TINY)
+
+
+def test_sweep_checks_speeds_before_any_work(tmp_path):
+    """An unwalkable speed in the list fails at once, before optimising the others."""
+    with pytest.raises(biped.BipedError, match="speed = 3.5"):
+        run_sweep(tmp_path, biped.Robot.paper(), (0.2, 3.5), jobs=1, stream=io.StringIO(), **TINY)
+    assert not list(tmp_path.glob("*.json"))

@@ -42,7 +42,18 @@ KNEE_SOLIMP = "0.9999 0.99999 0.0001 0.5 2"
 FOOT_WIDTH = 0.10
 SOLE_THICKNESS = 0.02
 FOOT_FRICTION = "1.0 0.02 0.0001"
+# Stiff foot contact: the gaits clear the ground by millimetres, so the stance foot must not
+# sink into it (default contacts let the loaded heel sink by about 1.5 mm, these by 0.5 mm).
+FOOT_SOLREF = "0.004 1"
+FOOT_SOLIMP = "0.99 0.999 0.0005 0.5 2"
 TIMESTEP = 0.001  # [s]
+# Elliptic friction cones with a high impedance ratio: MuJoCo's soft friction then holds a
+# loaded foot with little creep (the gaits need |Fx| / Fz of about 0.1 at most).
+IMPRATIO = 50.0
+# Legs side by side, for the eye only: the motion is planar (slides along x, z and hinges
+# about y), so offsets along y change nothing in it. Feet collide with the floor, not each
+# other (contype / conaffinity).
+HIP_OFFSET = 0.09  # [m]
 FOLDER = Path(__file__).resolve().parent.parent / "mjcf"
 
 
@@ -55,8 +66,14 @@ def _inertial(pos_z: float, mass: float, inertia: float) -> str:
     return f'<inertial pos="0 0 {_f(pos_z)}" mass="{_f(mass)}" diaginertia="{i} {i} {i}"/>'
 
 
-def robot_xml(robot: Robot, knee: str) -> str:
-    """The robot's MJCF (no floor), for one knee kinematic."""
+def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None) -> str:
+    """The robot's MJCF (no floor), for one knee kinematic.
+
+    Args:
+        servos: (kp [N·m/rad], kv [N·m·s/rad]) adds, after the six motors, a position and a
+            velocity actuator on each joint (the knee tendon for the rolling knee), in MuJoCo's
+            joint coordinates: the joint-space feedback of the forward simulation.
+    """
     check_knee(knee)
     rolling = knee == "rolling"
     r = robot
@@ -69,7 +86,8 @@ def robot_xml(robot: Robot, knee: str) -> str:
     lines = [
         f'<mujoco model="biped_{knee}">',
         '  <compiler angle="radian" autolimits="true" inertiafromgeom="false"/>',
-        f'  <option timestep="{_f(TIMESTEP)}" integrator="implicitfast"/>',
+        f'  <option timestep="{_f(TIMESTEP)}" integrator="implicitfast" cone="elliptic" '
+        f'impratio="{_f(IMPRATIO)}"/>',
         "",
         "  <default>",
         '    <joint type="hinge" axis="0 -1 0"/>',
@@ -78,7 +96,8 @@ def robot_xml(robot: Robot, knee: str) -> str:
         '      <geom contype="0" conaffinity="0" group="2" rgba="0.7 0.7 0.75 1"/>',
         "    </default>",
         '    <default class="collision">',
-        f'      <geom group="3" friction="{FOOT_FRICTION}" condim="3"/>',
+        f'      <geom group="3" friction="{FOOT_FRICTION}" condim="3" contype="1" conaffinity="0" '
+        f'solref="{FOOT_SOLREF}" solimp="{FOOT_SOLIMP}"/>',
         "    </default>",
         '    <site size="0.01" group="4" rgba="1 0.2 0.2 1"/>',
         "  </default>",
@@ -95,7 +114,7 @@ def robot_xml(robot: Robot, knee: str) -> str:
     for side in SIDES:
         pad = "      "
         lines += [
-            f'{pad}<body name="{side}_thigh">',
+            f'{pad}<body name="{side}_thigh" pos="0 {_f(HIP_OFFSET if side == "left" else -HIP_OFFSET)} 0">',
             f'{pad}  <joint name="{side}_hip"/>',
             f"{pad}  {_inertial(-r.thigh_com, r.thigh_mass, r.thigh_inertia)}",
             f'{pad}  <geom class="visual" type="capsule" size="0.045" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
@@ -129,6 +148,9 @@ def robot_xml(robot: Robot, knee: str) -> str:
             f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
             f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}"/>',
             f'{pad}      <site name="{side}_ankle"/>',
+            f'{pad}      <site name="{side}_sole_touch" type="box" '
+            f'size="{_f(r.foot_length / 2 + 0.005)} {_f(FOOT_WIDTH / 2 + 0.005)} {_f(SOLE_THICKNESS / 2 + 0.005)}" '
+            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}" rgba="0 0 0 0"/>',
             f'{pad}      <site name="{side}_heel" pos="{_f(-r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
             f'{pad}      <site name="{side}_toe" pos="{_f(r.foot_length - r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
             f"{pad}    </body>",
@@ -163,11 +185,40 @@ def robot_xml(robot: Robot, knee: str) -> str:
             f'    <motor name="{side}_knee" {knee_target}/>',
             f'    <motor name="{side}_ankle" joint="{side}_ankle"/>',
         ]
-    lines += ["  </actuator>", "", "  <keyframe>"]
+    if servos is not None:
+        kp, kv = servos
+        for kind, gain in (("position", f'kp="{_f(kp)}"'), ("velocity", f'kv="{_f(kv)}"')):
+            for side in SIDES:
+                for joint in ("hip", "knee", "ankle"):
+                    target = (
+                        f'tendon="{side}_knee"'
+                        if rolling and joint == "knee"
+                        else f'joint="{side}_{joint}"'
+                    )
+                    lines += [
+                        f'    <{kind} name="{side}_{joint}_{kind}" {target} {gain} gear="1" '
+                        'ctrllimited="false"/>'
+                    ]
+    lines += ["  </actuator>", "", "  <sensor>"]
+    for side in SIDES:
+        lines += [
+            f'    <touch name="{side}_touch" site="{side}_sole_touch"/>',
+            f'    <framepos name="{side}_ankle_pos" objtype="site" objname="{side}_ankle"/>',
+        ]
+    lines += ["  </sensor>", "", "  <keyframe>"]
     nq = 3 + 2 * (4 if rolling else 3)
     home = ["0", _f(stand)] + ["0"] * (nq - 2)
     lines += [f'    <key name="home" qpos="{" ".join(home)}"/>', "  </keyframe>", "</mujoco>", ""]
     return "\n".join(lines)
+
+
+def scene_model(robot: Robot, knee: str, servos=None):
+    """Compiled MuJoCo model of the scene (floor and robot) from ``robot``, in memory."""
+    import mujoco
+
+    return mujoco.MjModel.from_xml_string(
+        scene_xml(knee), assets={f"biped_{knee}.xml": robot_xml(robot, knee, servos).encode()}
+    )
 
 
 def scene_xml(knee: str) -> str:
@@ -188,7 +239,7 @@ def scene_xml(knee: str) -> str:
             "  <worldbody>",
             '    <light pos="0 -2 3" dir="0 1 -1"/>',
             '    <geom name="floor" type="plane" size="0 0 0.05" material="grid" '
-            f'friction="{FOOT_FRICTION}"/>',
+            f'friction="{FOOT_FRICTION}" contype="0" conaffinity="1"/>',
             "  </worldbody>",
             "</mujoco>",
             "",
