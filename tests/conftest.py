@@ -37,3 +37,24 @@ def smooth_motion(model, seed, t):
 def complex_step_velocity(model, q, qd, names, h=1e-30):
     """Exact velocities (..., P, 2) of named points by complex-step differentiation."""
     return model.points(np.asarray(q) + 1j * h * np.asarray(qd), names).imag / h
+
+
+_GAITS: dict = {}
+
+
+def small_optimum(knee: str):
+    """A feasible optimal gait at 0.3 m/s from a small budget, computed once per session."""
+    from biped.optimize import initial_parameters, optimize
+
+    if knee not in _GAITS:
+        model = biped.Biped(biped.Robot.paper(), knee)
+        _GAITS[knee] = optimize(
+            model,
+            0.3,
+            "sthenic",
+            starts=initial_parameters(model, 0.3),
+            max_restarts=0,
+            evaluations_per_run=300,
+            polish_iterations=30,
+        )
+    return _GAITS[knee]
