@@ -22,6 +22,7 @@ from biped.sweep import DEFAULT_SPEEDS
 EXIT_BAD_INPUT = 2
 DEFAULT_SWEEP = "logs/sweep"
 DEFAULT_FIGURES = "logs/figures"
+DEFAULT_RECORDINGS = "logs/recordings"
 ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
 
 
@@ -232,6 +233,36 @@ def _positive(text: str) -> int:
     return value
 
 
+def cmd_validate(args) -> int:
+    """Cross-check a gait file in MuJoCo and record it for rerun.
+
+    Checks: analytical inverse dynamics and impact against MuJoCo's dynamics of the MJCF, and
+    a forward simulation with contact over --steps steps (no fall, no slip, ZMP in the foot).
+    Prints a table (or JSON with --json) and writes a rerun recording; exits 0 only when
+    every check passes, 1 otherwise.
+    """
+    import json
+    from pathlib import Path
+
+    from biped import gait_file
+    from validate.record import record
+    from validate.report import as_json, validate
+
+    gait = gait_file.read(args.gait)
+    rrd = Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / (Path(args.gait).stem + ".rrd")
+    _check_output(str(rrd))
+    result = validate(gait, steps=args.steps)
+    path = record(rrd, result.biped, result.step, result.simulation, result.contact)
+    if args.json:
+        print(json.dumps({**as_json(result.checks), "recording": str(path)}, indent=1))
+    else:
+        print(f"{args.gait}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
+        for check in result.checks:
+            print("  " + check.line())
+        print(f"recording: {path}  (open with: rerun {path})")
+    return 0 if result.passed else 1
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2."""
 
@@ -302,6 +333,19 @@ def build_parser() -> argparse.ArgumentParser:
     _add_budget(sweep)
     sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     sweep.set_defaults(run=cmd_sweep)
+
+    val = commands.add_parser(
+        "validate",
+        help="cross-check a gait in MuJoCo and record it",
+        description=cmd_validate.__doc__,
+    )
+    val.add_argument("gait", metavar="GAIT.json", help="gait file from optimize or sweep")
+    val.add_argument("--steps", type=_positive, default=20, help="steps to walk (default 20)")
+    val.add_argument(
+        "--rrd", metavar="PATH", help=f"recording (default {DEFAULT_RECORDINGS}/<gait>.rrd)"
+    )
+    val.add_argument("--json", action="store_true", help="print the report as JSON")
+    val.set_defaults(run=cmd_validate)
 
     fig = commands.add_parser(
         "figures", help="figures and table of the comparison", description=cmd_figures.__doc__

@@ -45,3 +45,19 @@ def test_knee_link_mass_is_negligible():
     model = biped.Biped(ROBOT, "rolling")
     q, qd, qdd = random_state(model, seed=42, n=20)
     assert knee_link_effect(model, q, qd, qdd) < 1e-4
+
+
+def test_impact_map_agrees_with_mujoco(model):
+    """MuJoCo's mass matrix and landing-foot Jacobian give the same q̇⁺ and impulse (eq. 23-24)."""
+    from tests.test_impact import touchdown_state
+    from validate.crosscheck import mujoco_impact
+    from validate.mapping import mapping
+
+    q, qd = touchdown_state(model, seed=44, n=8)
+    qd_plus, impulse = model.impact(q, qd)
+    mj = load_model(model, exact=True)
+    mapped = mapping(mj, "left", model.radii)
+    for k in range(len(q)):
+        mj_qd_plus, mj_impulse = mujoco_impact(mj, model, q[k], qd[k])
+        np.testing.assert_allclose(mj_qd_plus, mapped.qpos(qd_plus[k]), atol=1e-9)
+        np.testing.assert_allclose(mj_impulse, impulse[k], atol=1e-9)

@@ -125,3 +125,28 @@ def knee_link_effect(biped: Biped, q, qd, qdd, stance="left") -> float:
     a = mujoco_inverse_dynamics(with_link, biped, q, qd, qdd, stance).torques
     b = mujoco_inverse_dynamics(exact, biped, q, qd, qdd, stance).torques
     return float(np.abs(a - b).max())
+
+
+def mujoco_impact(model: mujoco.MjModel, biped: Biped, q, qd_minus, stance: str = "left"):
+    """Impact map (eqs. 21-22) with MuJoCo's mass matrix and the landing foot's Jacobian.
+
+    The swing foot (the other side than ``stance``) lands flat: its ankle stops and its angle
+    stays (rows x, z, rotation about -y); the knee equalities of the rolling knee hold through
+    the impact as well. Solves [M  -Aᵀ; A  0] [q̇⁺; ι] = [M q̇⁻; 0] and returns MuJoCo's q̇⁺
+    (nv,) and the ground impulse (3,), in MuJoCo's coordinates for ``stance``.
+    """
+    mapped = mapping(model, stance, biped.radii)
+    data = mujoco.MjData(model)
+    data.qpos[:] = mapped.qpos(q)
+    mujoco.mj_fwdPosition(model, data)
+    mass = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, mass)
+    swing = "right" if stance == "left" else "left"
+    jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    mujoco.mj_jacSite(model, data, jacp, jacr, model.site(f"{swing}_ankle").id)
+    rows = np.concatenate([np.stack([jacp[0], jacp[2], -jacr[1]]), equality_jacobian(model)])
+    k = len(rows)
+    system = np.block([[mass, -rows.T], [rows, np.zeros((k, k))]])
+    rhs = np.concatenate([mass @ mapped.qpos(qd_minus), np.zeros(k)])
+    solution = np.linalg.solve(system, rhs)
+    return solution[: model.nv], solution[model.nv : model.nv + 3]

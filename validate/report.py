@@ -1,0 +1,263 @@
+"""Validation of a gait: every cross-check against MuJoCo, as a report of named checks.
+
+inverse_dynamics  analytical Γ, F_e, ZMP against MuJoCo's dynamics of the MJCF (1e-6)
+impact            analytical q̇⁺ and impulse against MuJoCo's mass matrix and Jacobian (1e-6)
+forward           the gait walked in MuJoCo with contact: every step lands, no fall, no
+                  slip of the stance foot (< 1 mm), centre of pressure in the foot,
+                  no MuJoCo warning; ground reaction, ZMP, feedback share, energy and the
+                  rolling-knee equality reported beside their analytical values
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from biped import gait_file
+from biped.dynamics import Biped, zmp_from
+from biped.gait import angles_at, build_step
+from validate.crosscheck import load_model, mujoco_impact, mujoco_inverse_dynamics
+from validate.mapping import mapping, other
+from validate.simulate import Simulation, simulate
+
+# Agreement of two exact rigid-body models of one robot.
+EXACT = 1e-6
+MAX_SLIP = 1e-3  # [m] stance-foot travel during its stance, after the landing settles
+SETTLE = 0.05  # fraction of a step after touchdown excluded from the slip (impact transient)
+# Fall: hip lower than this fraction of its planned minimum, or trunk beyond this angle.
+HIP_DROP = 0.9
+TRUNK_LIMIT = 0.5  # [rad]
+SAMPLE_EVERY = 5  # post-process every 5th simulation state (5 ms)
+# MuJoCo places a box-plane contact midway through the penetration, a fraction of a
+# millimetre outside the sole's outline: the centre of pressure may lie that far out.
+COP_TOLERANCE = 1e-3  # [m]
+
+
+@dataclass
+class Check:
+    name: str
+    passed: bool
+    figures: dict
+
+    def line(self) -> str:
+        values = ", ".join(f"{k} {_fmt(v)}" for k, v in self.figures.items())
+        return f"{'PASS' if self.passed else 'FAIL'}  {self.name:17} {values}"
+
+
+def _fmt(value) -> str:
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    return f"{value:.3g}"
+
+
+def check_inverse_dynamics(biped: Biped, gait: dict) -> Check:
+    s = gait["samples"]
+    result = mujoco_inverse_dynamics(
+        load_model(biped, exact=True), biped, s["q"], s["qd"], s["qdd"]
+    )
+    figures = {
+        "max_torque_error": float(np.abs(result.torques - s["torques"]).max()),
+        "max_wrench_error": float(np.abs(result.wrench - s["wrench"]).max()),
+        "max_zmp_error": float(np.abs(result.zmp - s["zmp"]).max()),
+    }
+    if result.coupling.size:
+        figures["max_knee_coupling"] = float(np.abs(result.coupling).max())
+    passed = max(figures["max_torque_error"], figures["max_wrench_error"]) < EXACT
+    return Check("inverse_dynamics", passed and figures["max_zmp_error"] < EXACT, figures)
+
+
+def check_impact(biped: Biped, step) -> Check:
+    q, qd_minus = step.end
+    qd_plus, impulse = biped.impact(q, qd_minus)
+    model = load_model(biped, exact=True)
+    mj_qd_plus, mj_impulse = mujoco_impact(model, biped, q, qd_minus)
+    figures = {
+        "max_velocity_error": float(
+            np.abs(mj_qd_plus - mapping(model, "left", biped.radii).qpos(qd_plus)).max()
+        ),
+        "max_impulse_error": float(np.abs(mj_impulse - impulse).max()),
+        "normal_impulse": float(impulse[1]),
+    }
+    passed = max(figures["max_velocity_error"], figures["max_impulse_error"]) < EXACT
+    return Check("impact", passed, figures)
+
+
+def contact_samples(biped: Biped, sim: Simulation) -> dict:
+    """Stance-foot force (N, 2) and centre of pressure (N,) in single support, joint power
+    (N,) and squared feedback and total torques (N,), every ``SAMPLE_EVERY`` states (NaN or
+    zero elsewhere)."""
+    model = sim.model
+    data = mujoco.MjData(model)
+    starts = sim.step_starts + [len(sim.time)]
+    force = np.full((len(sim.time), 2), np.nan)
+    cop = np.full(len(sim.time), np.nan)
+    power = np.zeros(len(sim.time))
+    feedback, total = np.zeros(len(sim.time)), np.zeros(len(sim.time))
+    frame = np.zeros(6)
+    index = np.arange(len(sim.time))
+    stance_of = np.repeat(sim.stances, np.diff(starts))
+    for k in index[::SAMPLE_EVERY]:
+        data.qpos[:], data.qvel[:], data.ctrl[:] = sim.qpos[k], sim.qvel[k], sim.ctrl[k]
+        mujoco.mj_forward(model, data)
+        stance = stance_of[k]
+        ankle = data.site(f"{stance}_ankle").xpos
+        f_sum, moment, swing_touch = np.zeros(3), 0.0, False
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            names = model.geom(contact.geom1).name + model.geom(contact.geom2).name
+            if f"{other(stance)}_sole" in names:
+                swing_touch = True
+                continue
+            mujoco.mj_contactForce(model, data, i, frame)
+            world = contact.frame.reshape(3, 3).T @ frame[:3]
+            f_sum += world
+            moment += (contact.pos[0] - ankle[0]) * world[2]
+        if not swing_touch and f_sum[2] > 0.0:
+            force[k] = f_sum[[0, 2]]
+            cop[k] = moment / f_sum[2]
+        motor = data.actuator_force[:6] * data.actuator_velocity[:6]
+        servo = data.actuator_force[6:] * data.actuator_velocity[6:]
+        power[k] = np.abs(motor + servo[:6] + servo[6:]).sum()
+        feedback_torque = data.actuator_force[6:12] + data.actuator_force[12:18]
+        feedback[k] = np.sum(feedback_torque**2)
+        total[k] = np.sum((feedback_torque - data.actuator_force[:6]) ** 2)
+    return {"force": force, "cop": cop, "power": power, "feedback": feedback, "total": total}
+
+
+def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=None) -> dict:
+    """Figures of a forward simulation (see the module docstring)."""
+    model = sim.model
+    robot = biped.robot
+    starts = sim.step_starts + [len(sim.time)]
+    settle = int(SETTLE * step.period / model.opt.timestep)
+    slips, slides = [], []
+    for j, stance in enumerate(sim.stances):
+        x = sim.sensor(f"{stance}_ankle_pos")[starts[j] : starts[j + 1], 0]
+        slides.append(float(np.ptp(x[:settle])) if len(x) else 0.0)
+        slips.append(float(np.ptp(x[settle:])) if len(x) > settle else 0.0)
+    # Reference along the simulation: phase of each state within its step.
+    phase = np.zeros(len(sim.time))
+    for j in range(len(sim.stances)):
+        a, b = starts[j], starts[j + 1]
+        phase[a:b] = np.minimum(sim.time[a:b] - sim.time[a] + model.opt.timestep, step.period)
+    angles, rates, accel = angles_at(step, phase / step.period)
+    q_ref, _, _, torques_ref, wrench_ref, _ = biped.single_support(angles, rates, accel)
+    zmp_ref = zmp_from(torques_ref, wrench_ref, robot.ankle_height)
+    planned_hip = q_ref[:, 8].min()
+    # Steps walked: leading steps that land, with the stance foot still, hip and trunk held.
+    walked = 0
+    for j in range(len(sim.stances)):
+        a, b = starts[j], starts[j + 1]
+        upright = (
+            sim.qpos[a:b, 1].min() >= HIP_DROP * planned_hip
+            and np.abs(sim.qpos[a:b, 2]).max() <= TRUNK_LIMIT
+        )
+        if not (sim.landed[j] and upright and slips[j] < MAX_SLIP):
+            break
+        walked += 1
+    samples = contact if contact is not None else contact_samples(biped, sim)
+    # Comparisons with the gait over the steps walked (at least the first): after a fall
+    # they would only measure the fall.
+    end = starts[max(walked, 1)]
+    force, cop = samples["force"][:end], samples["cop"][:end]
+    power, feedback, total = (
+        samples["power"][:end],
+        samples["feedback"][:end],
+        samples["total"][:end],
+    )
+    wrench_ref, zmp_ref = wrench_ref[:end], zmp_ref[:end]
+    sampled = np.arange(end)[::SAMPLE_EVERY]
+    single = ~np.isnan(cop)
+    weight = robot.total_mass * robot.gravity
+    figures = {
+        "steps": walked,
+        "fell": bool(
+            not all(sim.landed)
+            or sim.qpos[:, 1].min() < HIP_DROP * planned_hip
+            or np.abs(sim.qpos[:, 2]).max() > TRUNK_LIMIT
+        ),
+        "max_slip": float(max(slips)),
+        "max_landing_slide": float(max(slides)),
+        "zmp_in_foot": bool(
+            np.all(
+                (cop[single] >= -robot.foot_heel)
+                & (cop[single] <= robot.foot_length - robot.foot_heel)
+            )
+        ),
+        "zmp_rms_error": float(np.sqrt(np.nanmean((cop - zmp_ref) ** 2))),
+        "ground_force_rms_error": float(
+            np.sqrt(np.nanmean(((force - wrench_ref[:, :2]) / weight) ** 2))
+        ),
+        "feedback_share": float(
+            np.sqrt(feedback[sampled].sum() / max(total[sampled].sum(), 1e-12))
+        ),
+        "energy_per_step": float(
+            np.trapezoid(power[sampled], sim.time[sampled]) / max(len(sim.stances), 1)
+        ),
+        "analytic_energy_per_step": float(energy),
+        "warnings": int(sim.warnings),
+        "distance": float(sim.qpos[-1, 0] - sim.qpos[0, 0]),
+        "seconds_simulated": float(sim.time[-1] - sim.time[0]),
+    }
+    if biped.knee == "rolling":
+        worst = 0.0
+        for k in range(model.neq):
+            j1, j2 = model.eq_obj1id[k], model.eq_obj2id[k]
+            a, b = model.jnt_qposadr[j1], model.jnt_qposadr[j2]
+            worst = max(
+                worst, float(np.abs(sim.qpos[:, a] - model.eq_data[k, 1] * sim.qpos[:, b]).max())
+            )
+        figures["max_knee_equality_violation"] = worst
+    return figures
+
+
+def check_forward(biped: Biped, step, steps: int, energy: float):
+    """Simulate and check; returns (check, simulation, contact samples)."""
+    began = time.perf_counter()
+    sim = simulate(biped, step, steps)
+    wall = time.perf_counter() - began
+    samples = contact_samples(biped, sim)
+    figures = forward_figures(biped, step, sim, energy, samples)
+    figures["real_time_factor"] = figures["seconds_simulated"] / wall
+    passed = (
+        figures["steps"] >= steps
+        and not figures["fell"]
+        and figures["max_slip"] < MAX_SLIP
+        and figures["zmp_in_foot"]
+        and figures["warnings"] == 0
+    )
+    return Check("forward", passed, figures), sim, samples
+
+
+@dataclass
+class Validation:
+    checks: list
+    biped: Biped
+    step: object
+    simulation: Simulation
+    contact: dict
+
+    @property
+    def passed(self) -> bool:
+        return all(check.passed for check in self.checks)
+
+
+def validate(gait: dict, steps: int = 20) -> Validation:
+    """All checks of a gait read by ``biped.gait_file.read``."""
+    biped = Biped(gait["robot"], gait["knee"])
+    step = build_step(biped, gait["speed"], gait_file.parameters(gait))
+    checks = [check_inverse_dynamics(biped, gait), check_impact(biped, step)]
+    forward, sim, contact = check_forward(biped, step, steps, gait["costs"]["energy"])
+    checks.append(forward)
+    return Validation(checks, biped, step, sim, contact)
+
+
+def as_json(checks) -> dict:
+    content = {check.name: {**check.figures, "passed": check.passed} for check in checks}
+    content["passed"] = all(check.passed for check in checks)
+    return content
