@@ -72,12 +72,8 @@ def test_recording_holds_both_robots_and_the_series(report):
         "/zmp/mujoco",
     ):
         assert expected in paths, expected
-    fz = (
-        [c for c in chunks if c.entity_path == "/ground/Fz/analytic"][0]
-        .to_record_batch()
-        .to_pydict()
-    )
-    values = np.array([v[0] for v in fz["Scalars:scalars"]])
+    batch = [c for c in chunks if c.entity_path == "/ground/Fz/analytic"][0].to_record_batch()
+    values = np.array([v[0] for v in batch.column("Scalars:scalars").to_pylist()])
     # The analytical normal force hovers around the robot's weight.
     assert 0.8 * 686.7 < np.median(values) < 1.2 * 686.7
     assert "time" in [c for c in chunks if c.entity_path == "/mujoco/robot/links"][0].timeline_names
