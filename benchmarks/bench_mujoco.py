@@ -1,0 +1,69 @@
+"""MuJoCo beside the analytical model: inverse dynamics per sample, and the forward
+validation's speed (simulated seconds per wall second).
+
+    python benchmarks/bench_mujoco.py
+"""
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"  # one core, set before numpy loads its BLAS
+
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+import biped  # noqa: E402
+from biped.optimize import initial_parameters, optimize  # noqa: E402
+from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
+from validate.simulate import simulate  # noqa: E402
+
+SAMPLES = 1000
+
+
+def main():
+    rng = np.random.default_rng(0)
+    print(f"inverse dynamics per sample ({SAMPLES} samples), one thread")
+    print(f"{'knee':10}{'analytical':>14}{'MuJoCo':>14}{'ratio':>9}")
+    for knee in biped.KNEES:
+        model = biped.Biped(biped.Robot.paper(), knee)
+        angles = rng.uniform(-0.6, 0.6, (SAMPLES, 6))
+        q, qd, qdd = model.stance_state(
+            angles, rng.normal(size=(SAMPLES, 6)), rng.normal(size=(SAMPLES, 6))
+        )
+        mj = load_model(model, exact=True)
+        began = time.perf_counter()
+        for _ in range(20):
+            model.inverse_dynamics(q, qd, qdd)
+        analytic = (time.perf_counter() - began) / 20 / SAMPLES
+        began = time.perf_counter()
+        mujoco_inverse_dynamics(mj, model, q, qd, qdd)
+        reference = (time.perf_counter() - began) / SAMPLES
+        print(
+            f"{knee:10}{analytic * 1e6:11.2f} µs{reference * 1e6:11.2f} µs"
+            f"{reference / analytic:8.0f}x"
+        )
+    print("\nforward validation, 20 steps of a gait optimised at 0.3 m/s (small budget)")
+    for knee in biped.KNEES:
+        model = biped.Biped(biped.Robot.paper(), knee)
+        optimum = optimize(
+            model,
+            0.3,
+            starts=initial_parameters(model, 0.3),
+            max_restarts=0,
+            evaluations_per_run=300,
+            polish_iterations=30,
+        )
+        began = time.perf_counter()
+        sim = simulate(model, optimum.step, steps=20)
+        wall = time.perf_counter() - began
+        simulated = sim.time[-1] - sim.time[0]
+        print(
+            f"{knee:10}{simulated:6.2f} s simulated in {wall:5.2f} s: "
+            f"{simulated / wall:5.0f} x real time"
+        )
+    print("target: 200 x real time")
+
+
+if __name__ == "__main__":
+    main()
