@@ -22,11 +22,11 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from biped.dynamics import JOINTS, Biped, zmp_from
+from biped.dynamics import JOINTS, Biped
 from biped.gait import angles_at
 from validate.mapping import mapping
 from validate.mjcf import SIDES
-from validate.simulate import Simulation
+from validate.simulate import Simulation, reference_along
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
 CIRCLE = np.linspace(0.0, 2 * np.pi, 33)
@@ -134,18 +134,6 @@ def mujoco_points(model: mujoco.MjModel, data: mujoco.MjData, biped: Biped) -> d
     return points
 
 
-def reference(biped: Biped, step, sim: Simulation):
-    """Analytical torques, wrench and ZMP at every simulation state."""
-    phase = np.zeros(len(sim.time))
-    starts = sim.step_starts + [len(sim.time)]
-    for j in range(len(sim.stances)):
-        a, b = starts[j], starts[j + 1]
-        phase[a:b] = np.minimum(sim.time[a:b] - sim.time[a] + sim.model.opt.timestep, step.period)
-    angles, rates, accel = angles_at(step, phase / step.period)
-    _, _, _, torques, wrench, _ = biped.single_support(angles, rates, accel)
-    return torques, wrench, zmp_from(torques, wrench, biped.robot.ankle_height)
-
-
 def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict) -> Path:
     """Write the recording of a validation to ``path`` (.rrd), atomically.
 
@@ -161,7 +149,7 @@ def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict)
     model = sim.model
     data = mujoco.MjData(model)
     time_column = [rr.TimeColumn("time", duration=sim.time)]
-    torques, wrench, zmp = reference(biped, step, sim)
+    _, torques, wrench, zmp = reference_along(biped, step, sim)
     # MuJoCo's torques in the paper's order: motor (gear -1) plus the feedback servos.
     stance_of = np.repeat(sim.stances, np.diff(sim.step_starts + [len(sim.time)]))
     mj_torques = np.zeros_like(torques)

@@ -17,11 +17,11 @@ import mujoco
 import numpy as np
 
 from biped import gait_file
-from biped.dynamics import Biped, zmp_from
-from biped.gait import angles_at, build_step
+from biped.dynamics import Biped
+from biped.gait import build_step
 from validate.crosscheck import load_model, mujoco_impact, mujoco_inverse_dynamics
 from validate.mapping import mapping, other
-from validate.simulate import Simulation, simulate
+from validate.simulate import Simulation, reference_along, simulate
 
 # Agreement of two exact rigid-body models of one robot.
 EXACT = 1e-6
@@ -140,14 +140,7 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
         x = sim.sensor(f"{stance}_ankle_pos")[starts[j] : starts[j + 1], 0]
         slides.append(float(np.ptp(x[:settle])) if len(x) else 0.0)
         slips.append(float(np.ptp(x[settle:])) if len(x) > settle else 0.0)
-    # Reference along the simulation: phase of each state within its step.
-    phase = np.zeros(len(sim.time))
-    for j in range(len(sim.stances)):
-        a, b = starts[j], starts[j + 1]
-        phase[a:b] = np.minimum(sim.time[a:b] - sim.time[a] + model.opt.timestep, step.period)
-    angles, rates, accel = angles_at(step, phase / step.period)
-    q_ref, _, _, torques_ref, wrench_ref, _ = biped.single_support(angles, rates, accel)
-    zmp_ref = zmp_from(torques_ref, wrench_ref, robot.ankle_height)
+    q_ref, _, wrench_ref, zmp_ref = reference_along(biped, step, sim)
     planned_hip = q_ref[:, 8].min()
     # Steps walked: leading steps that land, with the stance foot still, hip and trunk held.
     walked = 0

@@ -26,7 +26,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from biped.dynamics import Biped
+from biped.dynamics import Biped, zmp_from
 from biped.gait import Step, angles_at
 from validate.mapping import mapping, other
 from validate.mjcf import SIDES, scene_model
@@ -173,3 +173,20 @@ def simulate(biped: Biped, step: Step, steps: int = 20, kp: float = KP, kv: floa
     result.ctrl = np.concatenate([p[1] for p in parts])
     result.sensors = np.concatenate([p[2] for p in parts])
     return result
+
+
+def reference_along(biped: Biped, step: Step, sim: Simulation):
+    """The gait at every simulation state, its phase restarting at each touchdown.
+
+    Returns:
+        q (N, 9), torques (N, 6), wrench (N, 3) and ZMP (N,) of the analytical gait.
+    """
+    phase = np.zeros(len(sim.time))
+    starts = sim.step_starts + [len(sim.time)]
+    for j in range(len(sim.stances)):
+        a, b = starts[j], starts[j + 1]
+        elapsed = sim.time[a:b] - sim.time[a] + sim.model.opt.timestep
+        phase[a:b] = np.minimum(elapsed, step.period)
+    angles, rates, accel = angles_at(step, phase / step.period)
+    q, _, _, torques, wrench, _ = biped.single_support(angles, rates, accel)
+    return q, torques, wrench, zmp_from(torques, wrench, biped.robot.ankle_height)
