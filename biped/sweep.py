@@ -64,58 +64,73 @@ def _saved(path: Path, point: Point, robot: Robot):
     return gait
 
 
+def _continued(model, criterion, speed, source, seed, budget):
+    """Polish the optimum ``source`` = (speed, parameters, value) of a neighbouring speed at
+    ``speed``: same step length, period scaled to the new speed, so the posture stays in reach."""
+    last_speed, warm, _ = source
+    warm = warm.copy()
+    warm[-1] *= last_speed / speed
+    return optimize(model, speed, criterion, seed=seed, starts=[], polish_starts=[warm], **budget)
+
+
 def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.stderr):
-    """Optimise one (knee, criterion) series over increasing speeds; returns points run."""
+    """Optimise one (knee, criterion) series over increasing speeds; returns points run.
+
+    Forward pass: each speed continues from the previous one (or starts from the first
+    guess). Backward pass, once every speed is done: where a speed's criterion lies above the
+    next speed's by more than ``CONTINUATION_GROWTH``, it sat in a worse basin and is polished
+    again from the next speed's optimum, kept if better. An interrupted sweep resumes in the
+    same pass with the same inputs, so it ends with the numbers of an uninterrupted one.
+    """
     model = Biped(robot, knee)
-    previous = None  # (speed, parameters, criterion) of the previous speed's optimum
+    speeds = sorted(speeds)
+    found: list = [None] * len(speeds)  # (speed, parameters, value) of feasible optima
     ran = 0
-    for i, speed in enumerate(sorted(speeds), start=1):
+
+    def save(i, optimum, note=""):
+        point = Point(knee, criterion, float(speeds[i]))
+        gait_file.write_json(
+            Path(folder) / point.filename(), gait_file.to_dict(optimum, robot, seed)
+        )
+        status = "feasible" if optimum.feasible else "INFEASIBLE"
+        print(
+            f"[{knee:8} {criterion:7} {i + 1:2d}/{len(speeds)}] {point.speed:.3f} m/s  "
+            f"C = {optimum.value:12.4f}  {status}  {optimum.seconds:5.1f} s{note}",
+            file=stream,
+            flush=True,
+        )
+        found[i] = (point.speed, optimum.parameters, optimum.value) if optimum.feasible else None
+
+    for i, speed in enumerate(speeds):
         point = Point(knee, criterion, float(speed))
-        path = Path(folder) / point.filename()
-        saved = _saved(path, point, robot)
-        if saved is None:
-            optimum = None
-            if previous is not None:
-                # Same step length, period scaled to the new speed: the posture stays in reach.
-                last_speed, warm, _ = previous
-                warm = warm.copy()
-                warm[-1] *= last_speed / point.speed
-                optimum = optimize(
-                    model,
-                    point.speed,
-                    criterion,
-                    seed=seed,
-                    starts=[],
-                    polish_starts=[warm],
-                    **budget,
-                )
-            if optimum is None or not _continues(optimum, previous):
-                fresh = optimize(
-                    model,
-                    point.speed,
-                    criterion,
-                    seed=seed,
-                    starts=[initial_parameters(model, point.speed)],
-                    **budget,
-                )
-                if optimum is None or fresh.rank() < optimum.rank():
-                    optimum = fresh
-            gait_file.write_json(path, gait_file.to_dict(optimum, robot, seed))
-            ran += 1
-            status = "feasible" if optimum.feasible else "INFEASIBLE"
-            print(
-                f"[{knee:8} {criterion:7} {i:2d}/{len(speeds)}] {point.speed:.3f} m/s  "
-                f"C = {optimum.value:12.4f}  {status}  {optimum.seconds:5.1f} s",
-                file=stream,
-                flush=True,
-            )
-            feasible, parameters, value = optimum.feasible, optimum.parameters, optimum.value
-        else:
-            feasible = saved["feasible"]
-            parameters = gait_file.parameters(saved)
-            value = saved["costs"][criterion]
-        if feasible:
-            previous = (point.speed, parameters, value)
+        saved = _saved(Path(folder) / point.filename(), point, robot)
+        if saved is not None:
+            if saved["feasible"]:
+                found[i] = (point.speed, gait_file.parameters(saved), saved["costs"][criterion])
+            continue
+        previous = next((f for f in reversed(found[:i]) if f is not None), None)
+        optimum = None
+        if previous is not None:
+            optimum = _continued(model, criterion, point.speed, previous, seed, budget)
+        if optimum is None or not _continues(optimum, previous):
+            start = initial_parameters(model, point.speed)
+            fresh = optimize(model, point.speed, criterion, seed=seed, starts=[start], **budget)
+            if optimum is None or fresh.rank() < optimum.rank():
+                optimum = fresh
+        save(i, optimum)
+        ran += 1
+        j = i
+        while (
+            j > 0
+            and found[j]
+            and found[j - 1]
+            and found[j - 1][2] > CONTINUATION_GROWTH * found[j][2]
+        ):
+            again = _continued(model, criterion, speeds[j - 1], found[j], seed, budget)
+            if not again.feasible or again.value >= found[j - 1][2]:
+                break
+            save(j - 1, again, "  (again, from the next speed)")
+            j -= 1
     return ran
 
 
