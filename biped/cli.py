@@ -187,6 +187,7 @@ def _budget(args) -> dict:
         "max_restarts": args.restarts,
         "evaluations_per_run": args.evaluations,
         "polish_iterations": args.polish,
+        "clearance": args.clearance,
     }
 
 
@@ -208,12 +209,32 @@ def _add_budget(parser):
         help=f"criterion evaluations per Nelder-Mead run (default {EVALUATIONS_PER_RUN})",
     )
     parser.add_argument(
+        "--clearance",
+        type=_clearance,
+        default=0.0,
+        metavar="M",
+        help="[m] height the swing foot must keep off the ground away from the ends of the "
+        "step (default 0, the paper's z >= 0)",
+    )
+    parser.add_argument(
         "--polish",
         type=_non_negative,
         default=POLISH_ITERATIONS,
         metavar="N",
         help=f"SLSQP polish iterations at most, 0 for none (default {POLISH_ITERATIONS})",
     )
+
+
+def _clearance(text: str) -> float:
+    from biped.optimize import MAX_CLEARANCE
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (0.0 <= value <= MAX_CLEARANCE):
+        raise argparse.ArgumentTypeError(f"clearance = {text!r} m: allowed 0 to {MAX_CLEARANCE}")
+    return value
 
 
 def _non_negative(text: str) -> int:

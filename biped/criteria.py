@@ -66,6 +66,21 @@ def margin_profile(samples_per_half: int) -> np.ndarray:
     return profile
 
 
+# The swing foot's required clearance (``clearance``, 0 in the paper) ramps up over this
+# fraction of the step at each end, where the foot leaves and reaches the ground.
+CLEARANCE_RAMP = 0.25
+
+
+@functools.cache
+def clearance_profile(samples_per_half: int, clearance: float) -> np.ndarray:
+    """Required height (N,) [m] of the swing heel and toe: ``clearance`` away from the ends."""
+    t_n = np.concatenate(half_grid(samples_per_half))
+    ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / CLEARANCE_RAMP, 0.0, 1.0)
+    profile = clearance * ramp
+    profile.setflags(write=False)
+    return profile
+
+
 @functools.cache
 def simpson_weights(samples_per_half: int) -> np.ndarray:
     """Weights w with Σ w f(t_n) = Simpson's rule on both pieces of the normalised grid.
@@ -151,18 +166,23 @@ def checked_mask(samples_per_half: int) -> np.ndarray:
 
 
 def evaluate_step(
-    model: Biped, step: Step, samples_per_half: int, margins: bool = False
+    model: Biped, step: Step, samples_per_half: int, margins: bool = False, clearance=0.0
 ) -> StepEvaluation:
     """Torques, wrench, ZMP, constraints and criteria of one step.
 
     Args:
         margins: penalise Ψ_i - δ_i instead of Ψ_i (``MARGINS``), as the optimiser does.
+        clearance: [m] height the swing foot must keep off the ground between the ends of the
+            step (``clearance_profile``); Ψ6, Ψ7 become the heights above it. The paper: 0.
     """
     t, q, qd, qdd, torques, wrench, feet = sample(
         model, step, samples_per_half, ("swing_heel", "swing_toe")
     )
     robot = model.robot
-    psi = constraints(robot, q, torques, wrench, feet[..., 1])
+    feet_z = feet[..., 1]
+    if clearance:
+        feet_z = feet_z - clearance_profile(samples_per_half, float(clearance))[:, None]
+    psi = constraints(robot, q, torques, wrench, feet_z)
     checked = checked_mask(samples_per_half)
     seen = psi - margin_profile(samples_per_half) if margins else psi
     power = np.abs(model.joint_angles(qd) * torques).sum(-1)

@@ -45,7 +45,7 @@ class Point:
         return f"{self.knee}-{self.criterion}-{self.speed:.3f}.json"
 
 
-def _saved(path: Path, point: Point, robot: Robot):
+def _saved(path: Path, point: Point, robot: Robot, clearance: float = 0.0):
     """The gait saved for ``point`` at ``path``, or None if missing or unreadable.
 
     Raises:
@@ -56,10 +56,11 @@ def _saved(path: Path, point: Point, robot: Robot):
     except BipedError:
         return None
     found = (gait["knee"], gait["criterion"], gait["speed"])
-    if found != (point.knee, point.criterion, point.speed) or gait["robot"] != robot:
+    same_problem = gait["robot"] == robot and gait["clearance"] == clearance
+    if found != (point.knee, point.criterion, point.speed) or not same_problem:
         raise BipedError(
-            f"{path} holds a gait of another robot or point ({found[0]}, {found[1]}, "
-            f"{found[2]} m/s): allowed only this sweep's, choose another --out folder"
+            f"{path} holds a gait of another robot, clearance or point ({found[0]}, "
+            f"{found[1]}, {found[2]} m/s): allowed only this sweep's, choose another --out folder"
         )
     return gait
 
@@ -103,7 +104,7 @@ def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.
 
     for i, speed in enumerate(speeds):
         point = Point(knee, criterion, float(speed))
-        saved = _saved(Path(folder) / point.filename(), point, robot)
+        saved = _saved(Path(folder) / point.filename(), point, robot, budget.get("clearance", 0.0))
         if saved is not None:
             if saved["feasible"]:
                 found[i] = (point.speed, gait_file.parameters(saved), saved["costs"][criterion])
@@ -148,9 +149,10 @@ def _run_series(args):
     return run_series(*args)
 
 
-def pending_points(points, folder: Path, robot: Robot):
+def pending_points(points, folder: Path, robot: Robot, clearance: float = 0.0):
     """Points whose gait file is missing or unreadable."""
-    return [p for p in points if _saved(Path(folder) / p.filename(), p, robot) is None]
+    folder = Path(folder)
+    return [p for p in points if _saved(folder / p.filename(), p, robot, clearance) is None]
 
 
 def check_speeds(robot: Robot, speeds, knees) -> list[float]:
@@ -181,13 +183,13 @@ def run_sweep(
     """Optimise every (knee, criterion, speed) not yet in ``folder``; returns all points.
 
     ``budget`` goes to ``biped.optimize.optimize`` (``max_restarts``, ``evaluations_per_run``,
-    ``polish_iterations``).
+    ``polish_iterations``, ``clearance``).
     """
     speeds = check_speeds(robot, speeds, knees)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
-    todo = pending_points(points, folder, robot)
+    todo = pending_points(points, folder, robot, budget.get("clearance", 0.0))
     print(
         f"sweep: {len(points)} points in {folder}, {len(points) - len(todo)} already done, "
         f"{len(todo)} to run",

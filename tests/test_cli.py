@@ -98,6 +98,7 @@ def test_infeasible_optimum_writes_nothing(tmp_path, capsys):
         (["sweep", "--speeds", "0.3:0.1"], "START:STOP:COUNT"),
         (["sweep", "--speeds", "0.2,-0.1"], "speeds > 0"),
         (["sweep", "--jobs", "0"], "'0'"),
+        (["sweep", "--clearance", "-0.01"], "clearance = '-0.01'"),
         (["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "."], "is a folder"),
         (["demo", "--knee", "rolling", "--hip-ahead", "nan"], "allowed finite numbers"),
     ],

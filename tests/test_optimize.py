@@ -65,3 +65,27 @@ def test_bad_input_is_rejected(speed, criterion, needle):
     with pytest.raises(biped.BipedError, match=needle):
         optimize(model, speed, criterion)
     assert 2.5 < max_walking_speed(model) < 3.0
+
+
+def test_clearance_is_kept_by_the_optimum():
+    """With a required clearance the optimal swing foot stays that high away from the ends,
+    and the gait costs more than without it (the constraint is active)."""
+    from biped.criteria import clearance_profile
+
+    model = biped.Biped(ROBOT, "rolling")
+    optimum = optimize(model, 0.3, "sthenic", clearance=0.02)
+    assert optimum.feasible and optimum.clearance == 0.02
+    feet = model.points(optimum.evaluation.q, ["swing_heel", "swing_toe"])[..., 1]
+    required = clearance_profile(100, 0.02)
+    assert np.all(feet[1:-1] >= required[1:-1, None] - 1e-12)
+    assert required.max() == pytest.approx(0.02)
+    free = optimize(model, 0.3, "sthenic")
+    assert optimum.value > free.value
+
+
+def test_bad_clearance_is_rejected():
+    """A negative or huge clearance is a clear error."""
+    model = biped.Biped(ROBOT, "rolling")
+    for bad in (-0.01, 1.0, float("nan")):
+        with pytest.raises(biped.BipedError, match="clearance"):
+            optimize(model, 0.3, clearance=bad)
