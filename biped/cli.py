@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-from biped.criteria import CRITERIA
+from biped.criteria import CRITERIA, MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
 from biped.dynamics import JOINTS, Biped
 from biped.errors import BipedError
 from biped.kinematics import KNEES
@@ -187,7 +187,7 @@ def _budget(args) -> dict:
         "max_restarts": args.restarts,
         "evaluations_per_run": args.evaluations,
         "polish_iterations": args.polish,
-        "clearance": args.clearance,
+        "safety": Safety(clearance=args.clearance, zmp_margin=args.zmp_margin),
     }
 
 
@@ -217,6 +217,13 @@ def _add_budget(parser):
         "step (default 0, the paper's z >= 0)",
     )
     parser.add_argument(
+        "--zmp-margin",
+        type=_zmp_margin,
+        default=0.0,
+        metavar="M",
+        help="[m] distance the ZMP must keep inside the sole's heel and toe (default 0)",
+    )
+    parser.add_argument(
         "--polish",
         type=_non_negative,
         default=POLISH_ITERATIONS,
@@ -225,16 +232,21 @@ def _add_budget(parser):
     )
 
 
-def _clearance(text: str) -> float:
-    from biped.optimize import MAX_CLEARANCE
+def _margin(name: str, high: float):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = float("nan")
+        if not (0.0 <= value <= high):
+            raise argparse.ArgumentTypeError(f"{name} = {text!r} m: allowed 0 to {high}")
+        return value
 
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not (0.0 <= value <= MAX_CLEARANCE):
-        raise argparse.ArgumentTypeError(f"clearance = {text!r} m: allowed 0 to {MAX_CLEARANCE}")
-    return value
+    return parse
+
+
+_clearance = _margin("clearance", MAX_CLEARANCE)
+_zmp_margin = _margin("zmp margin", MAX_ZMP_MARGIN)
 
 
 def _non_negative(text: str) -> int:

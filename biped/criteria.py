@@ -20,12 +20,14 @@ checked at the interior samples only.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import simpson
 
 from biped.dynamics import Biped, zmp_from
+from biped.errors import BipedError
 from biped.gait import Step, half_grid, sample
 from biped.kinematics import Q1, Q2, Q3, Q4
 
@@ -66,17 +68,48 @@ def margin_profile(samples_per_half: int) -> np.ndarray:
     return profile
 
 
-# The swing foot's required clearance (``clearance``, 0 in the paper) ramps up over this
-# fraction of the step at each end, where the foot leaves and reaches the ground.
+# The swing foot's required clearance (``Safety.clearance``, 0 in the paper) ramps up over
+# this fraction of the step at each end, where the foot leaves and reaches the ground.
 CLEARANCE_RAMP = 0.25
+# Largest safety margins accepted [m].
+MAX_CLEARANCE = 0.2
+MAX_ZMP_MARGIN = 0.05
+
+
+@dataclass(frozen=True)
+class Safety:
+    """Margins of ours on top of the paper's constraints, for gaits that stand a physics
+    engine's contact model and tracking errors. ``Safety()`` is the paper's problem.
+
+    Attributes:
+        clearance: [m] height the swing foot keeps off the ground away from the ends of the
+            step (``clearance_profile``); Ψ6, Ψ7 become the heights above it.
+        zmp_margin: [m] distance the ZMP keeps inside the sole's heel and toe (Ψ2, Ψ3).
+    """
+
+    clearance: float = 0.0
+    zmp_margin: float = 0.0
+
+    def __post_init__(self):
+        for name, high in (("clearance", MAX_CLEARANCE), ("zmp_margin", MAX_ZMP_MARGIN)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise BipedError(f"{name} = {value!r}: allowed a number of metres")
+            if not (math.isfinite(value) and 0.0 <= value <= high):
+                raise BipedError(f"{name} = {value!r} m: allowed 0 to {high} m")
+            object.__setattr__(self, name, float(value))
+
+
+PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
 
 
 @functools.cache
 def clearance_profile(samples_per_half: int, clearance: float) -> np.ndarray:
-    """Required height (N,) [m] of the swing heel and toe: ``clearance`` away from the ends."""
+    """Required height (N,) [m] of the swing heel and toe: ``clearance`` away from the ends,
+    reached by a smooth step (zero slope at lift-off and touchdown)."""
     t_n = np.concatenate(half_grid(samples_per_half))
-    ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / CLEARANCE_RAMP, 0.0, 1.0)
-    profile = clearance * ramp
+    x = np.clip(np.minimum(t_n, 1.0 - t_n) / CLEARANCE_RAMP, 0.0, 1.0)
+    profile = clearance * x * x * (3.0 - 2.0 * x)
     profile.setflags(write=False)
     return profile
 
@@ -166,23 +199,27 @@ def checked_mask(samples_per_half: int) -> np.ndarray:
 
 
 def evaluate_step(
-    model: Biped, step: Step, samples_per_half: int, margins: bool = False, clearance=0.0
+    model: Biped,
+    step: Step,
+    samples_per_half: int,
+    margins: bool = False,
+    safety: Safety = PAPER_SAFETY,
 ) -> StepEvaluation:
     """Torques, wrench, ZMP, constraints and criteria of one step.
 
     Args:
         margins: penalise Ψ_i - δ_i instead of Ψ_i (``MARGINS``), as the optimiser does.
-        clearance: [m] height the swing foot must keep off the ground between the ends of the
-            step (``clearance_profile``); Ψ6, Ψ7 become the heights above it. The paper: 0.
+        safety: margins of ours on the constraints (``Safety``); the paper's by default.
     """
     t, q, qd, qdd, torques, wrench, feet = sample(
         model, step, samples_per_half, ("swing_heel", "swing_toe")
     )
     robot = model.robot
     feet_z = feet[..., 1]
-    if clearance:
-        feet_z = feet_z - clearance_profile(samples_per_half, float(clearance))[:, None]
+    if safety.clearance:
+        feet_z = feet_z - clearance_profile(samples_per_half, safety.clearance)[:, None]
     psi = constraints(robot, q, torques, wrench, feet_z)
+    psi[:, 1:3] -= safety.zmp_margin
     checked = checked_mask(samples_per_half)
     seen = psi - margin_profile(samples_per_half) if margins else psi
     power = np.abs(model.joint_angles(qd) * torques).sum(-1)

@@ -2,8 +2,8 @@
 
 Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at x = 0):
 
-    knee, criterion, speed [m/s], period [s], step_length [m], clearance [m] (swing foot
-    height required, 0 as in the paper), feasible,
+    knee, criterion, speed [m/s], period [s], step_length [m],
+    safety {clearance, zmp_margin} [m] (margins beyond the paper's constraints), feasible,
     costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]},
     robot {field: value}, parameters {name: value} (the 21 of ``biped.gait.PARAMETERS``),
     constraints {name: worst Ψ_i on the samples},
@@ -19,6 +19,7 @@ left and right limits, because the accelerations (and torques) jump at the knot.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -27,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from biped.criteria import CONSTRAINTS, CRITERIA
+from biped.criteria import CONSTRAINTS, CRITERIA, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
 from biped.gait import PARAMETERS
@@ -53,7 +54,7 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
         "speed": optimum.speed,
         "period": step.period,
         "step_length": step.step_length,
-        "clearance": optimum.clearance,
+        "safety": dataclasses.asdict(optimum.safety),
         "feasible": optimum.feasible,
         "costs": {
             "sthenic": ev.sthenic,
@@ -145,9 +146,10 @@ def read(path: str | Path) -> dict:
     for key in ("speed", "period", "step_length"):
         if not _positive_number(content[key]):
             raise bad(f"{key} = {content[key]!r}, allowed a number > 0")
-    clearance = content.setdefault("clearance", 0.0)
-    if not isinstance(clearance, (int, float)) or not math.isfinite(clearance) or clearance < 0:
-        raise bad(f"clearance = {clearance!r}, allowed a number >= 0")
+    try:
+        content["safety"] = Safety(**content.get("safety", {}))
+    except (TypeError, BipedError) as error:
+        raise bad(f"safety {content.get('safety')!r}: {error}") from None
     if content["knee"] not in KNEES:
         raise bad(f"knee = {content['knee']!r}, allowed {', '.join(KNEES)}")
     if content["criterion"] not in CRITERIA:

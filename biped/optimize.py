@@ -27,6 +27,8 @@ from biped.criteria import (
     BUILD_ERROR_COST,
     BUILD_ERROR_SLOPE,
     CRITERIA,
+    PAPER_SAFETY,
+    Safety,
     StepEvaluation,
     checked_mask,
     evaluate_step,
@@ -42,8 +44,6 @@ CHECK_SAMPLES_PER_HALF = 100  # 202 samples per step
 # Default search budget: a first Nelder-Mead run, then restarts from the best point.
 EVALUATIONS_PER_RUN = 1500
 MAX_RESTARTS = 1
-# Largest swing-foot clearance accepted [m].
-MAX_CLEARANCE = 0.2
 # Duration of a step in the first guess [s].
 FIRST_GUESS_PERIOD = 0.6
 # Samples per spline piece of the polish (its constraints are Ψ - δ at every sample).
@@ -74,13 +74,6 @@ def check_speed(model: Biped, speed: float) -> float:
     return float(speed)
 
 
-def check_clearance(clearance: float) -> float:
-    """Return ``clearance`` [m] if it is a usable swing-foot clearance."""
-    if not (np.isfinite(clearance) and 0.0 <= clearance <= MAX_CLEARANCE):
-        raise BipedError(f"clearance = {clearance!r} m: allowed 0 to {MAX_CLEARANCE} m")
-    return float(clearance)
-
-
 def check_criterion(criterion: str) -> str:
     if criterion not in CRITERIA:
         raise BipedError(f"criterion = {criterion!r}: allowed 'sthenic', 'energy'")
@@ -105,7 +98,7 @@ def initial_parameters(model: Biped, speed: float, period: float = FIRST_GUESS_P
     return p
 
 
-def cost(model: Biped, speed: float, criterion: str, p, samples_per_half: int, clearance=0.0):
+def cost(model: Biped, speed, criterion, p, samples_per_half, safety: Safety = PAPER_SAFETY):
     """The criterion (30) or (31) of parameters p, penalties (with margins) and Err included."""
     try:
         step = build_step(model, speed, p)
@@ -113,7 +106,7 @@ def cost(model: Biped, speed: float, criterion: str, p, samples_per_half: int, c
         return BUILD_ERROR_COST + BUILD_ERROR_SLOPE * error.excess
     except UnreachableError:
         return BUILD_ERROR_COST
-    evaluation = evaluate_step(model, step, samples_per_half, margins=True, clearance=clearance)
+    evaluation = evaluate_step(model, step, samples_per_half, margins=True, safety=safety)
     value = evaluation.cost(criterion, step.step_length)
     return value if np.isfinite(value) else BUILD_ERROR_COST
 
@@ -132,7 +125,7 @@ class Optimum:
     evaluations: int  # number of criterion evaluations
     seconds: float
     history: list = field(default_factory=list)  # best value after each restart
-    clearance: float = 0.0  # [m] swing-foot clearance required
+    safety: Safety = PAPER_SAFETY  # margins required beyond the paper's constraints
 
     @property
     def feasible(self) -> bool:
@@ -152,9 +145,9 @@ class _Polish:
     SLSQP. SLSQP differentiates both by finite differences at the same points, so the step
     evaluations of the latest points are kept and serve both."""
 
-    def __init__(self, model, speed, criterion, origin, samples_per_half, clearance=0.0):
+    def __init__(self, model, speed, criterion, origin, samples_per_half, safety=PAPER_SAFETY):
         self.model, self.speed, self.criterion, self.origin = model, speed, criterion, origin
-        self.clearance = clearance
+        self.safety = safety
         self.samples = samples_per_half
         self.cache: dict = {}
         self.count = 0
@@ -173,7 +166,7 @@ class _Polish:
         except StepBuildError as error:
             value = (None, -(1.0 + error.excess) * np.ones(self.margins.shape))
         else:
-            ev = evaluate_step(self.model, step, self.samples, clearance=self.clearance)
+            ev = evaluate_step(self.model, step, self.samples, safety=self.safety)
             criterion = ev.sthenic if self.criterion == "sthenic" else ev.energy
             psi = (ev.constraints[self.mask] - self.margins) / self.scales
             if not np.all(np.isfinite(psi)) or not np.isfinite(criterion):
@@ -195,14 +188,16 @@ class _Polish:
         return self._evaluate(z)[1]
 
 
-def polish(model, speed, criterion, parameters, max_iterations=POLISH_ITERATIONS, clearance=0.0):
+def polish(
+    model, speed, criterion, parameters, max_iterations=POLISH_ITERATIONS, safety=PAPER_SAFETY
+):
     """SLSQP from ``parameters`` on min C s.t. Ψ_i >= δ_i on the optimisation grid.
 
     Returns (parameters, evaluations). The criterion here is smooth in the parameters
     except where |Γ_i θ̇_i| changes sign (energy criterion), which SLSQP tolerates.
     """
     problem = _Polish(
-        model, speed, criterion, np.asarray(parameters, float), POLISH_SAMPLES_PER_HALF, clearance
+        model, speed, criterion, np.asarray(parameters, float), POLISH_SAMPLES_PER_HALF, safety
     )
     result = minimize(
         problem.objective,
@@ -215,7 +210,7 @@ def polish(model, speed, criterion, parameters, max_iterations=POLISH_ITERATIONS
 
 
 def nelder_mead(
-    model, speed, criterion, start, rng, max_restarts, evaluations_per_run, clearance=0.0
+    model, speed, criterion, start, rng, max_restarts, evaluations_per_run, safety=PAPER_SAFETY
 ):
     """Nelder-Mead on the penalised criterion, restarted from the best point (§4).
 
@@ -226,7 +221,7 @@ def nelder_mead(
     def objective(z):
         counter[0] += 1
         p = start + SCALES * z
-        return cost(model, speed, criterion, p, OPTIMIZE_SAMPLES_PER_HALF, clearance)
+        return cost(model, speed, criterion, p, OPTIMIZE_SAMPLES_PER_HALF, safety)
 
     best_z = np.zeros(N_PARAMETERS)
     best = objective(best_z)
@@ -266,7 +261,7 @@ def optimize(
     starts=None,
     polish_iterations: int = POLISH_ITERATIONS,
     polish_starts=(),
-    clearance: float = 0.0,
+    safety: Safety = PAPER_SAFETY,
 ) -> Optimum:
     """Minimise the criterion at walking speed ``speed`` [m/s].
 
@@ -282,11 +277,10 @@ def optimize(
         polish_iterations: SLSQP iterations at most (0: no polish).
         polish_starts: guesses close to an optimum (e.g. the optimum at a neighbouring
             speed), polished directly without Nelder-Mead.
-        clearance: [m] height the swing foot must keep off the ground away from the ends of
-            the step, a constraint added to the paper's (which ask z >= 0 only).
+        safety: margins of ours beyond the paper's constraints (``Safety``): swing-foot
+            clearance, ZMP distance from the sole's edges. The paper's problem by default.
     """
     speed = check_speed(model, speed)
-    clearance = check_clearance(clearance)
     criterion = check_criterion(criterion)
     rng = np.random.default_rng(seed)
     if starts is None:
@@ -305,21 +299,19 @@ def optimize(
             rng,
             max_restarts,
             evaluations_per_run,
-            clearance,
+            safety,
         )
         evaluations += count
         history.append(runs)
         candidates.append(parameters)
         if polish_iterations > 0:
-            polished, count = polish(
-                model, speed, criterion, parameters, polish_iterations, clearance
-            )
+            polished, count = polish(model, speed, criterion, parameters, polish_iterations, safety)
             evaluations += count
             candidates.append(polished)
     for start in polish_starts:
         candidates.append(np.asarray(start, float))
         if polish_iterations > 0:
-            polished, count = polish(model, speed, criterion, start, polish_iterations, clearance)
+            polished, count = polish(model, speed, criterion, start, polish_iterations, safety)
             evaluations += count
             candidates.append(polished)
     best = None
@@ -328,7 +320,7 @@ def optimize(
             step = build_step(model, speed, parameters)
         except (StepBuildError, UnreachableError):
             continue
-        evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF, clearance=clearance)
+        evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF, safety=safety)
         value = evaluation.cost(criterion, step.step_length)
         rank = (not evaluation.feasible, value)
         if best is None or rank < best[0]:
@@ -347,5 +339,5 @@ def optimize(
         evaluations=evaluations,
         seconds=time.perf_counter() - began,
         history=history,
-        clearance=clearance,
+        safety=safety,
     )

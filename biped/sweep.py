@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from biped import gait_file
-from biped.criteria import CRITERIA
+from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
 from biped.kinematics import KNEES
@@ -45,7 +45,7 @@ class Point:
         return f"{self.knee}-{self.criterion}-{self.speed:.3f}.json"
 
 
-def _saved(path: Path, point: Point, robot: Robot, clearance: float = 0.0):
+def _saved(path: Path, point: Point, robot: Robot, safety: Safety = PAPER_SAFETY):
     """The gait saved for ``point`` at ``path``, or None if missing or unreadable.
 
     Raises:
@@ -56,10 +56,10 @@ def _saved(path: Path, point: Point, robot: Robot, clearance: float = 0.0):
     except BipedError:
         return None
     found = (gait["knee"], gait["criterion"], gait["speed"])
-    same_problem = gait["robot"] == robot and gait["clearance"] == clearance
+    same_problem = gait["robot"] == robot and gait["safety"] == safety
     if found != (point.knee, point.criterion, point.speed) or not same_problem:
         raise BipedError(
-            f"{path} holds a gait of another robot, clearance or point ({found[0]}, "
+            f"{path} holds a gait of another robot, safety or point ({found[0]}, "
             f"{found[1]}, {found[2]} m/s): allowed only this sweep's, choose another --out folder"
         )
     return gait
@@ -104,7 +104,9 @@ def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.
 
     for i, speed in enumerate(speeds):
         point = Point(knee, criterion, float(speed))
-        saved = _saved(Path(folder) / point.filename(), point, robot, budget.get("clearance", 0.0))
+        saved = _saved(
+            Path(folder) / point.filename(), point, robot, budget.get("safety", PAPER_SAFETY)
+        )
         if saved is not None:
             if saved["feasible"]:
                 found[i] = (point.speed, gait_file.parameters(saved), saved["costs"][criterion])
@@ -149,10 +151,10 @@ def _run_series(args):
     return run_series(*args)
 
 
-def pending_points(points, folder: Path, robot: Robot, clearance: float = 0.0):
+def pending_points(points, folder: Path, robot: Robot, safety: Safety = PAPER_SAFETY):
     """Points whose gait file is missing or unreadable."""
     folder = Path(folder)
-    return [p for p in points if _saved(folder / p.filename(), p, robot, clearance) is None]
+    return [p for p in points if _saved(folder / p.filename(), p, robot, safety) is None]
 
 
 def check_speeds(robot: Robot, speeds, knees) -> list[float]:
@@ -183,13 +185,13 @@ def run_sweep(
     """Optimise every (knee, criterion, speed) not yet in ``folder``; returns all points.
 
     ``budget`` goes to ``biped.optimize.optimize`` (``max_restarts``, ``evaluations_per_run``,
-    ``polish_iterations``, ``clearance``).
+    ``polish_iterations``, ``safety``).
     """
     speeds = check_speeds(robot, speeds, knees)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
-    todo = pending_points(points, folder, robot, budget.get("clearance", 0.0))
+    todo = pending_points(points, folder, robot, budget.get("safety", PAPER_SAFETY))
     print(
         f"sweep: {len(points)} points in {folder}, {len(points) - len(todo)} already done, "
         f"{len(todo)} to run",

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import biped
+from biped.criteria import Safety
 from biped.optimize import cost, initial_parameters, max_walking_speed, optimize
 
 ROBOT = biped.Robot.paper()
@@ -73,8 +74,8 @@ def test_clearance_is_kept_by_the_optimum():
     from biped.criteria import clearance_profile
 
     model = biped.Biped(ROBOT, "rolling")
-    optimum = optimize(model, 0.3, "sthenic", clearance=0.02)
-    assert optimum.feasible and optimum.clearance == 0.02
+    optimum = optimize(model, 0.3, "sthenic", safety=Safety(clearance=0.02))
+    assert optimum.feasible and optimum.safety.clearance == 0.02
     feet = model.points(optimum.evaluation.q, ["swing_heel", "swing_toe"])[..., 1]
     required = clearance_profile(100, 0.02)
     assert np.all(feet[1:-1] >= required[1:-1, None] - 1e-12)
@@ -83,9 +84,10 @@ def test_clearance_is_kept_by_the_optimum():
     assert optimum.value > free.value
 
 
-def test_bad_clearance_is_rejected():
-    """A negative or huge clearance is a clear error."""
-    model = biped.Biped(ROBOT, "rolling")
+def test_bad_safety_margins_are_rejected():
+    """A negative or huge clearance or ZMP margin is a clear error."""
     for bad in (-0.01, 1.0, float("nan")):
         with pytest.raises(biped.BipedError, match="clearance"):
-            optimize(model, 0.3, clearance=bad)
+            Safety(clearance=bad)
+    with pytest.raises(biped.BipedError, match="zmp_margin"):
+        Safety(zmp_margin=0.2)

@@ -96,7 +96,7 @@ def test_sweep_refuses_another_robots_folder(sweep):
     """Resuming into a folder of another robot's gaits is an error, not a silent mix."""
     folder, _ = sweep
     other = biped.Robot.from_mapping({"r1": 0.08})
-    with pytest.raises(biped.BipedError, match="another robot, clearance or point"):
+    with pytest.raises(biped.BipedError, match="another robot, safety or point"):
         run_sweep(folder, other, SPEEDS, jobs=1, stream=io.StringIO(), **TINY)
 
 

@@ -35,6 +35,11 @@ KNEE_LINK_INERTIA = 1e-10
 # Armature on the rolling-knee hinges [kg·m²]: with a stiff equality, it keeps the coupling
 # tight under load. It enters MuJoCo's mass matrix; the cross-check removes it.
 KNEE_ARMATURE = 1e-3
+# Armature on the ankles [kg·m²], the rotor inertia of an ankle drive seen through its
+# gearbox. Without it the foot (0.002 kg·m² about the ankle) under a stiff joint feedback
+# oscillates at about 1000 rad/s, beyond what a 1 ms explicit step resolves, and rocks itself
+# across the floor. It enters MuJoCo's mass matrix; the cross-check removes it.
+ANKLE_ARMATURE = 0.02
 # Equality constraint of the rolling knee: stiff and hard (solimp close to 1).
 KNEE_SOLREF = "0.002 1"
 KNEE_SOLIMP = "0.9999 0.99999 0.0001 0.5 2"
@@ -139,7 +144,7 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
             f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia)}",
             f'{pad}    <geom class="visual" type="capsule" size="0.035" fromto="0 0 0 0 0 {_f(-shank)}"/>',
             f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
-            f'{pad}      <joint name="{side}_ankle"/>',
+            f'{pad}      <joint name="{side}_ankle" armature="{_f(ANKLE_ARMATURE)}"/>',
             f"{pad}      {_inertial(-r.foot_com, r.foot_mass, r.foot_inertia)}",
             f'{pad}      <geom name="{side}_sole" class="collision" type="box" '
             f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '

@@ -33,10 +33,10 @@ from validate.mjcf import SIDES, scene_model
 
 JOINT_ORDER = tuple(f"{side}_{joint}" for side in SIDES for joint in ("hip", "knee", "ankle"))
 # Joint-space feedback gains: stiffness [N·m/rad] and damping [N·m·s/rad].
-KP = 2000.0
-KV = 60.0
+KP = 1000.0
+KV = 40.0
 # Damping of the stance ankle as a fraction of kv (see ``set_gains``).
-STANCE_ANKLE_DAMPING = 0.1
+STANCE_ANKLE_DAMPING = 0.2
 # A step waits for the swing foot at most this many periods.
 STEP_TIMEOUT = 1.5
 # Normal force [N] of the touch sensor that counts as a touchdown.
