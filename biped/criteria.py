@@ -70,7 +70,8 @@ def margin_profile(samples_per_half: int) -> np.ndarray:
 
 # The swing foot's required clearance (``Safety.clearance``, 0 in the paper) ramps up over
 # this fraction of the step at each end, where the foot leaves and reaches the ground.
-CLEARANCE_RAMP = 0.25
+CLEARANCE_RAMP = 0.3
+CLEARANCE_DELAY = 0.03
 # Largest safety margins accepted [m].
 MAX_CLEARANCE = 0.2
 MAX_ZMP_MARGIN = 0.05
@@ -105,11 +106,12 @@ PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
 
 @functools.cache
 def clearance_profile(samples_per_half: int, clearance: float) -> np.ndarray:
-    """Required height (N,) [m] of the swing heel and toe: ``clearance`` away from the ends,
-    reached by a smooth step (zero slope at lift-off and touchdown)."""
+    """Required height (N,) [m] of the swing heel and toe: none for the first and last
+    ``CLEARANCE_DELAY`` of the step (lift-off and touchdown), then ``clearance`` reached
+    linearly at ``CLEARANCE_RAMP``."""
     t_n = np.concatenate(half_grid(samples_per_half))
-    x = np.clip(np.minimum(t_n, 1.0 - t_n) / CLEARANCE_RAMP, 0.0, 1.0)
-    profile = clearance * x * x * (3.0 - 2.0 * x)
+    x = (np.minimum(t_n, 1.0 - t_n) - CLEARANCE_DELAY) / (CLEARANCE_RAMP - CLEARANCE_DELAY)
+    profile = clearance * np.clip(x, 0.0, 1.0)
     profile.setflags(write=False)
     return profile
 
