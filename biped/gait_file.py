@@ -37,7 +37,7 @@ from biped.kinematics import KNEES
 from biped.optimize import Optimum
 from biped.robot import Robot
 
-FORMAT = "biped-gait/1"
+FORMAT = "biped-gait/2"  # 2: safety margins recorded
 SAMPLE_FIELDS = {"t": 1, "q": 9, "qd": 9, "qdd": 9, "torques": 6, "wrench": 3, "zmp": 1}
 
 
@@ -147,8 +147,8 @@ def read(path: str | Path) -> dict:
         if not _positive_number(content[key]):
             raise bad(f"{key} = {content[key]!r}, allowed a number > 0")
     try:
-        content["safety"] = Safety(**content.get("safety", {}))
-    except (TypeError, BipedError) as error:
+        content["safety"] = Safety(**content["safety"])
+    except (KeyError, TypeError, BipedError) as error:
         raise bad(f"safety {content.get('safety')!r}: {error}") from None
     if content["knee"] not in KNEES:
         raise bad(f"knee = {content['knee']!r}, allowed {', '.join(KNEES)}")

@@ -165,6 +165,8 @@ class _Polish:
             step = build_step(self.model, self.speed, self.origin + SCALES * z)
         except StepBuildError as error:
             value = (None, -(1.0 + error.excess) * np.ones(self.margins.shape))
+        except UnreachableError:
+            value = (None, -np.ones(self.margins.shape))
         else:
             ev = evaluate_step(self.model, step, self.samples, safety=self.safety)
             criterion = ev.sthenic if self.criterion == "sthenic" else ev.energy

@@ -26,7 +26,7 @@ from biped.dynamics import JOINTS, Biped
 from biped.gait import angles_at
 from validate.mapping import mapping
 from validate.mjcf import SIDES
-from validate.simulate import Simulation, reference_along
+from validate.simulate import Simulation, reference_along, set_gains
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
 CIRCLE = np.linspace(0.0, 2 * np.pi, 33)
@@ -154,6 +154,7 @@ def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict)
     stance_of = np.repeat(sim.stances, np.diff(sim.step_starts + [len(sim.time)]))
     mj_torques = np.zeros_like(torques)
     for stance in SIDES:
+        set_gains(model, stance, sim.kp, sim.kv)
         rows = stance_of == stance
         order = mapping(model, stance, biped.radii).actuator_order
         feedback = np.zeros((rows.sum(), 6))

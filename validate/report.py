@@ -21,7 +21,7 @@ from biped.dynamics import Biped
 from biped.gait import build_step
 from validate.crosscheck import load_model, mujoco_impact, mujoco_inverse_dynamics
 from validate.mapping import mapping, other
-from validate.simulate import Simulation, reference_along, simulate
+from validate.simulate import Simulation, reference_along, set_gains, simulate
 
 # Agreement of two exact rigid-body models of one robot.
 EXACT = 1e-6
@@ -30,6 +30,9 @@ SETTLE = 0.05  # fraction of a step after touchdown excluded from the slip (impa
 # Fall: hip lower than this fraction of its planned minimum, or trunk beyond this angle.
 HIP_DROP = 0.9
 TRUNK_LIMIT = 0.5  # [rad]
+# A step counts as walked only if its swing foot lands within this fraction of the period
+# (a foot dragging on the ground is caught as an early "touchdown").
+STEP_TIMING = 0.15
 SAMPLE_EVERY = 5  # post-process every 5th simulation state (5 ms)
 # MuJoCo places a box-plane contact midway through the penetration, a fraction of a
 # millimetre outside the sole's outline: the centre of pressure may lie that far out.
@@ -105,6 +108,7 @@ def contact_samples(biped: Biped, sim: Simulation) -> dict:
         data.qpos[:], data.qvel[:], data.ctrl[:] = sim.qpos[k], sim.qvel[k], sim.ctrl[k]
         mujoco.mj_forward(model, data)
         stance = stance_of[k]
+        set_gains(model, stance, sim.kp, sim.kv)  # the gains of that step, not the last one
         ankle = data.site(f"{stance}_ankle").xpos
         f_sum, moment, swing_touch = np.zeros(3), 0.0, False
         for i in range(data.ncon):
@@ -150,7 +154,9 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
             sim.qpos[a:b, 1].min() >= HIP_DROP * planned_hip
             and np.abs(sim.qpos[a:b, 2]).max() <= TRUNK_LIMIT
         )
-        if not (sim.landed[j] and upright and slips[j] < MAX_SLIP):
+        duration = sim.time[b - 1] - sim.time[a] + model.opt.timestep
+        on_time = abs(duration - step.period) <= STEP_TIMING * step.period
+        if not (sim.landed[j] and upright and on_time and slips[j] < MAX_SLIP):
             break
         walked += 1
     samples = contact if contact is not None else contact_samples(biped, sim)
@@ -178,8 +184,8 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
         "max_landing_slide": float(max(slides)),
         "zmp_in_foot": bool(
             np.all(
-                (cop[single] >= -robot.foot_heel)
-                & (cop[single] <= robot.foot_length - robot.foot_heel)
+                (cop[single] >= -robot.foot_heel - COP_TOLERANCE)
+                & (cop[single] <= robot.foot_length - robot.foot_heel + COP_TOLERANCE)
             )
         ),
         "zmp_rms_error": float(np.sqrt(np.nanmean((cop - zmp_ref) ** 2))),
@@ -189,9 +195,7 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
         "feedback_share": float(
             np.sqrt(feedback[sampled].sum() / max(total[sampled].sum(), 1e-12))
         ),
-        "energy_per_step": float(
-            np.trapezoid(power[sampled], sim.time[sampled]) / max(len(sim.stances), 1)
-        ),
+        "energy_per_step": float(np.trapezoid(power[sampled], sim.time[sampled]) / max(walked, 1)),
         "analytic_energy_per_step": float(energy),
         "warnings": int(sim.warnings),
         "distance": float(sim.qpos[-1, 0] - sim.qpos[0, 0]),

@@ -143,6 +143,8 @@ def simulate(biped: Biped, step: Step, steps: int = 20, kp: float = KP, kv: floa
                 model, data, state, controls[stance][None, done : done + size]
             )
             states, sensors = states[0], sensors[0]
+            # rollout resets data.warning at each call: count them chunk by chunk.
+            result.warnings += int(sum(w.number for w in data.warning))
             finite = np.all(np.isfinite(states), axis=1)
             down = np.flatnonzero(sensors[:, touch] > TOUCH_THRESHOLD) if done else []
             end = down[0] + 1 if len(down) else size
@@ -161,7 +163,6 @@ def simulate(biped: Biped, step: Step, steps: int = 20, kp: float = KP, kv: floa
         count += done
         if not landed:
             break
-    result.warnings = int(sum(w.number for w in data.warning))
     states = np.concatenate([p[0] for p in parts])
     nq, nv = model.nq, model.nv
     result.time = states[:, 0]
