@@ -209,6 +209,8 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         lines += [
             f'    <touch name="{side}_touch" site="{side}_sole_touch"/>',
             f'    <framepos name="{side}_ankle_pos" objtype="site" objname="{side}_ankle"/>',
+            f'    <framepos name="{side}_heel_pos" objtype="site" objname="{side}_heel"/>',
+            f'    <framepos name="{side}_toe_pos" objtype="site" objname="{side}_toe"/>',
         ]
     lines += ["  </sensor>", "", "  <keyframe>"]
     nq = 3 + 2 * (4 if rolling else 3)

@@ -26,7 +26,7 @@ from biped.dynamics import JOINTS, Biped
 from biped.gait import angles_at
 from validate.mapping import mapping
 from validate.mjcf import SIDES
-from validate.simulate import Simulation, reference_along, set_gains
+from validate.simulate import Simulation, reference_along
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
 CIRCLE = np.linspace(0.0, 2 * np.pi, 33)
@@ -81,8 +81,7 @@ def _log_robot(rec, path, points: dict, radii, color):
 def analytic_points(biped: Biped, step, sim: Simulation, k: int) -> dict:
     """Named points of the analytical gait at simulation state k (same step as MuJoCo)."""
     j = int(np.searchsorted(sim.step_starts, k, side="right") - 1)
-    tau = min(sim.time[k] - sim.time[sim.step_starts[j]] + sim.model.opt.timestep, step.period)
-    angles, rates, accel = angles_at(step, tau / step.period)
+    angles, rates, accel = angles_at(step, sim.phase[k] / step.period)
     q, *_ = biped.single_support(angles, rates, accel)
     stance = sim.stances[j]
     swing = SIDES[1 - SIDES.index(stance)]
@@ -150,27 +149,14 @@ def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict)
     data = mujoco.MjData(model)
     time_column = [rr.TimeColumn("time", duration=sim.time)]
     _, torques, wrench, zmp = reference_along(biped, step, sim)
-    # MuJoCo's torques in the paper's order: motor (gear -1) plus the feedback servos.
+    # MuJoCo's torques in the paper's order (stance, swing): motors plus feedback servos.
     stance_of = np.repeat(sim.stances, np.diff(sim.step_starts + [len(sim.time)]))
+    applied = sim.force[:, :6] + sim.feedback()  # JOINT_ORDER = motor order
     mj_torques = np.zeros_like(torques)
     for stance in SIDES:
-        set_gains(model, stance, sim.kp, sim.kv)
         rows = stance_of == stance
         order = mapping(model, stance, biped.radii).actuator_order
-        feedback = np.zeros((rows.sum(), 6))
-        for k, state in enumerate(np.flatnonzero(rows)):
-            data.qpos[:], data.qvel[:], data.ctrl[:] = (
-                sim.qpos[state],
-                sim.qvel[state],
-                sim.ctrl[state],
-            )
-            if k % 5 == 0:  # actuator forces change slowly: every 5 ms
-                mujoco.mj_fwdPosition(model, data)
-                mujoco.mj_fwdVelocity(model, data)
-                mujoco.mj_fwdActuation(model, data)
-            servo = data.actuator_force[6:12] + data.actuator_force[12:18]
-            feedback[k] = -servo[order]
-        mj_torques[rows] = sim.ctrl[np.ix_(rows, order)] + feedback
+        mj_torques[rows] = applied[np.ix_(rows, order)]
     for i, joint in enumerate(JOINTS):
         for source, values in (("analytic", torques[:, i]), ("mujoco", mj_torques[:, i])):
             rec.send_columns(

@@ -1,21 +1,27 @@
 """Forward simulation of a gait in MuJoCo with contact, legs alternating every step.
 
-Control: the gait's torques as feedforward plus joint-space feedback,
+Control, per joint, at every physics step:
 
-    u = Γ(τ) + kp (θ_ref(τ) - θ) + kv (θ̇_ref(τ) - θ̇)
+    u = Γ(τ) + kp (θ_ref(τ) - θ) + kv (θ̇_ref(τ) ṡ - θ̇)
 
-with τ the time since the current step began. The feedback lives in MuJoCo position and
-velocity actuators (``validate.mjcf.robot_xml(servos=...)``), so a step's whole control is an
-open-loop sequence of feedforward torques and references, played by ``mujoco.rollout``
-without Python in the loop. A step ends when the swing foot's touch sensor reports contact
-after mid-step; the next step then starts from that state with the legs swapped (τ = 0). If
-the foot is late, the reference holds the end posture; if it never lands the robot has fallen.
+where the gait's time τ is not the clock but the phase of the step: the hip's advance over the
+stance ankle, x_H - x_ankle, mapped through the gait's own x_H(τ) (increasing over a step), and
+ṡ = ẋ_H / ẋ_H,ref(τ) the rate at which the robot goes through it. A robot a little late or
+early is then driven along the gait's path, not pulled back towards a clock; this is what a
+time reference cannot do for a walker, whose forward motion over its stance foot is an
+inverted pendulum.
 
-Status: with the paper's constraints (swing foot z >= 0) the optimal gaits clear the ground
-by millimetres and the robots walk a few steps before a scuff trips them. With safety margins
-(``biped.criteria.Safety``: a few centimetres of clearance, a ZMP kept 2 cm inside the sole)
-some optimal gaits walk 20 steps with the stance foot still to a fraction of a millimetre, but
-not all: the joint-space feedback here is not yet robust enough for every optimum.
+The stance ankle carries the feedforward torque Γ1 alone, no feedback: its torque places the
+centre of pressure under the foot, and a servo there (kp = 1000 N·m/rad against a pendulum
+of m g l ≈ 600 N·m/rad) would move the centre of pressure by centimetres for a few
+hundredths of a radian, roll the foot and trip the robot. The five other joints track their
+reference with ``KP``, ``KV``. The feedback lives in MuJoCo position and velocity actuators
+(``validate.mjcf.robot_xml(servos=...)``): Python sets the references and the feedforward,
+MuJoCo computes the feedback inside its implicit integration step.
+
+A step ends when the swing foot's touch sensor reports contact past mid-step; the legs then
+swap roles. If the foot is late, the reference holds the end posture; if it has not landed
+after ``STEP_TIMEOUT`` periods, or the hip has dropped to half its height, the walk ends.
 """
 
 from __future__ import annotations
@@ -24,23 +30,31 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
-from mujoco import rollout
 
 from biped.dynamics import Biped, zmp_from
+from biped.errors import BipedError
 from biped.gait import Step, angles_at
+from biped.kinematics import XH
 from validate.mapping import mapping, other
 from validate.mjcf import SIDES, scene_model
 
 JOINT_ORDER = tuple(f"{side}_{joint}" for side in SIDES for joint in ("hip", "knee", "ankle"))
-# Joint-space feedback gains: stiffness [N·m/rad] and damping [N·m·s/rad].
+# Joint-space feedback gains of the five tracked joints: stiffness [N·m/rad], damping
+# [N·m·s/rad]. The stance ankle has none (see the module docstring).
 KP = 1000.0
 KV = 40.0
-# Damping of the stance ankle as a fraction of kv (see ``set_gains``).
-STANCE_ANKLE_DAMPING = 0.2
 # A step waits for the swing foot at most this many periods.
-STEP_TIMEOUT = 1.5
+STEP_TIMEOUT = 2.0
 # Normal force [N] of the touch sensor that counts as a touchdown.
 TOUCH_THRESHOLD = 1.0
+# Points of the phase table (hip advance over one step).
+PHASE_POINTS = 2001
+# The phase rate ṡ is kept in this range (a robot stopped or thrown forward is not tracked
+# by scaling its reference rates further).
+RATE_RANGE = (0.25, 4.0)
+# Height of the hip, as a fraction of its planned minimum, below which the robot has fallen
+# and the simulation stops.
+FALLEN = 0.5
 
 
 def joint_matrix(model: mujoco.MjModel) -> np.ndarray:
@@ -57,47 +71,76 @@ def joint_matrix(model: mujoco.MjModel) -> np.ndarray:
 
 
 def set_gains(model: mujoco.MjModel, stance: str, kp: float, kv: float) -> None:
-    """Feedback gains of one step: ``kp``, ``kv`` on every joint, the stance ankle's damping
-    scaled by ``STANCE_ANKLE_DAMPING`` (tuned: full damping on the joint that carries the
-    whole body made the walks fall sooner in our trials).
-    """
+    """Feedback gains of one step: ``kp``, ``kv`` on every joint but the stance ankle."""
     for side in SIDES:
         for joint in ("hip", "knee", "ankle"):
-            damping = STANCE_ANKLE_DAMPING * kv if (joint == "ankle" and side == stance) else kv
+            free = joint == "ankle" and side == stance
+            stiffness, damping = (0.0, 0.0) if free else (kp, kv)
             position = model.actuator(f"{side}_{joint}_position").id
             velocity = model.actuator(f"{side}_{joint}_velocity").id
-            model.actuator_gainprm[position, 0] = kp
-            model.actuator_biasprm[position, 1] = -kp
+            model.actuator_gainprm[position, 0] = stiffness
+            model.actuator_biasprm[position, 1] = -stiffness
             model.actuator_gainprm[velocity, 0] = damping
             model.actuator_biasprm[velocity, 2] = -damping
 
 
-def step_controls(biped: Biped, step: Step, model: mujoco.MjModel, stance: str, n: int):
-    """Control sequence (n, nu) of one step with ``stance`` leg, τ = k dt clamped at T."""
-    tau = np.minimum(np.arange(n) * model.opt.timestep, step.period)
+@dataclass(frozen=True)
+class PhaseTable:
+    """The gait on a uniform grid of hip advance x = x_H - x_ankle over one step.
+
+    Attributes:
+        advance: (N,) x [m], from the start of the step to its end.
+        tau: (N,) the gait's time at each x [s].
+        speed: (N,) planned ẋ_H at each x [m/s].
+        controls: stance side -> (N, 18) feedforward torques of the six motors, then joint
+            references and reference rates in ``JOINT_ORDER`` (MuJoCo's joint coordinates).
+    """
+
+    advance: np.ndarray
+    tau: np.ndarray
+    speed: np.ndarray
+    controls: dict
+
+
+def phase_table(biped: Biped, step: Step, model: mujoco.MjModel, points: int = PHASE_POINTS):
+    """Tabulate the gait against the hip's advance; raises if the hip does not advance."""
+    tau = np.linspace(0.0, step.period, 20 * points)
     angles, rates, accel = angles_at(step, tau / step.period)
-    held = tau >= step.period
-    rates[held], accel[held] = 0.0, 0.0
+    q, qd, *_ = biped.single_support(angles, rates, accel)
+    if not np.all(qd[:, XH] > 0.0):
+        raise BipedError(
+            f"the hip's speed falls to {qd[:, XH].min():.3g} m/s during the step: a phase "
+            "needs a hip moving forward throughout (allowed > 0)"
+        )
+    advance = np.linspace(q[0, XH], q[-1, XH], points)
+    tau = np.interp(advance, q[:, XH], tau)
+    angles, rates, accel = angles_at(step, tau / step.period)
     q, qd, _, torques, _, _ = biped.single_support(angles, rates, accel)
     select = joint_matrix(model)
-    mapped = mapping(model, stance, biped.radii)
-    ctrl = np.zeros((n, model.nu))
-    ctrl[:, mapped.actuator_order] = torques
-    ctrl[:, 6:12] = mapped.qpos(q) @ select.T
-    ctrl[:, 12:18] = mapped.qpos(qd) @ select.T
-    return ctrl
+    controls = {}
+    for side in SIDES:
+        mapped = mapping(model, side, biped.radii)
+        table = np.zeros((points, 18))
+        table[:, mapped.actuator_order] = torques
+        table[:, 6:12] = mapped.qpos(q) @ select.T
+        table[:, 12:18] = mapped.qpos(qd) @ select.T
+        controls[side] = table
+    return PhaseTable(advance, tau, qd[:, XH], controls)
 
 
 @dataclass
 class Simulation:
-    """States, controls and sensors of a forward simulation, and its step events."""
+    """States, controls and sensors of a forward simulation, and its step events. Row k holds
+    the state at time[k] and what acted on it during the physics step that followed."""
 
     model: mujoco.MjModel
     time: np.ndarray  # (N,) [s]
     qpos: np.ndarray  # (N, nq)
     qvel: np.ndarray  # (N, nv)
-    ctrl: np.ndarray  # (N, nu) control applied during the step that led to this state
+    ctrl: np.ndarray  # (N, nu) controls: feedforward, references, reference rates
+    force: np.ndarray  # (N, nu) actuator forces: motors, position and velocity feedback
     sensors: np.ndarray  # (N, nsensordata)
+    phase: np.ndarray  # (N,) the gait's time τ the controller followed [s]
     step_starts: list = field(default_factory=list)  # index of each step's first state
     stances: list = field(default_factory=list)  # stance side of each step
     landed: list = field(default_factory=list)  # whether each step ended on a touchdown
@@ -110,81 +153,104 @@ class Simulation:
         sensor = self.model.sensor(name)
         return self.sensors[:, sensor.adr[0] : sensor.adr[0] + sensor.dim[0]]
 
+    def feedback(self) -> np.ndarray:
+        """Feedback torques (N, 6) in the paper's sign (motors' gear is -1), JOINT_ORDER."""
+        return -(self.force[:, 6:12] + self.force[:, 12:18])
 
-def simulate(biped: Biped, step: Step, steps: int = 20, kp: float = KP, kv: float = KV):
-    """Play ``steps`` steps of the gait from its start state, left leg in stance first."""
+
+def simulate(
+    biped: Biped,
+    step: Step,
+    steps: int = 20,
+    kp: float = KP,
+    kv: float = KV,
+    feedforward: float = 1.0,
+):
+    """Play ``steps`` steps of the gait from its start state, left leg in stance first.
+
+    Args:
+        feedforward: scale of the gait's torques in the control (1: the gait's own; other
+            values show what the check of a walk detects of wrong torques).
+    """
     model = scene_model(biped.robot, biped.knee, servos=(kp, kv))
     data = mujoco.MjData(model)
+    table = phase_table(biped, step, model)
+    if feedforward != 1.0:
+        for controls in table.controls.values():
+            controls[:, :6] *= feedforward
     q0, qd0 = step.start
     start = mapping(model, "left", biped.radii)
     data.qpos[:] = start.qpos(q0)
     data.qvel[:] = start.qpos(qd0)
     mujoco.mj_forward(model, data)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state = np.zeros(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, state, spec)
-    n = int(np.ceil(STEP_TIMEOUT * step.period / model.opt.timestep))
-    controls = {side: step_controls(biped, step, model, side, n) for side in SIDES}
-    earliest = int(0.5 * step.period / model.opt.timestep)
-    chunk = max(1, int(0.05 * step.period / model.opt.timestep))
-    parts = []
-    result = Simulation(model, *(None,) * 5, kp=kp, kv=kv)
-    count = 0
+
+    dt = model.opt.timestep
+    capacity = int(np.ceil(steps * STEP_TIMEOUT * step.period / dt)) + 1
+    log = {
+        "time": np.empty(capacity),
+        "qpos": np.empty((capacity, model.nq)),
+        "qvel": np.empty((capacity, model.nv)),
+        "ctrl": np.empty((capacity, model.nu)),
+        "force": np.empty((capacity, model.nu)),
+        "sensors": np.empty((capacity, model.nsensordata)),
+        "phase": np.empty(capacity),
+    }
+    result = Simulation(model, **{k: None for k in log}, kp=kp, kv=kv)
+    x0, span = table.advance[0], table.advance[-1] - table.advance[0]
+    last = len(table.advance) - 1
+    ankle_site = {side: model.site(f"{side}_ankle").id for side in SIDES}
+    touch = {side: model.sensor(f"{side}_touch").adr[0] for side in SIDES}
+    floor = FALLEN * min(q0[1], step.end[0][1])
+    held = np.zeros(6)
+    k = 0
     for j in range(steps):
         stance = SIDES[j % 2]
-        touch = model.sensor(f"{other(stance)}_touch").adr[0]
+        controls = table.controls[stance]
         set_gains(model, stance, kp, kv)
-        # Roll out to mid-step, then in short chunks until the swing foot lands.
-        done, landed = 0, False
-        pieces = []
-        while done < n and not landed:
-            size = earliest if done == 0 else min(chunk, n - done)
-            states, sensors = rollout.rollout(
-                model, data, state, controls[stance][None, done : done + size]
-            )
-            states, sensors = states[0], sensors[0]
-            # rollout resets data.warning at each call: count them chunk by chunk.
-            result.warnings += int(sum(w.number for w in data.warning))
-            finite = np.all(np.isfinite(states), axis=1)
-            down = np.flatnonzero(sensors[:, touch] > TOUCH_THRESHOLD) if done else []
-            end = down[0] + 1 if len(down) else size
-            if not finite[:end].all():
-                end = int(np.argmin(finite))
-            pieces.append((states[:end], controls[stance][done : done + end], sensors[:end]))
-            landed = bool(len(down)) and finite[:end].all()
-            done += end
-            if not finite.all() or end == 0:
-                break
-            state = states[end - 1]
-        parts += pieces
-        result.step_starts.append(count)
+        result.step_starts.append(k)
         result.stances.append(stance)
+        began, landed = data.time, False
+        while data.time - began < STEP_TIMEOUT * step.period and k < capacity:
+            advance = data.qpos[0] - data.site_xpos[ankle_site[stance], 0]
+            where = min(max((advance - x0) / span, 0.0), 1.0) * last
+            i = min(int(where), last - 1)
+            w = where - i
+            row = controls[i] * (1.0 - w) + controls[i + 1] * w
+            speed = table.speed[i] * (1.0 - w) + table.speed[i + 1] * w
+            if where >= last:  # past the end of the step: hold the end posture
+                row[12:18] = held
+            else:
+                row[12:18] *= min(max(data.qvel[0] / speed, RATE_RANGE[0]), RATE_RANGE[1])
+            data.ctrl[:] = row
+            log["time"][k] = data.time
+            log["qpos"][k] = data.qpos
+            log["qvel"][k] = data.qvel
+            log["ctrl"][k] = row
+            log["phase"][k] = table.tau[i] * (1.0 - w) + table.tau[i + 1] * w
+            mujoco.mj_step(model, data)
+            log["force"][k] = data.actuator_force
+            log["sensors"][k] = data.sensordata
+            k += 1
+            if not np.all(np.isfinite(data.qpos)) or data.qpos[1] < floor:
+                break
+            if where > 0.5 * last and data.sensordata[touch[other(stance)]] > TOUCH_THRESHOLD:
+                landed = True
+                break
         result.landed.append(landed)
-        count += done
         if not landed:
             break
-    states = np.concatenate([p[0] for p in parts])
-    nq, nv = model.nq, model.nv
-    result.time = states[:, 0]
-    result.qpos = states[:, 1 : 1 + nq]
-    result.qvel = states[:, 1 + nq : 1 + nq + nv]
-    result.ctrl = np.concatenate([p[1] for p in parts])
-    result.sensors = np.concatenate([p[2] for p in parts])
+    result.warnings = int(sum(w.number for w in data.warning))
+    for key, values in log.items():
+        setattr(result, key, values[:k])
     return result
 
 
 def reference_along(biped: Biped, step: Step, sim: Simulation):
-    """The gait at every simulation state, its phase restarting at each touchdown.
+    """The gait at the phase the controller followed at every simulation state.
 
     Returns:
         q (N, 9), torques (N, 6), wrench (N, 3) and ZMP (N,) of the analytical gait.
     """
-    phase = np.zeros(len(sim.time))
-    starts = sim.step_starts + [len(sim.time)]
-    for j in range(len(sim.stances)):
-        a, b = starts[j], starts[j + 1]
-        elapsed = sim.time[a:b] - sim.time[a] + sim.model.opt.timestep
-        phase[a:b] = np.minimum(elapsed, step.period)
-    angles, rates, accel = angles_at(step, phase / step.period)
+    angles, rates, accel = angles_at(step, sim.phase / step.period)
     q, _, _, torques, wrench, _ = biped.single_support(angles, rates, accel)
     return q, torques, wrench, zmp_from(torques, wrench, biped.robot.ankle_height)
