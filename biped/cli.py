@@ -23,6 +23,8 @@ EXIT_BAD_INPUT = 2
 DEFAULT_SWEEP = "logs/sweep"
 DEFAULT_FIGURES = "logs/figures"
 DEFAULT_RECORDINGS = "logs/recordings"
+DEFAULT_PIPELINE = "logs/pipeline"
+DEFAULT_SPEED = 0.3  # [m/s] the walking speed of the pipeline
 ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
 
 
@@ -296,6 +298,74 @@ def cmd_validate(args) -> int:
     return 0 if result.passed else 1
 
 
+def cmd_pipeline(args) -> int:
+    """The whole pipeline at one walking speed, for each knee: optimal gait (as
+    ``biped optimize``), validation in MuJoCo (as ``biped validate``: inverse dynamics,
+    impact, forward walk with contact) and its rerun recording; then the two knees compared.
+
+    Writes, per knee, the gait file and the validation report (JSON) in --out and the
+    recording in --recordings; prints where they are. Exits 0 only when every gait is
+    feasible and passes every check, 1 otherwise.
+    """
+    from pathlib import Path
+
+    from biped import gait_file
+    from biped.optimize import check_speed, optimize
+    from validate.record import record
+    from validate.report import as_json, validate
+
+    robot = _robot(args.robot)
+    out, recordings = Path(args.out), Path(args.recordings)
+    for knee in args.knees:
+        check_speed(Biped(robot, knee), args.speed)
+    for folder in (out, recordings):
+        _check_output(str(folder / "probe"))
+    passed, costs, written = True, {}, []
+    for knee in args.knees:
+        name = f"{knee}-{args.criterion}-{args.speed:.3f}"
+        print(f"[{knee}] optimizing at {args.speed} m/s ({args.criterion})...", flush=True)
+        optimum = optimize(
+            Biped(robot, knee), args.speed, args.criterion, seed=args.seed, **_budget(args)
+        )
+        ev = optimum.evaluation
+        print(
+            f"[{knee}] sthenic {ev.sthenic:.4g} N²·m·s, energy {ev.energy:.4g} J, period "
+            f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m "
+            f"({optimum.seconds:.1f} s)"
+        )
+        if not optimum.feasible:
+            worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
+            print(f"[{knee}] FAIL  optimum infeasible: {worst}")
+            passed = False
+            continue
+        costs[knee] = optimum.costs()
+        gait = gait_file.to_dict(optimum, robot, seed=args.seed)
+        gait_path = gait_file.write_json(out / f"{name}.json", gait)
+        print(f"[{knee}] validating {args.steps} steps in MuJoCo...", flush=True)
+        result = validate(gait_file.read(gait_path), steps=args.steps)
+        for check in result.checks:
+            print(f"[{knee}]   " + check.line())
+        rrd = record(
+            recordings / f"{name}.rrd", result.biped, result.step, result.simulation, result.contact
+        )
+        report = {**as_json(result.checks), "gait": str(gait_path), "recording": str(rrd)}
+        report_path = gait_file.write_json(out / f"{name}.report.json", report)
+        written.append((knee, gait_path, report_path, rrd))
+        passed = passed and result.passed
+    if len(costs) == 2:
+        revolute, rolling = costs["revolute"], costs["rolling"]
+        changes = ", ".join(
+            f"{criterion} {100.0 * (rolling[criterion] / revolute[criterion] - 1.0):+.1f} %"
+            for criterion in CRITERIA
+        )
+        print(f"rolling vs revolute knee, {args.criterion}-optimal gaits: {changes}")
+    for knee, gait_path, report_path, rrd in written:
+        print(f"{knee:9} gait {gait_path}, report {report_path}")
+        print(f"{knee:9} recording {rrd}  (open with: rerun {rrd})")
+    print("all checks passed" if passed else "some checks FAILED")
+    return 0 if passed else 1
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2."""
 
@@ -379,6 +449,33 @@ def build_parser() -> argparse.ArgumentParser:
     )
     val.add_argument("--json", action="store_true", help="print the report as JSON")
     val.set_defaults(run=cmd_validate)
+
+    pipe = commands.add_parser(
+        "pipeline",
+        help="optimize, validate and record both knees at one speed",
+        description=cmd_pipeline.__doc__,
+    )
+    pipe.add_argument(
+        "--speed", type=_speed, default=DEFAULT_SPEED, metavar="V", help="[m/s] (default 0.3)"
+    )
+    pipe.add_argument("--knees", nargs="+", choices=KNEES, default=list(KNEES))
+    pipe.add_argument("--criterion", choices=CRITERIA, default="sthenic")
+    pipe.add_argument("--steps", type=_positive, default=20, help="steps to walk (default 20)")
+    pipe.add_argument(
+        "--out",
+        default=DEFAULT_PIPELINE,
+        metavar="DIR",
+        help=f"gait files and reports (default {DEFAULT_PIPELINE})",
+    )
+    pipe.add_argument(
+        "--recordings",
+        default=DEFAULT_RECORDINGS,
+        metavar="DIR",
+        help=f"rerun recordings (default {DEFAULT_RECORDINGS})",
+    )
+    _add_budget(pipe)
+    pipe.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    pipe.set_defaults(run=cmd_pipeline)
 
     fig = commands.add_parser(
         "figures", help="figures and table of the comparison", description=cmd_figures.__doc__

@@ -58,3 +58,16 @@ def small_optimum(knee: str):
             polish_iterations=30,
         )
     return _GAITS[knee]
+
+
+_OPTIMA: dict = {}
+
+
+def optimal_gait(knee: str):
+    """The optimal gait at 0.3 m/s with the optimiser's defaults (seed 0): the gait
+    ``biped optimize --knee KNEE --speed 0.3`` writes, computed once per session."""
+    from biped.optimize import optimize
+
+    if knee not in _OPTIMA:
+        _OPTIMA[knee] = optimize(biped.Biped(biped.Robot.paper(), knee), 0.3, "sthenic", seed=0)
+    return _OPTIMA[knee]

@@ -150,8 +150,8 @@ def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict)
     time_column = [rr.TimeColumn("time", duration=sim.time)]
     _, torques, wrench, zmp = reference_along(biped, step, sim)
     # MuJoCo's torques in the paper's order (stance, swing): motors plus feedback servos.
-    stance_of = np.repeat(sim.stances, np.diff(sim.step_starts + [len(sim.time)]))
-    applied = sim.force[:, :6] + sim.feedback()  # JOINT_ORDER = motor order
+    stance_of = sim.stance_of()
+    applied = sim.motors() + sim.feedback()  # JOINT_ORDER = motor order
     mj_torques = np.zeros_like(torques)
     for stance in SIDES:
         rows = stance_of == stance

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
+from mujoco import rollout
 
 from biped.dynamics import Biped, zmp_from
 from biped.errors import BipedError
@@ -52,6 +53,8 @@ PHASE_POINTS = 2001
 # The phase rate ṡ is kept in this range (a robot stopped or thrown forward is not tracked
 # by scaling its reference rates further).
 RATE_RANGE = (0.25, 4.0)
+# Period [s] at which the controller reads the phase from the state.
+RESYNC = 0.01
 # Height of the hip, as a fraction of its planned minimum, below which the robot has fallen
 # and the simulation stops.
 FALLEN = 0.5
@@ -104,7 +107,7 @@ class PhaseTable:
 
 def phase_table(biped: Biped, step: Step, model: mujoco.MjModel, points: int = PHASE_POINTS):
     """Tabulate the gait against the hip's advance; raises if the hip does not advance."""
-    tau = np.linspace(0.0, step.period, 20 * points)
+    tau = np.linspace(0.0, step.period, 4 * points)
     angles, rates, accel = angles_at(step, tau / step.period)
     q, qd, *_ = biped.single_support(angles, rates, accel)
     if not np.all(qd[:, XH] > 0.0):
@@ -131,14 +134,14 @@ def phase_table(biped: Biped, step: Step, model: mujoco.MjModel, points: int = P
 @dataclass
 class Simulation:
     """States, controls and sensors of a forward simulation, and its step events. Row k holds
-    the state at time[k] and what acted on it during the physics step that followed."""
+    the state at time[k], the controls of the physics step that followed it and the sensors
+    MuJoCo computed at it."""
 
     model: mujoco.MjModel
     time: np.ndarray  # (N,) [s]
     qpos: np.ndarray  # (N, nq)
     qvel: np.ndarray  # (N, nv)
-    ctrl: np.ndarray  # (N, nu) controls: feedforward, references, reference rates
-    force: np.ndarray  # (N, nu) actuator forces: motors, position and velocity feedback
+    ctrl: np.ndarray  # (N, nu) feedforward torques, joint references, reference rates
     sensors: np.ndarray  # (N, nsensordata)
     phase: np.ndarray  # (N,) the gait's time τ the controller followed [s]
     step_starts: list = field(default_factory=list)  # index of each step's first state
@@ -153,9 +156,27 @@ class Simulation:
         sensor = self.model.sensor(name)
         return self.sensors[:, sensor.adr[0] : sensor.adr[0] + sensor.dim[0]]
 
+    def stance_of(self) -> np.ndarray:
+        """Stance side (N,) of every state."""
+        return np.repeat(self.stances, np.diff(self.step_starts + [len(self.time)]))
+
+    def motors(self) -> np.ndarray:
+        """Feedforward torques (N, 6) the motors applied, in ``JOINT_ORDER``."""
+        low, high = self.model.actuator_ctrlrange[:6].T
+        return np.clip(self.ctrl[:, :6], low, high)
+
     def feedback(self) -> np.ndarray:
-        """Feedback torques (N, 6) in the paper's sign (motors' gear is -1), JOINT_ORDER."""
-        return -(self.force[:, 6:12] + self.force[:, 12:18])
+        """Torques (N, 6) of the position and velocity servos, in the paper's sign
+        (conjugate to θ of eq. 32, like the motors' Γ), in ``JOINT_ORDER``."""
+        select = joint_matrix(self.model)
+        stiffness = np.full((len(self.time), 6), self.kp)
+        damping = np.full((len(self.time), 6), self.kv)
+        for i, side in enumerate(SIDES):
+            free = self.stance_of() == side
+            stiffness[free, 3 * i + 2] = damping[free, 3 * i + 2] = 0.0
+        servo = stiffness * (self.ctrl[:, 6:12] - self.qpos @ select.T)
+        servo += damping * (self.ctrl[:, 12:18] - self.qvel @ select.T)
+        return -servo  # the servos act on MuJoCo's joint angle, minus θ
 
 
 def simulate(
@@ -167,6 +188,10 @@ def simulate(
     feedforward: float = 1.0,
 ):
     """Play ``steps`` steps of the gait from its start state, left leg in stance first.
+
+    The controller updates its phase every ``RESYNC`` seconds; in between, the phase
+    advances at the hip's speed and MuJoCo runs the physics steps on its own
+    (``mujoco.rollout``), the servos closing the loop at every step.
 
     Args:
         feedforward: scale of the gait's torques in the control (1: the gait's own; other
@@ -183,25 +208,32 @@ def simulate(
     data.qpos[:] = start.qpos(q0)
     data.qvel[:] = start.qpos(qd0)
     mujoco.mj_forward(model, data)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state, spec)
+    sensors = data.sensordata.copy()
+    data.warning.number[:] = 0
+    nq, nv = model.nq, model.nv
 
     dt = model.opt.timestep
-    capacity = int(np.ceil(steps * STEP_TIMEOUT * step.period / dt)) + 1
+    chunk = max(1, round(RESYNC / dt))
+    capacity = int(np.ceil(steps * STEP_TIMEOUT * step.period / dt)) + chunk
     log = {
-        "time": np.empty(capacity),
-        "qpos": np.empty((capacity, model.nq)),
-        "qvel": np.empty((capacity, model.nv)),
+        "state": np.empty((capacity, state.size)),
         "ctrl": np.empty((capacity, model.nu)),
-        "force": np.empty((capacity, model.nu)),
         "sensors": np.empty((capacity, model.nsensordata)),
         "phase": np.empty(capacity),
     }
-    result = Simulation(model, **{k: None for k in log}, kp=kp, kv=kv)
+    result = Simulation(model, *(None,) * 6, kp=kp, kv=kv)
     x0, span = table.advance[0], table.advance[-1] - table.advance[0]
     last = len(table.advance) - 1
-    ankle_site = {side: model.site(f"{side}_ankle").id for side in SIDES}
+    ankle = {side: model.sensor(f"{side}_ankle_pos").adr[0] for side in SIDES}
     touch = {side: model.sensor(f"{side}_touch").adr[0] for side in SIDES}
     floor = FALLEN * min(q0[1], step.end[0][1])
-    held = np.zeros(6)
+    ticks = np.arange(chunk) * dt
+    state = state[None]
+    out_state = np.empty((1, chunk, state.size))
+    out_sensors = np.empty((1, chunk, model.nsensordata))
     k = 0
     for j in range(steps):
         stance = SIDES[j % 2]
@@ -209,39 +241,64 @@ def simulate(
         set_gains(model, stance, kp, kv)
         result.step_starts.append(k)
         result.stances.append(stance)
-        began, landed = data.time, False
-        while data.time - began < STEP_TIMEOUT * step.period and k < capacity:
-            advance = data.qpos[0] - data.site_xpos[ankle_site[stance], 0]
-            where = min(max((advance - x0) / span, 0.0), 1.0) * last
-            i = min(int(where), last - 1)
-            w = where - i
-            row = controls[i] * (1.0 - w) + controls[i + 1] * w
-            speed = table.speed[i] * (1.0 - w) + table.speed[i + 1] * w
-            if where >= last:  # past the end of the step: hold the end posture
-                row[12:18] = held
-            else:
-                row[12:18] *= min(max(data.qvel[0] / speed, RATE_RANGE[0]), RATE_RANGE[1])
-            data.ctrl[:] = row
-            log["time"][k] = data.time
-            log["qpos"][k] = data.qpos
-            log["qvel"][k] = data.qvel
-            log["ctrl"][k] = row
-            log["phase"][k] = table.tau[i] * (1.0 - w) + table.tau[i + 1] * w
-            mujoco.mj_step(model, data)
-            log["force"][k] = data.actuator_force
-            log["sensors"][k] = data.sensordata
-            k += 1
-            if not np.all(np.isfinite(data.qpos)) or data.qpos[1] < floor:
-                break
-            if where > 0.5 * last and data.sensordata[touch[other(stance)]] > TOUCH_THRESHOLD:
-                landed = True
+        began, landed, fallen = state[0, 0], False, False
+        landing = touch[other(stance)]
+        while state[0, 0] - began < STEP_TIMEOUT * step.period and k < capacity - chunk:
+            # The phase now, and as it goes on at the hip's present speed (the stance ankle's
+            # position is the reading of one physics step before: the foot is on the ground).
+            hip_speed = state[0, 1 + nq]
+            advance = state[0, 1] - sensors[ankle[stance]] + hip_speed * ticks
+            where = np.clip((advance - x0) / span, 0.0, 1.0) * last
+            i = np.minimum(where.astype(int), last - 1)
+            w = (where - i)[:, None]
+            rows = controls[i] * (1.0 - w) + controls[i + 1] * w
+            rate = hip_speed / (
+                table.speed[i[0]] * (1.0 - w[0, 0]) + table.speed[i[0] + 1] * w[0, 0]
+            )
+            rows[:, 12:18] *= min(max(rate, RATE_RANGE[0]), RATE_RANGE[1])
+            rows[where >= last, 12:18] = 0.0  # past the end of the step: hold the posture
+            rollout.rollout(
+                [model],
+                [data],
+                state,
+                rows[None],
+                nstep=chunk,
+                initial_warmstart=data.qacc_warmstart[None],
+                state=out_state,
+                sensordata=out_sensors,
+                skip_checks=True,
+            )
+            result.warnings += int(data.warning.number.sum())  # reset by every rollout
+            states, readings = out_state[0], out_sensors[0]
+            # Row r: the state before physics step r and the sensors computed at it.
+            n = chunk
+            down = np.flatnonzero((where > 0.5 * last) & (readings[:, landing] > TOUCH_THRESHOLD))
+            if len(down):
+                n, landed = down[0] + 1, True
+            bad = ~np.isfinite(states[:n, 2]) | (states[:n, 2] < floor)
+            if bad.any():
+                n, fallen, landed = int(np.argmax(bad)) + 1, True, False
+            log["state"][k] = state[0]
+            log["state"][k + 1 : k + n] = states[: n - 1]
+            log["ctrl"][k : k + n] = rows[:n]
+            log["sensors"][k : k + n] = readings[:n]
+            log["phase"][k : k + n] = (
+                table.tau[i[:n]] * (1.0 - w[:n, 0]) + table.tau[i[:n] + 1] * w[:n, 0]
+            )
+            k += n
+            state, sensors = states[n - 1 : n].copy(), readings[n - 1]
+            if landed or fallen:
                 break
         result.landed.append(landed)
         if not landed:
             break
-    result.warnings = int(sum(w.number for w in data.warning))
-    for key, values in log.items():
-        setattr(result, key, values[:k])
+    states = log["state"][:k]
+    result.time = states[:, 0]
+    result.qpos = states[:, 1 : 1 + nq]
+    result.qvel = states[:, 1 + nq : 1 + nq + nv]
+    result.ctrl = log["ctrl"][:k]
+    result.sensors = log["sensors"][:k]
+    result.phase = log["phase"][:k]
     return result
 
 
