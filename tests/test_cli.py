@@ -120,3 +120,41 @@ def test_figures_reject_a_corrupt_gait_file(tmp_path, capsys):
     assert main(["figures", "--sweep", str(tmp_path), "--out", str(tmp_path / "fig")]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "rolling-sthenic-0.300.json" in lines[0]
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["pipeline", "--speed", "-0.3"], "-0.3"),
+        (["pipeline", "--steps", "0"], "'0'"),
+        (["pipeline", "--knees", "hinge"], "hinge"),
+    ],
+)
+def test_pipeline_rejects_bad_options(capsys, argv, needle):
+    """Bad pipeline options are one line on stderr and exit 2, before any work."""
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0]
+
+
+def test_pipeline_writes_gait_report_and_recording(tmp_path, capsys):
+    """One knee, a small budget and 2 steps: the gait file, its report and its recording are
+    written where the command says, and the exit status is the report's verdict."""
+    import json
+
+    from biped import gait_file
+
+    out, rrd = tmp_path / "pipeline", tmp_path / "recordings"
+    argv = ["pipeline", "--knees", "rolling", "--steps", "2", "--restarts", "0"]
+    argv += ["--evaluations", "300", "--polish", "30", "--out", str(out)]
+    code = main(argv + ["--recordings", str(rrd)])
+    printed = capsys.readouterr().out
+    gait = gait_file.read(out / "rolling-sthenic-0.300.json")
+    assert gait["knee"] == "rolling" and gait["speed"] == 0.3
+    report = json.loads((out / "rolling-sthenic-0.300.report.json").read_text())
+    assert code == (0 if report["passed"] else 1)
+    assert report["forward"]["steps"] <= 2 and report["inverse_dynamics"]["max_torque_error"] < 1e-6
+    recording = rrd / "rolling-sthenic-0.300.rrd"
+    assert recording.stat().st_size > 0 and str(recording) in printed
