@@ -11,6 +11,10 @@ early is then driven along the gait's path, not pulled back towards a clock; thi
 time reference cannot do for a walker, whose forward motion over its stance foot is an
 inverted pendulum.
 
+The phase is read from the state every ``RESYNC`` (10 ms) and carried forward at the hip's
+speed in between, so MuJoCo runs each 10 ms on its own (``mujoco.rollout``, no Python in the
+loop) with the feedback closed at every physics step by its servos.
+
 The stance ankle carries the feedforward torque Γ1 alone, no feedback: its torque places the
 centre of pressure under the foot, and a servo there (kp = 1000 N·m/rad against a pendulum
 of m g l ≈ 600 N·m/rad) would move the centre of pressure by centimetres for a few
@@ -188,10 +192,6 @@ def simulate(
     feedforward: float = 1.0,
 ):
     """Play ``steps`` steps of the gait from its start state, left leg in stance first.
-
-    The controller updates its phase every ``RESYNC`` seconds; in between, the phase
-    advances at the hip's speed and MuJoCo runs the physics steps on its own
-    (``mujoco.rollout``), the servos closing the loop at every step.
 
     Args:
         feedforward: scale of the gait's torques in the control (1: the gait's own; other
