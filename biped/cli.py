@@ -269,12 +269,13 @@ def _positive(text: str) -> int:
 
 
 def cmd_validate(args) -> int:
-    """Cross-check a gait file in MuJoCo and record it for rerun.
+    """Cross-check gait files in MuJoCo and record each for rerun.
 
     Checks: analytical inverse dynamics and impact against MuJoCo's dynamics of the MJCF, and
-    a forward simulation with contact over --steps steps (no fall, no slip, ZMP in the foot).
-    Prints a table (or JSON with --json) and writes a rerun recording; exits 0 only when
-    every check passes, 1 otherwise.
+    a forward walk with contact over --steps steps (every step lands, no fall, no slip, centre
+    of pressure in the foot and on the gait's ZMP). Prints a table per gait (or JSON with
+    --json) and writes a rerun recording per gait; exits 0 only when every check of every
+    gait passes, 1 otherwise.
     """
     import json
     from pathlib import Path
@@ -283,19 +284,31 @@ def cmd_validate(args) -> int:
     from validate.record import record
     from validate.report import as_json, validate
 
-    gait = gait_file.read(args.gait)
-    rrd = Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / (Path(args.gait).stem + ".rrd")
-    _check_output(str(rrd))
-    result = validate(gait, steps=args.steps)
-    path = record(rrd, result.biped, result.step, result.simulation, result.contact)
+    if args.rrd and len(args.gait) > 1:
+        raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
+    gaits = [gait_file.read(path) for path in args.gait]  # all readable before any work
+    recordings = [
+        Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / (Path(path).stem + ".rrd")
+        for path in args.gait
+    ]
+    for rrd in recordings:
+        _check_output(str(rrd))
+    reports, passed = {}, 0
+    for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
+        result = validate(gait, steps=args.steps)
+        written = record(rrd, result.biped, result.step, result.simulation, result.contact)
+        reports[path] = {**as_json(result.checks), "recording": str(written)}
+        passed += result.passed
+        if not args.json:
+            print(f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
+            for check in result.checks:
+                print("  " + check.line())
+            print(f"recording: {written}  (open with: rerun {written})", flush=True)
     if args.json:
-        print(json.dumps({**as_json(result.checks), "recording": str(path)}, indent=1))
-    else:
-        print(f"{args.gait}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
-        for check in result.checks:
-            print("  " + check.line())
-        print(f"recording: {path}  (open with: rerun {path})")
-    return 0 if result.passed else 1
+        print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
+    elif len(args.gait) > 1:
+        print(f"{passed} of {len(args.gait)} gaits pass every check")
+    return 0 if passed == len(args.gait) else 1
 
 
 def cmd_pipeline(args) -> int:
@@ -442,12 +455,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="cross-check a gait in MuJoCo and record it",
         description=cmd_validate.__doc__,
     )
-    val.add_argument("gait", metavar="GAIT.json", help="gait file from optimize or sweep")
+    val.add_argument(
+        "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
+    )
     val.add_argument("--steps", type=_positive, default=20, help="steps to walk (default 20)")
     val.add_argument(
-        "--rrd", metavar="PATH", help=f"recording (default {DEFAULT_RECORDINGS}/<gait>.rrd)"
+        "--rrd",
+        metavar="PATH",
+        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<gait>.rrd)",
     )
-    val.add_argument("--json", action="store_true", help="print the report as JSON")
+    val.add_argument(
+        "--json",
+        action="store_true",
+        help="print the report as JSON (several gaits: an object keyed by file)",
+    )
     val.set_defaults(run=cmd_validate)
 
     pipe = commands.add_parser(

@@ -85,3 +85,21 @@ def test_validate_rejects_a_corrupt_gait(tmp_path, capsys):
     bad.write_text("{")
     assert main(["validate", str(bad)]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_validate_several_gaits(gait_path, tmp_path, capsys, monkeypatch):
+    """Several gaits: one report per file, keyed by it, and a recording per gait; --rrd, which
+    names one recording, is refused with several gaits."""
+    import shutil
+
+    other = tmp_path / "again.json"
+    shutil.copy(gait_path, other)
+    monkeypatch.chdir(tmp_path)
+    assert main(["validate", str(gait_path), str(other), "--rrd", "x.rrd"]) == 2
+    assert "--rrd" in capsys.readouterr().err
+    code = main(["validate", str(gait_path), str(other), "--steps", "1", "--json"])
+    content = json.loads(capsys.readouterr().out)
+    assert set(content) == {str(gait_path), str(other)}
+    assert code == (0 if all(r["passed"] for r in content.values()) else 1)
+    for report in content.values():
+        assert (tmp_path / report["recording"]).stat().st_size > 0

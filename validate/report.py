@@ -51,7 +51,18 @@ COP_TOLERANCE = 1e-3  # [m]
 
 
 def _rms(values) -> float:
+    """Root mean square; NaN for no values."""
     return float(np.sqrt(np.mean(np.square(values)))) if np.size(values) else float("nan")
+
+
+def _root_mean(squares) -> float:
+    """Square root of the mean of squared values; NaN for none."""
+    return float(np.sqrt(np.mean(squares))) if np.size(squares) else float("nan")
+
+
+def _median(values) -> float:
+    """Median; NaN for no values (a walk too short to measure)."""
+    return float(np.median(values)) if np.size(values) else float("nan")
 
 
 @dataclass
@@ -66,6 +77,8 @@ class Check:
 
 
 def _fmt(value) -> str:
+    if value is None or (isinstance(value, float) and np.isnan(value)):
+        return "n/a"
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, (int, np.integer)):
@@ -253,12 +266,12 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
             )
         ),
         "zmp_rms_error": _rms(cop[compared] - zmp_ref[compared]),
-        "touchdown_jump_error": float(np.median(touchdown_jumps(biped, sim, max(walked, 1)))),
+        "touchdown_jump_error": _median(touchdown_jumps(biped, sim, max(walked, 1))),
         "ground_force_rms_error": _rms((force[compared] - wrench_ref[compared, :2]) / weight),
         "feedforward_rms": _rms(feedforward[steady]),
-        "feedback_rms": float(np.sqrt(feedback[steady].mean())),
+        "feedback_rms": _root_mean(feedback[steady]),
         "feedback_share": float(np.sqrt(feedback[steady].sum() / max(total[steady].sum(), 1e-12))),
-        "landing_feedback_rms": float(np.sqrt(feedback[~steady].mean())),
+        "landing_feedback_rms": _root_mean(feedback[~steady]),
         "energy_per_step": float(np.trapezoid(power, sim.time[:end]) / max(walked, 1)),
         "analytic_energy_per_step": float(energy),
         "warnings": int(sim.warnings),
@@ -320,6 +333,12 @@ def validate(gait: dict, steps: int = 20) -> Validation:
 
 
 def as_json(checks) -> dict:
-    content = {check.name: {**check.figures, "passed": check.passed} for check in checks}
+    def clean(value):  # JSON has no NaN: a figure that could not be measured is null
+        return None if isinstance(value, float) and np.isnan(value) else value
+
+    content = {
+        check.name: {**{k: clean(v) for k, v in check.figures.items()}, "passed": check.passed}
+        for check in checks
+    }
     content["passed"] = all(check.passed for check in checks)
     return content
