@@ -23,9 +23,10 @@ reference with ``KP``, ``KV``. The feedback lives in MuJoCo position and velocit
 (``validate.mjcf.robot_xml(servos=...)``): Python sets the references and the feedforward,
 MuJoCo computes the feedback inside its implicit integration step.
 
-A step ends when the swing foot's touch sensor reports contact past mid-step; the legs then
-swap roles. If the foot is late, the reference holds the end posture; if it has not landed
-after ``STEP_TIMEOUT`` periods, or the hip has dropped to half its height, the walk ends.
+A step ends when the swing foot, after leaving the ground, touches it again past mid-step
+(its touch sensor); the legs then swap roles. If the foot is late, the reference holds the
+end posture; if it has not landed after ``STEP_TIMEOUT`` periods, or the hip has dropped to
+half its height, the walk ends.
 """
 
 from __future__ import annotations
@@ -241,7 +242,7 @@ def simulate(
         set_gains(model, stance, kp, kv)
         result.step_starts.append(k)
         result.stances.append(stance)
-        began, landed, fallen = state[0, 0], False, False
+        began, landed, fallen, lifted = state[0, 0], False, False, False
         landing = touch[other(stance)]
         while state[0, 0] - began < STEP_TIMEOUT * step.period and k < capacity - chunk:
             # The phase now, and as it goes on at the hip's present speed (the stance ankle's
@@ -272,7 +273,12 @@ def simulate(
             states, readings = out_state[0], out_sensors[0]
             # Row r: the state before physics step r and the sensors computed at it.
             n = chunk
-            down = np.flatnonzero((where > 0.5 * last) & (readings[:, landing] > TOUCH_THRESHOLD))
+            contact = readings[:, landing] > TOUCH_THRESHOLD
+            # A touchdown: the swing foot, off the ground since some time in this step, touches
+            # it past mid-step (a foot that never lifts does not make steps).
+            aloft = lifted | np.logical_or.accumulate(~contact)
+            down = np.flatnonzero((where > 0.5 * last) & contact & aloft)
+            lifted = bool(aloft[-1])
             if len(down):
                 n, landed = down[0] + 1, True
             bad = ~np.isfinite(states[:n, 2]) | (states[:n, 2] < floor)
