@@ -98,18 +98,29 @@ def _speeds(text: str) -> np.ndarray:
     return np.round(values, 6)
 
 
-def _check_output(path: str) -> None:
+def _check_output(path: str, option: str = "--out") -> None:
     """Fail before any work if ``path`` cannot become a file."""
     from pathlib import Path
 
     target = Path(path)
     if target.is_dir():
-        raise BipedError(f"--out {path!r} is a folder: allowed a file path")
-    parent = target.parent
-    while not parent.exists():
-        parent = parent.parent
-    if not os.access(parent, os.W_OK):
-        raise BipedError(f"--out {path!r}: folder {str(parent)!r} is not writable")
+        raise BipedError(f"{option} {path!r} is a folder: allowed a file path")
+    _check_folder(str(target.parent), option, of=path)
+
+
+def _check_folder(path: str, option: str, of: str | None = None) -> None:
+    """Fail before any work if ``path`` cannot be (or become) a writable folder."""
+    from pathlib import Path
+
+    folder = Path(path)
+    named = of if of is not None else path
+    existing = folder
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise BipedError(f"{option} {named!r}: {str(existing)!r} is a file, allowed a folder")
+    if not os.access(existing, os.W_OK):
+        raise BipedError(f"{option} {named!r}: folder {str(existing)!r} is not writable")
 
 
 def cmd_optimize(args) -> int:
@@ -262,8 +273,11 @@ def _non_negative(text: str) -> int:
 
 
 def _positive(text: str) -> int:
-    value = _non_negative(text)
-    if value == 0:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
         raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer >= 1")
     return value
 
@@ -291,8 +305,14 @@ def cmd_validate(args) -> int:
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / (Path(path).stem + ".rrd")
         for path in args.gait
     ]
+    duplicated = {str(p) for p in recordings if recordings.count(p) > 1}
+    if duplicated:
+        raise BipedError(
+            f"gaits of the same file name would share the recording {sorted(duplicated)[0]!r}: "
+            "allowed gait files with distinct names"
+        )
     for rrd in recordings:
-        _check_output(str(rrd))
+        _check_output(str(rrd), "--rrd")
     reports, passed = {}, 0
     for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
         result = validate(gait, steps=args.steps)
@@ -331,8 +351,8 @@ def cmd_pipeline(args) -> int:
     out, recordings = Path(args.out), Path(args.recordings)
     for knee in args.knees:
         check_speed(Biped(robot, knee), args.speed)
-    for folder in (out, recordings):
-        _check_output(str(folder / "probe"))
+    _check_folder(args.out, "--out")
+    _check_folder(args.recordings, "--recordings")
     passed, costs, written = True, {}, []
     for knee in args.knees:
         name = f"{knee}-{args.criterion}-{args.speed:.3f}"

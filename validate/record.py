@@ -144,7 +144,10 @@ def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
     rec = rr.RecordingStream("biped_validation", recording_id=f"{biped.knee}-{path.stem}")
-    rec.save(str(tmp), default_blueprint=blueprint())
+    try:
+        rec.save(str(tmp), default_blueprint=blueprint())
+    except RuntimeError as error:  # rerun reports an unwritable file this way
+        raise OSError(f"cannot write the recording {str(path)!r}: {error}") from None
     model = sim.model
     data = mujoco.MjData(model)
     time_column = [rr.TimeColumn("time", duration=sim.time)]

@@ -4,7 +4,8 @@ inverse_dynamics  analytical Γ, F_e, ZMP against MuJoCo's dynamics of the MJCF 
 impact            analytical q̇⁺ and impulse against MuJoCo's mass matrix and Jacobian (1e-6)
 forward           the gait walked in MuJoCo with contact: every step lands, no fall, no
                   slip of the stance foot (< 1 mm), centre of pressure in the foot and on
-                  the gait's ZMP (1 mm RMS away from the landings), no MuJoCo warning;
+                  the gait's ZMP (to 30 % of the ankle torque's effect on it, away from
+                  the landings), no MuJoCo warning;
                   ground reaction, velocity jump at touchdown, feedback, energy and the
                   rolling-knee equality reported beside their analytical values
 """
@@ -31,17 +32,18 @@ SETTLE = 0.05  # fraction of a step after touchdown excluded from the slip (impa
 # Fall: hip lower than this fraction of its planned minimum, or trunk beyond this angle.
 HIP_DROP = 0.9
 TRUNK_LIMIT = 0.5  # [rad]
-# A step counts as walked only if its swing foot lands where the gait puts it: with the hip
-# past this fraction of its advance over the step (a foot dragging on the ground is caught
-# as an early "touchdown"). When, is the walk's own affair: its step durations are reported.
+# A step counts as walked only if it goes through the gait's step: it starts before this
+# fraction of the gait's period is left and its swing foot lands past this fraction (a
+# foot dragging on the ground, or shuffling, makes early "touchdowns" or short steps). When,
+# is the walk's own affair: its step durations are reported.
 LANDING_PLACE = 0.9
 # Fraction of a step after touchdown left out of the comparisons with the gait: MuJoCo's
 # soft landing takes that long to settle.
 LANDING = 0.1
-# The walk's centre of pressure must follow the gait's ZMP to this RMS [m] away from the
-# landings: it is where the feedforward torques show (without them, or with half or twice
-# them, the error is 1.5-4 mm on the gaits at 0.3 m/s; with them 0.2 mm).
-ZMP_AGREEMENT = 1e-3
+# The walk's centre of pressure must follow the gait's ZMP away from the landings, to this
+# fraction of how far the gait's stance-ankle torque moves the ZMP (RMS of Γ1 / Fz): that is
+# where the feedforward torques show, the feedback carrying the robot without them.
+ZMP_AGREEMENT = 0.3
 # Time after a landing's first contact at which its velocity jump is read [s].
 JUMP_WINDOW = 0.02
 SAMPLE_EVERY = 5  # post-process every 5th simulation state (5 ms)
@@ -214,7 +216,7 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
         x = sole_x(sim, stance)[starts[j] : starts[j + 1]]
         slides.append(float(np.ptp(x[:settle])) if len(x) else 0.0)
         slips.append(float(np.ptp(x[settle:])) if len(x) > settle else 0.0)
-    q_ref, _, wrench_ref, zmp_ref = reference_along(biped, step, sim)
+    q_ref, torques_ref, wrench_ref, zmp_ref = reference_along(biped, step, sim)
     planned_hip = q_ref[:, 8].min()
     # Steps walked: leading steps that land, with the stance foot still, hip and trunk held.
     walked = 0
@@ -224,7 +226,10 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
             sim.qpos[a:b, 1].min() >= HIP_DROP * planned_hip
             and np.abs(sim.qpos[a:b, 2]).max() <= TRUNK_LIMIT
         )
-        in_place = sim.phase[b - 1] >= LANDING_PLACE * step.period
+        in_place = (
+            sim.phase[a] <= (1.0 - LANDING_PLACE) * step.period
+            and sim.phase[b - 1] >= LANDING_PLACE * step.period
+        )
         if not (sim.landed[j] and upright and in_place and slips[j] < MAX_SLIP):
             break
         walked += 1
@@ -266,6 +271,8 @@ def forward_figures(biped: Biped, step, sim: Simulation, energy: float, contact=
             )
         ),
         "zmp_rms_error": _rms(cop[compared] - zmp_ref[compared]),
+        "zmp_relative_error": _rms(cop[compared] - zmp_ref[compared])
+        / _rms(torques_ref[:end][compared, 0] / wrench_ref[compared, 1]),
         "touchdown_jump_error": _median(touchdown_jumps(biped, sim, max(walked, 1))),
         "ground_force_rms_error": _rms((force[compared] - wrench_ref[compared, :2]) / weight),
         "feedforward_rms": _rms(feedforward[steady]),
@@ -303,7 +310,7 @@ def check_forward(biped: Biped, step, steps: int, energy: float):
         and not figures["fell"]
         and figures["max_slip"] < MAX_SLIP
         and figures["zmp_in_foot"]
-        and figures["zmp_rms_error"] < ZMP_AGREEMENT
+        and figures["zmp_relative_error"] < ZMP_AGREEMENT
         and figures["warnings"] == 0
     )
     return Check("forward", passed, figures), sim, samples
