@@ -70,6 +70,7 @@ def test_recording_holds_both_robots_and_the_series(report):
         "/torques/Γ1_stance_ankle/mujoco",
         "/ground/Fz/analytic",
         "/zmp/mujoco",
+        "/phase",
     ):
         assert expected in paths, expected
     batch = [c for c in chunks if c.entity_path == "/ground/Fz/analytic"][0].to_record_batch()

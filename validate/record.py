@@ -7,6 +7,7 @@ Entity paths, on the timeline ``time`` (seconds of simulation):
     torques/Γ{i}_{joint}/{analytic,mujoco}  motor torques [N·m] (MuJoCo: feedforward + feedback)
     ground/{Fx,Fz}/{analytic,mujoco}    ground reaction on the stance foot [N]
     zmp/{analytic,mujoco,heel,toe}      ZMP from the stance ankle and the foot's limits [m]
+    phase                               the gait's time the controller follows, over T
 
 The default blueprint puts the two robots side by side above the time series. Drawings use
 (x, -z) so that the robot stands upright in rerun's 2D views (y down).
@@ -46,6 +47,7 @@ def blueprint() -> rrb.Blueprint:
                 rrb.TimeSeriesView(origin="torques", name="torques [N·m]"),
                 rrb.TimeSeriesView(origin="ground", name="ground reaction [N]"),
                 rrb.TimeSeriesView(origin="zmp", name="ZMP [m]"),
+                rrb.TimeSeriesView(origin="phase", name="phase [T]"),
             ),
             row_shares=[3, 2],
         ),
@@ -180,6 +182,9 @@ def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict)
             columns=rr.Scalars.columns(scalars=contact["force"][sampled, i]),
         )
     rec.send_columns("zmp/analytic", indexes=time_column, columns=rr.Scalars.columns(scalars=zmp))
+    rec.send_columns(
+        "phase", indexes=time_column, columns=rr.Scalars.columns(scalars=sim.phase / step.period)
+    )
     sampled = ~np.isnan(contact["cop"])
     rec.send_columns(
         "zmp/mujoco",
