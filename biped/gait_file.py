@@ -6,7 +6,7 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
     safety {clearance, zmp_margin} [m] (margins beyond the paper's constraints), feasible,
     costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]},
     robot {field: value}, parameters {name: value} (the 21 of ``biped.gait.PARAMETERS``),
-    constraints {name: worst Ψ_i on the samples},
+    constraints {name: worst Ψ_i on the samples, less the safety margins: >= 0 when met},
     impact {impulse [N·s, N·s, N·m·s], trailing_foot_lift [m/s] (heel, toe), consistent
             (Iz > 0 and the trailing foot lifts: the flat-foot impact model holds), qd_minus,
             qd_plus},
