@@ -46,7 +46,10 @@ def main():
             f"{reference / analytic:8.0f}x"
         )
     print("\nforward validation, 20 steps of the optimal gait at 0.3 m/s (median of 3 runs)")
-    print(f"{'knee':10}{'simulated':>11}{'simulate':>11}{'x real':>8}{'physics':>10}{'x real':>8}")
+    print(
+        f"{'knee':10}{'simulated':>11}{'simulate':>11}{'x real':>8}{'physics':>10}{'x real':>8}"
+        f"{'per step':>11}"
+    )
     for knee in biped.KNEES:
         model = biped.Biped(biped.Robot.paper(), knee)
         optimum = optimize(model, 0.3)
@@ -68,7 +71,7 @@ def main():
         wall, floor = np.median(walls), np.median(physics)
         print(
             f"{knee:10}{simulated:9.2f} s{wall:9.3f} s{simulated / wall:7.0f}x"
-            f"{floor:8.3f} s{simulated / floor:7.0f}x"
+            f"{floor:8.3f} s{simulated / floor:7.0f}x{floor / len(sim.ctrl) * 1e6:8.1f} µs"
         )
     print(
         "target: 200 x real time; 'physics' is MuJoCo's own stepping at the model's 1 ms "
