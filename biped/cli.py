@@ -282,6 +282,19 @@ def _positive(text: str) -> int:
     return value
 
 
+def _validate_and_record(gait: dict, steps: int, rrd):
+    """Every check of a gait read by ``gait_file.read`` and its recording at ``rrd``.
+
+    Returns the validation and its report (the checks as JSON, and the recording's path).
+    """
+    from validate.record import record
+    from validate.report import as_json, validate
+
+    result = validate(gait, steps=steps)
+    written = record(rrd, result.biped, result.step, result.simulation, result.contact)
+    return result, {**as_json(result.checks), "recording": str(written)}
+
+
 def cmd_validate(args) -> int:
     """Cross-check gait files in MuJoCo and record each for rerun.
 
@@ -295,8 +308,6 @@ def cmd_validate(args) -> int:
     from pathlib import Path
 
     from biped import gait_file
-    from validate.record import record
-    from validate.report import as_json, validate
 
     if args.rrd and len(args.gait) > 1:
         raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
@@ -315,9 +326,8 @@ def cmd_validate(args) -> int:
         _check_output(str(rrd), "--rrd")
     reports, passed = {}, 0
     for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
-        result = validate(gait, steps=args.steps)
-        written = record(rrd, result.biped, result.step, result.simulation, result.contact)
-        reports[path] = {**as_json(result.checks), "recording": str(written)}
+        result, reports[path] = _validate_and_record(gait, args.steps, rrd)
+        written = reports[path]["recording"]
         passed += result.passed
         if not args.json:
             print(f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
@@ -344,8 +354,6 @@ def cmd_pipeline(args) -> int:
 
     from biped import gait_file
     from biped.optimize import check_speed, optimize
-    from validate.record import record
-    from validate.report import as_json, validate
 
     robot = _robot(args.robot)
     out, recordings = Path(args.out), Path(args.recordings)
@@ -375,14 +383,15 @@ def cmd_pipeline(args) -> int:
         gait = gait_file.to_dict(optimum, robot, seed=args.seed)
         gait_path = gait_file.write_json(out / f"{name}.json", gait)
         print(f"[{knee}] validating {args.steps} steps in MuJoCo...", flush=True)
-        result = validate(gait_file.read(gait_path), steps=args.steps)
+        result, report = _validate_and_record(
+            gait_file.read(gait_path), args.steps, recordings / f"{name}.rrd"
+        )
         for check in result.checks:
             print(f"[{knee}]   " + check.line())
-        rrd = record(
-            recordings / f"{name}.rrd", result.biped, result.step, result.simulation, result.contact
+        rrd = report["recording"]
+        report_path = gait_file.write_json(
+            out / f"{name}.report.json", {**report, "gait": str(gait_path)}
         )
-        report = {**as_json(result.checks), "gait": str(gait_path), "recording": str(rrd)}
-        report_path = gait_file.write_json(out / f"{name}.report.json", report)
         written.append((knee, gait_path, report_path, rrd))
         passed = passed and result.passed
     if len(costs) == 2:
