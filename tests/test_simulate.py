@@ -94,3 +94,25 @@ def test_phase_follows_the_hip():
     assert sim.phase[0] == pytest.approx(0.0, abs=1e-9)
     assert sim.phase[-1] > 0.9 * optimum.step.period
     assert np.diff(sim.phase).min() > -RESYNC
+
+
+@pytest.mark.parametrize("knee", ["revolute", "rolling"])
+def test_walk_spends_the_gait_energy(knee):
+    """For a gait whose motors work (a small-budget optimum, about 4 N·m RMS), the energy
+    MuJoCo's actuators spend per step, feedback and landings included, is the gait's
+    energy criterion to a few per cent."""
+    optimum = small_optimum(knee)
+    model = Biped(Robot.paper(), knee)
+    sim = simulate(model, optimum.step, steps=4)
+    figures = forward_figures(model, optimum.step, sim, optimum.costs()["energy"])
+    assert figures["steps"] == 4
+    assert figures["feedforward_rms"] > 3.0
+    assert figures["energy_per_step"] == pytest.approx(optimum.costs()["energy"], rel=0.05)
+
+
+def test_simulation_is_deterministic():
+    """The same gait simulated twice gives the same states, bit for bit."""
+    optimum = small_optimum("rolling")
+    model = Biped(Robot.paper(), "rolling")
+    first, second = (simulate(model, optimum.step, steps=2) for _ in range(2))
+    assert np.array_equal(first.qpos, second.qpos) and np.array_equal(first.ctrl, second.ctrl)
