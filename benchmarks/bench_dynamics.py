@@ -42,16 +42,20 @@ def reference(model, q, qd, qdd):
     return np.linalg.solve(system, tau[..., None])[..., 0]
 
 
+def random_states(model, rng, n: int):
+    """n random single-support states (q, q̇, q̈) with the stance foot flat: the benchmarks'
+    samples."""
+    angles = rng.uniform(-0.6, 0.6, (n, 6))
+    return model.stance_state(angles, rng.normal(size=(n, 6)), rng.normal(size=(n, 6)))
+
+
 def main():
     rng = np.random.default_rng(0)
     print(f"inverse dynamics, batch of {BATCH} samples, median of {REPEATS} runs, one thread")
     print(f"{'knee':10}{'closed form':>16}{'reference':>16}{'speed-up':>10}")
     for knee in biped.KNEES:
         model = biped.Biped(biped.Robot.paper(), knee)
-        angles = rng.uniform(-0.6, 0.6, (BATCH, 6))
-        q, qd, qdd = model.stance_state(
-            angles, rng.normal(size=(BATCH, 6)), rng.normal(size=(BATCH, 6))
-        )
+        q, qd, qdd = random_states(model, rng, BATCH)
         torques, wrench = model.inverse_dynamics(q, qd, qdd)
         assert np.allclose(np.concatenate([torques, wrench], -1), reference(model, q, qd, qdd))
         fast = median_time(model.inverse_dynamics, q, qd, qdd) / BATCH

@@ -13,6 +13,7 @@ import time  # noqa: E402
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
+from bench_dynamics import random_states  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
 import biped  # noqa: E402
@@ -29,10 +30,7 @@ def main():
     print(f"{'knee':10}{'analytical':>14}{'MuJoCo':>14}{'ratio':>9}")
     for knee in biped.KNEES:
         model = biped.Biped(biped.Robot.paper(), knee)
-        angles = rng.uniform(-0.6, 0.6, (SAMPLES, 6))
-        q, qd, qdd = model.stance_state(
-            angles, rng.normal(size=(SAMPLES, 6)), rng.normal(size=(SAMPLES, 6))
-        )
+        q, qd, qdd = random_states(model, rng, SAMPLES)
         mj = load_model(model, exact=True)
         began = time.perf_counter()
         for _ in range(20):
