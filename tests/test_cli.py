@@ -2,7 +2,7 @@
 
 import pytest
 
-from biped.cli import main
+from biped_cli import main
 
 
 def test_demo_prints_both_knees(capsys):

@@ -7,7 +7,7 @@ import pytest
 import rerun.chunk
 
 from biped import Robot, gait_file
-from biped.cli import main
+from biped_cli import main
 from tests.conftest import small_optimum
 
 

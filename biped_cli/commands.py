@@ -1,0 +1,266 @@
+"""The subcommands of ``biped``: one function per job, each returning the exit status.
+
+Errors in the input raise ``BipedError`` (one line on stderr, exit status 2).
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+
+import numpy as np
+
+from biped.criteria import CRITERIA
+from biped.dynamics import JOINTS, Biped
+from biped.errors import BipedError
+from biped.kinematics import KNEES
+from biped.robot import Robot
+from biped_cli.args import budget, check_folder, check_output
+
+EXIT_BAD_INPUT = 2
+DEFAULT_SWEEP = "logs/sweep"
+DEFAULT_FIGURES = "logs/figures"
+DEFAULT_RECORDINGS = "logs/recordings"
+DEFAULT_PIPELINE = "logs/pipeline"
+DEFAULT_SPEED = 0.3  # [m/s] the walking speed of the pipeline
+
+
+def _robot(path: str | None) -> Robot:
+    return Robot.paper() if path is None else Robot.from_file(path)
+
+
+def demo_posture(model: Biped, hip_ahead: float = 0.05, hip_height: float = 0.86):
+    """A single-support posture held still: stance leg from the inverse geometric model.
+
+    Args:
+        hip_ahead: [m] hip ahead of the stance ankle.
+        hip_height: [m] hip above the ground.
+    """
+    hip_from_ankle = [hip_ahead, hip_height - model.robot.ankle_height]
+    shank, thigh = model.leg_angles(hip_from_ankle)
+    # Swing leg behind, knee bent, foot level; trunk upright.
+    angles = np.array([0.0, shank, thigh, -0.15, -0.55, 0.0])
+    return model.stance_state(angles)
+
+
+def cmd_demo(args) -> int:
+    """Print the torques, ground wrench and ZMP that hold a one-leg posture still."""
+    robot = _robot(args.robot)
+    knees = KNEES if args.knee is None else (args.knee,)
+    names = [f"Γ {j} [N·m]" for j in JOINTS] + ["Fx [N]", "Fz [N]", "Cy [N·m]", "x_ZMP [m]"]
+    columns = []
+    for knee in knees:
+        model = Biped(robot, knee)
+        q, qd, qdd = demo_posture(model, args.hip_ahead, args.hip_height)
+        torques, wrench = model.inverse_dynamics(q, qd, qdd)
+        columns.append([*torques, *wrench, model.zmp(q, qd, qdd)])
+    print(
+        f"Robot: {robot.total_mass:.2f} kg, {robot.height:.3f} m, "
+        f"knee radii r1 = {robot.r1} m, r2 = {robot.r2} m"
+    )
+    print(
+        f"Posture held still: hip {args.hip_ahead:+.3f} m ahead of the stance ankle, "
+        f"{args.hip_height:.3f} m high; swing leg behind, trunk upright.\n"
+    )
+    print(f"{'':22}" + "".join(f"{knee:>12}" for knee in knees))
+    for i, name in enumerate(names):
+        print(f"{name:22}" + "".join(f"{column[i] + 0.0:12.4f}" for column in columns))
+    return 0
+
+
+def cmd_optimize(args) -> int:
+    """Find the optimal gait of one robot at one walking speed and write it as JSON.
+
+    Exits 0 with the gait file written when the optimum is feasible on the fine check grid;
+    otherwise names the violated constraints, writes nothing and exits 1.
+    """
+    from biped import gait_file
+    from biped.optimize import check_speed, optimize
+
+    robot = _robot(args.robot)
+    model = Biped(robot, args.knee)
+    check_speed(model, args.speed)
+    check_output(args.out)
+    print(
+        f"optimizing {args.knee} knee, {args.criterion} criterion, {args.speed} m/s "
+        f"(seed {args.seed})...",
+        file=sys.stderr,
+    )
+    optimum = optimize(model, args.speed, args.criterion, seed=args.seed, **budget(args))
+    ev = optimum.evaluation
+    print(
+        f"{args.knee} {args.criterion} {args.speed} m/s: criterion {optimum.value:.6g}, "
+        f"sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J, "
+        f"period {optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m, "
+        f"{optimum.evaluations} evaluations in {optimum.seconds:.1f} s"
+    )
+    if not optimum.feasible:
+        worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
+        print(
+            f"biped optimize: infeasible optimum, violated constraints (Ψ < 0): {worst}; "
+            f"no file written",
+            file=sys.stderr,
+        )
+        return 1
+    path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    """Optimal gaits over a range of speeds, both knees and both criteria, on all cores.
+
+    Each point is saved as it completes; run the same command again to resume.
+    """
+    from biped.sweep import run_sweep
+
+    # A terminated sweep stops its worker processes too (the pool closes on SystemExit).
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
+    robot = _robot(args.robot)
+    run_sweep(
+        args.out,
+        robot,
+        args.speeds,
+        args.knees,
+        args.criteria,
+        seed=args.seed,
+        jobs=args.jobs,
+        **budget(args),
+    )
+    print(f"sweep results in {args.out}")
+    return 0
+
+
+def cmd_figures(args) -> int:
+    """PNG figures reproducing the paper's Figs. 4-8 and a comparison table (markdown)."""
+    from biped.figures import make_figures
+
+    for path in make_figures(args.sweep, args.out):
+        print(f"wrote {path}")
+    return 0
+
+
+def _validate_and_record(gait: dict, steps: int, rrd):
+    """Every check of a gait read by ``gait_file.read`` and its recording at ``rrd``.
+
+    Returns the validation and its report (the checks as JSON, and the recording's path).
+    """
+    from validate.record import record
+    from validate.report import as_json, validate
+
+    result = validate(gait, steps=steps)
+    written = record(rrd, result.biped, result.step, result.simulation, result.contact)
+    return result, {**as_json(result.checks), "recording": str(written)}
+
+
+def cmd_validate(args) -> int:
+    """Cross-check gait files in MuJoCo and record each for rerun.
+
+    Checks: analytical inverse dynamics and impact against MuJoCo's dynamics of the MJCF, and
+    a forward walk with contact over --steps steps (every step lands, no fall, no slip, centre
+    of pressure in the foot and on the gait's ZMP). Prints a table per gait (or JSON with
+    --json) and writes a rerun recording per gait; exits 0 only when every check of every
+    gait passes, 1 otherwise.
+    """
+    import json
+    from pathlib import Path
+
+    from biped import gait_file
+
+    if args.rrd and len(args.gait) > 1:
+        raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
+    gaits = [gait_file.read(path) for path in args.gait]  # all readable before any work
+    recordings = [
+        Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / (Path(path).stem + ".rrd")
+        for path in args.gait
+    ]
+    duplicated = {str(p) for p in recordings if recordings.count(p) > 1}
+    if duplicated:
+        raise BipedError(
+            f"gaits of the same file name would share the recording {sorted(duplicated)[0]!r}: "
+            "allowed gait files with distinct names"
+        )
+    for rrd in recordings:
+        check_output(str(rrd), "--rrd")
+    reports, passed = {}, 0
+    for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
+        result, reports[path] = _validate_and_record(gait, args.steps, rrd)
+        written = reports[path]["recording"]
+        passed += result.passed
+        if not args.json:
+            print(f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
+            for check in result.checks:
+                print("  " + check.line())
+            print(f"recording: {written}  (open with: rerun {written})", flush=True)
+    if args.json:
+        print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
+    elif len(args.gait) > 1:
+        print(f"{passed} of {len(args.gait)} gaits pass every check")
+    return 0 if passed == len(args.gait) else 1
+
+
+def cmd_pipeline(args) -> int:
+    """The whole pipeline at one walking speed, for each knee: optimal gait (as
+    ``biped optimize``), validation in MuJoCo (as ``biped validate``: inverse dynamics,
+    impact, forward walk with contact) and its rerun recording; then the two knees compared.
+
+    Writes, per knee, the gait file and the validation report (JSON) in --out and the
+    recording in --recordings; prints where they are. Exits 0 only when every gait is
+    feasible and passes every check, 1 otherwise.
+    """
+    from pathlib import Path
+
+    from biped import gait_file
+    from biped.optimize import check_speed, optimize
+
+    robot = _robot(args.robot)
+    out, recordings = Path(args.out), Path(args.recordings)
+    for knee in args.knees:
+        check_speed(Biped(robot, knee), args.speed)
+    check_folder(args.out, "--out")
+    check_folder(args.recordings, "--recordings")
+    passed, costs, written = True, {}, []
+    for knee in args.knees:
+        name = f"{knee}-{args.criterion}-{args.speed:.3f}"
+        print(f"[{knee}] optimizing at {args.speed} m/s ({args.criterion})...", flush=True)
+        optimum = optimize(
+            Biped(robot, knee), args.speed, args.criterion, seed=args.seed, **budget(args)
+        )
+        ev = optimum.evaluation
+        print(
+            f"[{knee}] sthenic {ev.sthenic:.4g} N²·m·s, energy {ev.energy:.4g} J, period "
+            f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m "
+            f"({optimum.seconds:.1f} s)"
+        )
+        if not optimum.feasible:
+            worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
+            print(f"[{knee}] FAIL  optimum infeasible: {worst}")
+            passed = False
+            continue
+        costs[knee] = optimum.costs()
+        gait = gait_file.to_dict(optimum, robot, seed=args.seed)
+        gait_path = gait_file.write_json(out / f"{name}.json", gait)
+        print(f"[{knee}] validating {args.steps} steps in MuJoCo...", flush=True)
+        result, report = _validate_and_record(
+            gait_file.read(gait_path), args.steps, recordings / f"{name}.rrd"
+        )
+        for check in result.checks:
+            print(f"[{knee}]   " + check.line())
+        rrd = report["recording"]
+        report_path = gait_file.write_json(
+            out / f"{name}.report.json", {**report, "gait": str(gait_path)}
+        )
+        written.append((knee, gait_path, report_path, rrd))
+        passed = passed and result.passed
+    if len(costs) == 2:
+        revolute, rolling = costs["revolute"], costs["rolling"]
+        changes = ", ".join(
+            f"{criterion} {100.0 * (rolling[criterion] / revolute[criterion] - 1.0):+.1f} %"
+            for criterion in CRITERIA
+        )
+        print(f"rolling vs revolute knee, {args.criterion}-optimal gaits: {changes}")
+    for knee, gait_path, report_path, rrd in written:
+        print(f"{knee:9} gait {gait_path}, report {report_path}")
+        print(f"{knee:9} recording {rrd}  (open with: rerun {rrd})")
+    print("all checks passed" if passed else "some checks FAILED")
+    return 0 if passed else 1

@@ -1,0 +1,169 @@
+"""The ``biped`` program: its parser, one subcommand per job, and the top-level guard.
+
+Errors in the input print one line on stderr and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from biped.criteria import CRITERIA
+from biped.errors import BipedError
+from biped.kinematics import KNEES
+from biped.sweep import DEFAULT_SPEEDS
+from biped_cli import args as types
+from biped_cli.commands import (
+    DEFAULT_FIGURES,
+    DEFAULT_PIPELINE,
+    DEFAULT_RECORDINGS,
+    DEFAULT_SPEED,
+    DEFAULT_SWEEP,
+    EXIT_BAD_INPUT,
+    cmd_demo,
+    cmd_figures,
+    cmd_optimize,
+    cmd_pipeline,
+    cmd_sweep,
+    cmd_validate,
+)
+
+ROBOT_HELP = types.ROBOT_HELP
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2."""
+
+    def error(self, message):
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="biped",
+        description="Quasi-optimal gaits of planar bipeds with revolute or rolling knees.",
+    )
+    commands = parser.add_subparsers(
+        dest="command", required=True, metavar="COMMAND", parser_class=_Parser
+    )
+    demo = commands.add_parser(
+        "demo",
+        help="torques, ground wrench and ZMP of a one-leg posture",
+        description=cmd_demo.__doc__,
+    )
+    demo.add_argument("--knee", choices=KNEES, help="one knee kinematic (default: both)")
+    demo.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    demo.add_argument(
+        "--hip-ahead",
+        type=float,
+        default=0.05,
+        metavar="M",
+        help="[m] hip ahead of the stance ankle (default 0.05)",
+    )
+    demo.add_argument(
+        "--hip-height",
+        type=float,
+        default=0.86,
+        metavar="M",
+        help="[m] hip above the ground (default 0.86)",
+    )
+    demo.set_defaults(run=cmd_demo)
+
+    opt = commands.add_parser(
+        "optimize", help="optimal gait at one speed", description=cmd_optimize.__doc__
+    )
+    opt.add_argument("--knee", choices=KNEES, required=True)
+    opt.add_argument("--criterion", choices=CRITERIA, default="sthenic")
+    opt.add_argument("--speed", type=types.speed, required=True, metavar="V", help="[m/s] > 0")
+    opt.add_argument("--out", required=True, metavar="FILE", help="gait file to write (JSON)")
+    types.add_budget(opt)
+    opt.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    opt.set_defaults(run=cmd_optimize)
+
+    sweep = commands.add_parser(
+        "sweep", help="optimal gaits over speeds, knees, criteria", description=cmd_sweep.__doc__
+    )
+    sweep.add_argument(
+        "--speeds",
+        type=types.speeds,
+        default=DEFAULT_SPEEDS,
+        metavar="S",
+        help="START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.15:0.45:13)",
+    )
+    sweep.add_argument("--knees", nargs="+", choices=KNEES, default=list(KNEES))
+    sweep.add_argument("--criteria", nargs="+", choices=CRITERIA, default=list(CRITERIA))
+    sweep.add_argument(
+        "--out", default=DEFAULT_SWEEP, metavar="DIR", help=f"(default {DEFAULT_SWEEP})"
+    )
+    sweep.add_argument(
+        "--jobs", type=types.positive, default=None, help="processes (default: all cores)"
+    )
+    types.add_budget(sweep)
+    sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    sweep.set_defaults(run=cmd_sweep)
+
+    val = commands.add_parser(
+        "validate",
+        help="cross-check a gait in MuJoCo and record it",
+        description=cmd_validate.__doc__,
+    )
+    val.add_argument(
+        "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
+    )
+    val.add_argument("--steps", type=types.positive, default=20, help="steps to walk (default 20)")
+    val.add_argument(
+        "--rrd",
+        metavar="PATH",
+        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<gait>.rrd)",
+    )
+    val.add_argument(
+        "--json",
+        action="store_true",
+        help="print the report as JSON (several gaits: an object keyed by file)",
+    )
+    val.set_defaults(run=cmd_validate)
+
+    pipe = commands.add_parser(
+        "pipeline",
+        help="optimize, validate and record both knees at one speed",
+        description=cmd_pipeline.__doc__,
+    )
+    pipe.add_argument(
+        "--speed", type=types.speed, default=DEFAULT_SPEED, metavar="V", help="[m/s] (default 0.3)"
+    )
+    pipe.add_argument("--knees", nargs="+", choices=KNEES, default=list(KNEES))
+    pipe.add_argument("--criterion", choices=CRITERIA, default="sthenic")
+    pipe.add_argument("--steps", type=types.positive, default=20, help="steps to walk (default 20)")
+    pipe.add_argument(
+        "--out",
+        default=DEFAULT_PIPELINE,
+        metavar="DIR",
+        help=f"gait files and reports (default {DEFAULT_PIPELINE})",
+    )
+    pipe.add_argument(
+        "--recordings",
+        default=DEFAULT_RECORDINGS,
+        metavar="DIR",
+        help=f"rerun recordings (default {DEFAULT_RECORDINGS})",
+    )
+    types.add_budget(pipe)
+    pipe.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    pipe.set_defaults(run=cmd_pipeline)
+
+    fig = commands.add_parser(
+        "figures", help="figures and table of the comparison", description=cmd_figures.__doc__
+    )
+    fig.add_argument("--sweep", default=DEFAULT_SWEEP, metavar="DIR", help="sweep results")
+    fig.add_argument("--out", default=DEFAULT_FIGURES, metavar="DIR", help="(default logs/figures)")
+    fig.set_defaults(run=cmd_figures)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the ``biped`` command; returns the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except (BipedError, OSError) as error:
+        print(f"biped {args.command}: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
