@@ -22,8 +22,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +29,7 @@ import numpy as np
 from biped.criteria import CONSTRAINTS, CRITERIA, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
+from biped.files import atomic_write_text
 from biped.gait import PARAMETERS
 from biped.impact import trailing_foot_lift
 from biped.kinematics import KNEES
@@ -92,23 +91,10 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
 
 
 def write_json(path: str | Path, content: dict) -> Path:
-    """Write JSON atomically: a temporary file in the same folder, then a rename."""
+    """Write JSON whole or not at all (``biped.files``), creating the folder; returns the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        umask = os.umask(0)
-        os.umask(umask)
-        os.fchmod(fd, 0o666 & ~umask)  # as a plain open() would create it
-        with os.fdopen(fd, "w") as handle:
-            json.dump(content, handle, indent=1, allow_nan=False)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return atomic_write_text(path, json.dumps(content, indent=1, allow_nan=False))
 
 
 def _positive_number(value) -> bool:

@@ -1,0 +1,109 @@
+"""Files written whole or not at all.
+
+Every output of the project (gait files, reports, figures, MJCF models, recordings) is written
+to a temporary file in the destination's folder, flushed to disk, then renamed over the
+destination (``os.replace``, atomic on POSIX and Windows). A reader, or a run interrupted at
+any moment, sees the old file or the new one, never a part. The temporary file is named
+``.<name>.<random>.tmp``; it is removed on any exception, ``KeyboardInterrupt`` included. A
+process killed outright (SIGKILL, power loss) can leave one behind: ``clean_stale_temporaries``
+removes them before a run writes into the folder again.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+TEMPORARY_SUFFIX = ".tmp"
+
+
+def _umask() -> int:
+    """The process's umask (read by setting it, so read once)."""
+    global _UMASK
+    if _UMASK is None:
+        _UMASK = os.umask(0o022)
+        os.umask(_UMASK)
+    return _UMASK
+
+
+_UMASK: int | None = None
+
+
+def _fsync_folder(folder: Path) -> None:
+    """Make a rename in ``folder`` durable (a no-op where folders cannot be opened)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """A temporary path to write ``path`` through, for writers that take a file name.
+
+    The body writes the temporary file (``figure.savefig(tmp)``, ``recording.save(tmp)``);
+    when it returns, the file is flushed to disk and renamed to ``path``. If the body raises,
+    nothing is renamed and the temporary file is removed. The folder of ``path`` must exist.
+
+        with atomic_path("logs/figures/fig4.png") as tmp:
+            figure.savefig(tmp, format="png")
+    """
+    path = Path(path)
+    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMPORARY_SUFFIX)
+    tmp = Path(name)
+    try:
+        os.close(fd)
+        os.chmod(tmp, 0o666 & ~_umask())  # as a plain open() would create it
+        yield tmp
+        with open(tmp, "rb+") as handle:
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    _fsync_folder(path.parent)
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` whole or not at all; returns ``path``. Its folder must exist."""
+    path = Path(path)
+    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
+        handle.write(data)
+    return path
+
+
+def atomic_write_text(path: str | Path, text: str, encoding: str = "utf-8") -> Path:
+    """Write ``text`` to ``path`` whole or not at all; returns ``path``. Its folder must exist."""
+    return atomic_write_bytes(path, text.encode(encoding))
+
+
+def is_temporary(path: str | Path) -> bool:
+    """Whether ``path`` is named as a temporary file of ``atomic_path`` (``.<name>.<x>.tmp``)."""
+    name = Path(path).name
+    return name.startswith(".") and name.endswith(TEMPORARY_SUFFIX) and name.count(".") >= 3
+
+
+def clean_stale_temporaries(folder: str | Path) -> list[Path]:
+    """Remove the temporary files a killed run left in ``folder``; returns those removed.
+
+    Call it before any writer starts in ``folder``: a temporary file being written at the
+    same moment would be removed too. A missing folder has none.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    removed = []
+    for path in sorted(folder.iterdir()):
+        if is_temporary(path) and path.is_file() and not path.is_symlink():
+            path.unlink(missing_ok=True)
+            removed.append(path)
+    return removed
