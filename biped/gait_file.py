@@ -11,6 +11,8 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
             (Iz > 0 and the trailing foot lifts: the flat-foot impact model holds), qd_minus,
             qd_plus},
     optimizer {seed, evaluations, seconds, history},
+    provenance {package, version, python, platform, numpy, scipy, casadi, mujoco, command}
+        (``biped.provenance``: what produced the file),
     samples {t, q, qd, qdd, torques, wrench, zmp}
 
 The samples run from t = 0 to t = T inclusive on both spline pieces; t = T/2 appears twice,
@@ -33,15 +35,22 @@ from biped.files import atomic_write_text
 from biped.gait import PARAMETERS
 from biped.impact import trailing_foot_lift
 from biped.kinematics import KNEES
-from biped.optimize import Optimum
+from biped.optimize import Optimum, check_speed
+from biped.provenance import provenance as make_provenance
 from biped.robot import Robot
 
 FORMAT = "biped-gait/2"  # 2: safety margins recorded
+# Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
+MIN_STEP_LENGTH = 1e-3
 SAMPLE_FIELDS = {"t": 1, "q": 9, "qd": 9, "qdd": 9, "torques": 6, "wrench": 3, "zmp": 1}
 
 
-def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
-    """The JSON-ready content of a gait file."""
+def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None = None) -> dict:
+    """The JSON-ready content of a gait file.
+
+    Args:
+        provenance: what produced it (default: ``biped.provenance.provenance()`` now).
+    """
     ev = optimum.evaluation
     step = optimum.step
     model = Biped(robot, optimum.knee)
@@ -78,6 +87,7 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int) -> dict:
             "seconds": optimum.seconds,
             "history": [list(map(float, run)) for run in optimum.history],
         },
+        "provenance": dict(provenance) if provenance is not None else make_provenance(),
         "samples": {
             "t": ev.t.tolist(),
             "q": ev.q.tolist(),
@@ -97,13 +107,18 @@ def write_json(path: str | Path, content: dict) -> Path:
     return atomic_write_text(path, json.dumps(content, indent=1, allow_nan=False))
 
 
+def _finite_number(value) -> bool:
+    """A JSON number other than a boolean, finite as a float (integers beyond floats are not)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return math.isfinite(float(value))
+    except OverflowError:
+        return False
+
+
 def _positive_number(value) -> bool:
-    return (
-        isinstance(value, (int, float))
-        and not isinstance(value, bool)
-        and math.isfinite(value)
-        and value > 0
-    )
+    return _finite_number(value) and value > 0
 
 
 def parameters(gait: dict) -> np.ndarray:
@@ -118,8 +133,9 @@ def read(path: str | Path) -> dict:
         content = json.loads(path.read_text())
     except OSError as error:
         raise BipedError(f"gait file {str(path)!r} cannot be read: {error.strerror}") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as error:
-        raise BipedError(f"gait file {str(path)!r} is not valid JSON: {error}") from None
+    except (ValueError, RecursionError) as error:  # JSONDecodeError and UnicodeDecodeError too
+        reason = "nested too deeply" if isinstance(error, RecursionError) else error
+        raise BipedError(f"gait file {str(path)!r} is not valid JSON: {reason}") from None
 
     def bad(what):
         return BipedError(f"gait file {str(path)!r} is corrupt: {what}")
@@ -143,34 +159,61 @@ def read(path: str | Path) -> dict:
     if not isinstance(content["feasible"], bool):
         raise bad(f"feasible = {content['feasible']!r}, allowed true or false")
     costs = content["costs"]
-    if not isinstance(costs, dict) or not all(
-        isinstance(costs.get(name), (int, float)) and math.isfinite(costs[name])
-        for name in CRITERIA
-    ):
+    if not isinstance(costs, dict) or not all(_finite_number(costs.get(name)) for name in CRITERIA):
         raise bad(f"costs = {costs!r}, allowed finite numbers for {', '.join(CRITERIA)}")
     try:
-        content["robot"] = Robot.from_mapping(content["robot"], source=str(path))
+        content["robot"] = Robot.from_mapping(content["robot"], source="robot")
         names = set(content["parameters"])
     except (KeyError, TypeError) as error:
         raise bad(f"robot or parameters missing ({error})") from None
-    if names != set(PARAMETERS) or not all(
-        isinstance(v, (int, float)) and math.isfinite(v) for v in content["parameters"].values()
+    except BipedError as error:
+        raise bad(str(error)) from None
+    if (
+        not isinstance(content["parameters"], dict)
+        or names != set(PARAMETERS)
+        or not all(map(_finite_number, content["parameters"].values()))
     ):
         raise bad(f"parameters are not the {len(PARAMETERS)} finite numbers of the gait")
+    try:
+        check_speed(Biped(content["robot"], content["knee"]), content["speed"])
+    except BipedError as error:
+        raise bad(str(error)) from None
+    speed, period, length = content["speed"], content["period"], content["step_length"]
+    if length < MIN_STEP_LENGTH:
+        raise bad(f"step_length = {length!r} m, allowed {MIN_STEP_LENGTH} m or more")
+    if not math.isclose(length, speed * period, rel_tol=1e-6):
+        raise bad(
+            f"step_length = {length!r} m, allowed speed × period = {speed * period!r} m "
+            f"(speed {speed!r} m/s, period {period!r} s)"
+        )
     samples = content.get("samples")
     if not isinstance(samples, dict):
         raise bad("missing samples")
-    length = None
     for key, width in SAMPLE_FIELDS.items():
+        if key not in samples:
+            raise bad(f"samples.{key} missing")
         try:
             array = np.asarray(samples[key], dtype=float)
-        except (KeyError, TypeError, ValueError):
-            raise bad(f"samples.{key} missing or not numeric") from None
-        expected = (array.shape[0],) if width == 1 else (array.shape[0], width)
-        if array.ndim == 0 or array.shape != expected or not np.all(np.isfinite(array)):
-            raise bad(f"samples.{key} has shape {array.shape}, allowed (N,{width})")
-        length = array.shape[0] if length is None else length
-        if array.shape[0] != length:
-            raise bad(f"samples.{key} has {array.shape[0]} rows, others {length}")
+        except (TypeError, ValueError, OverflowError):
+            raise bad(f"samples.{key} is not an array of numbers") from None
+        shape = "(N,)" if width == 1 else f"(N, {width})"
+        if array.ndim != (1 if width == 1 else 2) or (width > 1 and array.shape[1] != width):
+            raise bad(f"samples.{key} has shape {array.shape}, allowed {shape}")
+        if not np.all(np.isfinite(array)):
+            where = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
+            raise bad(
+                f"samples.{key}{list(where)} = {array[where]} is not finite: allowed finite numbers"
+            )
         samples[key] = array
+    rows = {key: len(samples[key]) for key in SAMPLE_FIELDS}
+    counts = list(rows.values())
+    common = max(counts, key=counts.count)  # the odd one out is to blame
+    for key, count in rows.items():
+        if count != common:
+            raise bad(f"samples.{key} has {count} rows, the other samples {common}")
+    t = samples["t"]
+    if common < 2 or t[0] != 0.0 or np.any(np.diff(t) < 0.0):
+        raise bad("samples.t does not rise from 0: allowed 2 or more times from 0 to period")
+    if not math.isclose(t[-1], period, rel_tol=1e-6):
+        raise bad(f"samples.t ends at {t[-1]!r} s, allowed the period {period!r} s")
     return content

@@ -27,6 +27,23 @@ from biped.errors import ParameterError
 # Standard gravity [m/s²].
 STANDARD_GRAVITY = 9.81
 
+# Plausible ranges, wide enough for any walking robot from a toy to twice human size; beyond
+# them the numbers are typos or overflow (a 1e308 kg trunk gives torques of inf and nan).
+# Mass of one segment [kg].
+MASS_RANGE = (1e-3, 1e3)
+# Moments of inertia of one segment about its centre of mass [kg·m²].
+INERTIA_RANGE = (1e-8, 1e4)
+# Lengths and distances [m]: segment lengths, the sole, the ankle height are at least LENGTH_MIN;
+# centres of mass and knee radii lie within their segment (checked against its length).
+LENGTH_MIN = 1e-3
+LENGTH_MAX = 10.0
+# Gravitational acceleration [m/s²]: from a small moon's to a few times the Earth's.
+GRAVITY_RANGE = (0.1, 100.0)
+
+_MASSES = ("foot_mass", "shank_mass", "thigh_mass", "trunk_mass")
+_INERTIAS = ("foot_inertia", "shank_inertia", "thigh_inertia", "trunk_inertia")
+_LENGTHS = ("foot_length", "ankle_height", "shank_length", "thigh_length", "trunk_length")
+
 
 @dataclasses.dataclass(frozen=True)
 class Robot:
@@ -36,42 +53,48 @@ class Robot:
     """
 
     foot_length: float
-    """[m] Length of the sole, heel to toe (L_p)."""
+    """[m] Length of the sole, heel to toe (L_p); plausible 0.001 to 10 m."""
     foot_heel: float
     """[m] Horizontal distance from the heel to the ankle (l_p)."""
     ankle_height: float
-    """[m] Height of the ankle above the sole (h_p)."""
+    """[m] Height of the ankle above the sole (h_p); plausible 0.001 to 10 m."""
     foot_mass: float
-    """[kg] Mass of one foot (m_p)."""
+    """[kg] Mass of one foot (m_p); plausible 0.001 to 1000 kg."""
     foot_inertia: float
-    """[kg·m²] Moment of inertia of one foot about its centre of mass (I_p)."""
+    """[kg·m²] Moment of inertia of one foot about its centre of mass (I_p).
+
+    Plausible 1e-8 to 1e4 kg·m² (``INERTIA_RANGE``, as for every segment)."""
     foot_com: float
     """[m] Distance of the foot centre of mass below the ankle (s_p)."""
 
     shank_length: float
-    """[m] Ankle to knee (l_1), the rolling-knee radius r1 included."""
+    """[m] Ankle to knee (l_1), the rolling-knee radius r1 included.
+
+    Plausible 0.001 to 10 m (``LENGTH_MIN``, ``LENGTH_MAX``)."""
     shank_mass: float
-    """[kg] (m_1)."""
+    """[kg] (m_1); plausible 0.001 to 1000 kg."""
     shank_inertia: float
-    """[kg·m²] About the shank centre of mass (I_1)."""
+    """[kg·m²] About the shank centre of mass (I_1); plausible 1e-8 to 1e4 kg·m²."""
     shank_com: float
     """[m] Knee to shank centre of mass (s_1); s1 - r1 from the rolling circle centre C1."""
 
     thigh_length: float
-    """[m] Knee to hip (l_2), the rolling-knee radius r2 included."""
+    """[m] Knee to hip (l_2), the rolling-knee radius r2 included.
+
+    Plausible 0.001 to 10 m (``LENGTH_MIN``, ``LENGTH_MAX``)."""
     thigh_mass: float
-    """[kg] (m_2)."""
+    """[kg] (m_2); plausible 0.001 to 1000 kg."""
     thigh_inertia: float
-    """[kg·m²] About the thigh centre of mass (I_2)."""
+    """[kg·m²] About the thigh centre of mass (I_2); plausible 1e-8 to 1e4 kg·m²."""
     thigh_com: float
     """[m] Hip to thigh centre of mass (s_2)."""
 
     trunk_length: float
-    """[m] Hip to top of the head-arms-trunk segment (l_3)."""
+    """[m] Hip to top of the head-arms-trunk segment (l_3); plausible 0.001 to 10 m."""
     trunk_mass: float
-    """[kg] (m_3)."""
+    """[kg] (m_3); plausible 0.001 to 1000 kg."""
     trunk_inertia: float
-    """[kg·m²] About the trunk centre of mass (I_3)."""
+    """[kg·m²] About the trunk centre of mass (I_3); plausible 1e-8 to 1e4 kg·m²."""
     trunk_com: float
     """[m] Hip to trunk centre of mass (s_3)."""
 
@@ -80,16 +103,20 @@ class Robot:
     r2: float = 0.05
     """[m] Radius of the thigh's rolling surface (rolling knee only)."""
     gravity: float = STANDARD_GRAVITY
-    """[m/s²] Gravitational acceleration."""
+    """[m/s²] Gravitational acceleration; plausible 0.1 to 100 m/s²."""
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ParameterError(field.name, value, "a real number")
-            if not math.isfinite(value):
+            try:
+                number = float(value)
+            except OverflowError:  # an integer beyond the floats
+                number = math.inf
+            if not math.isfinite(number):
                 raise ParameterError(field.name, value, "a finite number")
-            object.__setattr__(self, field.name, float(value))
+            object.__setattr__(self, field.name, number)
         positive = [f.name for f in dataclasses.fields(self) if f.name not in ("r1", "r2")]
         for name in positive:
             if getattr(self, name) <= 0.0:
@@ -97,6 +124,18 @@ class Robot:
         for name in ("r1", "r2"):
             if getattr(self, name) < 0.0:
                 raise ParameterError(name, getattr(self, name), ">= 0")
+        # After the signs, so that a negative mass is told "> 0" (the range's floor is arbitrary).
+        for names, (low, high), unit in (
+            (_MASSES, MASS_RANGE, "kg"),
+            (_INERTIAS, INERTIA_RANGE, "kg·m²"),
+            (_LENGTHS, (LENGTH_MIN, LENGTH_MAX), "m"),
+            (("gravity",), GRAVITY_RANGE, "m/s²"),
+        ):
+            for name in names:
+                if not low <= getattr(self, name) <= high:
+                    raise ParameterError(
+                        name, getattr(self, name), f"{low:g} to {high:g} {unit} (plausible range)"
+                    )
         self._check_below("foot_heel", "foot_length", "0 < foot_heel < foot_length")
         self._check_below("foot_com", "ankle_height", "0 < foot_com <= ankle_height", strict=False)
         for segment in ("shank", "thigh", "trunk"):
@@ -160,9 +199,13 @@ class Robot:
         if suffix not in (".json", ".toml"):
             raise ParameterError("file", str(path), "a .json or .toml file")
         try:
-            text = path.read_text()
+            text = path.read_text(encoding="utf-8")
         except OSError as error:
             raise ParameterError("file", str(path), f"a readable file ({error.strerror})") from None
+        except UnicodeDecodeError as error:
+            raise ParameterError(
+                "file", str(path), f"a UTF-8 text file (byte {error.start} is not UTF-8)"
+            ) from None
         try:
             values = json.loads(text) if suffix == ".json" else tomllib.loads(text)
         except (json.JSONDecodeError, tomllib.TOMLDecodeError) as error:

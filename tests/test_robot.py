@@ -63,12 +63,15 @@ def test_load_toml_and_json(tmp_path):
         ("robot.toml", "r1 = \n", "valid TOML"),
         ("robot.json", "[1, 2]", "table"),
         ("robot.yaml", "r1: 0.1", ".json or .toml"),
+        ("robot.toml", b"r1 = 0.1\n\xff\xfe\x00", "UTF-8"),
+        ("robot.json", '{"trunk_mass": 1e999}', "finite"),
+        ("robot.json", '{"trunk_mass": 1' + "0" * 400 + "}", "finite"),
     ],
 )
 def test_bad_files_are_rejected(tmp_path, name, text, needle):
-    """Unknown fields, bad values, bad syntax and unknown formats raise clear errors."""
+    """Unknown fields, bad values, bad syntax, binary content and unknown formats raise clear errors."""
     path = tmp_path / name
-    path.write_text(text)
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
     with pytest.raises(ParameterError, match=needle.replace(".", r"\.")):
         biped.Robot.from_file(path)
 
@@ -77,3 +80,36 @@ def test_unknown_knee_is_rejected():
     """Only 'revolute' and 'rolling' are knee kinematics."""
     with pytest.raises(biped.BipedError, match="'hinge'.*allowed 'revolute', 'rolling'"):
         biped.Biped(biped.Robot.paper(), knee="hinge")
+
+
+@pytest.mark.parametrize(
+    "field, value, allowed",
+    [
+        ("trunk_mass", 1e308, "0.001 to 1000 kg"),
+        ("foot_mass", 1e-9, "0.001 to 1000 kg"),
+        ("trunk_inertia", 1e9, "1e-08 to 10000 kg·m²"),
+        ("foot_inertia", 1e-12, "1e-08 to 10000 kg·m²"),
+        ("thigh_length", 1e6, "0.001 to 10 m"),
+        ("ankle_height", 1e-6, "0.001 to 10 m"),
+        ("gravity", 1e5, "0.1 to 100 m/s²"),
+    ],
+)
+def test_absurd_parameters_are_refused_with_the_plausible_range(field, value, allowed):
+    """Masses, inertias, lengths and gravity beyond their plausible range are refused, naming it."""
+    with pytest.raises(ParameterError) as error:
+        dataclasses.replace(biped.Robot.paper(), **{field: value})
+    message = str(error.value)
+    assert field in message and repr(value) in message and allowed in message
+
+
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {"trunk_mass": 1000.0, "trunk_inertia": 1e4, "gravity": 0.1},
+        {"foot_mass": 0.001, "foot_inertia": 1e-8, "shank_length": 10.0, "thigh_length": 10.0},
+    ],
+)
+def test_plausible_range_is_inclusive(changes):
+    """The ends of the plausible ranges are accepted."""
+    robot = dataclasses.replace(biped.Robot.paper(), **changes)
+    assert all(getattr(robot, k) == v for k, v in changes.items())
