@@ -1,11 +1,15 @@
-"""MJCF models: generated from Robot, committed up to date, mass properties read back."""
+"""MJCF models: generated from Robot, committed up to date, mass properties read back, standing
+on the floor at qpos0 and seen by their camera."""
+
+import os
 
 import mujoco
 import numpy as np
 import pytest
 
 import biped
-from validate.mjcf import FOLDER, KNEE_LINK_MASS, model_files
+from validate.mjcf import FOLDER, KNEE_LINK_MASS, model_files, scene_model
+from validate.simulate import JOINT_ORDER, joint_matrix
 
 ROBOT = biped.Robot.paper()
 
@@ -84,3 +88,113 @@ def test_rolling_knee_equality_and_tendon():
     for side in ("left", "right"):
         assert data.tendon(f"{side}_knee").length[0] == pytest.approx(0.5)
         assert model.actuator(f"{side}_knee").trntype[0] == mujoco.mjtTrn.mjTRN_TENDON
+
+
+def standing(model: mujoco.MjModel, qpos, seconds: float = 0.5) -> dict:
+    """Hold ``qpos`` with the position servos for ``seconds``: deepest penetration of a sole
+    into the floor [m], hip travel [m], largest contact force [N] and MuJoCo warnings."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    hip = data.site("hip").xpos.copy()
+    targets = joint_matrix(model) @ qpos
+    position = [model.actuator(f"{name}_position").id for name in JOINT_ORDER]
+    data.ctrl[position] = targets
+    depth, force, wrench = 0.0, 0.0, np.zeros(6)
+    for _ in range(round(seconds / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+        for i in range(data.ncon):
+            depth = max(depth, -data.contact[i].dist)
+            mujoco.mj_contactForce(model, data, i, wrench)
+            force = max(force, float(np.abs(wrench[:3]).max()))
+    return {
+        "depth": depth,
+        "travel": float(np.linalg.norm(data.site("hip").xpos - hip)),
+        "force": force,
+        "warnings": int(sum(w.number for w in data.warning)),
+    }
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_qpos0_stands_on_the_floor(knee):
+    """qpos0 is the home key and the robot standing straight, its soles on the floor."""
+    model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
+    np.testing.assert_array_equal(model.key("home").qpos, model.qpos0)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    for side in ("left", "right"):
+        for site in ("heel", "toe"):
+            assert abs(data.site(f"{side}_{site}").xpos[2]) < 1e-12
+    height = ROBOT.ankle_height + ROBOT.shank_length + ROBOT.thigh_length
+    assert data.site("hip").xpos[2] == pytest.approx(height)
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_robot_held_at_qpos0_stays_on_the_floor(knee):
+    """Held at qpos0 by its servos for 0.5 s, the robot sinks under 1 mm, moves under 1 cm,
+    with finite contact forces near its weight; started 5 cm into the floor, it is thrown."""
+    model = scene_model(ROBOT, knee, servos=(1000.0, 40.0))
+    held = standing(model, model.qpos0)
+    weight = ROBOT.total_mass * ROBOT.gravity
+    assert held["depth"] < 1e-3, held
+    assert held["travel"] < 1e-2, held
+    assert np.isfinite(held["force"]) and held["force"] < weight, held
+    assert held["warnings"] == 0, held
+    sunk = model.qpos0.copy()
+    sunk[model.joint("rootz").qposadr[0]] -= 0.05
+    thrown = standing(model, sunk)
+    assert thrown["depth"] > 1e-3 or thrown["travel"] > 1e-2, thrown
+
+
+def render(model: mujoco.MjModel, data: mujoco.MjData, camera: str = "track") -> np.ndarray:
+    renderer = mujoco.Renderer(model, height=240, width=320)
+    try:
+        renderer.update_scene(data, camera=camera)
+        return renderer.render()
+    finally:
+        renderer.close()
+
+
+needs_gl = pytest.mark.skipif(
+    os.environ.get("MUJOCO_GL") not in ("egl", "osmesa") and not os.environ.get("DISPLAY"),
+    reason="offscreen rendering needs MUJOCO_GL=egl (or osmesa) or a display",
+)
+
+
+@needs_gl
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_tracking_camera_sees_both_legs(knee):
+    """From the scene's tracking camera at qpos0, both legs' colours fill part of the frame and
+    the robot's middle is in its middle third; a robot made invisible leaves none."""
+    from validate.video import leg_pixels
+
+    model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
+    data = mujoco.MjData(model)
+    # Legs apart, so that the far (left) leg shows beside the near one.
+    data.qpos[model.joint("left_hip").qposadr[0]] = 0.4
+    data.qpos[model.joint("right_hip").qposadr[0]] = -0.3
+    mujoco.mj_forward(model, data)
+    image = render(model, data)
+    seen = leg_pixels(image)
+    assert seen["left"] > 0.003 and seen["right"] > 0.003, seen
+    blue = np.argwhere((image[..., 2].astype(int) - image[..., 0]) > 60)
+    assert 320 / 3 < blue[:, 1].mean() < 2 * 320 / 3
+    model.mat_rgba[:, 3] = 0.0  # every material transparent: the legs vanish
+    seen = leg_pixels(render(model, data))
+    assert seen["left"] < 1e-4 and seen["right"] < 1e-4, seen
+
+
+@pytest.mark.parametrize("knee", ["rolling"])
+def test_rolling_knee_discs_are_drawn(knee):
+    """The rolling knee's discs have the radii r2 (thigh) and r1 (shank) and stand out of the
+    links' side faces, where a side camera sees them."""
+    from validate.mjcf import SHANK_RADIUS, THIGH_RADIUS
+
+    model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
+    for side in ("left", "right"):
+        thigh, shank = model.geom(f"{side}_thigh_disc"), model.geom(f"{side}_shank_disc")
+        assert thigh.size[0] == pytest.approx(ROBOT.r2)
+        assert shank.size[0] == pytest.approx(ROBOT.r1)
+        for disc in (thigh, shank):
+            assert disc.size[1] > max(THIGH_RADIUS, SHANK_RADIUS)
+            assert model.geom_group[disc.id] == 2  # shown by default

@@ -4,7 +4,10 @@
 
 Layout (mujoco_menagerie style): the trunk is the root body, at the hip, with the planar base
 ``rootx``, ``rootz`` (slides, equal to the paper's x_H, z_H) and ``rooty`` (hinge, equal to
-the trunk angle q5). Every hinge turns about "0 -1 0", so a positive angle is
+the trunk angle q5). The trunk body stands at the hip height of the straight robot and
+``rootz`` has that height as its ``ref``, so qpos0 (all joints 0 but rootz = that height) is
+the robot standing straight with its soles on the floor, the ``home`` key, and qpos still
+equals x_H, z_H, q5 (MuJoCo moves a body by qpos - ref). Every hinge turns about "0 -1 0", so a positive angle is
 counter-clockwise in the x-z plane like the paper's angles: a child's absolute angle is its
 parent's plus the joint angle. The legs are ``left`` and ``right``; which one is the stance leg
 changes every step (``validate.mapping``).
@@ -18,6 +21,9 @@ the knee motor.
 Motors have gear -1: the paper's Γ_i is conjugate to θ_i of eq. (32), which is minus the
 MuJoCo joint angle of the same joint (θ1 = q1 - qp1 = -ankle, θ3 = q5 - q2 = -hip, ...), so a
 motor's control is the paper's torque Γ_i [N·m].
+
+For the eye: the left leg is blue, the right one orange (their knee discs darker), the trunk
+grey; the camera ``track`` follows the robot's centre of mass from its right side (-y).
 """
 
 from __future__ import annotations
@@ -25,6 +31,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from biped.files import atomic_write_text
 from biped.kinematics import check_knee
 from biped.robot import Robot
 
@@ -59,6 +66,18 @@ IMPRATIO = 50.0
 # about y), so offsets along y change nothing in it. Feet collide with the floor, not each
 # other (contype / conaffinity).
 HIP_OFFSET = 0.09  # [m]
+# Colours (RGBA) of the trunk and of each leg, and of each leg's knee discs.
+TRUNK_RGBA = "0.62 0.62 0.66 1"
+LEG_RGBA = {"left": "0.16 0.42 0.86 1", "right": "0.93 0.52 0.12 1"}
+DISC_RGBA = {"left": "0.08 0.2 0.45 1", "right": "0.5 0.25 0.04 1"}
+# Radii of the drawn segments [m] and half-width of the knee discs [m], wider than the links
+# so that the rolling circles show from the side.
+THIGH_RADIUS, SHANK_RADIUS, DISC_HALF_WIDTH = 0.04, 0.032, 0.05
+# Tracking camera: from the robot's right side (-y), this far from its centre of mass and
+# this high above it [m], looking slightly down.
+CAMERA_DISTANCE, CAMERA_HEIGHT = 2.8, 0.25
+# Largest offscreen image [px] (width, height): the video's frames.
+OFFSCREEN = (1280, 720)
 FOLDER = Path(__file__).resolve().parent.parent / "mjcf"
 
 
@@ -94,11 +113,17 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         f'  <option timestep="{_f(TIMESTEP)}" integrator="implicitfast" cone="elliptic" '
         f'impratio="{_f(IMPRATIO)}"/>',
         "",
+        "  <asset>",
+        f'    <material name="trunk" rgba="{TRUNK_RGBA}"/>',
+        *(f'    <material name="{side}" rgba="{LEG_RGBA[side]}"/>' for side in SIDES),
+        *(f'    <material name="{side}_disc" rgba="{DISC_RGBA[side]}"/>' for side in SIDES),
+        "  </asset>",
+        "",
         "  <default>",
         '    <joint type="hinge" axis="0 -1 0"/>',
         '    <motor ctrlrange="-400 400" gear="-1"/>',
         '    <default class="visual">',
-        '      <geom contype="0" conaffinity="0" group="2" rgba="0.7 0.7 0.75 1"/>',
+        '      <geom contype="0" conaffinity="0" group="2"/>',
         "    </default>",
         '    <default class="collision">',
         f'      <geom group="3" friction="{FOOT_FRICTION}" condim="3" contype="1" conaffinity="0" '
@@ -108,12 +133,13 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         "  </default>",
         "",
         "  <worldbody>",
-        '    <body name="trunk" pos="0 0 0">',
+        f'    <body name="trunk" pos="0 0 {_f(stand)}">',
+        f'      <camera name="track" mode="trackcom" pos="0 {_f(-CAMERA_DISTANCE)} {_f(CAMERA_HEIGHT)}" xyaxes="1 0 0 0 0.1 1"/>',
         '      <joint name="rootx" type="slide" axis="1 0 0"/>',
-        '      <joint name="rootz" type="slide" axis="0 0 1"/>',
+        f'      <joint name="rootz" type="slide" axis="0 0 1" ref="{_f(stand)}"/>',
         '      <joint name="rooty"/>',
         f"      {_inertial(r.trunk_com, r.trunk_mass, r.trunk_inertia)}",
-        f'      <geom class="visual" type="capsule" size="0.08" fromto="0 0 0.1 0 0 {_f(r.trunk_length - 0.1)}"/>',
+        f'      <geom class="visual" type="capsule" size="0.08" fromto="0 0 0.1 0 0 {_f(r.trunk_length - 0.1)}" material="trunk"/>',
         '      <site name="hip"/>',
     ]
     for side in SIDES:
@@ -122,19 +148,19 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
             f'{pad}<body name="{side}_thigh" pos="0 {_f(HIP_OFFSET if side == "left" else -HIP_OFFSET)} 0">',
             f'{pad}  <joint name="{side}_hip"/>',
             f"{pad}  {_inertial(-r.thigh_com, r.thigh_mass, r.thigh_inertia)}",
-            f'{pad}  <geom class="visual" type="capsule" size="0.045" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
+            f'{pad}  <geom class="visual" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}" material="{side}"/>',
         ]
         if rolling:
             lines += [
-                f'{pad}  <geom class="visual" type="cylinder" size="{_f(r2)} 0.03" pos="0 0 {_f(-thigh)}" zaxis="0 1 0"/>',
+                f'{pad}  <geom name="{side}_thigh_disc" class="visual" type="cylinder" size="{_f(r2)} {_f(DISC_HALF_WIDTH)}" pos="0 0 {_f(-thigh)}" zaxis="0 1 0" material="{side}_disc"/>',
                 f'{pad}  <body name="{side}_knee_link" pos="0 0 {_f(-thigh)}">',
                 f'{pad}    <joint name="{side}_knee_upper" armature="{_f(KNEE_ARMATURE)}"/>',
                 f"{pad}    {_inertial(-link / 2, KNEE_LINK_MASS, KNEE_LINK_INERTIA)}",
                 f'{pad}    <body name="{side}_shank" pos="0 0 {_f(-link)}">',
                 f'{pad}      <joint name="{side}_knee_lower" armature="{_f(KNEE_ARMATURE)}"/>',
-                f'{pad}      <geom class="visual" type="cylinder" size="{_f(r1)} 0.03" zaxis="0 1 0" rgba="0.5 0.5 0.55 1"/>',
+                f'{pad}      <geom name="{side}_shank_disc" class="visual" type="cylinder" size="{_f(r1)} {_f(DISC_HALF_WIDTH)}" zaxis="0 1 0" material="{side}_disc"/>',
             ]
-            pad += "    "
+            pad += "  "  # inside the knee link and the shank
         else:
             lines += [
                 f'{pad}  <body name="{side}_shank" pos="0 0 {_f(-thigh)}">',
@@ -142,7 +168,7 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
             ]
         lines += [
             f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia)}",
-            f'{pad}    <geom class="visual" type="capsule" size="0.035" fromto="0 0 0 0 0 {_f(-shank)}"/>',
+            f'{pad}    <geom class="visual" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}" material="{side}"/>',
             f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
             f'{pad}      <joint name="{side}_ankle" armature="{_f(ANKLE_ARMATURE)}"/>',
             f"{pad}      {_inertial(-r.foot_com, r.foot_mass, r.foot_inertia)}",
@@ -151,7 +177,7 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
             f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}"/>',
             f'{pad}      <geom class="visual" type="box" '
             f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
-            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}"/>',
+            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}" material="{side}"/>',
             f'{pad}      <site name="{side}_ankle"/>',
             f'{pad}      <site name="{side}_sole_touch" type="box" '
             f'size="{_f(r.foot_length / 2 + 0.005)} {_f(FOOT_WIDTH / 2 + 0.005)} {_f(SOLE_THICKNESS / 2 + 0.005)}" '
@@ -214,7 +240,7 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         ]
     lines += ["  </sensor>", "", "  <keyframe>"]
     nq = 3 + 2 * (4 if rolling else 3)
-    home = ["0", _f(stand)] + ["0"] * (nq - 2)
+    home = ["0", _f(stand)] + ["0"] * (nq - 2)  # qpos0: standing straight on the floor
     lines += [f'    <key name="home" qpos="{" ".join(home)}"/>', "  </keyframe>", "</mujoco>", ""]
     return "\n".join(lines)
 
@@ -229,22 +255,28 @@ def scene_model(robot: Robot, knee: str, servos=None):
 
 
 def scene_xml(knee: str) -> str:
-    """A scene that includes the robot file and adds the floor and a light."""
+    """A scene that includes the robot file and adds the floor, a sky and a light."""
     return "\n".join(
         [
             f'<mujoco model="scene_{knee}">',
             f'  <include file="biped_{knee}.xml"/>',
             "",
-            '  <visual><global azimuth="90" elevation="-15"/></visual>',
+            "  <visual>",
+            '    <headlight diffuse="0.5 0.5 0.5" ambient="0.3 0.3 0.3" specular="0 0 0"/>',
+            f'    <global azimuth="90" elevation="-10" offwidth="{OFFSCREEN[0]}" '
+            f'offheight="{OFFSCREEN[1]}"/>',
+            "  </visual>",
             "",
             "  <asset>",
+            '    <texture type="skybox" builtin="gradient" rgb1="0.86 0.88 0.9" '
+            'rgb2="0.6 0.63 0.67" width="512" height="3072"/>',
             '    <texture name="grid" type="2d" builtin="checker" width="512" height="512" '
-            'rgb1="0.2 0.3 0.4" rgb2="0.3 0.4 0.5"/>',
+            'rgb1="0.42 0.43 0.45" rgb2="0.32 0.33 0.35"/>',
             '    <material name="grid" texture="grid" texrepeat="1 1" texuniform="true"/>',
             "  </asset>",
             "",
             "  <worldbody>",
-            '    <light pos="0 -2 3" dir="0 1 -1"/>',
+            '    <light name="sun" type="directional" dir="0.3 0.6 -1" diffuse="0.6 0.6 0.6"/>',
             '    <geom name="floor" type="plane" size="0 0 0.05" material="grid" '
             f'friction="{FOOT_FRICTION}" contype="0" conaffinity="1"/>',
             "  </worldbody>",
@@ -268,11 +300,7 @@ def write_models(folder: Path = FOLDER, robot: Robot | None = None) -> list[Path
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
     for name, text in model_files(robot).items():
-        path = folder / name
-        tmp = path.with_suffix(".xml.tmp")
-        tmp.write_text(text)
-        tmp.replace(path)
-        paths.append(path)
+        paths.append(atomic_write_text(folder / name, text))
     return paths
 
 
