@@ -1,0 +1,361 @@
+"""Videos of MuJoCo's walk: the tracking camera, the floor, the analytical gait as a ghost and a
+caption band with the step, the time and the verdict of the validation.
+
+    python -m validate.video GAIT.json --out walk.mp4 [--gif walk.gif] [--steps 20]
+    python -m validate.video GAIT.json --frame docs/walk.png [--at 2.0]
+
+The frames are the states that ``validate.simulate.simulate`` recorded (no simulation of
+its own): one every 1 / ``FPS`` s, drawn by MuJoCo's offscreen renderer (set
+``MUJOCO_GL=egl`` on a machine without a display) from the model's ``track`` camera. The
+ghost is the gait at the phase the controller followed, its stance foot on MuJoCo's stance
+foot, drawn as translucent copies of the model's geoms (``mjv_addGeoms``) a little behind the
+robot. The MP4 is H.264
+(yuv420p) written by imageio-ffmpeg's ffmpeg; the GIF, smaller and slower, by Pillow.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from functools import lru_cache
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from biped.dynamics import Biped
+from biped.files import atomic_path
+from biped.gait import angles_at
+from validate.mapping import mapping
+from validate.mjcf import SIDES
+from validate.simulate import Simulation
+
+# Frames per second of the video (simulated time runs at real time).
+FPS = 30
+# Rendered image [px] (width, height), multiples of 16 as H.264 encoders prefer; the caption
+# band adds CAPTION_HEIGHT above it.
+SIZE = (768, 432)
+CAPTION_HEIGHT = 48
+# The GIF: every GIF_EVERY-th frame, scaled by GIF_SCALE.
+GIF_EVERY = 2
+GIF_SCALE = 0.5
+# Colour (RGBA) of the analytical gait's ghost, and its offset behind the robot (+y, away
+# from the camera) [m]: beside the robot, not through it.
+GHOST_RGBA = (0.95, 0.95, 1.0, 0.4)
+GHOST_OFFSET = 0.35
+# Offscreen rendering on a CPU (llvmpipe): shadows from a 1024 px map and no multisampling
+# draw a frame in about 45 ms instead of 110 ms.
+SHADOW_SIZE = 1024
+OFFSCREEN_SAMPLES = 0
+# A pixel shows a leg when its colour's dominant channel (blue for the left leg, red for the
+# right one) exceeds the other two by these margins [0-255]: grey floor, sky and trunk do not.
+LEG_MARGIN = (40, 60)
+PASS_COLOR, FAIL_COLOR, TEXT_COLOR = (90, 210, 110), (240, 80, 70), (235, 235, 235)
+
+
+def leg_pixels(image: np.ndarray) -> dict:
+    """Fraction of the image's pixels (0-1) in the colour of each leg: {'left': .., 'right': ..}.
+
+    The left leg is blue (blue above green and red), the right one orange (red above green
+    and blue); the floor, the sky and the trunk are grey and count for neither.
+    """
+    rgb = np.asarray(image, dtype=np.int16)[..., :3]
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    near, far = LEG_MARGIN
+    left = (b - g > near) & (b - r > far)
+    right = (r - g > near) & (r - b > far)
+    return {"left": float(left.mean()), "right": float(right.mean())}
+
+
+class WalkRenderer:
+    """Frames of a simulated walk, with the gait's ghost, from the model's tracking camera."""
+
+    def __init__(
+        self,
+        biped: Biped,
+        step,
+        sim: Simulation,
+        size: tuple[int, int] = SIZE,
+        ghost: bool = True,
+    ):
+        self.biped, self.step, self.sim = biped, step, sim
+        self.model = sim.model
+        self.data = mujoco.MjData(self.model)
+        self.ghost_data = mujoco.MjData(self.model) if ghost else None
+        quality = self.model.vis.quality
+        kept = quality.shadowsize, quality.offsamples
+        quality.shadowsize, quality.offsamples = SHADOW_SIZE, OFFSCREEN_SAMPLES
+        try:
+            self.renderer = mujoco.Renderer(self.model, height=size[1], width=size[0])
+        finally:
+            quality.shadowsize, quality.offsamples = kept
+        self.option = mujoco.MjvOption()
+        self.perturb = mujoco.MjvPerturb()
+        self.maps = {side: mapping(self.model, side, biped.radii) for side in SIDES}
+        self.ankle_x = {
+            side: sim.sensor(f"{side}_ankle_pos")[:, 0] for side in SIDES
+        }  # MuJoCo's ankles [m]
+
+    def close(self) -> None:
+        self.renderer.close()
+
+    def step_of(self, k: int) -> int:
+        """Index of the step that state k belongs to."""
+        return int(np.searchsorted(self.sim.step_starts, k, side="right") - 1)
+
+    def ghost_qpos(self, k: int) -> np.ndarray:
+        """MuJoCo's qpos of the gait at the phase of state k, with its stance ankle at MuJoCo's
+        stance ankle at the start of the step."""
+        sim = self.sim
+        j = self.step_of(k)
+        stance = sim.stances[j]
+        angles, rates, accel = angles_at(self.step, np.array([sim.phase[k] / self.step.period]))
+        q = self.biped.single_support(angles, rates, accel)[0][0]
+        qpos = self.maps[stance].qpos(q)
+        qpos[self.model.joint("rootx").qposadr[0]] += self.ankle_x[stance][sim.step_starts[j]]
+        return qpos
+
+    def render(self, k: int) -> np.ndarray:
+        """The image (height, width, 3) of simulation state k."""
+        self.data.qpos[:] = self.sim.qpos[k]
+        self.data.qvel[:] = self.sim.qvel[k]
+        mujoco.mj_forward(self.model, self.data)
+        self.renderer.update_scene(self.data, camera="track", scene_option=self.option)
+        if self.ghost_data is not None:
+            self.ghost_data.qpos[:] = self.ghost_qpos(k)
+            mujoco.mj_kinematics(self.model, self.ghost_data)
+            scene = self.renderer.scene
+            first = scene.ngeom
+            mujoco.mjv_addGeoms(
+                self.model,
+                self.ghost_data,
+                self.option,
+                self.perturb,
+                mujoco.mjtCatBit.mjCAT_DYNAMIC,
+                scene,
+            )
+            for i in range(first, scene.ngeom):
+                scene.geoms[i].rgba[:] = GHOST_RGBA
+                scene.geoms[i].matid = -1
+                scene.geoms[i].pos[1] += GHOST_OFFSET
+        return self.renderer.render()
+
+
+@lru_cache(maxsize=8)
+def _font(size: int):
+    from matplotlib import font_manager
+    from PIL import ImageFont
+
+    return ImageFont.truetype(font_manager.findfont("DejaVu Sans"), size)
+
+
+@lru_cache(maxsize=64)
+def caption_band(left: str, right: str, passed: bool | None, width: int) -> np.ndarray:
+    """A dark band (CAPTION_HEIGHT, width, 3) with ``left`` at its left and ``right`` at its
+    right, the latter green if ``passed``, red if not, grey if None."""
+    from PIL import Image, ImageDraw
+
+    band = Image.new("RGB", (width, CAPTION_HEIGHT), (28, 30, 34))
+    draw = ImageDraw.Draw(band)
+    font = _font(20)
+    middle = CAPTION_HEIGHT // 2
+    draw.text((14, middle), left, fill=TEXT_COLOR, font=font, anchor="lm")
+    color = TEXT_COLOR if passed is None else PASS_COLOR if passed else FAIL_COLOR
+    draw.text((width - 14, middle), right, fill=color, font=font, anchor="rm")
+    return np.asarray(band)
+
+
+def frame_states(sim: Simulation, fps: int = FPS) -> np.ndarray:
+    """Indices of the simulation states shown at ``fps`` frames per second."""
+    times = np.arange(sim.time[0], sim.time[-1] + 1e-9, 1.0 / fps)
+    return np.minimum(np.searchsorted(sim.time, times), len(sim.time) - 1)
+
+
+class Captioned:
+    """Frames with the caption: step j of n and the time at the left, the verdict at the right.
+
+    Args:
+        verdict: the text at the right (e.g. "validation PASS: 20 steps walked").
+        passed: colours the verdict (green, red; None: grey).
+    """
+
+    def __init__(self, renderer: WalkRenderer, verdict: str, passed: bool | None):
+        self.renderer, self.verdict, self.passed = renderer, verdict, passed
+
+    def frame(self, k: int) -> np.ndarray:
+        r = self.renderer
+        image = r.render(k)
+        steps = len(r.sim.stances)
+        left = f"step {r.step_of(k) + 1} / {steps}   t = {r.sim.time[k]:5.2f} s"
+        band = caption_band(left, self.verdict, self.passed, image.shape[1])
+        return np.concatenate([band, image], axis=0)
+
+
+def verdict_of(checks) -> tuple[str, bool]:
+    """Caption of a list of ``validate.report.Check``: PASS or the failed checks, and the
+    steps walked."""
+    passed = all(check.passed for check in checks)
+    failed = [check.name for check in checks if not check.passed]
+    text = "PASS" if passed else "FAIL: " + ", ".join(failed)
+    for check in checks:
+        if check.name == "forward":
+            text += f"   walked {check.figures['steps']} steps"
+    return text, passed
+
+
+def write_mp4(path: str | Path, frames, fps: int = FPS) -> Path:
+    """Write frames (iterable of equal (H, W, 3) uint8 arrays) as an H.264 MP4, atomically."""
+    import imageio_ffmpeg
+
+    path = Path(path)
+    frames = iter(frames)
+    first = next(frames)
+    height, width = first.shape[:2]
+    with atomic_path(path) as tmp:
+        writer = imageio_ffmpeg.write_frames(
+            str(tmp),
+            (width, height),
+            fps=fps,
+            codec="libx264",
+            pix_fmt_out="yuv420p",
+            quality=7,
+            macro_block_size=16,
+            output_params=["-f", "mp4", "-movflags", "+faststart"],
+        )
+        writer.send(None)  # start ffmpeg
+        try:
+            writer.send(np.ascontiguousarray(first))
+            for frame in frames:
+                writer.send(np.ascontiguousarray(frame))
+        finally:
+            writer.close()
+    return path
+
+
+def write_gif(path: str | Path, frames, fps: int = FPS) -> Path:
+    """Write frames as an animated GIF (every GIF_EVERY-th, scaled by GIF_SCALE), atomically."""
+    from PIL import Image
+
+    images = []
+    for i, frame in enumerate(frames):
+        if i % GIF_EVERY == 0:
+            image = Image.fromarray(frame)
+            size = (round(image.width * GIF_SCALE), round(image.height * GIF_SCALE))
+            images.append(image.resize(size, Image.Resampling.BILINEAR))
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        images[0].save(
+            tmp,
+            format="GIF",
+            save_all=True,
+            append_images=images[1:],
+            duration=round(1000 * GIF_EVERY / fps),
+            loop=0,
+        )
+    return path
+
+
+def write_video(
+    path: str | Path | None,
+    biped: Biped,
+    step,
+    sim: Simulation,
+    checks=(),
+    gif: str | Path | None = None,
+    ghost: bool = True,
+    fps: int = FPS,
+) -> list[Path]:
+    """Render the walk of ``sim`` to an MP4 at ``path`` and/or a GIF at ``gif``; returns the
+    files written. ``checks`` (``validate.report.Check``) give the verdict in the caption."""
+    verdict, passed = verdict_of(checks) if checks else ("", None)
+    renderer = WalkRenderer(biped, step, sim, ghost=ghost)
+    try:
+        captioned = Captioned(renderer, verdict, passed)
+        states = frame_states(sim, fps)
+        written = []
+        if gif is not None:
+            frames = [captioned.frame(k) for k in states]
+            if path is not None:
+                written.append(write_mp4(path, frames, fps))
+            written.append(write_gif(gif, frames, fps))
+        elif path is not None:
+            written.append(write_mp4(path, (captioned.frame(k) for k in states), fps))
+    finally:
+        renderer.close()
+    return written
+
+
+def write_frame(
+    path: str | Path, biped: Biped, step, sim: Simulation, at: float, checks=(), ghost=True
+) -> Path:
+    """One captioned frame of the walk, at ``at`` seconds of simulation, as a PNG."""
+    from PIL import Image
+
+    verdict, passed = verdict_of(checks) if checks else ("", None)
+    renderer = WalkRenderer(biped, step, sim, ghost=ghost)
+    try:
+        k = int(min(np.searchsorted(sim.time, sim.time[0] + at), len(sim.time) - 1))
+        frame = Captioned(renderer, verdict, passed).frame(k)
+    finally:
+        renderer.close()
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        Image.fromarray(frame).save(tmp, format="PNG")
+    return path
+
+
+def main(argv=None) -> int:
+    """Validate a gait file and write the video, GIF or one frame of its walk in MuJoCo."""
+    from biped import gait_file
+    from biped.errors import BipedError
+    from validate.report import validate
+
+    parser = argparse.ArgumentParser(prog="python -m validate.video", description=main.__doc__)
+    parser.add_argument("gait", metavar="GAIT.json", help="a gait file (optimize, pipeline)")
+    parser.add_argument("--out", metavar="FILE.mp4", help="the video (H.264)")
+    parser.add_argument("--gif", metavar="FILE.gif", help="an animated GIF of the walk")
+    parser.add_argument("--frame", metavar="FILE.png", help="one frame of the walk (PNG)")
+    parser.add_argument(
+        "--at", type=float, default=2.0, help="time of --frame [s of simulation] (default 2)"
+    )
+    parser.add_argument("--steps", type=int, default=20, help="steps walked (default 20)")
+    parser.add_argument("--no-ghost", action="store_true", help="leave out the gait's ghost")
+    args = parser.parse_args(argv)
+    if not (args.out or args.gif or args.frame):
+        parser.error("nothing to write: give --out, --gif or --frame")
+    try:
+        result = validate(gait_file.read(args.gait), steps=args.steps)
+        ghost = not args.no_ghost
+        written = []
+        if args.out or args.gif:
+            written += write_video(
+                args.out,
+                result.biped,
+                result.step,
+                result.simulation,
+                result.checks,
+                gif=args.gif,
+                ghost=ghost,
+            )
+        if args.frame:
+            written.append(
+                write_frame(
+                    args.frame,
+                    result.biped,
+                    result.step,
+                    result.simulation,
+                    args.at,
+                    result.checks,
+                    ghost,
+                )
+            )
+    except (BipedError, OSError) as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
