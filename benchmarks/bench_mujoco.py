@@ -18,6 +18,7 @@ from mujoco import rollout  # noqa: E402
 
 import biped  # noqa: E402
 from biped.optimize import optimize  # noqa: E402
+from biped.problem import GaitProblem  # noqa: E402
 from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
 from validate.simulate import simulate  # noqa: E402
 
@@ -50,7 +51,7 @@ def main():
     )
     for knee in biped.KNEES:
         model = biped.Biped(biped.Robot.paper(), knee)
-        optimum = optimize(model, 0.3)
+        optimum = optimize(GaitProblem(model, 0.3))
         walls = []
         for _ in range(3):
             began = time.perf_counter()

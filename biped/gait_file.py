@@ -10,7 +10,9 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
     impact {impulse [N·s, N·s, N·m·s], trailing_foot_lift [m/s] (heel, toe), consistent
             (Iz > 0 and the trailing foot lifts: the flat-foot impact model holds), qd_minus,
             qd_plus},
-    optimizer {seed, evaluations, seconds, history},
+    optimizer {method, status ("converged" when the best start's solver converged), starts,
+               starts_at_best, iterations, constraint_violation, dual_infeasibility,
+               seconds, seed, history (each start), variables (the solver's variables)},
     provenance {package, version, python, platform, numpy, scipy, casadi, mujoco, command}
         (``biped.provenance``: what produced the file),
     samples {t, q, qd, qdd, torques, wrench, zmp}
@@ -36,6 +38,7 @@ from biped.gait import PARAMETERS
 from biped.impact import trailing_foot_lift
 from biped.kinematics import KNEES
 from biped.optimize import Optimum, check_speed
+from biped.problem import VARIABLES
 from biped.provenance import provenance as make_provenance
 from biped.robot import Robot
 
@@ -82,10 +85,8 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None =
             "qd_plus": step.start[1].tolist(),
         },
         "optimizer": {
-            "seed": seed,
-            "evaluations": optimum.evaluations,
-            "seconds": optimum.seconds,
-            "history": [list(map(float, run)) for run in optimum.history],
+            **optimum.report.to_dict(),
+            "variables": dict(zip(VARIABLES, map(_finite_or_none, optimum.variables), strict=True)),
         },
         "provenance": dict(provenance) if provenance is not None else make_provenance(),
         "samples": {
@@ -115,6 +116,10 @@ def _finite_number(value) -> bool:
         return math.isfinite(float(value))
     except OverflowError:
         return False
+
+
+def _finite_or_none(value):
+    return float(value) if math.isfinite(value) else None
 
 
 def _positive_number(value) -> bool:

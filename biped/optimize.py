@@ -1,345 +1,375 @@
-"""Optimal gait at a given speed: Nelder-Mead with restarts (§4), then an SLSQP polish.
+"""Certified optimal gaits: IPOPT with exact derivatives from several starts.
 
-1. The paper's method. The constraints enter the criterion through the exponential penalty
-   of eqs. (30)-(31), so the problem is unconstrained and solved by
-   ``scipy.optimize.minimize(method="Nelder-Mead")``, restarted from the best point with a
-   fresh simplex as the paper suggests. The simplex works on scaled parameters so that one
-   unit is a comparable change of every parameter (``SCALES``).
-2. A polish. Nelder-Mead in 21 dimensions stalls far from the minimum (its result changes by
-   factors of several with the budget and the first guess), so its result is refined by
-   ``scipy.optimize.minimize(method="SLSQP")`` on the same criterion with the constraints
-   written explicitly, Ψ_i >= δ_i at every sample of the polish grid.
+``optimize(problem)`` solves a ``GaitProblem`` with IPOPT (``biped.solver``) from several
+first guesses and keeps the best converged one:
 
-A gait is reported feasible only if every constraint holds with zero penalty on a fine grid
-(``CHECK_SAMPLES_PER_HALF`` per spline piece); of the candidates (after Nelder-Mead, after
-the polish) the best feasible one is returned.
+- the default first guess (``GaitProblem.first_guess``);
+- perturbed first guesses, drawn from ``numpy.random.default_rng(seed)``;
+- optionally the paper's Nelder-Mead from a few seeds (``nelder_mead_starts``);
+- any given guesses, e.g. the optimum at a neighbouring speed in a sweep (``given``).
+
+The optimum is certified when IPOPT converged from its start, and confirmed when at least
+two starts reach the same value (within ``AGREEMENT``, relative). A solver that did not
+converge is reported as such (``Report.status``), never replaced by a silent fallback; the
+command line exits 1 on it.
+
+Every optimum is then checked on a fine grid (``CHECK_SAMPLES_PER_HALF`` samples per spline
+piece, where the solver imposed the constraints with margins at ``samples_per_half``): it is
+feasible only if every constraint holds there with zero penalty.
+
+``method="nelder-mead"`` runs the paper's method alone (``biped.penalty``) so that its
+results can be set beside certified optima.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize
 
-from biped.criteria import (
-    BUILD_ERROR_COST,
-    BUILD_ERROR_SLOPE,
-    CRITERIA,
-    PAPER_SAFETY,
-    Safety,
-    StepEvaluation,
-    checked_mask,
-    evaluate_step,
-    margin_profile,
+from biped.criteria import StepEvaluation, evaluate_step
+from biped.errors import BipedError
+from biped.gait import Step, build_step
+from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
+from biped.problem import (  # noqa: F401 (re-exported)
+    SCALES,
+    GaitProblem,
+    bounds,
+    check_criterion,
+    check_speed,
+    max_walking_speed,
 )
-from biped.dynamics import Biped
-from biped.errors import BipedError, UnreachableError
-from biped.gait import N_PARAMETERS, Step, StepBuildError, build_step
+from biped.solver import CONVERGED, solver_for
 
-# Samples per spline piece while optimising and when checking the optimum.
-OPTIMIZE_SAMPLES_PER_HALF = 40
-CHECK_SAMPLES_PER_HALF = 100  # 202 samples per step
-# Default search budget: a first Nelder-Mead run, then restarts from the best point.
-EVALUATIONS_PER_RUN = 1500
-MAX_RESTARTS = 1
-# Duration of a step in the first guess [s].
-FIRST_GUESS_PERIOD = 0.6
-# Samples per spline piece of the polish (its constraints are Ψ - δ at every sample).
-POLISH_SAMPLES_PER_HALF = 25
-# SLSQP iterations of the polish at most.
-POLISH_ITERATIONS = 200
-# Constraints are divided by these in the polish so that all are of order one [N, m, ...].
-CONSTRAINT_SCALES = np.array([1000.0, 0.1, 0.1, 1.0, 1.0, 0.1, 0.1])
-# One unit of the scaled search space, per parameter: [m, m, rad, rad/s x5, rad/s² x12, s].
-SCALES = np.array([0.02, 0.02, 0.03] + [0.3] * 5 + [2.0] * 12 + [0.05])
+METHODS = ("ipopt", "nelder-mead")
+# Starts of IPOPT by default: the first guess and this many perturbed guesses, minus one.
+DEFAULT_STARTS = 3
+# Standard deviation of the perturbed starts, in units of ``SCALES``.
+PERTURBATION = 1.0
+# Two starts reach the same optimum when their values agree to this, relative.
+AGREEMENT = 1e-6
+# Samples per spline piece of the feasibility check of an optimum (202 per step).
+CHECK_SAMPLES_PER_HALF = 100
 
 
-def max_walking_speed(model: Biped) -> float:
-    """[m/s] √(g L), L the leg length: above it (Froude number > 1) gravity cannot keep the
-    stance foot on the ground as the hip vaults over it, whatever the gait."""
-    leg = model.robot.shank_length + model.robot.thigh_length
-    return float(np.sqrt(model.gravity * leg))
+@dataclass(frozen=True)
+class Start:
+    """One start of the solver and where it ended."""
+
+    kind: str  # "first guess", "perturbed", "nelder-mead", "given"
+    value: float  # criterion reached (solver's samples)
+    status: str  # solver status
+    iterations: int
 
 
-def check_speed(model: Biped, speed: float) -> float:
-    """Return ``speed`` if walkable at all, raise a clear error otherwise."""
-    high = max_walking_speed(model)
-    if not (np.isfinite(speed) and 0.0 < speed <= high):
-        raise BipedError(
-            f"speed = {speed!r} m/s: allowed 0 < speed <= {high:.3g} m/s "
-            f"(√(g·leg length): faster, the stance foot leaves the ground)"
-        )
-    return float(speed)
+@dataclass(frozen=True)
+class Report:
+    """How an optimum was found, as recorded in gait files (``optimizer``).
 
-
-def check_criterion(criterion: str) -> str:
-    if criterion not in CRITERIA:
-        raise BipedError(f"criterion = {criterion!r}: allowed 'sthenic', 'energy'")
-    return criterion
-
-
-def initial_parameters(model: Biped, speed: float, period: float = FIRST_GUESS_PERIOD):
-    """A walkable first guess: hip midway between the feet, legs turning as stiff pendulums.
-
-    Args:
-        period: duration of the step T [s]; the step length is speed x T.
+    Attributes:
+        method: ``"ipopt"`` or ``"nelder-mead"``.
+        status: ``"converged"`` when the best start's solver converged, else the solver's
+            own status (IPOPT's return status, or ``"budget exhausted"`` for Nelder-Mead).
+        starts: number of starts.
+        starts_at_best: converged starts within ``AGREEMENT`` of the best value.
+        iterations: solver iterations of the best start.
+        constraint_violation: largest violation of a constraint or bound at the best point,
+            in the solver's scaled units.
+        dual_infeasibility: at the best point (IPOPT's measure; NaN for Nelder-Mead).
+        seconds: wall time of all starts.
+        seed: seed of the perturbed starts and of Nelder-Mead's restarts.
+        history: every start with its kind, value, status and iterations.
     """
-    leg = model.robot.shank_length + model.robot.thigh_length
-    length = min(speed * period, leg)  # a step the legs can reach at any speed
-    period = length / speed
-    height = np.sqrt((0.97 * leg) ** 2 - (length / 2) ** 2) + model.robot.ankle_height
-    rate = -speed / leg
-    p = np.zeros(N_PARAMETERS)
-    p[0:3] = [-length / 2, height, 0.0]
-    p[3:7] = rate  # q1..q4 turn backwards as the hip passes over the feet
-    p[20] = period
-    return p
+
+    method: str
+    status: str
+    starts: int
+    starts_at_best: int
+    iterations: int
+    constraint_violation: float
+    dual_infeasibility: float
+    seconds: float
+    seed: int
+    history: tuple = field(default_factory=tuple)
+    value: float = float("nan")  # the best start's criterion on the solver's samples
+
+    @property
+    def converged(self) -> bool:
+        return self.status == "converged"
+
+    @property
+    def confirmed(self) -> bool:
+        """Reached from at least two starts."""
+        return self.starts_at_best >= 2
+
+    def to_dict(self) -> dict:
+        return {
+            "method": self.method,
+            "status": self.status,
+            "starts": self.starts,
+            "starts_at_best": self.starts_at_best,
+            "iterations": self.iterations,
+            "constraint_violation": _finite_or_none(self.constraint_violation),
+            "dual_infeasibility": _finite_or_none(self.dual_infeasibility),
+            "seconds": self.seconds,
+            "seed": self.seed,
+            "value": _finite_or_none(self.value),
+            "history": [
+                {
+                    "kind": s.kind,
+                    "value": _finite_or_none(s.value),
+                    "status": s.status,
+                    "iterations": s.iterations,
+                }
+                for s in self.history
+            ],
+        }
+
+    @classmethod
+    def from_dict(cls, content: dict) -> Report:
+        """The report written by ``to_dict``."""
+
+        def number(value):
+            return float("nan") if value is None else float(value)
+
+        return cls(
+            method=content["method"],
+            status=content["status"],
+            starts=int(content["starts"]),
+            starts_at_best=int(content["starts_at_best"]),
+            iterations=int(content["iterations"]),
+            constraint_violation=number(content["constraint_violation"]),
+            dual_infeasibility=number(content["dual_infeasibility"]),
+            seconds=float(content["seconds"]),
+            seed=int(content["seed"]),
+            value=number(content.get("value")),
+            history=tuple(
+                Start(s["kind"], number(s["value"]), s["status"], int(s["iterations"]))
+                for s in content["history"]
+            ),
+        )
+
+    def summary(self) -> str:
+        """One line for the command line."""
+        agreement = (
+            f"{self.starts_at_best} of {self.starts} starts at the best value"
+            if self.method == "ipopt"
+            else f"{self.starts} start"
+        )
+        return (
+            f"{self.method}: {self.status}, {agreement}, {self.iterations} iterations, "
+            f"constraint violation {self.constraint_violation:.1e}, dual infeasibility "
+            f"{self.dual_infeasibility:.1e}, {self.seconds:.2f} s"
+        )
 
 
-def cost(model: Biped, speed, criterion, p, samples_per_half, safety: Safety = PAPER_SAFETY):
-    """The criterion (30) or (31) of parameters p, penalties (with margins) and Err included."""
-    try:
-        step = build_step(model, speed, p)
-    except StepBuildError as error:
-        return BUILD_ERROR_COST + BUILD_ERROR_SLOPE * error.excess
-    except UnreachableError:
-        return BUILD_ERROR_COST
-    evaluation = evaluate_step(model, step, samples_per_half, margins=True, safety=safety)
-    value = evaluation.cost(criterion, step.step_length)
-    return value if np.isfinite(value) else BUILD_ERROR_COST
+def _finite_or_none(value):
+    return float(value) if np.isfinite(value) else None
 
 
 @dataclass
 class Optimum:
-    """Result of one optimisation."""
+    """A solution of a ``GaitProblem`` with its solver report.
 
-    knee: str
-    criterion: str
-    speed: float  # [m/s]
-    parameters: np.ndarray  # (21,)
+    Attributes:
+        problem: what was solved.
+        variables: the solvers' variables (``biped.problem.VARIABLES``).
+        parameters: the paper's 21 parameters (``biped.gait.PARAMETERS``).
+        step: the step they build.
+        evaluation: on the fine check grid.
+        value: the criterion there (penalty included: equal to the criterion when feasible).
+        report: how it was found.
+    """
+
+    problem: GaitProblem
+    variables: np.ndarray
+    parameters: np.ndarray
     step: Step
-    evaluation: StepEvaluation  # on the fine check grid
-    value: float  # criterion on the fine grid
-    evaluations: int  # number of criterion evaluations
-    seconds: float
-    history: list = field(default_factory=list)  # best value after each restart
-    safety: Safety = PAPER_SAFETY  # margins required beyond the paper's constraints
+    evaluation: StepEvaluation
+    value: float
+    report: Report
+
+    knee = property(lambda self: self.problem.knee)
+    criterion = property(lambda self: self.problem.criterion)
+    speed = property(lambda self: self.problem.speed)
+    safety = property(lambda self: self.problem.safety)
+    seconds = property(lambda self: self.report.seconds)
 
     @property
     def feasible(self) -> bool:
         return self.evaluation.feasible
 
+    @property
+    def certified(self) -> bool:
+        """Converged, feasible on the fine grid."""
+        return self.report.converged and self.feasible
+
     def rank(self) -> tuple:
-        """Sort key: feasible before infeasible, then lower criterion."""
-        return (not self.feasible, self.value)
+        """Sort key: certified first, then feasible, then lower criterion."""
+        return (not self.certified, not self.feasible, self.value)
 
     def costs(self) -> dict:
         """Both criteria of the gait (no penalty)."""
         return {"sthenic": self.evaluation.sthenic, "energy": self.evaluation.energy}
 
 
-class _Polish:
-    """The criterion without penalty and the constraints Ψ - δ as separate functions, for
-    SLSQP. SLSQP differentiates both by finite differences at the same points, so the step
-    evaluations of the latest points are kept and serve both."""
-
-    def __init__(self, model, speed, criterion, origin, samples_per_half, safety=PAPER_SAFETY):
-        self.model, self.speed, self.criterion, self.origin = model, speed, criterion, origin
-        self.safety = safety
-        self.samples = samples_per_half
-        self.cache: dict = {}
-        self.count = 0
-        self.reference = None
-        self.mask = checked_mask(samples_per_half)
-        self.margins = margin_profile(samples_per_half)[self.mask]
-        self.scales = np.broadcast_to(CONSTRAINT_SCALES, self.mask.shape)[self.mask]
-
-    def _evaluate(self, z):
-        key = z.tobytes()
-        if key in self.cache:
-            return self.cache[key]
-        self.count += 1
-        try:
-            step = build_step(self.model, self.speed, self.origin + SCALES * z)
-        except StepBuildError as error:
-            value = (None, -(1.0 + error.excess) * np.ones(self.margins.shape))
-        except UnreachableError:
-            value = (None, -np.ones(self.margins.shape))
-        else:
-            ev = evaluate_step(self.model, step, self.samples, safety=self.safety)
-            criterion = ev.sthenic if self.criterion == "sthenic" else ev.energy
-            psi = (ev.constraints[self.mask] - self.margins) / self.scales
-            if not np.all(np.isfinite(psi)) or not np.isfinite(criterion):
-                value = (None, -np.ones(self.margins.shape))
-            else:
-                value = (criterion, psi)
-        if len(self.cache) > 4 * N_PARAMETERS:
-            self.cache.pop(next(iter(self.cache)))
-        self.cache[key] = value
-        return value
-
-    def objective(self, z):
-        value, _ = self._evaluate(z)
-        if self.reference is None:
-            self.reference = abs(value) if value else 1.0
-        return BUILD_ERROR_COST if value is None else value / self.reference
-
-    def constraints(self, z):
-        return self._evaluate(z)[1]
+def check_method(method: str) -> str:
+    if method not in METHODS:
+        raise BipedError(f"method = {method!r}: allowed {', '.join(map(repr, METHODS))}")
+    return method
 
 
-def polish(
-    model, speed, criterion, parameters, max_iterations=POLISH_ITERATIONS, safety=PAPER_SAFETY
-):
-    """SLSQP from ``parameters`` on min C s.t. Ψ_i >= δ_i on the optimisation grid.
-
-    Returns (parameters, evaluations). The criterion here is smooth in the parameters
-    except where |Γ_i θ̇_i| changes sign (energy criterion), which SLSQP tolerates.
-    """
-    problem = _Polish(
-        model, speed, criterion, np.asarray(parameters, float), POLISH_SAMPLES_PER_HALF, safety
-    )
-    result = minimize(
-        problem.objective,
-        np.zeros(N_PARAMETERS),
-        method="SLSQP",
-        constraints=[{"type": "ineq", "fun": problem.constraints}],
-        options={"maxiter": max_iterations, "ftol": 1e-10},
-    )
-    return problem.origin + SCALES * result.x, problem.count
-
-
-def nelder_mead(
-    model, speed, criterion, start, rng, max_restarts, evaluations_per_run, safety=PAPER_SAFETY
-):
-    """Nelder-Mead on the penalised criterion, restarted from the best point (§4).
-
-    Returns (parameters, best value after each run, evaluations).
-    """
-    counter = [0]
-
-    def objective(z):
-        counter[0] += 1
-        p = start + SCALES * z
-        return cost(model, speed, criterion, p, OPTIMIZE_SAMPLES_PER_HALF, safety)
-
-    best_z = np.zeros(N_PARAMETERS)
-    best = objective(best_z)
-    history = [best]
-    for run in range(max_restarts + 1):
-        signs = np.ones(N_PARAMETERS) if run == 0 else rng.choice([-1.0, 1.0], N_PARAMETERS)
-        size = 1.0 if run == 0 else 0.5
-        simplex = np.vstack([best_z, best_z + size * np.diag(signs)])
-        result = minimize(
-            objective,
-            best_z,
-            method="Nelder-Mead",
-            options={
-                "initial_simplex": simplex,
-                "maxfev": evaluations_per_run,
-                "xatol": 1e-4,
-                "fatol": 1e-6 * max(abs(best), 1.0),
-                "adaptive": True,
-            },
-        )
-        improved = result.fun < best - 1e-6 * abs(best)
-        if result.fun < best:
-            best, best_z = float(result.fun), result.x
-        history.append(best)
-        if run > 0 and not improved:
-            break
-    return start + SCALES * best_z, history, counter[0]
+def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[str, np.ndarray]]:
+    """The default first guess and ``starts - 1`` perturbations of it, in the bounds."""
+    if isinstance(starts, bool) or not isinstance(starts, int) or starts < 0:
+        raise BipedError(f"starts = {starts!r}: allowed an integer >= 0")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise BipedError(f"seed = {seed!r}: allowed an integer >= 0")
+    guess = problem.first_guess()
+    lower, upper = bounds()
+    rng = np.random.default_rng(seed)
+    result = [("first guess", guess)] if starts else []
+    for _ in range(starts - 1):
+        z = guess + PERTURBATION * SCALES * rng.standard_normal(guess.shape)
+        z[:2] = np.abs(z[:2])  # the knee bends stay bends
+        result.append(("perturbed", np.clip(z, lower, upper)))
+    return result
 
 
 def optimize(
-    model: Biped,
-    speed: float,
-    criterion: str = "sthenic",
+    problem: GaitProblem,
     seed: int = 0,
+    starts: int = DEFAULT_STARTS,
+    given=(),
+    nelder_mead_starts: int = 0,
+    method: str = "ipopt",
     max_restarts: int = MAX_RESTARTS,
     evaluations_per_run: int = EVALUATIONS_PER_RUN,
-    starts=None,
-    polish_iterations: int = POLISH_ITERATIONS,
-    polish_starts=(),
-    safety: Safety = PAPER_SAFETY,
 ) -> Optimum:
-    """Minimise the criterion at walking speed ``speed`` [m/s].
-
-    From each first guess: Nelder-Mead with restarts on the penalised criterion (the paper's
-    method), then an SLSQP polish with the constraints explicit. The best feasible result
-    (on the fine check grid) over all first guesses wins; if none is feasible, the best.
+    """The best gait of ``problem``.
 
     Args:
-        seed: orients the restart simplices; the same seed gives the same result.
-        max_restarts: restarts from the best point after the first run.
-        evaluations_per_run: criterion evaluations per Nelder-Mead run.
-        starts: first guesses, each 21 parameters (default: ``initial_parameters``).
-        polish_iterations: SLSQP iterations at most (0: no polish).
-        polish_starts: guesses close to an optimum (e.g. the optimum at a neighbouring
-            speed), polished directly without Nelder-Mead.
-        safety: margins of ours beyond the paper's constraints (``Safety``): swing-foot
-            clearance, ZMP distance from the sole's edges. The paper's problem by default.
+        seed: seed of the perturbed starts and of Nelder-Mead; the same seed gives the
+            same result.
+        starts: IPOPT's own starts: the first guess and ``starts - 1`` perturbations.
+        given: further starts, each the solvers' variables (21,) (e.g. the optimum at a
+            neighbouring speed).
+        nelder_mead_starts: IPOPT also starts from the paper's Nelder-Mead run with seeds
+            ``seed``, ``seed + 1``, ...
+        method: ``"ipopt"`` or ``"nelder-mead"`` (the paper's method alone, from the first
+            guess, with ``max_restarts`` and ``evaluations_per_run``).
     """
-    speed = check_speed(model, speed)
-    criterion = check_criterion(criterion)
-    rng = np.random.default_rng(seed)
-    if starts is None:
-        starts = [initial_parameters(model, speed)]
-    starts = np.reshape(starts, (-1, N_PARAMETERS))
+    check_method(method)
+    if not isinstance(problem, GaitProblem):
+        raise BipedError(f"problem = {problem!r}: allowed a biped.problem.GaitProblem")
     began = time.perf_counter()
-    candidates = []
-    evaluations = 0
-    history = []
-    for start in starts:
-        parameters, runs, count = nelder_mead(
-            model,
-            speed,
-            criterion,
-            np.asarray(start, float),
-            rng,
+    if method == "nelder-mead":
+        return _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began)
+    solver = solver_for(problem)
+    candidates = first_guesses(problem, starts, seed)
+    candidates += [("given", np.asarray(z, dtype=float)) for z in given]
+    for k in range(nelder_mead_starts):
+        parameters, *_ = nelder_mead(
+            problem,
+            problem.to_parameters(problem.first_guess()),
+            np.random.default_rng(seed + k),
             max_restarts,
             evaluations_per_run,
-            safety,
         )
-        evaluations += count
-        history.append(runs)
-        candidates.append(parameters)
-        if polish_iterations > 0:
-            polished, count = polish(model, speed, criterion, parameters, polish_iterations, safety)
-            evaluations += count
-            candidates.append(polished)
-    for start in polish_starts:
-        candidates.append(np.asarray(start, float))
-        if polish_iterations > 0:
-            polished, count = polish(model, speed, criterion, start, polish_iterations, safety)
-            evaluations += count
-            candidates.append(polished)
-    best = None
-    for parameters in candidates:
         try:
-            step = build_step(model, speed, parameters)
-        except (StepBuildError, UnreachableError):
-            continue
-        evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF, safety=safety)
-        value = evaluation.cost(criterion, step.step_length)
-        rank = (not evaluation.feasible, value)
-        if best is None or rank < best[0]:
-            best = (rank, parameters, step, evaluation, value)
-    if best is None:
-        raise BipedError(f"no first guess at {speed} m/s gives a posture within reach")
-    _, parameters, step, evaluation, value = best
+            candidates.append(("nelder-mead", problem.from_parameters(parameters)))
+        except BipedError:
+            continue  # a Nelder-Mead point out of reach starts nothing
+    if not candidates:
+        raise BipedError("no start: allowed starts >= 1 or given guesses")
+    solutions = [(kind, solver.solve(problem, z)) for kind, z in candidates]
+    converged = [s for _, s in solutions if s.converged]
+    pool = converged or [s for _, s in solutions]
+    best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
+    history = tuple(Start(kind, s.value, s.status, s.iterations) for kind, s in solutions)
+    report = Report(
+        method="ipopt",
+        status="converged" if best.converged else best.status,
+        starts=len(solutions),
+        starts_at_best=_at_best(history, best.value),
+        iterations=best.iterations,
+        constraint_violation=best.constraint_violation,
+        dual_infeasibility=best.dual_infeasibility,
+        seconds=time.perf_counter() - began,
+        seed=int(seed),
+        history=history,
+        value=best.value,
+    )
+    return checked(problem, best.variables, report)
+
+
+def _at_best(history, value: float) -> int:
+    """Converged starts within ``AGREEMENT`` of ``value``."""
+    return int(
+        sum(
+            s.status in CONVERGED and abs(s.value - value) <= AGREEMENT * abs(value)
+            for s in history
+        )
+    )
+
+
+def best_of(problem: GaitProblem, optima) -> Optimum:
+    """The best of several optima of ``problem`` (certified first, then the lowest value),
+    its report counting the starts of all."""
+    optima = list(optima)
+    best = min(optima, key=lambda o: o.rank())
+    history = tuple(s for o in optima for s in o.report.history)
+    report = dataclasses.replace(
+        best.report,
+        starts=len(history),
+        starts_at_best=_at_best(history, best.report.value),
+        seconds=sum(o.report.seconds for o in optima),
+        history=history,
+    )
+    return dataclasses.replace(best, report=report)
+
+
+def _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began) -> Optimum:
+    start = problem.to_parameters(problem.first_guess())
+    parameters, history, count, converged = nelder_mead(
+        problem, start, np.random.default_rng(seed), max_restarts, evaluations_per_run
+    )
+    report = Report(
+        method="nelder-mead",
+        status="converged" if converged else "budget exhausted",
+        starts=1,
+        starts_at_best=1,
+        iterations=count,
+        constraint_violation=float("nan"),
+        dual_infeasibility=float("nan"),
+        seconds=time.perf_counter() - began,
+        seed=int(seed),
+        history=(Start("first guess", history[-1], "converged" if converged else "budget", count),),
+        value=history[-1],
+    )
+    return checked(problem, None, report, parameters)
+
+
+def checked(problem: GaitProblem, variables, report: Report, parameters=None) -> Optimum:
+    """An ``Optimum`` of ``variables`` (or the paper's ``parameters``), evaluated on the fine
+    check grid."""
+    if parameters is None:
+        parameters = problem.to_parameters(variables)
+    elif variables is None:
+        try:
+            variables = problem.from_parameters(parameters)
+        except BipedError:
+            variables = np.full(len(parameters), np.nan)
+    step = build_step(problem.model, problem.speed, parameters)
+    evaluation = evaluate_step(problem.model, step, CHECK_SAMPLES_PER_HALF, safety=problem.safety)
     return Optimum(
-        knee=model.knee,
-        criterion=criterion,
-        speed=speed,
-        parameters=parameters,
+        problem=problem,
+        variables=np.asarray(variables, dtype=float),
+        parameters=np.asarray(parameters, dtype=float),
         step=step,
         evaluation=evaluation,
-        value=value,
-        evaluations=evaluations,
-        seconds=time.perf_counter() - began,
-        history=history,
-        safety=safety,
+        value=evaluation.cost(problem.criterion, step.step_length),
+        report=report,
     )

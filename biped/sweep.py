@@ -1,22 +1,28 @@
-"""Sweeps of optimal gaits over walking speed, both knees and both criteria.
+"""Sweeps of certified optimal gaits over walking speed, both knees and both criteria.
 
-Each (knee, criterion) pair is a series over increasing speeds, and the series run in
-parallel on all cores. The first speed is optimised from the default first guess
-(Nelder-Mead, then SLSQP); each next one by continuation, polishing the optimum of the
-previous speed (same step length, period scaled to the new speed), and from the default first
-guess too if the continuation ends infeasible or with a jump of the criterion.
-Nelder-Mead and SLSQP find local minima, and continuation keeps a series in the basin it
-found instead of letting neighbouring speeds fall into unrelated ones.
+Every point (knee, criterion, speed) is solved in two stages, each point of a stage
+independent of the others, so the points run in parallel on all cores:
 
-Each point's gait file is written atomically as soon as it completes, so an interrupted
-sweep resumes with the points still missing (a saved point also seeds the continuation).
-Infeasible points are saved too (``feasible: false``) and are not optimised again.
+1. independent: IPOPT from the point's own starts (``biped.optimize.optimize``); the result
+   is kept in the hidden folder ``.independent/``;
+2. neighbours: IPOPT again from the independent optima of the neighbouring speeds of the
+   same series; the best of both stages is the point's gait file.
+
+Each result depends only on the files of the stage before, which are written whole
+(``biped.files``), so a sweep stopped at any moment and run again ends with exactly the files
+of an uninterrupted sweep. The folder's ``sweep.json`` records what shapes the numbers
+(robot, safety, speeds, seed, starts, method, versions); resuming with any of them changed is
+refused. Points whose solver did not converge, or whose optimum is infeasible, are saved
+with their status and counted in the summary; they are not optimised again.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import multiprocessing
 import os
+import signal
 import sys
 import time
 from dataclasses import dataclass
@@ -28,11 +34,17 @@ from biped import gait_file
 from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
+from biped.files import atomic_write_text, clean_stale_temporaries
 from biped.kinematics import KNEES
-from biped.optimize import check_speed, initial_parameters, optimize
+from biped.optimize import DEFAULT_STARTS, Optimum, best_of, optimize
+from biped.problem import VARIABLES, GaitProblem, check_speed
+from biped.provenance import version
 from biped.robot import Robot
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
+MANIFEST = "sweep.json"
+INDEPENDENT = ".independent"
+SWEEP_FORMAT = "biped-sweep/2"
 
 
 @dataclass(frozen=True)
@@ -45,19 +57,69 @@ class Point:
         return f"{self.knee}-{self.criterion}-{self.speed:.3f}.json"
 
 
-def _saved(path: Path, point: Point, robot: Robot, safety: Safety = PAPER_SAFETY):
-    """The gait saved for ``point`` at ``path``, or None if missing or unreadable.
+@dataclass(frozen=True)
+class Settings:
+    """What shapes a sweep's numbers, recorded in its folder."""
 
-    Raises:
-        BipedError: the file holds another robot's or another point's gait.
-    """
+    robot: Robot
+    safety: Safety
+    speeds: tuple
+    seed: int
+    starts: int
+
+    def to_dict(self) -> dict:
+        return {
+            "format": SWEEP_FORMAT,
+            "robot": self.robot.to_dict(),
+            "safety": dataclasses.asdict(self.safety),
+            "speeds": list(self.speeds),
+            "seed": self.seed,
+            "starts": self.starts,
+            "method": "ipopt",
+            "version": version(),
+            "casadi": version("casadi"),
+        }
+
+
+def _check_manifest(folder: Path, settings: Settings) -> None:
+    """Write the folder's manifest, or refuse a folder made with other settings."""
+    path = folder / MANIFEST
+    wanted = settings.to_dict()
+    if path.exists():
+        try:
+            found = json.loads(path.read_text())
+        except (OSError, ValueError, UnicodeDecodeError) as error:
+            raise BipedError(f"{path}: unreadable sweep record ({error})") from None
+        for key, value in wanted.items():
+            if found.get(key) != value:
+                raise BipedError(
+                    f"{path}: this folder's sweep was made with {key} = {found.get(key)!r}, "
+                    f"this run has {value!r}: allowed only the same settings, choose another "
+                    f"--out folder"
+                )
+        return
+    if any(folder.glob("*.json")):
+        raise BipedError(
+            f"{folder} holds gait files but no {MANIFEST}: allowed an empty folder or a "
+            f"sweep's, choose another --out folder"
+        )
+    atomic_write_text(path, json.dumps(wanted, indent=1))
+
+
+def _problem(settings: Settings, point: Point) -> GaitProblem:
+    model = Biped(settings.robot, point.knee)
+    return GaitProblem(model, point.speed, point.criterion, settings.safety)
+
+
+def _read_gait(path: Path, point: Point, settings: Settings):
+    """The gait saved at ``path`` or None if missing or unreadable."""
     try:
         gait = gait_file.read(path)
     except BipedError:
         return None
     found = (gait["knee"], gait["criterion"], gait["speed"])
-    same_problem = gait["robot"] == robot and gait["safety"] == safety
-    if found != (point.knee, point.criterion, point.speed) or not same_problem:
+    same = gait["robot"] == settings.robot and gait["safety"] == settings.safety
+    if found != (point.knee, point.criterion, point.speed) or not same:
         raise BipedError(
             f"{path} holds a gait of another robot, safety or point ({found[0]}, "
             f"{found[1]}, {found[2]} m/s): allowed only this sweep's, choose another --out folder"
@@ -65,96 +127,84 @@ def _saved(path: Path, point: Point, robot: Robot, safety: Safety = PAPER_SAFETY
     return gait
 
 
-def _continued(model, criterion, speed, source, seed, budget):
-    """Polish the optimum ``source`` = (speed, parameters, value) of a neighbouring speed at
-    ``speed``: same step length, period scaled to the new speed, so the posture stays in reach."""
-    last_speed, warm, _ = source
-    warm = warm.copy()
-    warm[-1] *= last_speed / speed
-    return optimize(model, speed, criterion, seed=seed, starts=[], polish_starts=[warm], **budget)
+def _optimum_of(gait: dict, settings: Settings, point: Point) -> Optimum:
+    """The ``Optimum`` stored in a gait file (same numbers: JSON keeps every bit)."""
+    from biped.optimize import Report, checked
+
+    variables = np.array([gait["optimizer"]["variables"][name] for name in VARIABLES], float)
+    report = Report.from_dict(gait["optimizer"])
+    return checked(_problem(settings, point), variables, report)
 
 
-def run_series(knee, criterion, speeds, robot, seed, folder, budget, stream=sys.stderr):
-    """Optimise one (knee, criterion) series over increasing speeds; returns points run.
-
-    Forward pass: each speed continues from the previous one (or starts from the first
-    guess). Backward pass, once every speed is done: where a speed's criterion lies above the
-    next speed's by more than ``CONTINUATION_GROWTH``, it sat in a worse basin and is polished
-    again from the next speed's optimum, kept if better. An interrupted sweep resumes in the
-    same pass with the same inputs, so it ends with the numbers of an uninterrupted one.
-    """
-    model = Biped(robot, knee)
-    speeds = sorted(speeds)
-    found: list = [None] * len(speeds)  # (speed, parameters, value) of feasible optima
-    ran = 0
-
-    def save(i, optimum, note=""):
-        point = Point(knee, criterion, float(speeds[i]))
-        gait_file.write_json(
-            Path(folder) / point.filename(), gait_file.to_dict(optimum, robot, seed)
-        )
-        status = "feasible" if optimum.feasible else "INFEASIBLE"
-        print(
-            f"[{knee:8} {criterion:7} {i + 1:2d}/{len(speeds)}] {point.speed:.3f} m/s  "
-            f"C = {optimum.value:12.4f}  {status}  {optimum.seconds:5.1f} s{note}",
-            file=stream,
-            flush=True,
-        )
-        found[i] = (point.speed, optimum.parameters, optimum.value) if optimum.feasible else None
-
-    for i, speed in enumerate(speeds):
-        point = Point(knee, criterion, float(speed))
-        saved = _saved(
-            Path(folder) / point.filename(), point, robot, budget.get("safety", PAPER_SAFETY)
-        )
-        if saved is not None:
-            if saved["feasible"]:
-                found[i] = (point.speed, gait_file.parameters(saved), saved["costs"][criterion])
-            continue
-        previous = next((f for f in reversed(found[:i]) if f is not None), None)
-        optimum = None
-        if previous is not None:
-            optimum = _continued(model, criterion, point.speed, previous, seed, budget)
-        if optimum is None or not _continues(optimum, previous):
-            start = initial_parameters(model, point.speed)
-            fresh = optimize(model, point.speed, criterion, seed=seed, starts=[start], **budget)
-            if optimum is None or fresh.rank() < optimum.rank():
-                optimum = fresh
-        save(i, optimum)
-        ran += 1
-        j = i
-        while (
-            j > 0
-            and found[j]
-            and found[j - 1]
-            and found[j - 1][2] > CONTINUATION_GROWTH * found[j][2]
-        ):
-            again = _continued(model, criterion, speeds[j - 1], found[j], seed, budget)
-            if not again.feasible or again.value >= found[j - 1][2]:
-                break
-            save(j - 1, again, "  (again, from the next speed)")
-            j -= 1
-    return ran
+def _save(path: Path, optimum: Optimum, settings: Settings) -> None:
+    gait_file.write_json(path, gait_file.to_dict(optimum, settings.robot, settings.seed))
 
 
-# A continued optimum is trusted if feasible and its criterion at most this factor above the
-# previous speed's (the criteria change by tens of percent between grid speeds).
-CONTINUATION_GROWTH = 1.5
+def _solve_independent(task) -> str:
+    settings, point, folder = task
+    problem = _problem(settings, point)
+    optimum = optimize(problem, seed=settings.seed, starts=settings.starts)
+    _save(Path(folder) / INDEPENDENT / point.filename(), optimum, settings)
+    return _line("independent", point, optimum)
 
 
-def _continues(optimum, previous) -> bool:
-    """Whether the continued optimum is plausible: feasible, no jump of the criterion."""
-    return optimum.feasible and optimum.value <= CONTINUATION_GROWTH * previous[2]
-
-
-def _run_series(args):
-    return run_series(*args)
-
-
-def pending_points(points, folder: Path, robot: Robot, safety: Safety = PAPER_SAFETY):
-    """Points whose gait file is missing or unreadable."""
+def _solve_with_neighbours(task) -> str:
+    settings, point, folder, neighbours = task
     folder = Path(folder)
-    return [p for p in points if _saved(folder / p.filename(), p, robot, safety) is None]
+    own = _optimum_of(gait_file.read(folder / INDEPENDENT / point.filename()), settings, point)
+    given = []
+    for other in neighbours:
+        gait = gait_file.read(folder / INDEPENDENT / other.filename())
+        variables = [gait["optimizer"]["variables"][name] for name in VARIABLES]
+        if all(v is not None for v in variables):
+            given.append(np.array(variables, float))
+    problem = _problem(settings, point)
+    optimum = own
+    if given:
+        again = optimize(problem, seed=settings.seed, starts=0, given=given)
+        optimum = best_of(problem, [own, again])
+    _save(folder / point.filename(), optimum, settings)
+    return _line("final", point, optimum)
+
+
+def _line(stage: str, point: Point, optimum: Optimum) -> str:
+    report = optimum.report
+    status = (
+        "certified"
+        if optimum.certified
+        else ("NOT CONVERGED: " + report.status if not report.converged else "INFEASIBLE")
+    )
+    return (
+        f"[{stage:11} {point.knee:8} {point.criterion:7}] {point.speed:.3f} m/s  "
+        f"C = {optimum.value:12.6f}  {status}  {report.starts_at_best}/{report.starts} starts "
+        f"at best  {report.seconds:5.1f} s"
+    )
+
+
+def _worker_init():
+    """Workers leave Ctrl-C to the main process, and stop cleanly when it terminates them:
+    SIGTERM raises SystemExit, so a file being written is removed, never left half-written."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+
+
+def _run(function, tasks, jobs, stream):
+    if not tasks:
+        return
+    if jobs == 1:
+        for task in tasks:
+            print(function(task), file=stream, flush=True)
+        return
+    pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_worker_init)
+    try:
+        for line in pool.imap(function, tasks):
+            print(line, file=stream, flush=True)
+        pool.close()
+    except BaseException:
+        pool.terminate()
+        raise
+    finally:
+        pool.join()
 
 
 def check_speeds(robot: Robot, speeds, knees) -> list[float]:
@@ -178,41 +228,64 @@ def run_sweep(
     knees=KNEES,
     criteria=CRITERIA,
     seed: int = 0,
+    starts: int = DEFAULT_STARTS,
+    safety: Safety = PAPER_SAFETY,
     jobs: int | None = None,
     stream=sys.stderr,
-    **budget,
 ) -> list[Point]:
-    """Optimise every (knee, criterion, speed) not yet in ``folder``; returns all points.
-
-    ``budget`` goes to ``biped.optimize.optimize`` (``max_restarts``, ``evaluations_per_run``,
-    ``polish_iterations``, ``safety``).
-    """
+    """Certified optima of every (knee, criterion, speed) not yet in ``folder``; returns all
+    points. ``seed`` and ``starts`` go to ``biped.optimize.optimize``."""
+    if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
+        raise BipedError(f"knees {list(knees)}, criteria {list(criteria)}: allowed each once")
     speeds = check_speeds(robot, speeds, knees)
+    settings = Settings(robot, safety, tuple(speeds), int(seed), int(starts))
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    (folder / INDEPENDENT).mkdir(parents=True, exist_ok=True)
+    _check_manifest(folder, settings)
+    for place in (folder, folder / INDEPENDENT):
+        clean_stale_temporaries(place)
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
-    todo = pending_points(points, folder, robot, budget.get("safety", PAPER_SAFETY))
+    final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
+    stage1 = [
+        p
+        for p in points
+        if _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is None
+        and (p in final or any(n in final for n in _neighbours(p, speeds)))
+    ]
     print(
-        f"sweep: {len(points)} points in {folder}, {len(points) - len(todo)} already done, "
-        f"{len(todo)} to run",
+        f"sweep: {len(points)} points in {folder}, {len(points) - len(final)} already done, "
+        f"{len(final)} to run",
         file=stream,
         flush=True,
     )
-    series = [
-        (k, c)
-        for c in criteria
-        for k in knees
-        if any(p.knee == k and p.criterion == c for p in todo)
-    ]
-    tasks = [(k, c, speeds, robot, seed, folder, budget) for k, c in series]
-    jobs = min(jobs or os.cpu_count() or 1, max(len(tasks), 1))
+    jobs = max(1, min(jobs or os.cpu_count() or 1, len(stage1) or 1))
     began = time.perf_counter()
-    if jobs == 1:
-        for task in tasks:
-            run_series(*task, stream=stream)
-    else:
-        with multiprocessing.get_context("spawn").Pool(jobs) as pool:
-            for _ in pool.imap_unordered(_run_series, tasks):
-                pass
-    print(f"sweep: done in {time.perf_counter() - began:.1f} s", file=stream, flush=True)
+    _run(_solve_independent, [(settings, p, str(folder)) for p in stage1], jobs, stream)
+    tasks = [(settings, p, str(folder), _neighbours(p, speeds)) for p in final]
+    _run(_solve_with_neighbours, tasks, jobs, stream)
+    summary = summarize(folder, points, settings)
+    print(f"sweep: done in {time.perf_counter() - began:.1f} s; {summary}", file=stream, flush=True)
     return points
+
+
+def _neighbours(point: Point, speeds) -> list[Point]:
+    i = list(speeds).index(point.speed)
+    return [
+        Point(point.knee, point.criterion, speeds[j])
+        for j in (i - 1, i + 1)
+        if 0 <= j < len(speeds)
+    ]
+
+
+def summarize(folder: Path, points, settings: Settings) -> str:
+    """How many points are certified, and which are not."""
+    bad = []
+    for p in points:
+        gait = _read_gait(Path(folder) / p.filename(), p, settings)
+        if gait is None:
+            bad.append(f"{p.filename()} missing")
+        elif gait["optimizer"].get("status") != "converged" or not gait["feasible"]:
+            bad.append(f"{p.filename()} {gait['optimizer'].get('status')}")
+    certified = len(points) - len(bad)
+    text = f"{certified} of {len(points)} points certified (converged and feasible)"
+    return text + ("; NOT: " + ", ".join(bad) if bad else "")

@@ -11,6 +11,18 @@ from biped.criteria import MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
 from biped.errors import BipedError
 
 ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
+# Slowest walking speed [m/s]: a step lasts a few seconds at most, so slower gaits take steps
+# of a few centimetres down to nothing (1e-9 m/s: a 0.0000 m step), which is not walking. The
+# fastest depends on the robot (``biped.optimize.check_speed``, √(g·leg length)).
+MIN_SPEED = 0.01
+SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower steps are mm long)"
+# Most speeds of a sweep: each is an optimisation per knee and criterion.
+MAX_SPEEDS = 1000
+# Most steps of a forward walk in MuJoCo: 1000 steps are about 10 simulated minutes.
+MAX_STEPS = 1000
+STEPS_HELP = f"steps to walk, 1 to {MAX_STEPS} (default 20)"
+# Most worker processes of a sweep.
+MAX_JOBS = 256
 
 
 def speed(text: str) -> float:
@@ -20,6 +32,8 @@ def speed(text: str) -> float:
         raise argparse.ArgumentTypeError(f"speed = {text!r} is not a number") from None
     if not (np.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"speed = {text!r} m/s: allowed > 0")
+    if value < MIN_SPEED:
+        raise argparse.ArgumentTypeError(f"speed = {text!r} m/s: {SLOW}")
     return value
 
 
@@ -28,6 +42,10 @@ def speeds(text: str) -> np.ndarray:
     try:
         if ":" in text:
             start, stop, count = text.split(":")
+            if not 1 <= int(count) <= MAX_SPEEDS:
+                raise argparse.ArgumentTypeError(
+                    f"speeds = {text!r}: COUNT = {count}, allowed 1 to {MAX_SPEEDS}"
+                )
             values = np.linspace(float(start), float(stop), int(count))
         else:
             values = np.array([float(v) for v in text.split(",")])
@@ -37,6 +55,12 @@ def speeds(text: str) -> np.ndarray:
         ) from None
     if values.size == 0 or not np.all(np.isfinite(values) & (values > 0)):
         raise argparse.ArgumentTypeError(f"speeds = {text!r}: allowed speeds > 0 m/s")
+    if values.size > MAX_SPEEDS:
+        raise argparse.ArgumentTypeError(f"speeds = {text!r}: allowed {MAX_SPEEDS} speeds at most")
+    if np.any(values < MIN_SPEED):
+        raise argparse.ArgumentTypeError(
+            f"speeds = {text!r}: {values.min():g} m/s is too slow: {SLOW}"
+        )
     return np.round(values, 6)
 
 
@@ -66,18 +90,54 @@ def check_folder(path: str, option: str, of: str | None = None) -> None:
 
 
 def budget(args) -> dict:
+    """The keyword arguments of ``biped.optimize.optimize`` given on the command line."""
     return {
+        "seed": args.seed,
+        "method": args.method,
+        "starts": args.starts,
+        "nelder_mead_starts": args.nelder_mead_starts,
         "max_restarts": args.restarts,
         "evaluations_per_run": args.evaluations,
-        "polish_iterations": args.polish,
-        "safety": Safety(clearance=args.clearance, zmp_margin=args.zmp_margin),
     }
 
 
-def add_budget(parser):
-    from biped.optimize import EVALUATIONS_PER_RUN, MAX_RESTARTS, POLISH_ITERATIONS
+def safety(args) -> Safety:
+    """The safety margins given on the command line."""
+    return Safety(clearance=args.clearance, zmp_margin=args.zmp_margin)
 
-    parser.add_argument("--seed", type=int, default=0, help="orients the restarts (default 0)")
+
+def add_budget(parser):
+    from biped.optimize import DEFAULT_STARTS, METHODS
+    from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
+
+    parser.add_argument(
+        "--method",
+        choices=METHODS,
+        default="ipopt",
+        help="ipopt: exact derivatives, several starts, certified optima (default); "
+        "nelder-mead: the paper's penalty method alone, to see where it stops",
+    )
+    parser.add_argument(
+        "--starts",
+        type=positive,
+        default=DEFAULT_STARTS,
+        metavar="N",
+        help=f"IPOPT starts: the first guess and N-1 perturbations of it (default "
+        f"{DEFAULT_STARTS})",
+    )
+    parser.add_argument(
+        "--nelder-mead-starts",
+        type=non_negative,
+        default=0,
+        metavar="K",
+        help="IPOPT also starts from the paper's Nelder-Mead with K seeds (default 0)",
+    )
+    parser.add_argument(
+        "--seed",
+        type=non_negative,
+        default=0,
+        help="seed of the perturbed starts and of Nelder-Mead (default 0)",
+    )
     parser.add_argument(
         "--restarts",
         type=non_negative,
@@ -105,13 +165,6 @@ def add_budget(parser):
         default=0.0,
         metavar="M",
         help="[m] distance the ZMP must keep inside the sole's heel and toe (default 0)",
-    )
-    parser.add_argument(
-        "--polish",
-        type=non_negative,
-        default=POLISH_ITERATIONS,
-        metavar="N",
-        help=f"SLSQP polish iterations at most, 0 for none (default {POLISH_ITERATIONS})",
     )
 
 
@@ -150,3 +203,43 @@ def positive(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer >= 1")
     return value
+
+
+def bounded(low: int, high: int):
+    """An integer type from ``low`` to ``high`` inclusive."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer from {low} to {high}")
+        return value
+
+    return parse
+
+
+steps = bounded(1, MAX_STEPS)
+jobs = bounded(1, MAX_JOBS)
+
+
+def metres(text: str) -> float:
+    """A finite length or position [m]."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not np.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} m: allowed a finite number")
+    return value
+
+
+class Distinct(argparse.Action):
+    """A list option whose values must differ (``--knees rolling rolling`` is refused)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        repeated = sorted({v for v in values if values.count(v) > 1})
+        if repeated:
+            raise argparse.ArgumentError(self, f"{repeated[0]!r} given twice: allowed each once")
+        setattr(namespace, self.dest, list(values))

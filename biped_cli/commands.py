@@ -5,19 +5,18 @@ Errors in the input raise ``BipedError`` (one line on stderr, exit status 2).
 
 from __future__ import annotations
 
-import signal
 import sys
 
 import numpy as np
 
 from biped.criteria import CRITERIA
 from biped.dynamics import JOINTS, Biped
-from biped.errors import BipedError
+from biped.errors import BipedError, UnreachableError
 from biped.kinematics import KNEES
+from biped.provenance import provenance
 from biped.robot import Robot
-from biped_cli.args import budget, check_folder, check_output
+from biped_cli.args import budget, check_folder, check_output, safety
 
-EXIT_BAD_INPUT = 2
 DEFAULT_SWEEP = "logs/sweep"
 DEFAULT_FIGURES = "logs/figures"
 DEFAULT_RECORDINGS = "logs/recordings"
@@ -27,6 +26,16 @@ DEFAULT_SPEED = 0.3  # [m/s] the walking speed of the pipeline
 
 def _robot(path: str | None) -> Robot:
     return Robot.paper() if path is None else Robot.from_file(path)
+
+
+def check_simulable(robot: Robot, knee: str, source: str) -> None:
+    """Fail before any work if MuJoCo cannot model the robot's knee (``validate.mjcf``: the
+    rolling knee is a link between the centres of its two rolling circles, so r1, r2 > 0)."""
+    if knee == "rolling" and (robot.r1 <= 0.0 or robot.r2 <= 0.0):
+        raise BipedError(
+            f"{source}: a rolling knee with r1 = {robot.r1} m, r2 = {robot.r2} m cannot be "
+            "simulated in MuJoCo: allowed r1, r2 > 0 (r1 = r2 = 0 is the revolute knee)"
+        )
 
 
 def demo_posture(model: Biped, hip_ahead: float = 0.05, hip_height: float = 0.86):
@@ -51,7 +60,12 @@ def cmd_demo(args) -> int:
     columns = []
     for knee in knees:
         model = Biped(robot, knee)
-        q, qd, qdd = demo_posture(model, args.hip_ahead, args.hip_height)
+        try:
+            q, qd, qdd = demo_posture(model, args.hip_ahead, args.hip_height)
+        except UnreachableError as error:
+            raise BipedError(
+                f"--hip-ahead {args.hip_ahead:g} m, --hip-height {args.hip_height:g} m: {error}"
+            ) from None
         torques, wrench = model.inverse_dynamics(q, qd, qdd)
         columns.append([*torques, *wrench, model.zmp(q, qd, qdd)])
     print(
@@ -71,29 +85,35 @@ def cmd_demo(args) -> int:
 def cmd_optimize(args) -> int:
     """Find the optimal gait of one robot at one walking speed and write it as JSON.
 
-    Exits 0 with the gait file written when the optimum is feasible on the fine check grid;
-    otherwise names the violated constraints, writes nothing and exits 1.
+    IPOPT with exact derivatives from several starts (``--starts``); the best converged
+    start wins. Exits 0 with the gait file written when the optimum is converged and
+    feasible on the fine check grid. Exits 1 when no start converged (naming the solver's
+    status) or the optimum is infeasible (naming the violated constraints); the file is
+    written only when feasible, with the solver's status in it.
     """
     from biped import gait_file
-    from biped.optimize import check_speed, optimize
+    from biped.optimize import optimize
+    from biped.problem import GaitProblem
 
     robot = _robot(args.robot)
-    model = Biped(robot, args.knee)
-    check_speed(model, args.speed)
+    problem = GaitProblem(Biped(robot, args.knee), args.speed, args.criterion, safety(args))
     check_output(args.out)
-    print(
-        f"optimizing {args.knee} knee, {args.criterion} criterion, {args.speed} m/s "
-        f"(seed {args.seed})...",
-        file=sys.stderr,
-    )
-    optimum = optimize(model, args.speed, args.criterion, seed=args.seed, **budget(args))
+    print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
+    optimum = optimize(problem, **budget(args))
     ev = optimum.evaluation
     print(
         f"{args.knee} {args.criterion} {args.speed} m/s: criterion {optimum.value:.6g}, "
         f"sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J, "
-        f"period {optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m, "
-        f"{optimum.evaluations} evaluations in {optimum.seconds:.1f} s"
+        f"period {optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m"
     )
+    report = optimum.report
+    print(report.summary())
+    if report.converged and report.method == "ipopt" and not report.confirmed:
+        print(
+            "warning: the best value was reached by a single start; more --starts may "
+            "find a better optimum",
+            file=sys.stderr,
+        )
     if not optimum.feasible:
         worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
         print(
@@ -104,6 +124,13 @@ def cmd_optimize(args) -> int:
         return 1
     path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
     print(f"wrote {path}")
+    if not report.converged:
+        print(
+            f"biped optimize: the solver did not converge ({report.method}: {report.status}); "
+            f"{path} is not a certified optimum",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 
@@ -114,9 +141,9 @@ def cmd_sweep(args) -> int:
     """
     from biped.sweep import run_sweep
 
-    # A terminated sweep stops its worker processes too (the pool closes on SystemExit).
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
     robot = _robot(args.robot)
+    if args.method != "ipopt":
+        raise BipedError(f"--method {args.method!r}: allowed 'ipopt' for sweeps")
     run_sweep(
         args.out,
         robot,
@@ -124,8 +151,9 @@ def cmd_sweep(args) -> int:
         args.knees,
         args.criteria,
         seed=args.seed,
+        starts=args.starts,
+        safety=safety(args),
         jobs=args.jobs,
-        **budget(args),
     )
     print(f"sweep results in {args.out}")
     return 0
@@ -150,7 +178,8 @@ def _validate_and_record(gait: dict, steps: int, rrd):
 
     result = validate(gait, steps=steps)
     written = record(rrd, result.biped, result.step, result.simulation, result.contact)
-    return result, {**as_json(result.checks), "recording": str(written)}
+    report = {**as_json(result.checks), "recording": str(written), "provenance": provenance()}
+    return result, report
 
 
 def cmd_validate(args) -> int:
@@ -166,10 +195,13 @@ def cmd_validate(args) -> int:
     from pathlib import Path
 
     from biped import gait_file
+    from biped_cli.progress import Progress
 
     if args.rrd and len(args.gait) > 1:
         raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
     gaits = [gait_file.read(path) for path in args.gait]  # all readable before any work
+    for path, gait in zip(args.gait, gaits, strict=True):
+        check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
     recordings = [
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / (Path(path).stem + ".rrd")
         for path in args.gait
@@ -183,15 +215,22 @@ def cmd_validate(args) -> int:
     for rrd in recordings:
         check_output(str(rrd), "--rrd")
     reports, passed = {}, 0
-    for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
-        result, reports[path] = _validate_and_record(gait, args.steps, rrd)
-        written = reports[path]["recording"]
-        passed += result.passed
-        if not args.json:
-            print(f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
-            for check in result.checks:
-                print("  " + check.line())
-            print(f"recording: {written}  (open with: rerun {written})", flush=True)
+    with Progress(len(args.gait), "validate") as bar:
+        for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
+            bar.update(note=path)
+            try:
+                result, reports[path] = _validate_and_record(gait, args.steps, rrd)
+            except BipedError as error:
+                raise BipedError(f"gait file {path!r}: {error}") from None
+            written = reports[path]["recording"]
+            passed += result.passed
+            bar.clear()
+            if not args.json:
+                print(f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
+                for check in result.checks:
+                    print("  " + check.line())
+                print(f"recording: {written}  (open with: rerun {written})", flush=True)
+            bar.advance()
     if args.json:
         print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
     elif len(args.gait) > 1:
@@ -212,26 +251,35 @@ def cmd_pipeline(args) -> int:
 
     from biped import gait_file
     from biped.optimize import check_speed, optimize
+    from biped.problem import GaitProblem
 
     robot = _robot(args.robot)
     out, recordings = Path(args.out), Path(args.recordings)
     for knee in args.knees:
         check_speed(Biped(robot, knee), args.speed)
+    for knee in args.knees:
+        check_simulable(robot, knee, f"--robot {args.robot!r}" if args.robot else "robot")
     check_folder(args.out, "--out")
     check_folder(args.recordings, "--recordings")
-    passed, costs, written = True, {}, []
+    passed, costs, written, optima = True, {}, [], {}
     for knee in args.knees:
         name = f"{knee}-{args.criterion}-{args.speed:.3f}"
         print(f"[{knee}] optimizing at {args.speed} m/s ({args.criterion})...", flush=True)
-        optimum = optimize(
-            Biped(robot, knee), args.speed, args.criterion, seed=args.seed, **budget(args)
-        )
+        problem = GaitProblem(Biped(robot, knee), args.speed, args.criterion, safety(args))
+        given = [o.variables for o in optima.values() if np.all(np.isfinite(o.variables))]
+        optimum = optimize(problem, given=given, **budget(args))
+        optima[knee] = optimum
         ev = optimum.evaluation
         print(
             f"[{knee}] sthenic {ev.sthenic:.4g} N²·m·s, energy {ev.energy:.4g} J, period "
             f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m "
             f"({optimum.seconds:.1f} s)"
         )
+        print(f"[{knee}] {optimum.report.summary()}")
+        if not optimum.report.converged:
+            print(f"[{knee}] FAIL  the solver did not converge: {optimum.report.status}")
+            passed = False
+            continue
         if not optimum.feasible:
             worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
             print(f"[{knee}] FAIL  optimum infeasible: {worst}")

@@ -7,7 +7,7 @@ from scipy.integrate import quad
 import biped
 from biped.criteria import CONSTRAINTS, PENALTY_WEIGHT, constraints, evaluate_step, penalty_rate
 from biped.gait import build_step, evaluate
-from biped.optimize import initial_parameters
+from biped.problem import GaitProblem
 
 SPEED = 0.3
 
@@ -23,7 +23,7 @@ def torques_at(model, step, t):
 
 def test_criteria_match_adaptive_quadrature(model):
     """Simpson on the grid equals scipy's adaptive quadrature of ΓᵀΓ and Σ|Γ θ̇|."""
-    step = build_step(model, SPEED, initial_parameters(model, SPEED))
+    step = build_step(model, SPEED, GaitProblem(model, SPEED).first_parameters())
     ev = evaluate_step(model, step, 100)
     half = step.period / 2
     squared = sum(
@@ -82,7 +82,7 @@ def test_penalty_rate_is_the_exponential_barrier():
 
 def test_infeasible_first_guess_reports_its_violations(model):
     """The first guess violates constraints: positive penalty, each violation negative."""
-    step = build_step(model, SPEED, initial_parameters(model, SPEED))
+    step = build_step(model, SPEED, GaitProblem(model, SPEED).first_parameters())
     ev = evaluate_step(model, step, 100)
     violated = ev.violations()
     assert violated and ev.penalty > 0.0 and not ev.feasible
@@ -92,7 +92,7 @@ def test_infeasible_first_guess_reports_its_violations(model):
 
 def test_margins_only_make_the_penalty_larger(model):
     """The optimiser's margins raise the penalty; feasibility is judged without them."""
-    step = build_step(model, SPEED, initial_parameters(model, SPEED))
+    step = build_step(model, SPEED, GaitProblem(model, SPEED).first_parameters())
     plain = evaluate_step(model, step, 40)
     strict = evaluate_step(model, step, 40, margins=True)
     assert strict.penalty >= plain.penalty

@@ -6,7 +6,7 @@ import pytest
 import biped
 from biped.gait import PARAMETERS, build_step, evaluate, sample
 from biped.kinematics import QP2, XH, ZH
-from biped.optimize import initial_parameters
+from biped.problem import GaitProblem
 
 SPEED = 0.3
 
@@ -14,7 +14,7 @@ SPEED = 0.3
 def perturbed_parameters(model, seed):
     """The first guess with seeded perturbations of every parameter."""
     rng = np.random.default_rng(seed)
-    p = initial_parameters(model, SPEED)
+    p = GaitProblem(model, SPEED).first_parameters()
     scale = np.array([0.02, 0.01, 0.05] + [0.3] * 5 + [3.0] * 12 + [0.1])
     return p + scale * rng.uniform(-1, 1, len(p))
 
@@ -95,7 +95,7 @@ def test_start_velocities_are_the_impact_of_the_end_velocities(model, step):
 
 def test_out_of_reach_hip_is_a_graded_error(model):
     """A hip out of the legs' reach raises StepBuildError with how far it is."""
-    p = initial_parameters(model, SPEED)
+    p = GaitProblem(model, SPEED).first_parameters()
     p[1] = 1.2
     with pytest.raises(biped.gait.StepBuildError) as error:
         build_step(model, SPEED, p)

@@ -1,0 +1,211 @@
+"""The gait optimisation problem shared by every solver, and its decision variables.
+
+A ``GaitProblem`` is one question: the best gait of one robot and knee at one walking speed
+for one criterion, under the paper's constraints and our safety margins, with the
+constraints imposed at ``samples_per_half`` samples per spline piece.
+
+Decision variables. The paper's 21 parameters start with the hip position (x_H, z_H) at the
+start of the step. The knees' bends at double support follow from it through the inverse
+geometric model, whose slope is unbounded at a straight knee, √(reach² − d²): the optimal
+gaits keep the stance knee straight to the 1 mrad margin, about 1e-7 m from the edge of the
+reach, where no derivative-based solver can work. The solvers therefore use the two knee
+bends at the start of the step instead (``VARIABLES``):
+
+    θ_s = q2(0) − q1(0) >= 0   stance knee flexion, θ_w = q3(0) − q4(0) >= 0   swing knee
+
+Each bend gives a leg length d(θ), smooth and even in θ, and the hip is where the circles of
+radii d_s about the stance ankle (x = 0) and d_w about the trailing ankle (x = −S) meet:
+
+    x_H = (d_w² − d_s² − S²) / (2 S),    z_H = h_p + √(d_s² − x_H²)                     (*)
+
+Every bend in its bounds is a posture of the leg; the two circles meet as long as
+|d_s − d_w| < S < d_s + d_w, far from walking postures: the solvers keep the hip at least
+``MIN_HIP_HEIGHT`` above the ankles (a smooth constraint). Gait files keep the paper's 21
+parameters (``to_parameters``, ``from_parameters``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
+from biped.dynamics import Biped
+from biped.errors import BipedError
+from biped.gait import N_PARAMETERS, PARAMETERS
+
+# Decision variables of the solvers: the paper's parameters with the hip replaced by the
+# two knee bends at the start of the step.
+VARIABLES = ("stance_knee_bend", "swing_knee_bend") + PARAMETERS[2:]
+N_VARIABLES = len(VARIABLES)  # 21
+_INDEX = {name: i for i, name in enumerate(VARIABLES)}
+
+# Simple bounds of the variables [rad, rad/s, rad/s², s]. The paper sets none; these are
+# wide enough never to bind at a walking gait, and a solver's report says when one does.
+_LOWER = {"stance_knee_bend": 0.0, "swing_knee_bend": 0.0, "trunk": -0.6, "period": 0.15}
+_UPPER = {"stance_knee_bend": 1.5, "swing_knee_bend": 1.5, "trunk": 0.6, "period": 3.0}
+RATE_BOUND = 20.0  # [rad/s]
+ACCEL_BOUND = 500.0  # [rad/s²]
+# [m] Least height of the hip above the ankles at the start of the step, far below any
+# walking posture: it keeps the two circles of (*) meeting.
+MIN_HIP_HEIGHT = 0.3
+# Slowest speed optimised [m/s]: below it a step of the longest period is under 1 mm.
+MIN_SPEED = 1e-3 / _UPPER["period"]
+# One unit of each variable in the solvers' scaled space (comparable changes of the gait).
+SCALES = np.array([0.03, 0.03, 0.03] + [0.3] * 5 + [2.0] * 12 + [0.05])
+# Duration of a step in the first guess [s].
+FIRST_GUESS_PERIOD = 0.6
+
+
+def bounds() -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds (21,) of the variables, in ``VARIABLES`` order."""
+    lower = np.empty(N_VARIABLES)
+    upper = np.empty(N_VARIABLES)
+    for i, name in enumerate(VARIABLES):
+        if name.startswith("end_rate"):
+            lower[i], upper[i] = -RATE_BOUND, RATE_BOUND
+        elif "accel" in name:
+            lower[i], upper[i] = -ACCEL_BOUND, ACCEL_BOUND
+        else:
+            lower[i], upper[i] = _LOWER[name], _UPPER[name]
+    return lower, upper
+
+
+def index(name: str) -> int:
+    """Position of a variable in ``VARIABLES``."""
+    try:
+        return _INDEX[name]
+    except KeyError:
+        raise BipedError(f"variable {name!r} is unknown: allowed {', '.join(VARIABLES)}") from None
+
+
+def max_walking_speed(model: Biped) -> float:
+    """[m/s] √(g L), L the leg length: above it (Froude number > 1) gravity cannot keep the
+    stance foot on the ground as the hip vaults over it, whatever the gait."""
+    leg = model.robot.shank_length + model.robot.thigh_length
+    return float(np.sqrt(model.gravity * leg))
+
+
+def check_speed(model: Biped, speed: float) -> float:
+    """Return ``speed`` if walkable at all, raise a clear error otherwise."""
+    high = max_walking_speed(model)
+    if not (isinstance(speed, (int, float, np.floating)) and np.isfinite(speed)):
+        raise BipedError(f"speed = {speed!r} m/s: allowed a finite number of m/s")
+    if not MIN_SPEED <= speed <= high:
+        raise BipedError(
+            f"speed = {speed!r} m/s: allowed {MIN_SPEED:.3g} <= speed <= {high:.3g} m/s "
+            f"(slower, a step of at most {_UPPER['period']:g} s is under a millimetre; faster "
+            f"than √(g·leg length), the stance foot leaves the ground)"
+        )
+    return float(speed)
+
+
+def check_criterion(criterion: str) -> str:
+    if criterion not in CRITERIA:
+        raise BipedError(f"criterion = {criterion!r}: allowed 'sthenic', 'energy'")
+    return criterion
+
+
+@dataclass(frozen=True)
+class GaitProblem:
+    """Minimise ``criterion`` over the gaits of ``model`` at ``speed``.
+
+    Attributes:
+        model: the robot and its knee.
+        speed: walking speed V [m/s]; the step length is V T.
+        criterion: ``"sthenic"`` (eq. 30) or ``"energy"`` (eq. 31).
+        safety: margins of ours beyond the paper's constraints (``Safety()``: the paper's).
+        samples_per_half: samples per spline piece where the solvers impose the constraints.
+    """
+
+    model: Biped
+    speed: float
+    criterion: str = "sthenic"
+    safety: Safety = PAPER_SAFETY
+    samples_per_half: int = 25
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", check_speed(self.model, self.speed))
+        check_criterion(self.criterion)
+        if not isinstance(self.safety, Safety):
+            raise BipedError(f"safety = {self.safety!r}: allowed a biped.criteria.Safety")
+        n = self.samples_per_half
+        if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 1000:
+            raise BipedError(f"samples_per_half = {n!r}: allowed an integer from 2 to 1000")
+
+    @property
+    def knee(self) -> str:
+        return self.model.knee
+
+    def at_speed(self, speed: float) -> GaitProblem:
+        """The same problem at another speed."""
+        return GaitProblem(self.model, speed, self.criterion, self.safety, self.samples_per_half)
+
+    def describe(self) -> str:
+        margins = ""
+        if self.safety != PAPER_SAFETY:
+            margins = (
+                f", clearance {self.safety.clearance:g} m, ZMP margin {self.safety.zmp_margin:g} m"
+            )
+        return f"{self.knee} knee, {self.criterion} criterion, {self.speed:.3f} m/s{margins}"
+
+    # ------------------------------------------------------------------ variables <-> parameters
+    def hip_start(self, stance_bend, swing_bend, period):
+        """Hip (x_H, z_H) [m] at the start of the step from the knee bends, eq. (*)."""
+        chain = self.model
+        d_s2 = chain._reach_squared(stance_bend)
+        d_w2 = chain._reach_squared(swing_bend)
+        length = self.speed * period
+        x = (d_w2 - d_s2 - length**2) / (2 * length)
+        height2 = d_s2 - x**2
+        if not height2 >= MIN_HIP_HEIGHT**2:
+            raise BipedError(
+                f"knee bends ({stance_bend:.6g}, {swing_bend:.6g}) rad with a step of "
+                f"{length:.6g} m put the hip {math.sqrt(max(height2, 0.0)):.6g} m above the "
+                f"ankles: allowed at least {MIN_HIP_HEIGHT} m"
+            )
+        return x, chain.robot.ankle_height + math.sqrt(height2)
+
+    def to_parameters(self, variables) -> np.ndarray:
+        """The paper's 21 parameters (``biped.gait.PARAMETERS``) of the solvers' variables."""
+        z = np.asarray(variables, dtype=float)
+        if z.shape != (N_VARIABLES,):
+            raise BipedError(f"variables have shape {z.shape}: allowed ({N_VARIABLES},)")
+        x, height = self.hip_start(z[0], z[1], z[index("period")])
+        return np.concatenate([[x, height], z[2:]])
+
+    def from_parameters(self, parameters) -> np.ndarray:
+        """The solvers' variables of the paper's 21 parameters (the knee bends at the start
+        of the step from the inverse geometric model)."""
+        p = np.asarray(parameters, dtype=float)
+        if p.shape != (N_PARAMETERS,):
+            raise BipedError(f"gait parameters have shape {p.shape}: allowed ({N_PARAMETERS},)")
+        x, height, period = p[0], p[1], p[PARAMETERS.index("period")]
+        lift = height - self.model.robot.ankle_height
+        hips = np.array([[x, lift], [x + self.speed * period, lift]])
+        (q1, q2), (q4, q3) = self.model.leg_angles(hips)
+        return np.concatenate([[q2 - q1, q3 - q4], p[2:]])
+
+    def first_guess(self, period: float = FIRST_GUESS_PERIOD) -> np.ndarray:
+        """A walkable first guess (variables): knees bent a little, the hip midway between
+        the feet, legs turning as stiff pendulums.
+
+        Args:
+            period: duration of the step T [s]; the step length is speed x T.
+        """
+        model = self.model
+        leg = model.robot.shank_length + model.robot.thigh_length
+        length = min(self.speed * period, leg)
+        period = length / self.speed
+        height = np.sqrt((0.97 * leg) ** 2 - (length / 2) ** 2) + model.robot.ankle_height
+        p = np.zeros(N_PARAMETERS)
+        p[0:3] = [-length / 2, height, 0.0]
+        p[3:7] = -self.speed / leg  # q1..q4 turn backwards as the hip passes over the feet
+        p[PARAMETERS.index("period")] = period
+        return self.from_parameters(p)
+
+    def first_parameters(self) -> np.ndarray:
+        """The paper's 21 parameters of ``first_guess``."""
+        return self.to_parameters(self.first_guess())

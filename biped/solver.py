@@ -1,0 +1,154 @@
+"""IPOPT on the CasADi graph of a step: exact gradients and Hessian, constraints explicit.
+
+    min  C(z)   subject to   (Ψ_i − δ_i) / scale_i >= 0 at the samples,
+                             hip height at the start >= ``MIN_HIP_HEIGHT``,
+                             bounds on z (``biped.problem.bounds``)
+
+C is the sthenic criterion (30) or the energy criterion (31) without penalty. The energy
+criterion's |Γ_i θ̇_i| is written exactly with slack variables s_ij (no smoothing):
+
+    ∫ Σ_i |Γ_i θ̇_i| dt  =  min T Σ_j w_j Σ_i s_ij   s.t.  s_ij >= Γ_i θ̇_i,  s_ij >= −Γ_i θ̇_i
+
+The solver works on scaled variables y = z / ``SCALES``. One ``Solver`` (graph, derivatives
+and IPOPT instance) is built per robot, knee, criterion, safety and sample count and serves
+every speed and every start (``solver_for``).
+"""
+
+from __future__ import annotations
+
+import functools
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from biped.criteria import Safety
+from biped.dynamics import Biped
+from biped.errors import BipedError
+from biped.problem import N_VARIABLES, SCALES, GaitProblem, bounds
+from biped.robot import Robot
+from biped.symbolic import StepGraph
+
+# IPOPT's settings. ``tol``: its scaled optimality error; certified optima from different
+# starts then agree to about 1e-8 relative.
+IPOPT_OPTIONS = {
+    "tol": 1e-9,
+    "constr_viol_tol": 1e-9,
+    "max_iter": 1000,
+    "print_level": 0,
+    "sb": "yes",
+    "mu_strategy": "adaptive",
+}
+# IPOPT's statuses that are a converged local optimum.
+CONVERGED = ("Solve_Succeeded",)
+
+
+@dataclass(frozen=True)
+class Solution:
+    """IPOPT's answer from one start.
+
+    Attributes:
+        variables: z (21,) at the end.
+        value: the criterion there (on the solver's samples, without penalty).
+        status: IPOPT's return status (``Solve_Succeeded`` when converged).
+        iterations: IPOPT iterations.
+        constraint_violation: largest violation of a constraint or bound at the end, in the
+            solver's scaled units.
+        dual_infeasibility: IPOPT's unscaled dual infeasibility at the end.
+        seconds: time of the solve.
+    """
+
+    variables: np.ndarray
+    value: float
+    status: str
+    iterations: int
+    constraint_violation: float
+    dual_infeasibility: float
+    seconds: float
+
+    @property
+    def converged(self) -> bool:
+        return self.status in CONVERGED
+
+
+class Solver:
+    """IPOPT on one problem family (every speed): ``solve(problem, start)``."""
+
+    def __init__(self, model: Biped, criterion: str, safety: Safety, samples_per_half: int):
+        self.graph = graph = StepGraph(model, samples_per_half, safety)
+        self.criterion = criterion
+        y = ca.SX.sym("y", N_VARIABLES)
+        z = ca.DM(SCALES) * y
+        constraints = ca.vertcat(graph.constraints, graph.hip_height)
+        if criterion == "sthenic":
+            x, objective, g = y, graph.sthenic, constraints
+            self.slacks = 0
+        else:
+            power = ca.vec(graph.power)  # Γ_i θ̇_i, sample-major
+            slack = ca.SX.sym("s", power.shape[0])
+            self.slacks = power.shape[0]
+            weights = ca.repmat(graph.weights, graph.power.shape[0], 1)
+            objective = graph.period * ca.dot(ca.vec(weights), slack)
+            x = ca.vertcat(y, slack)
+            g = ca.vertcat(constraints, slack - power, slack + power)
+        substituted = ca.substitute([objective, g], [graph.z], [z])
+        nlp = {"x": x, "p": graph.speed, "f": substituted[0], "g": substituted[1]}
+        options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
+        options["print_time"] = False
+        self.nlp = ca.nlpsol("gait", "ipopt", nlp, options)
+        self.evaluate = ca.Function(
+            "evaluate", [graph.z, graph.speed], [graph.sthenic, graph.energy, graph.power]
+        )
+        lower, upper = bounds()
+        self.lbx = np.concatenate([lower / SCALES, np.zeros(self.slacks)])
+        self.ubx = np.concatenate([upper / SCALES, np.full(self.slacks, np.inf)])
+        self.n_constraints = g.shape[0]
+
+    def solve(self, problem: GaitProblem, start) -> Solution:
+        """IPOPT from the variables ``start`` (21,), clipped into the bounds."""
+        began = time.perf_counter()
+        lower, upper = bounds()
+        z0 = np.clip(np.asarray(start, dtype=float), lower, upper)
+        x0 = z0 / SCALES
+        if self.slacks:
+            power = np.asarray(self.evaluate(z0, problem.speed)[2]).T.ravel()
+            x0 = np.concatenate([x0, np.abs(power) if np.all(np.isfinite(power)) else 0.0])
+        result = self.nlp(x0=x0, p=problem.speed, lbx=self.lbx, ubx=self.ubx, lbg=0.0, ubg=np.inf)
+        stats = self.nlp.stats()
+        x = np.asarray(result["x"]).ravel()
+        g = np.asarray(result["g"]).ravel()
+        violation = max(
+            float(np.max(np.maximum(-g, 0.0), initial=0.0)),
+            float(np.max(np.maximum(self.lbx - x, 0.0), initial=0.0)),
+            float(np.max(np.maximum(x - self.ubx, 0.0), initial=0.0)),
+        )
+        iterations = stats.get("iterations") or {}
+        dual = iterations.get("inf_du") or [float("nan")]
+        return Solution(
+            variables=x[:N_VARIABLES] * SCALES,
+            value=float(result["f"]),
+            status=str(stats["return_status"]),
+            iterations=int(stats["iter_count"]),
+            constraint_violation=violation,
+            dual_infeasibility=float(dual[-1]),
+            seconds=time.perf_counter() - began,
+        )
+
+
+@functools.lru_cache(maxsize=8)
+def _solver(robot: Robot, knee: str, criterion: str, safety: Safety, samples: int) -> Solver:
+    return Solver(Biped(robot, knee), criterion, safety, samples)
+
+
+def solver_for(problem: GaitProblem) -> Solver:
+    """The solver of ``problem``'s family, built once per process and reused."""
+    if not isinstance(problem, GaitProblem):
+        raise BipedError(f"problem = {problem!r}: allowed a biped.problem.GaitProblem")
+    return _solver(
+        problem.model.robot,
+        problem.knee,
+        problem.criterion,
+        problem.safety,
+        problem.samples_per_half,
+    )

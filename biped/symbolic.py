@@ -1,0 +1,306 @@
+"""The gait problem as a CasADi expression graph: exact derivatives for the solvers.
+
+The graph is built from the constants of the numeric model (``biped.dynamics.Biped``): the
+directions Φ, W, g, J, the point coefficients and the spline bases of ``biped.gait``, so the
+symbolic and the numeric criterion are one model written twice with the same numbers (a test
+holds them equal to 1e-12). From the variables z (``biped.problem.VARIABLES``) and the speed:
+
+1. hip at the start of the step from the knee bends (``biped.problem``, eq. *), the legs'
+   angles by the forward geometry of each leg (no inverse model, no square root at a straight
+   knee);
+2. the end state (legs swapped), the impact map (23) and the start velocities;
+3. the spline coefficients (25)-(26), then at each sample the stance state, the one-pass
+   inverse dynamics and the swing foot's heel and toe;
+4. the criterion (Simpson's rule per piece) and the constraints Ψ_i − δ_i.
+
+The speed is a parameter of the graph, so one built graph serves every speed of a sweep.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from biped.criteria import (
+    CONSTRAINTS,
+    checked_mask,
+    clearance_profile,
+    margin_profile,
+    simpson_weights,
+)
+from biped.dynamics import JOINT_MATRIX, Biped
+from biped.gait import _SWAP, _basis
+from biped.kinematics import Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH
+from biped.problem import MIN_HIP_HEIGHT, N_VARIABLES, index
+
+# Constraints are divided by these in the solvers so that all are of order one
+# [N, m, m, rad, rad, m, m].
+CONSTRAINT_SCALES = np.array([1000.0, 0.1, 0.1, 1.0, 1.0, 0.1, 0.1])
+_SWAP_ORDER = [QP2, QP1, Q4, Q3, Q2, Q1, Q5, XH, ZH]  # biped.kinematics.swap_legs
+
+
+class _Constants:
+    """The numeric model's constants as CasADi matrices."""
+
+    def __init__(self, model: Biped):
+        self.model = model
+        self.hp = model.robot.ankle_height
+        self.gravity = model.gravity
+        self.mass = model.mass
+        self.phi = _sparse(model.directions)  # (K, 7)
+        self.w = _sparse(model._w)
+        self.g = _sparse(model._g)
+        self.inertia = _sparse(model._inertia)
+        self.p = _sparse(model._p)  # y = P q
+        self.ankle = _sparse(model._stance_ankle)
+        self.stance_leg = _sparse(model._stance_leg)  # (K, 2)
+        self.k = model.directions.shape[0]
+
+    def point(self, name):
+        j = self.model.point_index(name)
+        return _sparse(self.model.point_a[:, j]), _sparse(self.model.point_b[:, j])
+
+
+def _sparse(array):
+    """A constant matrix without its structural zeros, so the graph holds no product by 0."""
+    return ca.sparsify(ca.DM(np.asarray(array, dtype=float)))
+
+
+def _stance_state(c: _Constants, angles, rates, accels):
+    """q, q̇, q̈ (9,) and φ̇, φ̈, sin φ, cos φ of a stance-foot-fixed motion
+    (``Chain._stance_state``)."""
+    zero = ca.SX.zeros(1)
+    q7, qd7, qdd7 = (ca.vertcat(zero, v) for v in (angles, rates, accels))
+    phi, phid, phidd = c.phi @ q7, c.phi @ qd7, c.phi @ qdd7
+    s, co = ca.sin(phi), ca.cos(phi)
+    rate2 = phid * phid
+    a = c.ankle
+    q = ca.vertcat(q7, -ca.dot(s, a), c.hp + ca.dot(co, a))
+    qd = ca.vertcat(qd7, -ca.dot(co * phid, a), -ca.dot(s * phid, a))
+    qdd = ca.vertcat(qdd7, -ca.dot(co * phidd - s * rate2, a), -ca.dot(s * phidd + co * rate2, a))
+    return q, qd, qdd, phid, phidd, s, co
+
+
+def _torques_and_wrench(c: _Constants, qdd, phid, phidd, s, co):
+    """Γ (6,) and F_e (3,): ``Biped._forces`` then ``Biped._torques_and_wrench``."""
+    rate2 = phid * phid
+    ax = co * phidd - s * rate2
+    az = s * phidd + co * rate2
+    hip_x = qdd[XH]
+    hip_z = qdd[ZH] + c.gravity
+    tau_phi = co * (c.w @ ax + c.g * hip_x) + s * (c.w @ az + c.g * hip_z) + c.inertia * phidd
+    tau = ca.vertcat(c.phi.T @ tau_phi, c.mass * hip_x + ca.dot(ax, c.g))
+    tau = ca.vertcat(tau, c.mass * hip_z + ca.dot(az, c.g))
+    fx, fz = tau[XH], tau[ZH]
+    weights = c.ankle * (co * fx + s * fz)
+    work = c.stance_leg.T @ weights
+    g6 = -tau[QP2]
+    g5 = g6 - tau[Q4]
+    g4 = g5 - tau[Q3]
+    g3 = tau[Q5] - g4
+    g2 = tau[Q2] + g3 - work[1]
+    g1 = tau[Q1] + g2 - work[0]
+    cy = tau[QP1] + g1
+    return ca.vertcat(g1, g2, g3, g4, g5, g6), ca.vertcat(fx, fz, cy)
+
+
+def _mass_matrix(c: _Constants, q):
+    """D(q) (9, 9) (``Biped.mass_matrix``)."""
+    phi = c.phi @ q[:7]
+    s, co = ca.sin(phi), ca.cos(phi)
+    k = c.k
+    top = c.w * (co @ co.T + s @ s.T) + ca.diag(c.inertia)
+    gx, gz = (c.g * co).T, (c.g * s).T
+    dy = ca.blockcat(
+        [
+            [top, gx.T, gz.T],
+            [gx, ca.DM(c.mass).reshape((1, 1)), ca.DM.zeros(1, 1)],
+            [gz, ca.DM.zeros(1, 1), ca.DM(c.mass).reshape((1, 1))],
+        ]
+    )
+    assert dy.shape == (k + 2, k + 2)
+    return c.p.T @ dy @ c.p
+
+
+def _swing_contact_jacobian(c: _Constants, q):
+    """A_c (3, 9) of the swing foot (``Chain.contact_jacobian(q, "swing")``)."""
+    a, b = c.point("swing_ankle")
+    phi = c.phi @ q[:7]
+    s, co = ca.sin(phi), ca.cos(phi)
+    dx = ((a * co - b * s).T @ c.phi).T
+    dz = ((a * s + b * co).T @ c.phi).T
+    row_x = ca.vertcat(dx, 1.0, 0.0)
+    row_z = ca.vertcat(dz, 0.0, 1.0)
+    row_angle = ca.DM.zeros(9)
+    row_angle[QP2] = 1.0
+    return ca.horzcat(row_x, row_z, row_angle).T
+
+
+def _leg_angles(c: _Constants, bend, hip_from_ankle):
+    """(shank, thigh) angles of a leg with knee flexion ``bend`` and the hip at
+    ``hip_from_ankle`` (``Chain.leg_angles`` with the flexion known)."""
+    r1, r2 = c.model.radii
+    link = r1 + r2
+    shank = c.model.robot.shank_length - r1
+    thigh = c.model.robot.thigh_length - r2
+    gamma = r2 * bend / link if link > 0.0 else 0.0
+    vx = link * ca.sin(gamma) + thigh * ca.sin(bend)
+    vz = -shank - link * ca.cos(gamma) - thigh * ca.cos(bend)
+    angle = ca.atan2(hip_from_ankle[1], hip_from_ankle[0]) - ca.atan2(-vz, -vx)
+    return angle, angle + bend
+
+
+def _reach_squared(c: _Constants, bend):
+    r1, r2 = c.model.radii
+    link = r1 + r2
+    shank = c.model.robot.shank_length - r1
+    thigh = c.model.robot.thigh_length - r2
+    value = shank**2 + thigh**2 + link**2 + 2 * shank * thigh * ca.cos(bend)
+    if link > 0.0:
+        value = value + 2 * link * (
+            shank * ca.cos(r2 * bend / link) + thigh * ca.cos(r1 * bend / link)
+        )
+    return value
+
+
+class StepGraph:
+    """One step of one robot as a CasADi graph of the variables z and the speed V.
+
+    Args:
+        model: robot and knee.
+        samples_per_half: samples per spline piece (constraints and Simpson's rule).
+        safety: margins of ours (``biped.criteria.Safety``).
+
+    Attributes (SX expressions of ``z`` (21) and ``speed`` (1)):
+        parameters (21): the paper's parameters; torques (6, N); wrench (3, N); q (9, N);
+        qd (9, N); power (6, N) Γ_i θ̇_i; sthenic, energy: eqs. (30)-(31) without penalty;
+        constraints (M): (Ψ_i − δ_i − safety) / scale at the checked samples, >= 0 when met;
+        hip_height: hip above the ankles at the start less ``MIN_HIP_HEIGHT`` (>= 0).
+    """
+
+    def __init__(self, model: Biped, samples_per_half: int, safety):
+        self.model = model
+        self.samples_per_half = samples_per_half
+        self.safety = safety
+        c = _Constants(model)
+        z = ca.SX.sym("z", N_VARIABLES)
+        speed = ca.SX.sym("speed")
+        self.z, self.speed = z, speed
+        bend_s, bend_w = z[index("stance_knee_bend")], z[index("swing_knee_bend")]
+        trunk = z[index("trunk")]
+        period = z[index("period")]
+        end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
+        acc0 = z[index("start_accel_qp2") : index("start_accel_q5") + 1]
+        acc1 = z[index("end_accel_qp2") : index("end_accel_q5") + 1]
+
+        # 1. hip and legs at the start of the step
+        length = speed * period
+        d_s2, d_w2 = _reach_squared(c, bend_s), _reach_squared(c, bend_w)
+        x_hip = (d_w2 - d_s2 - length**2) / (2 * length)
+        height2 = d_s2 - x_hip**2
+        self.hip_height = (height2 - MIN_HIP_HEIGHT**2) / MIN_HIP_HEIGHT**2
+        lift = ca.sqrt(ca.fmax(height2, 1e-6))
+        q1, q2 = _leg_angles(c, bend_s, ca.vertcat(x_hip, lift))
+        q4, q3 = _leg_angles(c, bend_w, ca.vertcat(x_hip + length, lift))
+        self.parameters = ca.vertcat(x_hip, c.hp + lift, z[index("trunk") :])
+
+        # 2. end state, impact, start velocities
+        start_angles = ca.vertcat(0.0, q1, q2, q3, q4, trunk)
+        end_angles = ca.vertcat(*[start_angles[i] for i in _SWAP])
+        zeros = ca.SX.zeros(6)
+        q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, zeros)
+        mass = _mass_matrix(c, q_end)
+        jac = _swing_contact_jacobian(c, q_end)
+        d_inv_jt = ca.solve(mass, jac.T)
+        gram = jac @ d_inv_jt
+        impulse = -ca.solve(gram, jac @ qd_end)
+        qd_plus = qd_end + d_inv_jt @ impulse
+        start_rates = ca.vertcat(*[qd_plus[_SWAP_ORDER[i]] for i in range(1, 7)])
+        self.impulse = impulse
+
+        # 3. spline coefficients, as in biped.gait.build_step
+        a0, a1, a2 = start_angles, period * start_rates, 0.5 * period**2 * acc0
+        b0, b1, b2 = end_angles, -period * end_rates, 0.5 * period**2 * acc1
+        r1 = b0 + b1 / 2 + b2 / 4 - a0 - a1 / 2 - a2 / 4
+        r2 = -(b1 + b2) - a1 - a2
+        a3 = 4 * r1 + 2 * r2 / 3
+        b3 = 2 * r2 / 3 - 4 * r1
+        coefficients = ca.horzcat(a0, a1, a2, a3, b0, b1, b2, b3).T  # (8, 6)
+        _, (values, rates, accels) = _basis(samples_per_half)
+        angles = (ca.DM(values) @ coefficients).T  # (6, N)
+        rates = (ca.DM(rates) @ coefficients).T / period
+        accels = (ca.DM(accels) @ coefficients).T / period**2
+
+        heel_a, heel_b = c.point("swing_heel")
+        toe_a, toe_b = c.point("swing_toe")
+        n = angles.shape[1]
+        columns = {name: [] for name in ("q", "qd", "torques", "wrench", "feet")}
+        for j in range(n):
+            q, qd, qdd, phid, phidd, s, co = _stance_state(
+                c, angles[:, j], rates[:, j], accels[:, j]
+            )
+            torques, wrench = _torques_and_wrench(c, qdd, phid, phidd, s, co)
+            feet = ca.vertcat(
+                q[ZH] - ca.dot(co, heel_a) + ca.dot(s, heel_b),
+                q[ZH] - ca.dot(co, toe_a) + ca.dot(s, toe_b),
+            )
+            for name, value in zip(columns, (q, qd, torques, wrench, feet), strict=True):
+                columns[name].append(value)
+        self.q, self.qd, self.torques, self.wrench, feet = (
+            ca.horzcat(*columns[name]) for name in columns
+        )
+        joint_rates = ca.DM(JOINT_MATRIX) @ self.qd
+        self.power = self.torques * joint_rates
+
+        # 4. criteria and constraints
+        weights = ca.DM(simpson_weights(samples_per_half)).T  # (1, N)
+        squared = ca.sum1(self.torques**2)
+        self.sthenic = period * (weights @ squared.T) / length
+        self.energy = period * (weights @ ca.sum1(ca.fabs(self.power)).T)
+        self.weights = weights
+        self.period = period
+
+        robot = model.robot
+        zmp = (self.torques[0, :] - robot.ankle_height * self.wrench[0, :]) / self.wrench[1, :]
+        feet_z = feet
+        if safety.clearance:
+            required = ca.DM(clearance_profile(samples_per_half, safety.clearance)).T
+            feet_z = feet_z - ca.repmat(required, 2, 1)
+        psi = ca.vertcat(
+            self.wrench[1, :],
+            zmp + robot.foot_heel - safety.zmp_margin,
+            robot.foot_length - robot.foot_heel - zmp - safety.zmp_margin,
+            self.q[Q2, :] - self.q[Q1, :],
+            self.q[Q3, :] - self.q[Q4, :],
+            feet_z,
+        )  # (7, N)
+        self.psi = psi  # with the safety margins, without δ
+        mask = checked_mask(samples_per_half)
+        margins = margin_profile(samples_per_half)
+        scaled = (psi - ca.DM(margins).T) / ca.repmat(ca.DM(CONSTRAINT_SCALES), 1, n)
+        rows, cols = np.nonzero(mask.T)  # constraint-major order
+        self.constraints = ca.vertcat(*[scaled[i, j] for i, j in zip(rows, cols, strict=True)])
+        self.constraint_names = [CONSTRAINTS[i] for i in rows]
+
+    def function(self) -> ca.Function:
+        """A CasADi function (z, speed) -> every quantity of the step, for checks."""
+        names = (
+            "parameters",
+            "torques",
+            "wrench",
+            "q",
+            "qd",
+            "psi",
+            "sthenic",
+            "energy",
+            "constraints",
+            "hip_height",
+            "impulse",
+        )
+        return ca.Function(
+            "step",
+            [self.z, self.speed],
+            [getattr(self, name) for name in names],
+            ["z", "speed"],
+            list(names),
+        )
