@@ -326,13 +326,13 @@ class Chain:
         dist2 = (d**2).sum(-1)
         low, high = self.leg_reach()
         bad = (dist2 > high**2 * (1 + 1e-12)) | (dist2 < low**2)
-        dist2 = np.minimum(dist2, high**2)  # rounding above the straight leg
         if np.any(bad):
             worst = float(np.sqrt(np.atleast_1d(dist2)[np.atleast_1d(bad)][0]))
             raise UnreachableError(
                 f"hip at {worst:.6g} m from the ankle is out of reach: "
                 f"allowed {low:.6g} m to {high:.6g} m"
             )
+        dist2 = np.minimum(dist2, high**2)  # rounding above the straight leg
         r1, r2 = self.radii
         shank, thigh = self.robot.shank_length - r1, self.robot.thigh_length - r2
         if r1 + r2 == 0.0:  # revolute: closed form

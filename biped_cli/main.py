@@ -1,6 +1,7 @@
 """The ``biped`` program: its parser, one subcommand per job, and the top-level guard.
 
-Errors in the input print one line on stderr and exit with status 2.
+Errors in the input print one line on stderr and exit with status 2; exit statuses are those
+of ``biped_cli.guard``.
 """
 
 from __future__ import annotations
@@ -9,8 +10,8 @@ import argparse
 import sys
 
 from biped.criteria import CRITERIA
-from biped.errors import BipedError
 from biped.kinematics import KNEES
+from biped.provenance import command_line, version
 from biped.sweep import DEFAULT_SPEEDS
 from biped_cli import args as types
 from biped_cli.commands import (
@@ -19,7 +20,6 @@ from biped_cli.commands import (
     DEFAULT_RECORDINGS,
     DEFAULT_SPEED,
     DEFAULT_SWEEP,
-    EXIT_BAD_INPUT,
     cmd_demo,
     cmd_figures,
     cmd_optimize,
@@ -27,8 +27,10 @@ from biped_cli.commands import (
     cmd_sweep,
     cmd_validate,
 )
+from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
 
 ROBOT_HELP = types.ROBOT_HELP
+DEBUG_HELP = "on an error, print its traceback before the one-line message"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -42,7 +44,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="biped",
         description="Quasi-optimal gaits of planar bipeds with revolute or rolling knees.",
+        epilog="Exit status: 0 done, 1 a result fails a check, 2 bad input (one line on "
+        "stderr), 130 / 143 interrupted (Ctrl-C / SIGTERM).",
     )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {version()}")
+    parser.add_argument("--debug", action="store_true", help=DEBUG_HELP)
     commands = parser.add_subparsers(
         dest="command", required=True, metavar="COMMAND", parser_class=_Parser
     )
@@ -55,14 +61,14 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     demo.add_argument(
         "--hip-ahead",
-        type=float,
+        type=types.metres,
         default=0.05,
         metavar="M",
         help="[m] hip ahead of the stance ankle (default 0.05)",
     )
     demo.add_argument(
         "--hip-height",
-        type=float,
+        type=types.metres,
         default=0.86,
         metavar="M",
         help="[m] hip above the ground (default 0.86)",
@@ -90,13 +96,17 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="S",
         help="START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.15:0.45:13)",
     )
-    sweep.add_argument("--knees", nargs="+", choices=KNEES, default=list(KNEES))
-    sweep.add_argument("--criteria", nargs="+", choices=CRITERIA, default=list(CRITERIA))
+    sweep.add_argument(
+        "--knees", nargs="+", choices=KNEES, default=list(KNEES), action=types.Distinct
+    )
+    sweep.add_argument(
+        "--criteria", nargs="+", choices=CRITERIA, default=list(CRITERIA), action=types.Distinct
+    )
     sweep.add_argument(
         "--out", default=DEFAULT_SWEEP, metavar="DIR", help=f"(default {DEFAULT_SWEEP})"
     )
     sweep.add_argument(
-        "--jobs", type=types.positive, default=None, help="processes (default: all cores)"
+        "--jobs", type=types.jobs, default=None, help="processes (default: all cores)"
     )
     types.add_budget(sweep)
     sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
@@ -110,7 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument(
         "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
     )
-    val.add_argument("--steps", type=types.positive, default=20, help="steps to walk (default 20)")
+    val.add_argument("--steps", type=types.steps, default=20, help=types.STEPS_HELP)
     val.add_argument(
         "--rrd",
         metavar="PATH",
@@ -131,9 +141,11 @@ def build_parser() -> argparse.ArgumentParser:
     pipe.add_argument(
         "--speed", type=types.speed, default=DEFAULT_SPEED, metavar="V", help="[m/s] (default 0.3)"
     )
-    pipe.add_argument("--knees", nargs="+", choices=KNEES, default=list(KNEES))
+    pipe.add_argument(
+        "--knees", nargs="+", choices=KNEES, default=list(KNEES), action=types.Distinct
+    )
     pipe.add_argument("--criterion", choices=CRITERIA, default="sthenic")
-    pipe.add_argument("--steps", type=types.positive, default=20, help="steps to walk (default 20)")
+    pipe.add_argument("--steps", type=types.steps, default=20, help=types.STEPS_HELP)
     pipe.add_argument(
         "--out",
         default=DEFAULT_PIPELINE,
@@ -156,14 +168,26 @@ def build_parser() -> argparse.ArgumentParser:
     fig.add_argument("--sweep", default=DEFAULT_SWEEP, metavar="DIR", help="sweep results")
     fig.add_argument("--out", default=DEFAULT_FIGURES, metavar="DIR", help="(default logs/figures)")
     fig.set_defaults(run=cmd_figures)
+    for command in commands.choices.values():  # after the command too: biped demo --debug
+        command.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP
+        )
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the ``biped`` command; returns the exit status."""
-    args = build_parser().parse_args(argv)
-    try:
-        return args.run(args)
-    except (BipedError, OSError) as error:
-        print(f"biped {args.command}: error: {error}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    """Run the ``biped`` command with ``argv`` (default: ``sys.argv[1:]``); returns the exit
+    status (``biped_cli.guard``), printing at most one line on stderr when it is not 0 or 1."""
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    name = ["biped"]  # the command, once parsed, names the error lines
+
+    def run() -> int:
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit as exit_:  # --help, --version, or a one-line argparse error
+            return exit_.code if isinstance(exit_.code, int) else EXIT_BAD_INPUT
+        name[0] = f"biped {args.command}"
+        with command_line(["biped", *argv]):
+            return args.run(args)
+
+    return run_guarded(lambda: name[0], run, debug="--debug" in argv)

@@ -1,8 +1,16 @@
-"""The ``biped`` command: output of the demo and one-line errors with exit status 2."""
+"""The ``biped`` command: output of the demo, one-line errors (exit 2), interrupts (130, 143)."""
 
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
 import pytest
 
 from biped_cli import main
+from biped_cli.progress import Progress
 
 
 def test_demo_prints_both_knees(capsys):
@@ -31,14 +39,12 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):
 
 
 def test_unknown_knee_exits_2(capsys):
-    """argparse rejects an unknown knee with exit status 2."""
-    with pytest.raises(SystemExit) as exit_info:
-        main(["demo", "--knee", "hinge"])
-    assert exit_info.value.code == 2
+    """argparse rejects an unknown knee with exit status 2, returned by main."""
+    assert main(["demo", "--knee", "hinge"]) == 2
     assert "hinge" in capsys.readouterr().err
 
 
-FAST = ["--evaluations", "300", "--restarts", "0", "--polish", "30"]
+FAST = ["--starts", "1"]
 
 
 def test_optimize_writes_a_complete_gait_file(tmp_path, capsys):
@@ -82,7 +88,7 @@ def test_infeasible_optimum_writes_nothing(tmp_path, capsys):
     """An infeasible result names the violated constraints, exits 1 and writes no file."""
     out = tmp_path / "gait.json"
     argv = ["optimize", "--knee", "revolute", "--speed", "0.3", "--out", str(out)]
-    assert main([*argv, "--evaluations", "1", "--restarts", "0", "--polish", "0"]) == 1
+    assert main([*argv, "--method", "nelder-mead", "--evaluations", "1", "--restarts", "0"]) == 1
     err = capsys.readouterr().err
     assert "infeasible" in err and "swing_toe = -" in err
     assert not out.exists() and not list(tmp_path.iterdir())
@@ -100,16 +106,12 @@ def test_infeasible_optimum_writes_nothing(tmp_path, capsys):
         (["sweep", "--jobs", "0"], "'0'"),
         (["sweep", "--clearance", "-0.01"], "clearance = '-0.01'"),
         (["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "."], "is a folder"),
-        (["demo", "--knee", "rolling", "--hip-ahead", "nan"], "allowed finite numbers"),
+        (["demo", "--knee", "rolling", "--hip-ahead", "nan"], "allowed a finite number"),
     ],
 )
 def test_bad_arguments_one_line_exit_2(capsys, argv, needle):
     """Bad arguments: one line on stderr naming the value, exit status 2."""
-    try:
-        code = main(argv)
-    except SystemExit as exit_info:
-        code = exit_info.code
-    assert code == 2
+    assert main(argv) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], lines
 
@@ -132,9 +134,7 @@ def test_figures_reject_a_corrupt_gait_file(tmp_path, capsys):
 )
 def test_pipeline_rejects_bad_options(capsys, argv, needle):
     """Bad pipeline options are one line on stderr and exit 2, before any work."""
-    with pytest.raises(SystemExit) as exit_info:
-        main(argv)
-    assert exit_info.value.code == 2
+    assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0]
 
@@ -154,8 +154,7 @@ def test_pipeline_writes_gait_report_and_recording(tmp_path, capsys):
     from biped import gait_file
 
     out, rrd = tmp_path / "pipeline", tmp_path / "recordings"
-    argv = ["pipeline", "--knees", "rolling", "--steps", "2", "--restarts", "0"]
-    argv += ["--evaluations", "300", "--polish", "30", "--out", str(out)]
+    argv = ["pipeline", "--knees", "rolling", "--steps", "2", *FAST, "--out", str(out)]
     code = main(argv + ["--recordings", str(rrd)])
     printed = capsys.readouterr().out
     gait = gait_file.read(out / "rolling-sthenic-0.300.json")
@@ -166,3 +165,194 @@ def test_pipeline_writes_gait_report_and_recording(tmp_path, capsys):
     assert report["forward"]["steps"] == 2 and not report["forward"]["fell"]
     recording = rrd / "rolling-sthenic-0.300.rrd"
     assert recording.stat().st_size > 0 and str(recording) in printed
+    for record in (gait["provenance"], report["provenance"]):
+        assert record["command"].startswith("biped pipeline --knees rolling")
+        assert record["version"] and record["numpy"] and record["mujoco"]
+
+
+def _one_line(capsys, code, expected_code=2):
+    """The single line on stderr of a command that exited with ``expected_code``."""
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert code == expected_code, captured.err
+    assert len(lines) == 1 and "Traceback" not in captured.err, captured.err
+    return lines[0]
+
+
+@pytest.fixture
+def robot_files(tmp_path):
+    """Robot files a user might get wrong: binary, absurd, without knee radii."""
+    files = {
+        "binary": ("robot.toml", b"r1 = 0.08\n\x89PNG\r\n\x1a\n\x00\xff"),
+        "absurd": ("absurd.json", b'{"trunk_mass": 1e308}'),
+        "no_radii": ("flat.toml", b"r1 = 0.0\nr2 = 0.0\n"),
+    }
+    paths = {}
+    for key, (name, content) in files.items():
+        paths[key] = tmp_path / name
+        paths[key].write_bytes(content)
+    return paths
+
+
+@pytest.mark.parametrize(
+    "robot, needle",
+    [("binary", "UTF-8"), ("absurd", "trunk_mass = 1e+308"), ("absurd", "0.001 to 1000 kg")],
+)
+def test_bad_robot_file_is_one_line(capsys, robot_files, robot, needle):
+    """Binary content and absurd parameters: one line naming the file or field, exit 2."""
+    line = _one_line(capsys, main(["demo", "--robot", str(robot_files[robot])]))
+    assert needle in line
+
+
+def test_pipeline_refuses_a_rolling_knee_mujoco_cannot_model(capsys, robot_files, tmp_path):
+    """A rolling knee with r1 = r2 = 0 is refused before any work, nothing written."""
+    out = tmp_path / "out"
+    argv = ["pipeline", "--robot", str(robot_files["no_radii"]), "--out", str(out)]
+    line = _one_line(capsys, main(argv))
+    assert "r1 = 0.0" in line and "allowed r1, r2 > 0" in line and not out.exists()
+
+
+@pytest.mark.parametrize(
+    "argv, needles",
+    [
+        (["demo", "--hip-height", "5"], ["--hip-height 5 m", "hip at 4.93"]),
+        (
+            ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "x.json", "--seed", "-1"],
+            ["--seed", "'-1'"],
+        ),
+        (
+            ["optimize", "--knee", "rolling", "--speed", "1e-9", "--out", "x.json"],
+            ["1e-9", "0.01 m/s"],
+        ),
+        (["sweep", "--speeds", "0.001,0.3"], ["0.001", "0.01 m/s"]),
+        (["sweep", "--speeds", "0.1:0.3:100000000"], ["100000000", "1000"]),
+        (["validate", "x.json", "--steps", "1000000000"], ["1000000000", "1 to 1000"]),
+        (["pipeline", "--steps", "1001"], ["1001", "1 to 1000"]),
+        (["sweep", "--knees", "rolling", "rolling"], ["--knees", "'rolling' given twice"]),
+        (["sweep", "--jobs", "1000000"], ["--jobs", "1 to 256"]),
+        (["demo", "--hip-ahead", "inf"], ["--hip-ahead", "finite"]),
+    ],
+)
+def test_refused_values_are_named_with_what_is_allowed(capsys, argv, needles):
+    """Each refused value is one line naming the option or value and what is allowed, exit 2."""
+    line = _one_line(capsys, main(argv))
+    assert all(needle in line for needle in needles), line
+
+
+def _replace_command(monkeypatch, body):
+    """Make ``biped demo`` run ``body`` instead of the demo."""
+
+    def command(args):
+        return body()
+
+    program = sys.modules["biped_cli.main"]  # the module, shadowed by its function main
+    monkeypatch.setattr(program, "cmd_demo", command)
+
+
+def test_ctrl_c_in_a_command_is_one_line_and_exit_130(capsys, monkeypatch):
+    """KeyboardInterrupt inside a command: exit 130 and one line, no traceback."""
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    _replace_command(monkeypatch, interrupted)
+    assert "interrupted" in _one_line(capsys, main(["demo"]), 130)
+
+
+def test_sigterm_in_a_command_is_one_line_and_exit_143(capsys, monkeypatch):
+    """SIGTERM while a command runs: exit 143 and one line; the previous handler is back."""
+    previous = signal.getsignal(signal.SIGTERM)
+
+    def terminated():
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(10)  # interrupted by the handler
+        return 0
+
+    _replace_command(monkeypatch, terminated)
+    assert "interrupted (SIGTERM)" in _one_line(capsys, main(["demo"]), 143)
+    assert signal.getsignal(signal.SIGTERM) is previous
+
+
+def test_unexpected_error_is_one_line_with_a_hint(capsys, monkeypatch):
+    """A bug is one line saying so and how to see more; --debug shows the traceback."""
+
+    def bug():
+        return {}["missing"]
+
+    _replace_command(monkeypatch, bug)
+    line = _one_line(capsys, main(["demo"]))
+    assert "internal error: KeyError" in line and "--debug" in line
+    assert main(["demo", "--debug"]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" in err and err.strip().splitlines()[-1] == line
+
+
+def test_numpy_warnings_stay_off_the_terminal(capsys, monkeypatch):
+    """Overflow in numpy inside a command prints no warning (and --debug shows it)."""
+
+    def overflow():
+        print(np.expm1(np.array([1000.0]))[0])
+        return 0
+
+    _replace_command(monkeypatch, overflow)
+    assert main(["demo"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.strip() == "inf" and captured.err == ""
+    with pytest.warns(RuntimeWarning, match="overflow"):
+        assert main(["demo", "--debug"]) == 0
+
+
+def test_version_and_python_m_biped(capsys):
+    """--version prints the package's version; python -m biped runs the same program."""
+    from biped.provenance import version
+
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"biped {version()}"
+    done = subprocess.run(
+        [sys.executable, "-m", "biped", "demo", "--hip-height", "5"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.count("\n") == 1 and "--hip-height 5 m" in done.stderr
+
+
+def test_help_documents_exit_statuses(capsys):
+    """biped --help exits 0 and states the exit statuses."""
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    assert "130 / 143" in out and "1 a result fails a check" in out
+
+
+class _Terminal:
+    """A stream that says it is a terminal."""
+
+    def __init__(self):
+        self.text = ""
+
+    def write(self, text):
+        self.text += text
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return True
+
+
+def test_progress_draws_on_a_terminal_only(capsys):
+    """The bar draws one line (carriage returns, no newline) on a terminal, nothing elsewhere."""
+    import io
+
+    piped = io.StringIO()
+    terminal = _Terminal()
+    for stream in (piped, terminal):
+        with Progress(4, "validate", stream=stream) as bar:
+            for i in range(4):
+                bar.update(note=f"gait{i}.json")
+                bar.advance()
+    assert piped.getvalue() == ""
+    assert "\n" not in terminal.text and "validate  4/4" in terminal.text
+    assert terminal.text.endswith("\r\x1b[K")  # erased at the end
+    assert capsys.readouterr().err == ""  # stderr under pytest is not a terminal

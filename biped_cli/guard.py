@@ -1,0 +1,123 @@
+"""How a command ends: exit statuses, one line on stderr for every failure, interrupts.
+
+- 0: done, every check passed.
+- 1: done, but a result fails a check (an infeasible optimum, a gait that falls in MuJoCo).
+- 2: the input is wrong (one line naming the value, the option or file, and what is
+  allowed), or an unexpected internal error (one line; ``--debug`` shows the traceback).
+- 130 / 143: interrupted by Ctrl-C (SIGINT) / terminated (SIGTERM), as a shell reports a
+  process killed by those signals (128 + the signal's number): one line, no traceback.
+
+Floating-point warnings of numpy (overflow in ``expm1`` while the optimiser explores) are
+expected and handled where they matter; they never reach the terminal unless ``--debug``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+import threading
+import traceback
+import warnings
+from collections.abc import Callable, Iterator
+
+import numpy as np
+
+from biped.errors import BipedError
+
+EXIT_OK = 0
+EXIT_CHECK_FAILED = 1
+EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 128 + signal.SIGINT  # 130
+EXIT_TERMINATED = 128 + signal.SIGTERM  # 143
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM received: raised in the main thread as Ctrl-C raises KeyboardInterrupt, so the
+    same clean-up runs (``finally`` blocks, temporary files removed, worker pools closed)."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated
+
+
+@contextlib.contextmanager
+def sigterm_interrupts() -> Iterator[None]:
+    """Within the block, SIGTERM raises ``Terminated`` in the main thread (elsewhere: no-op)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def quiet_numerics(debug: bool = False) -> Iterator[None]:
+    """Within the block, numpy's floating-point warnings are silent (shown with ``debug``)."""
+    if debug:
+        yield
+        return
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
+
+
+def one_line(text: str) -> str:
+    """``text`` on one line: line breaks become spaces."""
+    return " ".join(str(text).split("\n")).strip()
+
+
+def _stdout_closed() -> None:
+    """After a broken pipe (``biped demo | head -1``): send further output to nowhere, so that
+    Python's final flush does not fail again."""
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+
+
+def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bool = False) -> int:
+    """Run a command and turn how it ends into an exit status with at most one line on stderr.
+
+    Args:
+        name: the program and command, first on the line (``biped validate``), or a function
+            that gives it when the line is printed.
+        run: the command; returns 0 or 1.
+        debug: print the traceback of an error before its line.
+    """
+
+    def say(text: str) -> None:
+        print(f"{name() if callable(name) else name}: {text}", file=sys.stderr, flush=True)
+
+    def fail(kind: str, error: BaseException | str, hint: str = "") -> int:
+        if debug:
+            traceback.print_exc()
+        say(f"{kind}: {one_line(error)}{hint}")
+        return EXIT_BAD_INPUT
+
+    try:
+        with sigterm_interrupts(), quiet_numerics(debug):
+            return run()
+    except Terminated:
+        say("interrupted (SIGTERM)")
+        return EXIT_TERMINATED
+    except KeyboardInterrupt:
+        say("interrupted (Ctrl-C)")
+        return EXIT_INTERRUPTED
+    except BrokenPipeError as error:
+        _stdout_closed()
+        return fail("error", f"output closed early ({error.strerror})")
+    except (BipedError, OSError) as error:
+        return fail("error", error)
+    except SystemExit as exit_:
+        code = exit_.code
+        return code if isinstance(code, int) else (EXIT_OK if code is None else EXIT_BAD_INPUT)
+    except Exception as error:  # a bug: say so on one line, the traceback on demand
+        return fail(
+            "internal error",
+            f"{type(error).__name__}: {error}" if str(error) else type(error).__name__,
+            " (rerun with --debug for the traceback)",
+        )
