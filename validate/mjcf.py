@@ -304,6 +304,51 @@ def write_models(folder: Path = FOLDER, robot: Robot | None = None) -> list[Path
     return paths
 
 
+def stale_models(folder: Path = FOLDER, robot: Robot | None = None) -> list[Path]:
+    """The model files in ``folder`` that are missing or differ from what ``robot`` gives."""
+    stale = []
+    for name, text in model_files(robot).items():
+        path = folder / name
+        try:
+            current = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            current = None
+        if current != text:
+            stale.append(path)
+    return stale
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m validate.mjcf [--check]``; returns the exit status."""
+    import argparse
+
+    parser = argparse.ArgumentParser(
+        prog="python -m validate.mjcf",
+        description=f"Write the MJCF models of both knees ({FOLDER}/*.xml) from "
+        "biped.Robot.paper(), or check that they are up to date.",
+        epilog="Exit status: 0 written or up to date, 1 out of date (--check), 2 error.",
+    )
+    parser.add_argument(
+        "--check",
+        action="store_true",
+        help="report the files that are missing or out of date, rewrite nothing; exit 1 if any",
+    )
+    args = parser.parse_args(argv)
+    try:
+        if args.check:
+            stale = stale_models(FOLDER)
+            for path in stale:
+                print(f"out of date: {path} (run: python -m validate.mjcf)")
+            if not stale:
+                print(f"up to date: {len(model_files())} files in {FOLDER}")
+            return 1 if stale else 0
+        for written in write_models(FOLDER):
+            print(f"wrote {written}", file=sys.stderr)
+    except OSError as error:
+        print(f"python -m validate.mjcf: error: {error}", file=sys.stderr)
+        return 2
+    return 0
+
+
 if __name__ == "__main__":
-    for written in write_models():
-        print(f"wrote {written}", file=sys.stderr)
+    sys.exit(main())

@@ -1,0 +1,100 @@
+"""Package layout and entry points: the analytical package stays free of the simulator."""
+
+import ast
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from biped.provenance import DEPENDENCIES, PACKAGE, provenance, version
+
+ROOT = Path(__file__).resolve().parents[1]
+# Packages ``biped`` must not import: the MuJoCo side and what only it needs.
+FORBIDDEN = ("validate", "mujoco", "rerun", "biped_cli")
+
+
+def imported_modules(path: Path) -> set[str]:
+    """Top-level names of the modules a Python file imports, anywhere in it."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_imported_modules_sees_nested_imports(tmp_path):
+    """The import scan finds imports inside functions too (a lazy import counts)."""
+    source = tmp_path / "m.py"
+    source.write_text("import os.path\ndef f():\n    from validate.mjcf import x\n")
+    assert imported_modules(source) == {"os", "validate"}
+
+
+def test_biped_never_imports_the_simulator():
+    """No module of biped/ but __main__.py imports validate, mujoco, rerun or biped_cli."""
+    modules = sorted((ROOT / "biped").rglob("*.py"))
+    assert len(modules) > 10
+    offenders = {
+        str(path.relative_to(ROOT)): sorted(imported_modules(path) & set(FORBIDDEN))
+        for path in modules
+        if path.name != "__main__.py"
+    }
+    assert {k: v for k, v in offenders.items() if v} == {}
+
+
+def test_entry_points():
+    """The biped script is biped_cli:main and every package is installed."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert project["project"]["scripts"]["biped"] == "biped_cli:main"
+    assert {"biped", "biped_cli", "validate"} <= set(project["tool"]["setuptools"]["packages"])
+    assert "from biped_cli import main" in (ROOT / "biped" / "__main__.py").read_text()
+
+
+def test_provenance_records_versions_and_command():
+    """Provenance holds this package's version, its numerical dependencies' and the command."""
+    record = provenance(["biped", "sweep", "--out", "a b"])
+    assert record["package"] == PACKAGE and record["version"] == version()
+    assert record["command"] == "biped sweep --out 'a b'"
+    assert set(DEPENDENCIES) <= set(record) and record["numpy"] and record["scipy"]
+    assert record["python"] == ".".join(map(str, sys.version_info[:3]))
+    assert version("no-such-distribution-here") is None
+
+
+def test_provenance_does_not_import_mujoco():
+    """Reading MuJoCo's version does not import it (biped stays free of the simulator)."""
+    import subprocess
+
+    code = "import sys, biped.provenance as p; p.provenance(); print('mujoco' in sys.modules)"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.stdout.strip() == "False", done.stderr
+
+
+def test_mjcf_check_reports_stale_files_without_rewriting(tmp_path, capsys, monkeypatch):
+    """python -m validate.mjcf --check: the repository's models are current (exit 0); a
+    changed or missing file is reported and left as it is."""
+    from validate import mjcf
+
+    assert mjcf.main(["--check"]) == 0
+    assert "up to date" in capsys.readouterr().out
+    written = mjcf.write_models(tmp_path)
+    assert mjcf.stale_models(tmp_path) == []
+    written[0].write_text("<mujoco/>")
+    written[1].unlink()
+    assert sorted(mjcf.stale_models(tmp_path)) == sorted(written[:2])
+    monkeypatch.setattr(mjcf, "FOLDER", tmp_path)
+    assert mjcf.main(["--check"]) == 1
+    reported = capsys.readouterr().out
+    assert str(written[0]) in reported and str(written[1]) in reported
+    assert str(written[2]) not in reported
+    assert written[0].read_text() == "<mujoco/>" and not written[1].exists()
+
+
+def test_mjcf_help_exits_0(capsys):
+    """python -m validate.mjcf --help documents --check."""
+    from validate import mjcf
+
+    with pytest.raises(SystemExit) as exit_info:
+        mjcf.main(["--help"])
+    assert exit_info.value.code == 0 and "--check" in capsys.readouterr().out
