@@ -63,9 +63,11 @@ def test_recording_holds_both_robots_and_the_series(report):
     chunks = rerun.chunk.RrdReader(rrd).stream().to_chunks()
     paths = {chunk.entity_path for chunk in chunks}
     for expected in (
-        "/analytic/robot/links",
-        "/mujoco/robot/links",
-        "/analytic/robot/knees",
+        "/world/analytic/trunk",
+        "/world/mujoco/trunk",
+        "/world/mujoco/left_shank/geometry",
+        "/world/contact/force",
+        "/summary",
         "/torques/Γ1_stance_ankle/analytic",
         "/torques/Γ1_stance_ankle/mujoco",
         "/ground/Fz/analytic",
@@ -77,7 +79,7 @@ def test_recording_holds_both_robots_and_the_series(report):
     values = np.array([v[0] for v in batch.column("Scalars:scalars").to_pylist()])
     # The analytical normal force hovers around the robot's weight.
     assert 0.8 * 686.7 < np.median(values) < 1.2 * 686.7
-    assert "time" in [c for c in chunks if c.entity_path == "/mujoco/robot/links"][0].timeline_names
+    assert "time" in [c for c in chunks if c.entity_path == "/world/mujoco/trunk"][0].timeline_names
 
 
 def test_validate_rejects_a_corrupt_gait(tmp_path, capsys):

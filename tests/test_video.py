@@ -1,18 +1,14 @@
 """Videos of the walk: frames that show the robot, its ghost and the verdict; H.264 MP4, GIF."""
 
-import os
-
 import mujoco
 import numpy as np
 import pytest
 
 from biped import Robot, gait_file
 from tests.conftest import small_optimum
+from tests.test_mjcf import needs_gl
 
-pytestmark = pytest.mark.skipif(
-    os.environ.get("MUJOCO_GL") not in ("egl", "osmesa") and not os.environ.get("DISPLAY"),
-    reason="offscreen rendering needs MUJOCO_GL=egl (or osmesa) or a display",
-)
+pytestmark = needs_gl
 
 
 @pytest.fixture(scope="module")
@@ -117,3 +113,23 @@ def test_video_is_h264_with_a_frame_per_thirtieth_of_a_second(walk, tmp_path):
     with Image.open(gif) as image:
         assert image.n_frames == (len(states) + 1) // 2
         assert image.size == (SIZE[0] // 2, (SIZE[1] + CAPTION_HEIGHT) // 2)
+
+
+def test_validate_command_writes_the_video_and_a_gif(tmp_path, capsys):
+    """biped validate --video --gif writes both beside each other and names them in its
+    report; --gif without --video, or --video with several gaits, is refused (exit 2)."""
+    import json
+
+    from biped_cli import main
+
+    gait = tmp_path / "rolling.json"
+    gait_file.write_json(gait, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
+    mp4 = tmp_path / "walk.mp4"
+    args = ["validate", str(gait), "--steps", "1", "--rrd", str(tmp_path / "r.rrd")]
+    assert main([*args, "--video", str(mp4), "--gif", "--json"]) in (0, 1)
+    report = json.loads(capsys.readouterr().out)
+    assert report["video"] == [str(mp4), str(mp4.with_suffix(".gif"))]
+    assert mp4.stat().st_size > 10_000 and mp4.with_suffix(".gif").stat().st_size > 10_000
+    assert main([*args, "--gif"]) == 2
+    assert "--gif" in capsys.readouterr().err
+    assert main(["validate", str(gait), str(gait), "--video", str(mp4)]) == 2

@@ -1,1 +1,14 @@
-"""Physics validation of analytical gaits in MuJoCo (models, cross-checks, recordings)."""
+"""Physics validation of analytical gaits in MuJoCo (models, cross-checks, recordings, videos).
+
+MuJoCo picks its OpenGL backend when it is first imported: on Linux without a display, this
+package asks for EGL (offscreen, Mesa or a GPU driver) unless ``MUJOCO_GL`` says otherwise,
+so that videos render from a terminal or a CI job. Import it before ``mujoco``.
+"""
+
+import os
+import sys
+
+if sys.platform.startswith("linux") and not (
+    os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+):
+    os.environ.setdefault("MUJOCO_GL", "egl")

@@ -1,21 +1,35 @@
-"""Rerun recordings of a validation: the analytical gait and MuJoCo's walk side by side.
+"""Rerun recordings of a validation: MuJoCo's walk in 3D beside the gait's ghost, the torques
+joint by joint, the ground reaction and a summary of the gait and its checks.
 
 Entity paths, on the timeline ``time`` (seconds of simulation):
 
-    analytic/robot/{links,feet,knees}   the gait, legs alternating, drawn in the x-z plane
-    mujoco/robot/{links,feet,knees}     the MuJoCo simulation, drawn the same way
-    torques/Γ{i}_{joint}/{analytic,mujoco}  motor torques [N·m] (MuJoCo: feedforward + feedback)
-    ground/{Fx,Fz}/{analytic,mujoco}    ground reaction on the stance foot [N]
-    zmp/{analytic,mujoco,heel,toe}      ZMP from the stance ankle and the foot's limits [m]
-    phase                               the gait's time the controller follows, over T
+    world/ground                          the floor (a thin slab) and lines every 0.5 m
+    world/mujoco/<body>                   pose of each body of MuJoCo's robot (Transform3D)
+    world/mujoco/<body>/geometry          its geoms in the body's frame, in the model's colours
+                                          (Capsules3D, Boxes3D, Cylinders3D: the knee discs)
+    world/analytic/<body>[/geometry]      the gait at the phase the controller followed, drawn
+                                          the same way as a pale ghost ``GHOST_OFFSET`` behind
+    world/contact/force                   MuJoCo's ground reaction on the stance foot, an arrow
+                                          from the centre of pressure (``ARROW_SCALE`` m per N)
+    world/contact/zmp                     the gait's ZMP, a point on the stance sole
+    torques/Γ<i>_<joint>/analytic         the gait's torque Γ_i [N·m]
+    torques/Γ<i>_<joint>/mujoco           MuJoCo's: feedforward + feedback
+    torques/Γ<i>_<joint>/feedforward      MuJoCo's motor (the gait's torque at the phase)
+    torques/Γ<i>_<joint>/feedback         MuJoCo's servos
+    torques/Γ<i>_<joint>/landing          marks the landing windows (first 10 % of each step)
+    ground/{Fx,Fz}/{analytic,mujoco}      ground reaction on the stance foot [N]
+    zmp/{analytic,mujoco,heel,toe}        ZMP, centre of pressure and the foot's ends, from the
+                                          stance ankle [m]
+    phase                                 the gait's time the controller follows, over T
+    summary                               the gait's parameters, criteria and every check
 
-The default blueprint puts the two robots side by side above the time series. Drawings use
-(x, -z) so that the robot stands upright in rerun's 2D views (y down).
+``blueprint()`` lays them out: the 3D view following the robot, one plot per joint with its
+y range fixed to the bulk of the gait's torques (the landings' spikes run off it rather than
+flatten it), the ground reaction, the ZMP, the phase and the summary.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import mujoco
@@ -24,151 +38,369 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from biped.dynamics import JOINTS, Biped
-from biped.gait import angles_at
+from biped.files import atomic_path
 from validate.mapping import mapping
-from validate.mjcf import SIDES
+from validate.mjcf import HIP_OFFSET, SIDES
+from validate.report import SAMPLE_EVERY
 from validate.simulate import Simulation, reference_along
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
-CIRCLE = np.linspace(0.0, 2 * np.pi, 33)
+# Series colours, the same in every plot (RGB).
 ANALYTIC_COLOR = (80, 140, 230)
 MUJOCO_COLOR = (230, 120, 60)
+FEEDFORWARD_COLOR = (70, 170, 90)
+FEEDBACK_COLOR = (200, 60, 160)
+LANDING_COLOR = (150, 150, 150)
+# The gait's ghost: pale and translucent (RGBA), this far behind MuJoCo's robot (+y) [m].
+GHOST_COLOR = (235, 235, 245, 110)
+GHOST_OFFSET = 0.35
+FORCE_COLOR = (220, 40, 40)
+ZMP_COLOR = (30, 200, 230)
+GROUND_COLOR = (120, 122, 128)
+# Length of the ground-reaction arrow per newton [m/N]: the weight (687 N) is 0.69 m.
+ARROW_SCALE = 1e-3
+# Fraction of a step after touchdown marked as landing (the report's comparisons skip it).
+LANDING = 0.1
+# The torque plots show the gait's torques away from the landings, widened by this fraction
+# of their span on each side, and at least this span [N·m].
+TORQUE_MARGIN = 0.25
+TORQUE_MIN_SPAN = 2.0
 
 
-def blueprint() -> rrb.Blueprint:
-    """Two robots side by side above torques, ground reaction and ZMP."""
+def torque_series_path(i: int, joint: str) -> str:
+    return f"torques/Γ{i + 1}_{joint}"
+
+
+def torque_range(analytic: np.ndarray, steady: np.ndarray) -> tuple[float, float]:
+    """y range [N·m] of a torque plot: the gait's torque away from the landings (``steady``),
+    widened by ``TORQUE_MARGIN`` of its span each side, at least ``TORQUE_MIN_SPAN`` wide."""
+    values = analytic[steady] if np.any(steady) else analytic
+    low, high = float(values.min()), float(values.max())
+    pad = max(TORQUE_MARGIN * (high - low), (TORQUE_MIN_SPAN - (high - low)) / 2, 0.0)
+    return low - pad, high + pad
+
+
+def blueprint(ranges: dict | None = None) -> rrb.Blueprint:
+    """The 3D walk above the ground reaction, ZMP and phase; one plot per joint's torque
+    (y range from ``ranges``: path -> (low, high)) above the summary."""
+    ranges = ranges or {}
+    legend = rrb.PlotLegend(corner=rrb.Corner2D.LeftTop)
+    torque_views = [
+        rrb.TimeSeriesView(
+            origin=torque_series_path(i, joint),
+            name=f"Γ{i + 1} {joint.replace('_', ' ')} [N·m]",
+            plot_legend=legend if i == 0 else rrb.PlotLegend(visible=False),
+            axis_y=rrb.ScalarAxis(range=ranges.get(torque_series_path(i, joint)), zoom_lock=False),
+        )
+        for i, joint in enumerate(JOINTS)
+    ]
     return rrb.Blueprint(
-        rrb.Vertical(
-            rrb.Horizontal(
-                rrb.Spatial2DView(origin="analytic", name="analytical gait"),
-                rrb.Spatial2DView(origin="mujoco", name="MuJoCo"),
+        rrb.Horizontal(
+            rrb.Vertical(
+                rrb.Spatial3DView(
+                    origin="world",
+                    name="MuJoCo's walk, the gait's ghost behind",
+                    eye_controls=rrb.EyeControls3D(
+                        position=(0.6, -3.2, 1.3),
+                        look_target=(0.6, 0.0, 0.8),
+                        eye_up=(0.0, 0.0, 1.0),
+                        tracking_entity="world/mujoco/trunk",
+                    ),
+                ),
+                rrb.Horizontal(
+                    rrb.TimeSeriesView(origin="ground", name="ground reaction [N]"),
+                    rrb.TimeSeriesView(origin="zmp", name="ZMP from the stance ankle [m]"),
+                    rrb.TimeSeriesView(origin="phase", name="phase [T]"),
+                ),
+                row_shares=[3, 1],
             ),
-            rrb.Horizontal(
-                rrb.TimeSeriesView(origin="torques", name="torques [N·m]"),
-                rrb.TimeSeriesView(origin="ground", name="ground reaction [N]"),
-                rrb.TimeSeriesView(origin="zmp", name="ZMP [m]"),
-                rrb.TimeSeriesView(origin="phase", name="phase [T]"),
+            rrb.Vertical(
+                rrb.Grid(*torque_views, grid_columns=2),
+                rrb.TextDocumentView(origin="summary", name="gait and checks"),
+                row_shares=[3, 1],
             ),
-            row_shares=[3, 2],
+            column_shares=[3, 2],
         ),
         collapse_panels=True,
     )
 
 
-def _flip(points):
-    points = np.asarray(points, dtype=float)
-    return np.stack([points[..., 0], -points[..., 1]], axis=-1)
+def _xyzw(wxyz: np.ndarray) -> np.ndarray:
+    """MuJoCo's quaternions (w, x, y, z) in rerun's order (x, y, z, w)."""
+    return np.asarray(wxyz)[..., [1, 2, 3, 0]]
 
 
-def _circle(centre, radius):
-    return _flip(centre + radius * np.stack([np.cos(CIRCLE), np.sin(CIRCLE)], -1))
+def _rgba(model: mujoco.MjModel, geom: int) -> np.ndarray:
+    matid = model.geom_matid[geom]
+    rgba = model.mat_rgba[matid] if matid >= 0 else model.geom_rgba[geom]
+    return np.round(255 * np.asarray(rgba)).astype(np.uint8)
 
 
-def _log_robot(rec, path, points: dict, radii, color):
-    legs = [[points[f"{s}_hip"], points[f"{s}_knee"], points[f"{s}_ankle"]] for s in SIDES]
-    links = [_flip(leg) for leg in legs] + [_flip([points["hip"], points["head"]])]
-    feet = [
-        _flip([points[f"{s}_ankle"], points[f"{s}_heel"], points[f"{s}_toe"], points[f"{s}_ankle"]])
-        for s in SIDES
+def visual_geoms(model: mujoco.MjModel, color=None) -> dict:
+    """Body name -> its visual geoms (group 2) as rerun archetypes in the body's frame, in
+    the model's colours or all in ``color`` (RGBA)."""
+    shapes: dict = {}
+    for g in range(model.ngeom):
+        body = model.geom_bodyid[g]
+        if model.geom_group[g] != 2 or body == 0:
+            continue
+        kind, size = model.geom_type[g], model.geom_size[g]
+        pos, quat = model.geom_pos[g], model.geom_quat[g]
+        entry = shapes.setdefault(model.body(body).name, {"capsule": [], "box": [], "cylinder": []})
+        rgba = _rgba(model, g) if color is None else np.array(color, dtype=np.uint8)
+        if kind == mujoco.mjtGeom.mjGEOM_CAPSULE:
+            rotation = np.zeros(9)
+            mujoco.mju_quat2Mat(rotation, quat)
+            base = pos - rotation.reshape(3, 3) @ [0.0, 0.0, size[1]]
+            entry["capsule"].append((base, quat, size[0], 2 * size[1], rgba))
+        elif kind == mujoco.mjtGeom.mjGEOM_BOX:
+            entry["box"].append((pos, quat, size[:3], rgba))
+        elif kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            entry["cylinder"].append((pos, quat, size[0], 2 * size[1], rgba))
+    archetypes = {}
+    for body, entry in shapes.items():
+        parts = []
+        if entry["capsule"]:
+            base, quat, radius, length, rgba = zip(*entry["capsule"], strict=True)
+            parts.append(
+                rr.Capsules3D(
+                    translations=base,
+                    quaternions=_xyzw(np.array(quat)),
+                    radii=radius,
+                    lengths=length,
+                    colors=rgba,
+                )
+            )
+        if entry["box"]:
+            pos, quat, half, rgba = zip(*entry["box"], strict=True)
+            parts.append(
+                rr.Boxes3D(
+                    centers=pos,
+                    quaternions=_xyzw(np.array(quat)),
+                    half_sizes=half,
+                    colors=rgba,
+                    fill_mode="solid",
+                )
+            )
+        if entry["cylinder"]:
+            pos, quat, radius, length, rgba = zip(*entry["cylinder"], strict=True)
+            parts.append(
+                rr.Cylinders3D(
+                    centers=pos,
+                    quaternions=_xyzw(np.array(quat)),
+                    radii=radius,
+                    lengths=length,
+                    colors=rgba,
+                    fill_mode="solid",
+                )
+            )
+        archetypes[body] = parts
+    return archetypes
+
+
+def gait_qpos(biped: Biped, sim: Simulation, q: np.ndarray) -> np.ndarray:
+    """MuJoCo's qpos (N, nq) of the gait's coordinates q (N, 9) along the walk: each step's
+    stance leg on MuJoCo's stance side, its stance ankle on MuJoCo's at the start of the step."""
+    model = sim.model
+    qpos = np.zeros((len(q), model.nq))
+    starts = sim.step_starts + [len(sim.time)]
+    rootx = model.joint("rootx").qposadr[0]
+    for j, stance in enumerate(sim.stances):
+        rows = slice(starts[j], starts[j + 1])
+        qpos[rows] = mapping(model, stance, biped.radii).qpos(q[rows])
+        qpos[rows, rootx] += sim.sensor(f"{stance}_ankle_pos")[starts[j], 0]
+    return qpos
+
+
+def _body_poses(model: mujoco.MjModel, qpos: np.ndarray, bodies: list) -> tuple:
+    """World positions (N, B, 3) and quaternions (N, B, 4, wxyz) of ``bodies`` at each qpos."""
+    data = mujoco.MjData(model)
+    ids = [model.body(name).id for name in bodies]
+    positions = np.zeros((len(qpos), len(ids), 3))
+    quaternions = np.zeros((len(qpos), len(ids), 4))
+    for k, row in enumerate(qpos):
+        data.qpos[:] = row
+        mujoco.mj_kinematics(model, data)
+        positions[k], quaternions[k] = data.xpos[ids], data.xquat[ids]
+    return positions, quaternions
+
+
+def summary(biped: Biped, step, sim: Simulation, checks=(), gait: dict | None = None) -> str:
+    """Markdown: the gait's parameters and criteria, then every check with its verdict."""
+    lines = [f"# {biped.knee} knee, {'PASS' if all(c.passed for c in checks) else 'FAIL'}"]
+    if not checks:
+        lines[0] = f"# {biped.knee} knee"
+    lines += ["", "## Gait", "", "| | |", "|---|---|"]
+    rows = [("knee", biped.knee)]
+    if gait is not None:
+        rows += [
+            ("criterion", gait.get("criterion")),
+            ("speed [m/s]", f"{gait['speed']:.3f}"),
+            ("feasible", "yes" if gait.get("feasible") else "no"),
+        ]
+    rows += [
+        ("period T [s]", f"{step.period:.4f}"),
+        ("step length [m]", f"{step.step_length:.4f}"),
+        ("steps simulated", str(len(sim.stances))),
     ]
-    rec.log(f"{path}/links", rr.LineStrips2D(links, colors=color, radii=0.012))
-    rec.log(f"{path}/feet", rr.LineStrips2D(feet, colors=color, radii=0.006))
-    r1, r2 = radii
-    if r1 + r2 > 0.0:
-        circles = [_circle(points[f"{s}_c2"], r2) for s in SIDES]
-        circles += [_circle(points[f"{s}_c1"], r1) for s in SIDES]
-        rec.log(f"{path}/knees", rr.LineStrips2D(circles, colors=color, radii=0.004))
+    if gait is not None:
+        rows += [(f"criterion {name}", f"{value:.4g}") for name, value in gait["costs"].items()]
+        rows += [
+            (f"constraint {name}", f"{value:.4g}")
+            for name, value in (gait.get("constraints") or {}).items()
+        ]
+    lines += [f"| {name} | {value} |" for name, value in rows]
+    if checks:
+        lines += ["", "## Checks", ""]
+        for check in checks:
+            lines += [f"### {check.name}: {'PASS' if check.passed else 'FAIL'}", ""]
+            lines += ["| figure | value |", "|---|---|"]
+            lines += [f"| {name} | {_value(value)} |" for name, value in check.figures.items()]
+            lines += [""]
+    return "\n".join(lines)
 
 
-def analytic_points(biped: Biped, step, sim: Simulation, k: int) -> dict:
-    """Named points of the analytical gait at simulation state k (same step as MuJoCo)."""
-    j = int(np.searchsorted(sim.step_starts, k, side="right") - 1)
-    angles, rates, accel = angles_at(step, sim.phase[k] / step.period)
-    q, *_ = biped.single_support(angles, rates, accel)
-    stance = sim.stances[j]
-    swing = SIDES[1 - SIDES.index(stance)]
-    names = {
-        "hip": "hip",
-        "head": "head",
-        **{
-            f"{side}_{part}": f"{role}_{part}"
-            for side, role in ((stance, "stance"), (swing, "swing"))
-            for part in ("knee", "ankle", "heel", "toe")
-        },
-        **{
-            f"{side}_c2": f"{role}_knee_thigh"
-            for side, role in ((stance, "stance"), (swing, "swing"))
-        },
-        **{
-            f"{side}_c1": f"{role}_knee_shank"
-            for side, role in ((stance, "stance"), (swing, "swing"))
-        },
-    }
-    xy = biped.points(q, list(names.values()))
-    offset = np.array([j * step.step_length, 0.0])
-    points = {key: xy[i] + offset for i, key in enumerate(names)}
-    for side in SIDES:
-        points[f"{side}_hip"] = points["hip"]
-    return points
+def _value(value) -> str:
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, (list, tuple)):
+        return " - ".join(f"{v:.4g}" for v in value)
+    if isinstance(value, (float, np.floating)):
+        return "n/a" if np.isnan(value) else f"{value:.4g}"
+    return str(value)
 
 
-def mujoco_points(model: mujoco.MjModel, data: mujoco.MjData, biped: Biped) -> dict:
-    """Named points of the MuJoCo robot in data (after mj_kinematics)."""
-    xz = lambda v: np.asarray(v)[[0, 2]]  # noqa: E731
-    points = {"hip": xz(data.site("hip").xpos)}
-    top = data.xmat[model.body("trunk").id].reshape(3, 3) @ [0.0, 0.0, biped.robot.trunk_length]
-    points["head"] = points["hip"] + top[[0, 2]]
-    rolling = biped.knee == "rolling"
-    for side in SIDES:
-        points[f"{side}_hip"] = points["hip"]
-        points[f"{side}_ankle"] = xz(data.site(f"{side}_ankle").xpos)
-        points[f"{side}_heel"] = xz(data.site(f"{side}_heel").xpos)
-        points[f"{side}_toe"] = xz(data.site(f"{side}_toe").xpos)
-        shank = xz(data.body(f"{side}_shank").xpos)
-        if rolling:
-            c2 = xz(data.body(f"{side}_knee_link").xpos)
-            points[f"{side}_c2"], points[f"{side}_c1"] = c2, shank
-            r2 = biped.radii[1]
-            points[f"{side}_knee"] = c2 + r2 * (shank - c2) / np.linalg.norm(shank - c2)
-        else:
-            points[f"{side}_knee"] = shank
-    return points
+def _sinks(tmp: Path, spawn: bool, connect: str | None) -> list:
+    sinks = [rr.FileSink(str(tmp))]
+    if spawn:
+        rr.spawn(connect=False)
+        sinks.append(rr.GrpcSink())
+    if connect is not None:
+        sinks.append(rr.GrpcSink(connect) if connect else rr.GrpcSink())
+    return sinks
 
 
-def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict) -> Path:
+def record(
+    path: str | Path,
+    biped: Biped,
+    step,
+    sim: Simulation,
+    contact: dict,
+    checks=(),
+    gait: dict | None = None,
+    spawn: bool = False,
+    connect: str | None = None,
+) -> Path:
     """Write the recording of a validation to ``path`` (.rrd), atomically.
 
     Args:
         contact: MuJoCo's stance-foot force (N, 2) and centre of pressure (N,) as
             ``{"force": ..., "cop": ...}`` (NaN where not sampled or in double support).
+        checks: the validation's checks (``validate.report.Check``), for the summary.
+        gait: the gait file's content (``biped.gait_file.read``), for the summary.
+        spawn: also stream to a rerun viewer started for it.
+        connect: also stream to a running viewer at this URL ("" for rerun's default).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    rec = rr.RecordingStream("biped_validation", recording_id=f"{biped.knee}-{path.stem}")
-    try:
-        rec.save(str(tmp), default_blueprint=blueprint())
-    except RuntimeError as error:  # rerun reports an unwritable file this way
-        raise OSError(f"cannot write the recording {str(path)!r}: {error}") from None
+    q_ref, torques, wrench, zmp = reference_along(biped, step, sim)
+    steady = sim.phase >= LANDING * step.period
+    ranges = {
+        torque_series_path(i, joint): torque_range(torques[:, i], steady)
+        for i, joint in enumerate(JOINTS)
+    }
+    with atomic_path(path) as tmp:
+        rec = rr.RecordingStream("biped_validation", recording_id=f"{biped.knee}-{path.stem}")
+        try:
+            rec.set_sinks(*_sinks(tmp, spawn, connect), default_blueprint=blueprint(ranges))
+        except RuntimeError as error:  # rerun reports an unwritable file this way
+            raise OSError(f"cannot write the recording {str(path)!r}: {error}") from None
+        _log_torques(rec, biped, sim, torques, ranges, steady)
+        _log_series(rec, biped, step, sim, contact, wrench, zmp)
+        _log_world(rec, biped, sim, contact, q_ref, zmp)
+        rec.log(
+            "summary",
+            rr.TextDocument(
+                summary(biped, step, sim, checks, gait), media_type=rr.MediaType.MARKDOWN
+            ),
+            static=True,
+        )
+        rec.flush()
+        rec.disconnect()
+        del rec
+    return path
+
+
+def _log_torques(rec, biped: Biped, sim: Simulation, torques, ranges: dict, steady) -> None:
+    """Per joint: the gait's torque, MuJoCo's, its feedforward and feedback, the landings."""
     model = sim.model
-    data = mujoco.MjData(model)
     time_column = [rr.TimeColumn("time", duration=sim.time)]
-    _, torques, wrench, zmp = reference_along(biped, step, sim)
-    # MuJoCo's torques in the paper's order (stance, swing): motors plus feedback servos.
     stance_of = sim.stance_of()
-    applied = sim.motors() + sim.feedback()  # JOINT_ORDER = motor order
-    mj_torques = np.zeros_like(torques)
+    feedforward, feedback = sim.motors(), sim.feedback()  # JOINT_ORDER = motor order
+    parts = {"feedforward": np.zeros_like(torques), "feedback": np.zeros_like(torques)}
     for stance in SIDES:
         rows = stance_of == stance
         order = mapping(model, stance, biped.radii).actuator_order
-        mj_torques[rows] = applied[np.ix_(rows, order)]
+        parts["feedforward"][rows] = feedforward[np.ix_(rows, order)]
+        parts["feedback"][rows] = feedback[np.ix_(rows, order)]
+    landing = np.flatnonzero(~steady)[::5]
+    styles = {
+        "analytic": ("gait", ANALYTIC_COLOR, 2.0),
+        "mujoco": ("MuJoCo", MUJOCO_COLOR, 1.5),
+        "feedforward": ("feedforward", FEEDFORWARD_COLOR, 1.0),
+        "feedback": ("feedback", FEEDBACK_COLOR, 1.0),
+    }
     for i, joint in enumerate(JOINTS):
-        for source, values in (("analytic", torques[:, i]), ("mujoco", mj_torques[:, i])):
-            rec.send_columns(
-                f"torques/Γ{i + 1}_{joint}/{source}",
-                indexes=time_column,
-                columns=rr.Scalars.columns(scalars=values),
+        base = torque_series_path(i, joint)
+        values = {
+            "analytic": torques[:, i],
+            "mujoco": parts["feedforward"][:, i] + parts["feedback"][:, i],
+            "feedforward": parts["feedforward"][:, i],
+            "feedback": parts["feedback"][:, i],
+        }
+        for source, series in values.items():
+            name, color, width = styles[source]
+            rec.log(
+                f"{base}/{source}",
+                rr.SeriesLines(colors=color, names=name, widths=width),
+                static=True,
             )
+            rec.send_columns(
+                f"{base}/{source}", indexes=time_column, columns=rr.Scalars.columns(scalars=series)
+            )
+        low = ranges[base][0]
+        rec.log(
+            f"{base}/landing",
+            rr.SeriesPoints(
+                colors=LANDING_COLOR, names="landing", markers="square", marker_sizes=2.0
+            ),
+            static=True,
+        )
+        rec.send_columns(
+            f"{base}/landing",
+            indexes=[rr.TimeColumn("time", duration=sim.time[landing])],
+            columns=rr.Scalars.columns(scalars=np.full(len(landing), low)),
+        )
+
+
+def _log_series(rec, biped: Biped, step, sim: Simulation, contact, wrench, zmp) -> None:
+    """Ground reaction, ZMP and phase plots, the gait's and MuJoCo's."""
+    time_column = [rr.TimeColumn("time", duration=sim.time)]
+    for name in ("Fx", "Fz"):
+        rec.log(
+            f"ground/{name}/analytic",
+            rr.SeriesLines(colors=ANALYTIC_COLOR, names=f"{name} gait"),
+            static=True,
+        )
+        rec.log(
+            f"ground/{name}/mujoco",
+            rr.SeriesLines(colors=MUJOCO_COLOR, names=f"{name} MuJoCo"),
+            static=True,
+        )
+    rec.log("zmp/analytic", rr.SeriesLines(colors=ANALYTIC_COLOR, names="ZMP gait"), static=True)
+    rec.log("zmp/mujoco", rr.SeriesLines(colors=MUJOCO_COLOR, names="CoP MuJoCo"), static=True)
+    for name in ("heel", "toe"):
+        rec.log(f"zmp/{name}", rr.SeriesLines(colors=LANDING_COLOR, names=name), static=True)
     for i, name in enumerate(("Fx", "Fz")):
         rec.send_columns(
             f"ground/{name}/analytic",
@@ -198,17 +430,77 @@ def record(path: str | Path, biped: Biped, step, sim: Simulation, contact: dict)
             indexes=time_column,
             columns=rr.Scalars.columns(scalars=np.full(len(sim.time), value)),
         )
-    for k in range(0, len(sim.time), FRAME_EVERY):
-        rec.set_time("time", duration=float(sim.time[k]))
-        _log_robot(
-            rec, "analytic/robot", analytic_points(biped, step, sim, k), biped.radii, ANALYTIC_COLOR
-        )
-        data.qpos[:] = sim.qpos[k]
-        mujoco.mj_kinematics(model, data)
-        _log_robot(
-            rec, "mujoco/robot", mujoco_points(model, data, biped), biped.radii, MUJOCO_COLOR
-        )
-    rec.flush()
-    del rec
-    os.replace(tmp, path)
-    return path
+
+
+def _log_world(rec, biped: Biped, sim: Simulation, contact, q_ref, zmp) -> None:
+    """The 3D scene: floor, MuJoCo's robot, the gait's ghost, ground reaction and ZMP."""
+    model = sim.model
+    frames = np.arange(0, len(sim.time), FRAME_EVERY)
+    frame_time = [rr.TimeColumn("time", duration=sim.time[frames])]
+    # Floor: a slab under the walk, lines across it every 0.5 m.
+    start, end = float(sim.qpos[:, 0].min()) - 1.0, float(sim.qpos[:, 0].max()) + 1.0
+    rec.log(
+        "world/ground",
+        rr.Boxes3D(
+            centers=[((start + end) / 2, 0.0, -0.005)],
+            half_sizes=[((end - start) / 2, 0.6, 0.005)],
+            colors=[GROUND_COLOR],
+            fill_mode="solid",
+        ),
+        static=True,
+    )
+    marks = np.arange(np.floor(start * 2) / 2, end, 0.5)
+    rec.log(
+        "world/ground/lines",
+        rr.LineStrips3D(
+            [[(x, -0.6, 0.001), (x, 0.6, 0.001)] for x in marks], colors=[(90, 92, 98)], radii=0.003
+        ),
+        static=True,
+    )
+    geometry = {"mujoco": visual_geoms(model), "analytic": visual_geoms(model, GHOST_COLOR)}
+    bodies = list(geometry["mujoco"])
+    robots = {
+        "mujoco": sim.qpos[frames],
+        "analytic": gait_qpos(biped, sim, q_ref[frames]),
+    }
+    for name, qpos in robots.items():
+        positions, quaternions = _body_poses(model, qpos, bodies)
+        if name == "analytic":
+            positions[..., 1] += GHOST_OFFSET
+        for b, body in enumerate(bodies):
+            rec.log(f"world/{name}/{body}/geometry", *geometry[name][body], static=True)
+            rec.send_columns(
+                f"world/{name}/{body}",
+                indexes=frame_time,
+                columns=rr.Transform3D.columns(
+                    translation=positions[:, b], quaternion=_xyzw(quaternions[:, b])
+                ),
+            )
+    # Ground reaction from the centre of pressure, in single support (none in double).
+    stance_of = sim.stance_of()
+    y = np.where(stance_of == "left", HIP_OFFSET, -HIP_OFFSET)
+    ankle_x = np.zeros(len(sim.time))
+    for side in SIDES:
+        rows = stance_of == side
+        ankle_x[rows] = sim.sensor(f"{side}_ankle_pos")[rows, 0]
+    sampled = np.arange(0, len(sim.time), SAMPLE_EVERY)
+    single = np.isfinite(contact["cop"][sampled])
+    rows = sampled[single]
+    origins = np.stack([ankle_x[rows] + contact["cop"][rows], y[rows], np.zeros(len(rows))], axis=1)
+    force = contact["force"][rows]
+    vectors = ARROW_SCALE * np.stack([force[:, 0], np.zeros(len(rows)), force[:, 1]], axis=1)
+    rec.log(
+        "world/contact/force", rr.Arrows3D.from_fields(colors=FORCE_COLOR, radii=0.008), static=True
+    )
+    rec.send_columns(
+        "world/contact/force",
+        indexes=[rr.TimeColumn("time", duration=sim.time[sampled])],
+        columns=rr.Arrows3D.columns(origins=origins, vectors=vectors).partition(single.astype(int)),
+    )
+    points = np.stack(
+        [ankle_x[frames] + zmp[frames], y[frames], np.full(len(frames), 0.002)], axis=1
+    )
+    rec.log("world/contact/zmp", rr.Points3D.from_fields(colors=ZMP_COLOR, radii=0.02), static=True)
+    rec.send_columns(
+        "world/contact/zmp", indexes=frame_time, columns=rr.Points3D.columns(positions=points)
+    )

@@ -1,0 +1,177 @@
+"""Rerun recordings read back: the 3D robot from the model's geometry where MuJoCo has it, the
+ground reaction from the foot, one torque plot per joint, the summary with every verdict."""
+
+import mujoco
+import numpy as np
+import pytest
+import rerun.chunk
+
+from biped import Robot, gait_file
+from tests.conftest import small_optimum
+
+ROBOT = Robot.paper()
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory):
+    """Two steps of the rolling knee's gait, validated and recorded; the chunks read back."""
+    from validate.record import record
+    from validate.report import validate
+
+    folder = tmp_path_factory.mktemp("record")
+    gait = gait_file.to_dict(small_optimum("rolling"), ROBOT, seed=0)
+    gait_file.write_json(folder / "rolling.json", gait)
+    gait = gait_file.read(folder / "rolling.json")
+    result = validate(gait, steps=2)
+    path = record(
+        folder / "rolling.rrd",
+        result.biped,
+        result.step,
+        result.simulation,
+        result.contact,
+        result.checks,
+        gait,
+    )
+    chunks = rerun.chunk.RrdReader(path).stream().to_chunks()
+    return result, chunks, folder
+
+
+def column(chunks, entity: str, name: str, timeless: bool | None = None):
+    """Values of one component of an entity, row by row, and the rows' times [s] if any."""
+    for chunk in chunks:
+        if chunk.entity_path != entity:
+            continue
+        if timeless is not None and timeless != (not chunk.timeline_names):
+            continue
+        batch = chunk.to_record_batch()
+        if name in batch.schema.names:
+            times = None
+            if "time" in batch.schema.names:
+                times = np.array([t.value for t in batch.column("time")], dtype=float) * 1e-9
+            return batch.column(name).to_pylist(), times
+    raise KeyError(f"{entity} has no {name}")
+
+
+def test_recording_holds_the_documented_entities(recorded):
+    """3D robot and ghost per body, floor, force arrow, ZMP, four series per joint and the
+    summary are in the recording, and nothing is left of its temporary file."""
+    _, chunks, folder = recorded
+    paths = {chunk.entity_path for chunk in chunks}
+    for robot in ("mujoco", "analytic"):
+        for body in ("trunk", "left_thigh", "left_shank", "left_foot", "right_thigh"):
+            assert f"/world/{robot}/{body}" in paths
+            assert f"/world/{robot}/{body}/geometry" in paths
+    for entity in ("/world/ground", "/world/contact/force", "/world/contact/zmp", "/summary"):
+        assert entity in paths
+    for i, joint in enumerate(
+        ("stance_ankle", "stance_knee", "stance_hip", "swing_hip", "swing_knee", "swing_ankle")
+    ):
+        for series in ("analytic", "mujoco", "feedforward", "feedback", "landing"):
+            assert f"/torques/Γ{i + 1}_{joint}/{series}" in paths
+    assert not [p for p in folder.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_recorded_geometry_is_where_mujoco_draws_it(recorded):
+    """Capsule ends and knee-disc centres, from the recorded body poses and shapes, lie on
+    MuJoCo's geoms at the same instant (to 1e-5 m, float32)."""
+    result, chunks, _ = recorded
+    sim = result.simulation
+    model, data = sim.model, mujoco.MjData(sim.model)
+    translation, times = column(chunks, "/world/mujoco/left_shank", "Transform3D:translation")
+    quaternion, _ = column(chunks, "/world/mujoco/left_shank", "Transform3D:quaternion")
+    k = len(times) // 2
+    state = int(np.argmin(np.abs(sim.time - times[k])))
+    data.qpos[:] = sim.qpos[state]
+    mujoco.mj_kinematics(model, data)
+    rotation = np.zeros(9)
+    x, y, z, w = quaternion[k][0]
+    mujoco.mju_quat2Mat(rotation, np.array([w, x, y, z]))
+    pose = rotation.reshape(3, 3), np.array(translation[k][0])
+
+    def world(point):
+        return pose[0] @ np.asarray(point) + pose[1]
+
+    base, _ = column(chunks, "/world/mujoco/left_shank/geometry", "Capsules3D:translations")
+    lengths, _ = column(chunks, "/world/mujoco/left_shank/geometry", "Capsules3D:lengths")
+    capsule = [
+        g
+        for g in range(model.ngeom)
+        if model.geom_bodyid[g] == model.body("left_shank").id
+        and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE
+    ][0]
+    axis = data.geom_xmat[capsule].reshape(3, 3)[:, 2]
+    bottom = data.geom_xpos[capsule] - model.geom_size[capsule, 1] * axis
+    np.testing.assert_allclose(world(base[0][0]), bottom, atol=1e-5)
+    top = data.geom_xpos[capsule] + model.geom_size[capsule, 1] * axis
+    tip = world(base[0][0]) + pose[0] @ (
+        rotation_of(
+            column(chunks, "/world/mujoco/left_shank/geometry", "Capsules3D:quaternions")[0][0][0]
+        )
+        @ [0, 0, lengths[0][0]]
+    )
+    np.testing.assert_allclose(tip, top, atol=1e-5)
+    centres, _ = column(chunks, "/world/mujoco/left_shank/geometry", "Cylinders3D:centers")
+    radii, _ = column(chunks, "/world/mujoco/left_shank/geometry", "Cylinders3D:radii")
+    np.testing.assert_allclose(
+        world(centres[0][0]), data.geom_xpos[model.geom("left_shank_disc").id], atol=1e-5
+    )
+    assert radii[0][0] == pytest.approx(ROBOT.r1)
+
+
+def rotation_of(xyzw) -> np.ndarray:
+    x, y, z, w = xyzw
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, np.array([w, x, y, z]))
+    return rotation.reshape(3, 3)
+
+
+def test_ground_reaction_arrow_stands_in_the_stance_foot(recorded):
+    """The arrow starts on the floor under the stance sole (heel to toe, 1 mm of slack) and
+    its vertical length is the robot's weight at ARROW_SCALE, to 20 % in the median; the
+    gait's ZMP point lies on the sole too."""
+    from validate.record import ARROW_SCALE
+
+    result, chunks, _ = recorded
+    sim = result.simulation
+    origins, times = column(chunks, "/world/contact/force", "Arrows3D:origins", timeless=False)
+    vectors, _ = column(chunks, "/world/contact/force", "Arrows3D:vectors", timeless=False)
+    drawn = [i for i, row in enumerate(origins) if row]
+    assert len(drawn) > 0.5 * len(origins)  # single support most of the time
+    stance_of = sim.stance_of()
+    for i in drawn:
+        k = int(np.argmin(np.abs(sim.time - times[i])))
+        ankle = sim.sensor(f"{stance_of[k]}_ankle_pos")[k]
+        x = origins[i][0][0] - ankle[0]
+        assert -ROBOT.foot_heel - 1e-3 <= x <= ROBOT.foot_length - ROBOT.foot_heel + 1e-3
+        assert origins[i][0][2] == 0.0
+    weight = ROBOT.total_mass * ROBOT.gravity
+    vertical = np.median([vectors[i][0][2] for i in drawn]) / ARROW_SCALE
+    assert vertical == pytest.approx(weight, rel=0.2)
+    points, _ = column(chunks, "/world/contact/zmp", "Points3D:positions", timeless=False)
+    assert all(abs(row[0][2]) < 0.01 for row in points)
+
+
+def test_summary_states_the_gait_and_every_verdict(recorded):
+    """The summary names the knee, the speed, the criteria and each check with its verdict."""
+    result, chunks, _ = recorded
+    text = column(chunks, "/summary", "TextDocument:text")[0][0][0]
+    assert "rolling" in text and "0.300" in text and "sthenic" in text
+    for check in result.checks:
+        assert f"{check.name}: {'PASS' if check.passed else 'FAIL'}" in text
+
+
+def test_torque_range_follows_the_gait_not_the_landings():
+    """A landing spike of 40 N·m does not set the plot's range around ±4 N·m torques, and a
+    range from every sample would have let it."""
+    from validate.record import torque_range
+
+    t = np.linspace(0.0, 1.0, 1001)
+    torque = 4.0 * np.sin(2 * np.pi * t)
+    steady = t >= 0.1
+    torque[:20] = 40.0  # landing
+    low, high = torque_range(torque, steady)
+    assert -7.0 < low < -4.0 and 4.0 < high < 7.0
+    assert torque_range(torque, np.ones_like(steady))[1] > 40.0
+    # A nearly flat torque still gets a readable span.
+    low, high = torque_range(np.full(10, 1.0), np.ones(10, bool))
+    assert high - low == pytest.approx(2.0)
