@@ -168,17 +168,39 @@ def cmd_figures(args) -> int:
     return 0
 
 
-def _validate_and_record(gait: dict, steps: int, rrd):
-    """Every check of a gait read by ``gait_file.read`` and its recording at ``rrd``.
+def _validate_and_record(
+    gait: dict, steps: int, rrd, video=None, gif=None, spawn=False, connect=None
+):
+    """Every check of a gait read by ``gait_file.read``, its recording at ``rrd`` (also
+    streamed to a viewer with ``spawn`` or ``connect``) and, if asked, the video of its walk
+    at ``video`` (MP4) and ``gif``.
 
-    Returns the validation and its report (the checks as JSON, and the recording's path).
+    Returns the validation and its report (the checks as JSON, the recording's and video's
+    paths).
     """
     from validate.record import record
     from validate.report import as_json, validate
 
     result = validate(gait, steps=steps)
-    written = record(rrd, result.biped, result.step, result.simulation, result.contact)
+    written = record(
+        rrd,
+        result.biped,
+        result.step,
+        result.simulation,
+        result.contact,
+        result.checks,
+        gait,
+        spawn=spawn,
+        connect=connect,
+    )
     report = {**as_json(result.checks), "recording": str(written), "provenance": provenance()}
+    if video is not None or gif is not None:
+        from validate.video import write_video
+
+        files = write_video(
+            video, result.biped, result.step, result.simulation, result.checks, gif=gif
+        )
+        report["video"] = [str(path) for path in files]
     return result, report
 
 
@@ -188,8 +210,9 @@ def cmd_validate(args) -> int:
     Checks: analytical inverse dynamics and impact against MuJoCo's dynamics of the MJCF, and
     a forward walk with contact over --steps steps (every step lands, no fall, no slip, centre
     of pressure in the foot and on the gait's ZMP). Prints a table per gait (or JSON with
-    --json) and writes a rerun recording per gait; exits 0 only when every check of every
-    gait passes, 1 otherwise.
+    --json) and writes a rerun recording per gait (--spawn, --connect: also to a viewer) and,
+    with --video, the video of the walk; exits 0 only when every check of every gait passes,
+    1 otherwise.
     """
     import json
     from pathlib import Path
@@ -199,6 +222,13 @@ def cmd_validate(args) -> int:
 
     if args.rrd and len(args.gait) > 1:
         raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
+    if args.video and len(args.gait) > 1:
+        raise BipedError(f"--video names one video: allowed with one gait (got {len(args.gait)})")
+    if args.gif and not args.video:
+        raise BipedError("--gif writes beside the --video: allowed with --video FILE.mp4")
+    if args.video:
+        check_output(args.video, "--video")
+    gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
     gaits = [gait_file.read(path) for path in args.gait]  # all readable before any work
     for path, gait in zip(args.gait, gaits, strict=True):
         check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
@@ -219,7 +249,9 @@ def cmd_validate(args) -> int:
         for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
             bar.update(note=path)
             try:
-                result, reports[path] = _validate_and_record(gait, args.steps, rrd)
+                result, reports[path] = _validate_and_record(
+                    gait, args.steps, rrd, args.video, gif, args.spawn, args.connect
+                )
             except BipedError as error:
                 raise BipedError(f"gait file {path!r}: {error}") from None
             written = reports[path]["recording"]
@@ -230,6 +262,8 @@ def cmd_validate(args) -> int:
                 for check in result.checks:
                     print("  " + check.line())
                 print(f"recording: {written}  (open with: rerun {written})", flush=True)
+                for video in reports[path].get("video", []):
+                    print(f"video: {video}", flush=True)
             bar.advance()
     if args.json:
         print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
@@ -241,11 +275,12 @@ def cmd_validate(args) -> int:
 def cmd_pipeline(args) -> int:
     """The whole pipeline at one walking speed, for each knee: optimal gait (as
     ``biped optimize``), validation in MuJoCo (as ``biped validate``: inverse dynamics,
-    impact, forward walk with contact) and its rerun recording; then the two knees compared.
+    impact, forward walk with contact), its rerun recording and the video of its walk; then
+    the two knees compared.
 
     Writes, per knee, the gait file and the validation report (JSON) in --out and the
-    recording in --recordings; prints where they are. Exits 0 only when every gait is
-    feasible and passes every check, 1 otherwise.
+    recording and the video (MP4, unless --no-video) in --recordings; prints where they are.
+    Exits 0 only when every gait is feasible and passes every check, 1 otherwise.
     """
     from pathlib import Path
 
@@ -289,12 +324,15 @@ def cmd_pipeline(args) -> int:
         gait = gait_file.to_dict(optimum, robot, seed=args.seed)
         gait_path = gait_file.write_json(out / f"{name}.json", gait)
         print(f"[{knee}] validating {args.steps} steps in MuJoCo...", flush=True)
+        video = None if args.no_video else recordings / f"{name}.mp4"
         result, report = _validate_and_record(
-            gait_file.read(gait_path), args.steps, recordings / f"{name}.rrd"
+            gait_file.read(gait_path), args.steps, recordings / f"{name}.rrd", video
         )
         for check in result.checks:
             print(f"[{knee}]   " + check.line())
         rrd = report["recording"]
+        if video is not None:
+            print(f"[{knee}] video {video}")
         report_path = gait_file.write_json(
             out / f"{name}.report.json", {**report, "gait": str(gait_path)}
         )

@@ -131,6 +131,29 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="print the report as JSON (several gaits: an object keyed by file)",
     )
+    val.add_argument(
+        "--video",
+        metavar="FILE.mp4",
+        help="also render MuJoCo's walk of a single gait to an H.264 video (MUJOCO_GL=egl "
+        "without a display)",
+    )
+    val.add_argument(
+        "--gif", action="store_true", help="with --video, also an animated GIF beside it"
+    )
+    viewer = val.add_mutually_exclusive_group()
+    viewer.add_argument(
+        "--spawn",
+        action="store_true",
+        help="also stream the recording to a rerun viewer started for it",
+    )
+    viewer.add_argument(
+        "--connect",
+        metavar="URL",
+        nargs="?",
+        const="",
+        default=None,
+        help="also stream the recording to a running rerun viewer (default its local address)",
+    )
     val.set_defaults(run=cmd_validate)
 
     pipe = commands.add_parser(
@@ -156,7 +179,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--recordings",
         default=DEFAULT_RECORDINGS,
         metavar="DIR",
-        help=f"rerun recordings (default {DEFAULT_RECORDINGS})",
+        help=f"rerun recordings and videos (default {DEFAULT_RECORDINGS})",
+    )
+    pipe.add_argument(
+        "--no-video",
+        action="store_true",
+        help="skip the videos of the walks (<recordings>/<gait>.mp4)",
     )
     types.add_budget(pipe)
     pipe.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
