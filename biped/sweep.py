@@ -6,7 +6,8 @@ independent of the others, so the points run in parallel on all cores:
 1. independent: IPOPT from the point's own starts (``biped.optimize.optimize``); the result
    is kept in the hidden folder ``.independent/``;
 2. neighbours: IPOPT again from the independent optima of the neighbouring speeds of the
-   same series; the best of both stages is the point's gait file.
+   same series and of the other knee at the same speed; the best of both stages is the
+   point's gait file.
 
 Each result depends only on the files of the stage before, which are written whole
 (``biped.files``), so a sweep stopped at any moment and run again ends with exactly the files
@@ -250,7 +251,7 @@ def run_sweep(
         p
         for p in points
         if _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is None
-        and (p in final or any(n in final for n in _neighbours(p, speeds)))
+        and (p in final or any(n in final for n in _neighbours(p, speeds, knees)))
     ]
     print(
         f"sweep: {len(points)} points in {folder}, {len(points) - len(final)} already done, "
@@ -261,20 +262,23 @@ def run_sweep(
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(stage1) or 1))
     began = time.perf_counter()
     _run(_solve_independent, [(settings, p, str(folder)) for p in stage1], jobs, stream)
-    tasks = [(settings, p, str(folder), _neighbours(p, speeds)) for p in final]
+    tasks = [(settings, p, str(folder), _neighbours(p, speeds, knees)) for p in final]
     _run(_solve_with_neighbours, tasks, jobs, stream)
     summary = summarize(folder, points, settings)
     print(f"sweep: done in {time.perf_counter() - began:.1f} s; {summary}", file=stream, flush=True)
     return points
 
 
-def _neighbours(point: Point, speeds) -> list[Point]:
+def _neighbours(point: Point, speeds, knees) -> list[Point]:
+    """The points whose optima start the second stage of ``point``: the neighbouring speeds
+    of its series, and the same speed with the other knees (the variables mean the same for
+    both knees)."""
     i = list(speeds).index(point.speed)
     return [
         Point(point.knee, point.criterion, speeds[j])
         for j in (i - 1, i + 1)
         if 0 <= j < len(speeds)
-    ]
+    ] + [Point(k, point.criterion, point.speed) for k in knees if k != point.knee]
 
 
 def summarize(folder: Path, points, settings: Settings) -> str:
