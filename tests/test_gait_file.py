@@ -77,7 +77,7 @@ def test_unwalkable_speed_names_the_field(content, tmp_path):
     "change, needle",
     [
         (lambda g: g.update(step_length=g["step_length"] * 2), "step_length"),
-        (lambda g: g.update(speed=1e-9, step_length=1e-9 * g["period"]), "step_length"),
+        (lambda g: g.update(speed=1e-9, step_length=1e-9 * g["period"]), "speed = 1e-09"),
         (lambda g: g["costs"].update(sthenic=10**400), "costs"),
         (lambda g: g["robot"].update(trunk_mass=1e308), "trunk_mass"),
         (lambda g: g["samples"].update(zmp=[[0.0]] * len(g["samples"]["t"])), "samples.zmp"),
