@@ -133,3 +133,21 @@ def test_validate_command_writes_the_video_and_a_gif(tmp_path, capsys):
     assert main([*args, "--gif"]) == 2
     assert "--gif" in capsys.readouterr().err
     assert main(["validate", str(gait), str(gait), "--video", str(mp4)]) == 2
+
+
+def test_frame_command_writes_a_png_of_the_walk(tmp_path):
+    """python -m validate.video GAIT --frame FILE.png writes one captioned frame showing both
+    legs; asked for nothing to write, it refuses."""
+    from PIL import Image
+
+    from validate.video import CAPTION_HEIGHT, leg_pixels, main
+
+    gait = tmp_path / "rolling.json"
+    gait_file.write_json(gait, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
+    png = tmp_path / "walk.png"
+    assert main([str(gait), "--steps", "1", "--frame", str(png), "--at", "0"]) == 0
+    image = np.asarray(Image.open(png).convert("RGB"))
+    seen = leg_pixels(image[CAPTION_HEIGHT:])
+    assert seen["left"] > 0.002 and seen["right"] > 0.002, seen
+    with pytest.raises(SystemExit):
+        main([str(gait)])

@@ -172,7 +172,8 @@ def frame_states(sim: Simulation, fps: int = FPS) -> np.ndarray:
 
 
 class Captioned:
-    """Frames with the caption: step j of n and the time at the left, the verdict at the right.
+    """Frames with the caption: knee, speed, step j of n and the time at the left, the
+    verdict at the right.
 
     Args:
         verdict: the text at the right (e.g. "validation PASS: 20 steps walked").
@@ -186,7 +187,11 @@ class Captioned:
         r = self.renderer
         image = r.render(k)
         steps = len(r.sim.stances)
-        left = f"step {r.step_of(k) + 1} / {steps}   t = {r.sim.time[k]:5.2f} s"
+        speed = r.step.step_length / r.step.period
+        left = (
+            f"{r.biped.knee} knee, {speed:.2f} m/s   step {r.step_of(k) + 1} / {steps}   "
+            f"t = {r.sim.time[k]:5.2f} s"
+        )
         band = caption_band(left, self.verdict, self.passed, image.shape[1])
         return np.concatenate([band, image], axis=0)
 
