@@ -26,6 +26,7 @@ import os
 import signal
 import sys
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -187,6 +188,8 @@ def _worker_init():
     SIGTERM raises SystemExit, so a file being written is removed, never left half-written."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    np.seterr(all="ignore")  # as in the command line: numpy's warnings stay off the terminal
+    warnings.simplefilter("ignore", RuntimeWarning)
 
 
 def _run(function, tasks, jobs, stream):
