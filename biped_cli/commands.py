@@ -114,6 +114,15 @@ def cmd_optimize(args) -> int:
             "find a better optimum",
             file=sys.stderr,
         )
+    if not report.converged:
+        message = f"biped optimize: the solver did not converge ({report.method}: {report.status})"
+        if optimum.feasible:
+            path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
+            message += f"; {path} is written but is not a certified optimum"
+        else:
+            message += "; the result is infeasible, no file written"
+        print(message, file=sys.stderr)
+        return 1
     if not optimum.feasible:
         worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
         print(
@@ -124,13 +133,6 @@ def cmd_optimize(args) -> int:
         return 1
     path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
     print(f"wrote {path}")
-    if not report.converged:
-        print(
-            f"biped optimize: the solver did not converge ({report.method}: {report.status}); "
-            f"{path} is not a certified optimum",
-            file=sys.stderr,
-        )
-        return 1
     return 0
 
 

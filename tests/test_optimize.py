@@ -247,3 +247,24 @@ def test_bad_safety_margins_are_rejected():
             Safety(clearance=bad)
     with pytest.raises(biped.BipedError, match="zmp_margin"):
         Safety(zmp_margin=0.2)
+
+
+def test_solver_that_does_not_converge_fails_loudly(tmp_path, monkeypatch, capsys):
+    """With IPOPT cut to 3 iterations no start converges: the report says so with IPOPT's
+    status, and 'biped optimize' exits 1 naming it (not a silent fallback)."""
+    from biped import solver
+    from biped_cli import main
+
+    monkeypatch.setitem(solver.IPOPT_OPTIONS, "max_iter", 3)
+    solver._solver.cache_clear()
+    try:
+        problem = GaitProblem(biped.Biped(ROBOT, "revolute"), 0.3)
+        optimum = optimize(problem, starts=1)
+        assert optimum.report.status == "Maximum_Iterations_Exceeded"
+        assert not optimum.certified
+        out = tmp_path / "gait.json"
+        argv = ["optimize", "--knee", "revolute", "--speed", "0.3", "--starts", "1"]
+        assert main([*argv, "--out", str(out)]) == 1
+        assert "Maximum_Iterations_Exceeded" in capsys.readouterr().err
+    finally:
+        solver._solver.cache_clear()
