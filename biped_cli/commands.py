@@ -120,7 +120,8 @@ def cmd_optimize(args) -> int:
             path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
             message += f"; {path} is written but is not a certified optimum"
         else:
-            message += "; the result is infeasible, no file written"
+            worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
+            message += f"; the result is infeasible (Ψ < 0: {worst}), no file written"
         print(message, file=sys.stderr)
         return 1
     if not optimum.feasible:
