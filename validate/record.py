@@ -45,6 +45,9 @@ from validate.report import SAMPLE_EVERY
 from validate.simulate import Simulation, reference_along
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
+APPLICATION = "biped_validation"
+# Longest wait [s] for a viewer (--spawn, --connect) to take the recording.
+VIEWER_TIMEOUT = 10.0
 # Series colours, the same in every plot (RGB).
 ANALYTIC_COLOR = (80, 140, 230)
 MUJOCO_COLOR = (230, 120, 60)
@@ -270,16 +273,6 @@ def _value(value) -> str:
     return str(value)
 
 
-def _sinks(tmp: Path, spawn: bool, connect: str | None) -> list:
-    sinks = [rr.FileSink(str(tmp))]
-    if spawn:
-        rr.spawn(connect=False)
-        sinks.append(rr.GrpcSink())
-    if connect is not None:
-        sinks.append(rr.GrpcSink(connect) if connect else rr.GrpcSink())
-    return sinks
-
-
 def record(
     path: str | Path,
     biped: Biped,
@@ -309,25 +302,38 @@ def record(
         torque_series_path(i, joint): torque_range(torques[:, i], steady)
         for i, joint in enumerate(JOINTS)
     }
-    with atomic_path(path) as tmp:
-        rec = rr.RecordingStream("biped_validation", recording_id=f"{biped.knee}-{path.stem}")
-        try:
-            rec.set_sinks(*_sinks(tmp, spawn, connect), default_blueprint=blueprint(ranges))
-        except RuntimeError as error:  # rerun reports an unwritable file this way
-            raise OSError(f"cannot write the recording {str(path)!r}: {error}") from None
+    recording_id = f"{biped.knee}-{path.stem}"
+    layout = blueprint(ranges)
+
+    def log_all(rec) -> None:
         _log_torques(rec, biped, sim, torques, ranges, steady)
         _log_series(rec, biped, step, sim, contact, wrench, zmp)
         _log_world(rec, biped, sim, contact, q_ref, zmp)
-        rec.log(
-            "summary",
-            rr.TextDocument(
-                summary(biped, step, sim, checks, gait), media_type=rr.MediaType.MARKDOWN
-            ),
-            static=True,
-        )
+        text = summary(biped, step, sim, checks, gait)
+        rec.log("summary", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
+
+    with atomic_path(path) as tmp:
+        rec = rr.RecordingStream(APPLICATION, recording_id=recording_id)
+        try:
+            rec.save(str(tmp), default_blueprint=layout)
+        except RuntimeError as error:  # rerun reports an unwritable file this way
+            raise OSError(f"cannot write the recording {str(path)!r}: {error}") from None
+        log_all(rec)
         rec.flush()
         rec.disconnect()
         del rec
+    if spawn or connect is not None:
+        # A stream of its own: a viewer that does not answer delays the command by at most
+        # VIEWER_TIMEOUT and never the file.
+        live = rr.RecordingStream(APPLICATION, recording_id=recording_id)
+        if spawn:
+            live.spawn(default_blueprint=layout)
+        else:
+            live.connect_grpc(connect or None, default_blueprint=layout)
+        log_all(live)
+        live.flush(timeout_sec=VIEWER_TIMEOUT)
+        live.disconnect()
+        del live
     return path
 
 
