@@ -100,7 +100,8 @@ class Solver:
         self.evaluate = ca.Function(
             "evaluate", [graph.z, graph.speed], [graph.sthenic, graph.energy, graph.power]
         )
-        lower, upper = bounds()
+        self.lower, self.upper = bounds()
+        lower, upper = self.lower, self.upper
         self.lbx = np.concatenate([lower / SCALES, np.zeros(self.slacks)])
         self.ubx = np.concatenate([upper / SCALES, np.full(self.slacks, np.inf)])
         self.n_constraints = g.shape[0]
@@ -108,8 +109,7 @@ class Solver:
     def solve(self, problem: GaitProblem, start) -> Solution:
         """IPOPT from the variables ``start`` (21,), clipped into the bounds."""
         began = time.perf_counter()
-        lower, upper = bounds()
-        z0 = np.clip(np.asarray(start, dtype=float), lower, upper)
+        z0 = np.clip(np.asarray(start, dtype=float), self.lower, self.upper)
         x0 = z0 / SCALES
         if self.slacks:
             power = np.asarray(self.evaluate(z0, problem.speed)[2]).T.ravel()

@@ -38,7 +38,7 @@ from biped.dynamics import Biped
 from biped.errors import BipedError
 from biped.files import atomic_write_text, clean_stale_temporaries
 from biped.kinematics import KNEES
-from biped.optimize import DEFAULT_STARTS, Optimum, best_of, optimize
+from biped.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, optimize
 from biped.problem import VARIABLES, GaitProblem, check_speed
 from biped.provenance import version
 from biped.robot import Robot
@@ -131,8 +131,6 @@ def _read_gait(path: Path, point: Point, settings: Settings):
 
 def _optimum_of(gait: dict, settings: Settings, point: Point) -> Optimum:
     """The ``Optimum`` stored in a gait file (same numbers: JSON keeps every bit)."""
-    from biped.optimize import Report, checked
-
     variables = np.array([gait["optimizer"]["variables"][name] for name in VARIABLES], float)
     report = Report.from_dict(gait["optimizer"])
     return checked(_problem(settings, point), variables, report)
