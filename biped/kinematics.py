@@ -59,6 +59,57 @@ def check_knee(knee: str) -> str:
     return knee
 
 
+def point_table(robot: Robot, r1, r2, links: bool) -> dict[str, tuple[dict, dict]]:
+    """Every named point as its coefficients over the directions: ``name -> (a, b)``, with
+    p = p_H + Σ_k a[k] u(φ_k) + b[k] u'(φ_k) over the direction names k of ``a`` and ``b``.
+
+    The one statement of the robot's geometry: ``Chain`` fills its tables from it with the
+    radii as numbers, the symbolic graph (``biped.symbolic``) with the radii as CasADi
+    symbols. Only sums and products of ``r1``, ``r2`` and ``robot``'s lengths appear.
+
+    Args:
+        robot: lengths and centres of mass.
+        r1, r2: [m] radii of the shank's and the thigh's rolling circles (0 for the
+            revolute knee).
+        links: include the knee links C1C2 (directions ``LINK_DIRECTIONS``, length
+            r1 + r2); without them the radii must be 0.
+    """
+    r = robot
+    link = r1 + r2
+    shank, thigh = r.shank_length - r1, r.thigh_length - r2  # l'1, l'2
+    points: dict[str, tuple[dict, dict]] = {"hip": ({}, {})}
+
+    def add(name, base, a=None, b=None):
+        a0, b0 = points[base]
+        a_new, b_new = dict(a0), dict(b0)
+        for target, extra in ((a_new, a or {}), (b_new, b or {})):
+            for key, value in extra.items():
+                target[key] = target.get(key, 0.0) + value
+        points[name] = (a_new, b_new)
+
+    for side in ("stance", "swing"):
+        add(f"{side}_thigh_com", "hip", {f"{side}_thigh": r.thigh_com})
+        add(f"{side}_knee_thigh", "hip", {f"{side}_thigh": thigh})  # C2
+        knee_link = {f"{side}_knee_link": link} if links else {}
+        add(f"{side}_knee_shank", f"{side}_knee_thigh", knee_link)  # C1
+        contact = {f"{side}_knee_link": r2} if links else {}
+        add(f"{side}_knee", f"{side}_knee_thigh", contact)  # rolling contact point
+        add(f"{side}_shank_com", f"{side}_knee_shank", {f"{side}_shank": r.shank_com - r1})
+        add(f"{side}_ankle", f"{side}_knee_shank", {f"{side}_shank": shank})
+        foot = f"{side}_foot"
+        add(f"{side}_foot_com", f"{side}_ankle", {foot: r.foot_com})
+        add(f"{side}_heel", f"{side}_ankle", {foot: r.ankle_height}, {foot: -r.foot_heel})
+        add(
+            f"{side}_toe",
+            f"{side}_ankle",
+            {foot: r.ankle_height},
+            {foot: r.foot_length - r.foot_heel},
+        )
+    add("trunk_com", "hip", {"trunk": -r.trunk_com})
+    add("head", "hip", {"trunk": -r.trunk_length})
+    return points
+
+
 @dataclass(frozen=True)
 class Body:
     """A rigid body of the dynamic model."""
@@ -99,37 +150,7 @@ class Chain:
         self.directions = np.array(rows)  # (K, 7): φ = directions @ angles
         index = {name: k for k, name in enumerate(names)}
 
-        shank, thigh = r.shank_length - r1, r.thigh_length - r2  # l'1, l'2
-        points: dict[str, tuple[dict, dict]] = {"hip": ({}, {})}
-
-        def add(name, base, a=None, b=None):
-            a0, b0 = points[base]
-            a_new, b_new = dict(a0), dict(b0)
-            for target, extra in ((a_new, a or {}), (b_new, b or {})):
-                for key, value in extra.items():
-                    target[key] = target.get(key, 0.0) + value
-            points[name] = (a_new, b_new)
-
-        for side in ("stance", "swing"):
-            add(f"{side}_thigh_com", "hip", {f"{side}_thigh": r.thigh_com})
-            add(f"{side}_knee_thigh", "hip", {f"{side}_thigh": thigh})  # C2
-            knee_link = {f"{side}_knee_link": link} if link > 0.0 else {}
-            add(f"{side}_knee_shank", f"{side}_knee_thigh", knee_link)  # C1
-            contact = {f"{side}_knee_link": r2} if link > 0.0 else {}
-            add(f"{side}_knee", f"{side}_knee_thigh", contact)  # rolling contact point
-            add(f"{side}_shank_com", f"{side}_knee_shank", {f"{side}_shank": r.shank_com - r1})
-            add(f"{side}_ankle", f"{side}_knee_shank", {f"{side}_shank": shank})
-            foot = f"{side}_foot"
-            add(f"{side}_foot_com", f"{side}_ankle", {foot: r.foot_com})
-            add(f"{side}_heel", f"{side}_ankle", {foot: r.ankle_height}, {foot: -r.foot_heel})
-            add(
-                f"{side}_toe",
-                f"{side}_ankle",
-                {foot: r.ankle_height},
-                {foot: r.foot_length - r.foot_heel},
-            )
-        add("trunk_com", "hip", {"trunk": -r.trunk_com})
-        add("head", "hip", {"trunk": -r.trunk_length})
+        points = point_table(r, r1, r2, links=link > 0.0)
 
         self.point_names = tuple(points)
         k = len(names)

@@ -12,6 +12,11 @@ criterion's |Γ_i θ̇_i| is written exactly with slack variables s_ij (no smoot
 The solver works on scaled variables y = z / ``SCALES``. One ``Solver`` (graph, derivatives
 and IPOPT instance) is built per robot, knee, criterion, safety and sample count and serves
 every speed and every start (``solver_for``).
+
+With ``radius_bounds`` the knee radii (r1, r2) [m] are variables too (scaled by
+``RADIUS_SCALE``), the rolling knee's graph built with them as symbols
+(``StepGraph(..., design=True)``): the gait and the knee optimised together
+(``biped.design``).
 """
 
 from __future__ import annotations
@@ -42,6 +47,8 @@ IPOPT_OPTIONS = {
 }
 # IPOPT's statuses that are a converged local optimum.
 CONVERGED = ("Solve_Succeeded",)
+# One unit of the knee radii in the solver's scaled space [m].
+RADIUS_SCALE = 0.05
 
 
 @dataclass(frozen=True)
@@ -57,6 +64,7 @@ class Solution:
             solver's scaled units.
         dual_infeasibility: IPOPT's unscaled dual infeasibility at the end.
         seconds: time of the solve.
+        radii: (r1, r2) [m] at the end, when the radii are variables (else None).
     """
 
     variables: np.ndarray
@@ -66,6 +74,7 @@ class Solution:
     constraint_violation: float
     dual_infeasibility: float
     seconds: float
+    radii: tuple | None = None
 
     @property
     def converged(self) -> bool:
@@ -73,13 +82,34 @@ class Solution:
 
 
 class Solver:
-    """IPOPT on one problem family (every speed): ``solve(problem, start)``."""
+    """IPOPT on one problem family (every speed): ``solve(problem, start)``.
 
-    def __init__(self, model: Biped, criterion: str, safety: Safety, samples_per_half: int):
-        self.graph = graph = StepGraph(model, samples_per_half, safety)
+    Args:
+        radius_bounds: ((r1 low, r2 low), (r1 high, r2 high)) [m]: the knee radii are
+            variables within these bounds (``solve(problem, start, radii)``); None: they
+            are ``model``'s.
+    """
+
+    def __init__(
+        self,
+        model: Biped,
+        criterion: str,
+        safety: Safety,
+        samples_per_half: int,
+        radius_bounds=None,
+    ):
+        design = radius_bounds is not None
+        self.graph = graph = StepGraph(model, samples_per_half, safety, design=design)
         self.criterion = criterion
+        self.design = design
         y = ca.SX.sym("y", N_VARIABLES)
         z = ca.DM(SCALES) * y
+        unknowns, scaled = [graph.z], [z]
+        if design:
+            rho = ca.SX.sym("rho", 2)
+            y = ca.vertcat(y, rho)
+            unknowns.append(graph.radii)
+            scaled.append(RADIUS_SCALE * rho)
         constraints = ca.vertcat(graph.constraints, graph.hip_height)
         if criterion == "sthenic":
             x, objective, g = y, graph.sthenic, constraints
@@ -92,27 +122,41 @@ class Solver:
             objective = graph.period * ca.dot(ca.vec(weights), slack)
             x = ca.vertcat(y, slack)
             g = ca.vertcat(constraints, slack - power, slack + power)
-        substituted = ca.substitute([objective, g], [graph.z], [z])
+        substituted = ca.substitute([objective, g], unknowns, scaled)
         nlp = {"x": x, "p": graph.speed, "f": substituted[0], "g": substituted[1]}
         options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
         options["print_time"] = False
-        self.nlp = ca.nlpsol("gait", "ipopt", nlp, options)
+        self.nlp = ca.nlpsol("design" if design else "gait", "ipopt", nlp, options)
         self.evaluate = ca.Function(
-            "evaluate", [graph.z, graph.speed], [graph.sthenic, graph.energy, graph.power]
+            "evaluate", graph.inputs, [graph.sthenic, graph.energy, graph.power]
         )
         self.lower, self.upper = bounds()
-        lower, upper = self.lower, self.upper
-        self.lbx = np.concatenate([lower / SCALES, np.zeros(self.slacks)])
-        self.ubx = np.concatenate([upper / SCALES, np.full(self.slacks, np.inf)])
+        lower, upper = self.lower / SCALES, self.upper / SCALES
+        if design:
+            self.radius_bounds = tuple(tuple(map(float, side)) for side in radius_bounds)
+            lower = np.concatenate([lower, np.array(self.radius_bounds[0]) / RADIUS_SCALE])
+            upper = np.concatenate([upper, np.array(self.radius_bounds[1]) / RADIUS_SCALE])
+        self.lbx = np.concatenate([lower, np.zeros(self.slacks)])
+        self.ubx = np.concatenate([upper, np.full(self.slacks, np.inf)])
         self.n_constraints = g.shape[0]
 
-    def solve(self, problem: GaitProblem, start) -> Solution:
-        """IPOPT from the variables ``start`` (21,), clipped into the bounds."""
+    def solve(self, problem, start, radii=None) -> Solution:
+        """IPOPT from the variables ``start`` (21,), clipped into the bounds, at
+        ``problem.speed``; with radii as variables, from the knee radii ``radii`` (r1, r2) [m]
+        clipped into theirs."""
         began = time.perf_counter()
         z0 = np.clip(np.asarray(start, dtype=float), self.lower, self.upper)
         x0 = z0 / SCALES
+        inputs = [z0, problem.speed]
+        if self.design:
+            if radii is None:
+                raise BipedError("radii = None: allowed the knee radii (r1, r2) to start from")
+            low, high = self.radius_bounds
+            r0 = np.clip(np.asarray(radii, dtype=float), low, high)
+            x0 = np.concatenate([x0, r0 / RADIUS_SCALE])
+            inputs.append(r0)
         if self.slacks:
-            power = np.asarray(self.evaluate(z0, problem.speed)[2]).T.ravel()
+            power = np.asarray(self.evaluate(*inputs)[2]).T.ravel()
             x0 = np.concatenate([x0, np.abs(power) if np.all(np.isfinite(power)) else 0.0])
         result = self.nlp(x0=x0, p=problem.speed, lbx=self.lbx, ubx=self.ubx, lbg=0.0, ubg=np.inf)
         stats = self.nlp.stats()
@@ -125,8 +169,10 @@ class Solver:
         )
         iterations = stats.get("iterations") or {}
         dual = iterations.get("inf_du") or [float("nan")]
+        end = N_VARIABLES + 2 * self.design
         return Solution(
             variables=x[:N_VARIABLES] * SCALES,
+            radii=tuple(map(float, x[N_VARIABLES:end] * RADIUS_SCALE)) if self.design else None,
             value=float(result["f"]),
             status=str(stats["return_status"]),
             iterations=int(stats["iter_count"]),

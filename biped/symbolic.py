@@ -14,6 +14,10 @@ holds them equal to 1e-12). From the variables z (``biped.problem.VARIABLES``) a
 4. the criterion (Simpson's rule per piece) and the constraints Ψ_i − δ_i.
 
 The speed is a parameter of the graph, so one built graph serves every speed of a sweep.
+With ``design=True`` the knee radii (r1, r2) are symbols too: the constants that depend on
+them (directions, point coefficients, W, g) are built by the numeric model's own point table
+(``biped.kinematics.point_table``) from the symbols, so the knee can be optimised with the
+gait (``biped.design``).
 """
 
 from __future__ import annotations
@@ -30,7 +34,21 @@ from biped.criteria import (
 )
 from biped.dynamics import JOINT_MATRIX, Biped
 from biped.gait import _SWAP, _basis
-from biped.kinematics import Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH
+from biped.kinematics import (
+    BODY_DIRECTIONS,
+    LINK_DIRECTIONS,
+    NQ,
+    Q1,
+    Q2,
+    Q3,
+    Q4,
+    Q5,
+    QP1,
+    QP2,
+    XH,
+    ZH,
+    point_table,
+)
 from biped.problem import MIN_HIP_HEIGHT, N_VARIABLES, index
 
 # Constraints are divided by these in the solvers so that all are of order one
@@ -40,13 +58,25 @@ _SWAP_ORDER = [QP2, QP1, Q4, Q3, Q2, Q1, Q5, XH, ZH]  # biped.kinematics.swap_le
 
 
 class _Constants:
-    """The numeric model's constants as CasADi matrices."""
+    """The numeric model's constants as CasADi matrices.
 
-    def __init__(self, model: Biped):
+    With ``radii`` (an SX of two symbols r1, r2) the constants that depend on the knee
+    radii are SX expressions of them, built by the same point table as the numeric model
+    (``biped.kinematics.point_table``) and the same sums over the bodies as
+    ``biped.dynamics.Biped``; the rolling knee's two links C1C2 are always present (of
+    length r1 + r2, so at r1 = r2 = 0 they carry nothing: the revolute knee).
+    """
+
+    def __init__(self, model: Biped, radii=None):
         self.model = model
         self.hp = model.robot.ankle_height
         self.gravity = model.gravity
         self.mass = model.mass
+        self.design = radii is not None
+        if self.design:
+            self._symbolic(model, radii)
+            return
+        self.radii = model.radii
         self.phi = _sparse(model.directions)  # (K, 7)
         self.w = _sparse(model._w)
         self.g = _sparse(model._g)
@@ -56,7 +86,52 @@ class _Constants:
         self.stance_leg = _sparse(model._stance_leg)  # (K, 2)
         self.k = model.directions.shape[0]
 
+    def _symbolic(self, model: Biped, radii):
+        r1, r2 = radii[0], radii[1]
+        link = r1 + r2
+        self.radii = (r1, r2)
+        # r1 / l and r2 / l: the hinges' shares of the knee flexion (any value at l = 0,
+        # where the links have no length).
+        self.shares = tuple(ca.if_else(link > 0.0, r / link, 0.5) for r in (r1, r2))
+        names = BODY_DIRECTIONS + LINK_DIRECTIONS
+        index = {name: k for k, name in enumerate(names)}
+        k = self.k = len(names)
+        phi = ca.SX(k, 7)
+        for i in range(7):
+            phi[i, i] = 1.0
+        row = index["stance_knee_link"]  # γ1 = (r1 q1 + r2 q2) / l
+        phi[row, Q1], phi[row, Q2] = self.shares
+        row = index["swing_knee_link"]  # γ2 = (r1 q4 + r2 q3) / l
+        phi[row, Q4], phi[row, Q3] = self.shares
+        self.phi = phi
+        table = point_table(model.robot, r1, r2, links=True)
+        self._points = {}
+        for name, (a, b) in table.items():
+            columns = []
+            for coefficients in (a, b):
+                column = ca.SX(k, 1)
+                for key, value in coefficients.items():
+                    column[index[key]] = value
+                columns.append(column)
+            self._points[name] = tuple(columns)
+        w, g = ca.SX(k, k), ca.SX(k, 1)
+        inertia = np.zeros(k)
+        for body in model.bodies:  # as biped.dynamics.Biped
+            a = self._points[body.com][0]
+            w = w + body.mass * (a @ a.T)
+            g = g + body.mass * a
+            inertia[index[body.direction]] += body.inertia
+        self.w, self.g, self.inertia = w, g, _sparse(inertia)
+        p = ca.SX(k + 2, NQ)  # y = P q, as Biped._p
+        p[:k, :7] = phi
+        p[k, XH] = p[k + 1, ZH] = 1.0
+        self.p = p
+        self.ankle = self._points["stance_ankle"][0]
+        self.stance_leg = ca.horzcat(phi[:, Q1], phi[:, Q2])
+
     def point(self, name):
+        if self.design:
+            return self._points[name]
         j = self.model.point_index(name)
         return _sparse(self.model.point_a[:, j]), _sparse(self.model.point_b[:, j])
 
@@ -139,11 +214,14 @@ def _swing_contact_jacobian(c: _Constants, q):
 def _leg_angles(c: _Constants, bend, hip_from_ankle):
     """(shank, thigh) angles of a leg with knee flexion ``bend`` and the hip at
     ``hip_from_ankle`` (``Chain.leg_angles`` with the flexion known)."""
-    r1, r2 = c.model.radii
+    r1, r2 = c.radii
     link = r1 + r2
     shank = c.model.robot.shank_length - r1
     thigh = c.model.robot.thigh_length - r2
-    gamma = r2 * bend / link if link > 0.0 else 0.0
+    if c.design:
+        gamma = c.shares[1] * bend
+    else:
+        gamma = r2 * bend / link if link > 0.0 else 0.0
     vx = link * ca.sin(gamma) + thigh * ca.sin(bend)
     vz = -shank - link * ca.cos(gamma) - thigh * ca.cos(bend)
     angle = ca.atan2(hip_from_ankle[1], hip_from_ankle[0]) - ca.atan2(-vz, -vx)
@@ -151,12 +229,16 @@ def _leg_angles(c: _Constants, bend, hip_from_ankle):
 
 
 def _reach_squared(c: _Constants, bend):
-    r1, r2 = c.model.radii
+    """|hip − ankle|² at knee flexion ``bend`` (``Chain._reach_squared``)."""
+    r1, r2 = c.radii
     link = r1 + r2
     shank = c.model.robot.shank_length - r1
     thigh = c.model.robot.thigh_length - r2
     value = shank**2 + thigh**2 + link**2 + 2 * shank * thigh * ca.cos(bend)
-    if link > 0.0:
+    if c.design:
+        share1, share2 = c.shares
+        value = value + 2 * link * (shank * ca.cos(share2 * bend) + thigh * ca.cos(share1 * bend))
+    elif link > 0.0:
         value = value + 2 * link * (
             shank * ca.cos(r2 * bend / link) + thigh * ca.cos(r1 * bend / link)
         )
@@ -170,19 +252,25 @@ class StepGraph:
         model: robot and knee.
         samples_per_half: samples per spline piece (constraints and Simpson's rule).
         safety: margins of ours (``biped.criteria.Safety``).
+        design: the knee radii (r1, r2) are symbols too (``radii``), the rolling knee's
+            links always present: ``model`` gives every other constant (its radii and knee
+            are not used). At r1 = r2 = 0 the graph is the revolute knee's.
 
-    Attributes (SX expressions of ``z`` (21) and ``speed`` (1)):
+    Attributes (SX expressions of ``z`` (21), ``speed`` (1) and, with ``design``,
+    ``radii`` (2) [m]):
         parameters (21): the paper's parameters; torques (6, N); wrench (3, N); q (9, N);
         qd (9, N); power (6, N) Γ_i θ̇_i; sthenic, energy: eqs. (30)-(31) without penalty;
         constraints (M): (Ψ_i − δ_i − safety) / scale at the checked samples, >= 0 when met;
         hip_height: hip above the ankles at the start less ``MIN_HIP_HEIGHT`` (>= 0).
     """
 
-    def __init__(self, model: Biped, samples_per_half: int, safety):
+    def __init__(self, model: Biped, samples_per_half: int, safety, design: bool = False):
         self.model = model
         self.samples_per_half = samples_per_half
         self.safety = safety
-        c = _Constants(model)
+        self.design = design
+        self.radii = ca.SX.sym("radii", 2) if design else None
+        c = _Constants(model, self.radii)
         z = ca.SX.sym("z", N_VARIABLES)
         speed = ca.SX.sym("speed")
         self.z, self.speed = z, speed
@@ -282,8 +370,13 @@ class StepGraph:
         self.constraints = ca.vertcat(*[scaled[i, j] for i, j in zip(rows, cols, strict=True)])
         self.constraint_names = [CONSTRAINTS[i] for i in rows]
 
+    @property
+    def inputs(self) -> list:
+        """The graph's symbols: [z, speed], then radii with ``design``."""
+        return [self.z, self.speed] + ([self.radii] if self.design else [])
+
     def function(self) -> ca.Function:
-        """A CasADi function (z, speed) -> every quantity of the step, for checks."""
+        """A CasADi function (z, speed[, radii]) -> every quantity of the step, for checks."""
         names = (
             "parameters",
             "torques",
@@ -299,8 +392,8 @@ class StepGraph:
         )
         return ca.Function(
             "step",
-            [self.z, self.speed],
+            self.inputs,
             [getattr(self, name) for name in names],
-            ["z", "speed"],
+            ["z", "speed", "radii"][: len(self.inputs)],
             list(names),
         )

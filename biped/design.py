@@ -1,0 +1,288 @@
+"""Knee co-design: the rolling knee's radii optimised together with the gait.
+
+The paper fixes the radii of the rolling knee at r1 = r2 = 5 cm and ends on "integrate the
+radii r1 and r2 in the parameter vector". A ``DesignProblem`` does that: minimise the
+criterion over the gait's variables z (``biped.problem.VARIABLES``) and the radii (r1, r2)
+together, under the gait's constraints, with IPOPT on the graph of the step whose radii are
+symbols (``biped.symbolic.StepGraph(..., design=True)``, ``biped.solver.Solver`` with
+``radius_bounds``). Every other parameter of the robot (masses, inertias, segment lengths,
+centres of mass) stays as given.
+
+Design bounds. The segment lengths l1, l2 include the radii (``biped.robot``: both knees
+have the same height), so a radius moves length from the shank or the thigh into the knee:
+l'1 = l1 − r1 from the ankle to the shank circle's centre C1, l'2 = l2 − r2 from the hip to
+the thigh circle's centre C2. The centres of mass are measured from the knee for the shank
+(s1, so s1 − r1 from C1) and from the hip for the thigh (s2). They stay on their segments
+(between C1 and the ankle, between the hip and C2) when
+
+    0 <= r1 <= s1            (shank: s1 − r1 >= 0; then l'1 >= l1 − s1 > 0)
+    0 <= r2 <= l2 − s2       (thigh: s2 <= l'2; then l'2 >= s2 > 0)
+
+which are the bounds by default (``radius_limits``: 0.181 m and 0.236 m for Table 1, 43 %
+and 57 % of the segments); narrower upper bounds may be given. Beyond them the robot's
+fixed masses and inertias would describe a segment whose centre of mass lies off it.
+At r1 = r2 = 0 the rolling knee is the revolute knee exactly (``biped.kinematics``).
+
+Starts, as for gaits (``biped.optimize``): the gait's first guess at the robot's own radii
+(Table 1's), then ``starts − 1`` starts with radii drawn uniformly in the bounds and the
+gait's first guess there perturbed, from ``numpy.random.default_rng(seed)``, and any given
+(gait, radii) pairs. The best converged start wins; its report counts the starts that
+reached the same value. When no start converged the report carries IPOPT's status (and the
+command line exits 1): never a silent fallback.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from biped.criteria import PAPER_SAFETY, Safety
+from biped.dynamics import Biped
+from biped.errors import BipedError
+from biped.optimize import (
+    AGREEMENT,
+    DEFAULT_STARTS,
+    PERTURBATION,
+    Optimum,
+    Report,
+    Start,
+    checked,
+)
+from biped.problem import SCALES, GaitProblem, bounds, check_criterion, check_speed
+from biped.robot import Robot
+from biped.solver import CONVERGED, Solver
+
+RADII = ("r1", "r2")
+
+
+def radius_limits(robot: Robot) -> tuple[float, float]:
+    """[m] The largest radii (r1, r2) that keep the centres of mass on the shank and the
+    thigh: r1 <= s1 (shank_com, measured from the knee), r2 <= l2 − s2 (thigh_com is
+    measured from the hip)."""
+    return robot.shank_com, robot.thigh_length - robot.thigh_com
+
+
+def check_radii(robot: Robot, radii, what: str = "radii") -> tuple[float, float]:
+    """``radii`` (r1, r2) [m] if each is a finite number within ``radius_limits``, else a
+    clear error naming the bad one."""
+    limits = radius_limits(robot)
+    try:
+        values = tuple(radii)
+    except TypeError:
+        raise BipedError(f"{what} = {radii!r}: allowed two numbers (r1, r2) [m]") from None
+    if len(values) != 2:
+        raise BipedError(f"{what} = {radii!r}: allowed two numbers (r1, r2) [m]")
+    for name, value, limit in zip(RADII, values, limits, strict=True):
+        number = isinstance(value, (int, float, np.floating)) and not isinstance(value, bool)
+        if not (number and math.isfinite(value) and 0.0 <= value <= limit):
+            raise BipedError(
+                f"{name} = {value!r} m: allowed 0 to {limit:.4g} m (the "
+                f"{'shank' if name == 'r1' else 'thigh'}'s centre of mass stays on the segment)"
+            )
+    return tuple(float(v) for v in values)
+
+
+@dataclass(frozen=True)
+class DesignProblem:
+    """Minimise ``criterion`` over the gaits and the knee radii (r1, r2) of the rolling knee
+    of ``robot`` at ``speed``.
+
+    Attributes:
+        robot: every parameter but the radii; its own radii (Table 1: 5 cm) are the
+            reference design and the first start.
+        speed: walking speed V [m/s].
+        criterion: ``"sthenic"`` (eq. 30) or ``"energy"`` (eq. 31).
+        safety: margins of ours beyond the paper's constraints.
+        samples_per_half: samples per spline piece of the solver's constraints.
+        upper: [m] upper bounds of (r1, r2); default ``radius_limits(robot)``; each within
+            (0, its limit].
+    """
+
+    robot: Robot
+    speed: float
+    criterion: str = "sthenic"
+    safety: Safety = PAPER_SAFETY
+    samples_per_half: int = 25
+    upper: tuple | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.robot, Robot):
+            raise BipedError(f"robot = {self.robot!r}: allowed a biped.robot.Robot")
+        object.__setattr__(self, "speed", check_speed(Biped(self.robot, "rolling"), self.speed))
+        check_criterion(self.criterion)
+        if not isinstance(self.safety, Safety):
+            raise BipedError(f"safety = {self.safety!r}: allowed a biped.criteria.Safety")
+        upper = radius_limits(self.robot) if self.upper is None else self.upper
+        upper = check_radii(self.robot, upper, "upper bounds of the radii")
+        for name, value in zip(RADII, upper, strict=True):
+            if value <= 0.0:
+                raise BipedError(f"upper bound of {name} = {value!r} m: allowed > 0")
+        object.__setattr__(self, "upper", upper)
+        # the sample count is checked by the gait problem
+        self.gait_problem(self.reference_radii)
+
+    @property
+    def lower(self) -> tuple[float, float]:
+        return (0.0, 0.0)
+
+    @property
+    def reference_radii(self) -> tuple[float, float]:
+        """The robot's own radii, clipped into the bounds: the first start."""
+        own = (self.robot.r1, self.robot.r2)
+        return tuple(float(np.clip(r, 0.0, u)) for r, u in zip(own, self.upper, strict=True))
+
+    def robot_with(self, radii) -> Robot:
+        """The robot with knee radii ``radii`` (r1, r2) [m]."""
+        r1, r2 = check_radii(self.robot, radii)
+        return dataclasses.replace(self.robot, r1=r1, r2=r2)
+
+    def gait_problem(self, radii, knee: str = "rolling") -> GaitProblem:
+        """The gait problem of the robot with radii ``radii`` (r1, r2) [m] (or of its
+        revolute knee, whose radii are not used)."""
+        model = Biped(self.robot_with(radii), knee)
+        return GaitProblem(model, self.speed, self.criterion, self.safety, self.samples_per_half)
+
+    def describe(self) -> str:
+        text = self.gait_problem(self.reference_radii).describe().replace("rolling knee, ", "")
+        return (
+            f"rolling knee radii r1 <= {self.upper[0]:.4g} m, r2 <= {self.upper[1]:.4g} m, " + text
+        )
+
+
+@dataclass
+class Design:
+    """The optimal radii of a ``DesignProblem`` and the gait that goes with them.
+
+    Attributes:
+        problem: what was solved.
+        radii: (r1, r2) [m].
+        optimum: the gait at these radii, checked on the fine grid as every optimum
+            (``biped.optimize.checked``); its report is the design's (starts, status).
+    """
+
+    problem: DesignProblem
+    radii: tuple
+    optimum: Optimum
+
+    report = property(lambda self: self.optimum.report)
+    value = property(lambda self: self.optimum.value)
+    certified = property(lambda self: self.optimum.certified)
+
+    @property
+    def robot(self) -> Robot:
+        return self.optimum.problem.model.robot
+
+    def at_bounds(self) -> list[str]:
+        """Radii at a bound (within 1e-6 m), e.g. ``["r1 = 0.181 m (upper)"]``."""
+        found = []
+        for name, value, low, high in zip(
+            RADII, self.radii, self.problem.lower, self.problem.upper, strict=True
+        ):
+            for bound, side in ((low, "lower"), (high, "upper")):
+                if abs(value - bound) <= 1e-6:
+                    found.append(f"{name} = {bound:.4g} m ({side})")
+        return found
+
+    def to_dict(self) -> dict:
+        """The ``design`` block of a gait file."""
+        return {
+            "radii": {name: float(r) for name, r in zip(RADII, self.radii, strict=True)},
+            "lower": dict(zip(RADII, self.problem.lower, strict=True)),
+            "upper": dict(zip(RADII, self.problem.upper, strict=True)),
+            "at_bounds": self.at_bounds(),
+        }
+
+
+@functools.lru_cache(maxsize=8)
+def _solver(robot: Robot, criterion: str, safety: Safety, samples: int, upper) -> Solver:
+    model = Biped(robot, "rolling")  # its radii are symbols in the graph
+    return Solver(model, criterion, safety, samples, radius_bounds=((0.0, 0.0), upper))
+
+
+def solver_for(problem: DesignProblem) -> Solver:
+    """The design solver of ``problem``'s family, built once per process (every speed)."""
+    if not isinstance(problem, DesignProblem):
+        raise BipedError(f"problem = {problem!r}: allowed a biped.design.DesignProblem")
+    robot = dataclasses.replace(problem.robot, r1=0.0, r2=0.0)  # the radii are variables
+    return _solver(
+        robot, problem.criterion, problem.safety, problem.samples_per_half, problem.upper
+    )
+
+
+def design_starts(problem: DesignProblem, starts: int, seed: int) -> list[tuple]:
+    """(kind, z, radii) of the first guess at the robot's radii and ``starts − 1`` random
+    starts: radii uniform in the bounds, the gait's first guess there perturbed as in
+    ``biped.optimize.first_guesses``."""
+    if isinstance(starts, bool) or not isinstance(starts, int) or starts < 0:
+        raise BipedError(f"starts = {starts!r}: allowed an integer >= 0")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise BipedError(f"seed = {seed!r}: allowed an integer >= 0")
+    rng = np.random.default_rng(seed)
+    lower, upper = bounds()
+    result = []
+    if starts:
+        radii = problem.reference_radii
+        result.append(("first guess", problem.gait_problem(radii).first_guess(), radii))
+    for _ in range(starts - 1):
+        radii = tuple(float(r) for r in rng.uniform(problem.lower, problem.upper))
+        z = problem.gait_problem(radii).first_guess()
+        z = z + PERTURBATION * SCALES * rng.standard_normal(z.shape)
+        z[:2] = np.abs(z[:2])  # the knee bends stay bends
+        result.append(("perturbed", np.clip(z, lower, upper), radii))
+    return result
+
+
+def optimize_design(
+    problem: DesignProblem, seed: int = 0, starts: int = DEFAULT_STARTS, given=()
+) -> Design:
+    """The best radii and gait of ``problem``.
+
+    Args:
+        seed: seed of the random starts; the same seed gives the same result.
+        starts: the first guess at the robot's radii and ``starts − 1`` random starts.
+        given: further starts, each (z (21,), (r1, r2)), e.g. the optimal gait at the
+            Table 1 radii.
+    """
+    if not isinstance(problem, DesignProblem):
+        raise BipedError(f"problem = {problem!r}: allowed a biped.design.DesignProblem")
+    began = time.perf_counter()
+    solver = solver_for(problem)
+    candidates = design_starts(problem, starts, seed)
+    for z, radii in given:
+        candidates.append(("given", np.asarray(z, dtype=float), check_radii(problem.robot, radii)))
+    if not candidates:
+        raise BipedError("no start: allowed starts >= 1 or given starts")
+    solutions = [(kind, solver.solve(problem, z, radii)) for kind, z, radii in candidates]
+    converged = [s for _, s in solutions if s.converged]
+    pool = converged or [s for _, s in solutions]
+    best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
+    history = tuple(Start(kind, s.value, s.status, s.iterations) for kind, s in solutions)
+    at_best = sum(
+        s.status in CONVERGED and abs(s.value - best.value) <= AGREEMENT * abs(best.value)
+        for s in history
+    )
+    report = Report(
+        method="ipopt",
+        status="converged" if best.converged else best.status,
+        starts=len(solutions),
+        starts_at_best=int(at_best),
+        iterations=best.iterations,
+        constraint_violation=best.constraint_violation,
+        dual_infeasibility=best.dual_infeasibility,
+        seconds=time.perf_counter() - began,
+        seed=int(seed),
+        history=history,
+        value=best.value,
+    )
+    # IPOPT may end a hair outside a bound (its bound_relax_factor): back inside
+    radii = tuple(
+        float(np.clip(r, low, high))
+        for r, low, high in zip(best.radii, problem.lower, problem.upper, strict=True)
+    )
+    optimum = checked(problem.gait_problem(radii), best.variables, report)
+    return Design(problem, radii, optimum)

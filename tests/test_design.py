@@ -1,0 +1,193 @@
+"""Knee co-design: the graph with symbolic radii is the numeric model of every radius, its
+derivatives with respect to the radii are the numeric model's, zero radii are the revolute
+knee, the designed knee beats the paper's and walks in MuJoCo as analysed."""
+
+import dataclasses
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import biped
+from biped.criteria import PAPER_SAFETY, Safety, evaluate_step
+from biped.design import (
+    DesignProblem,
+    check_radii,
+    optimize_design,
+    radius_limits,
+)
+from biped.gait import build_step
+from biped.problem import SCALES, GaitProblem
+from biped.symbolic import StepGraph
+from tests.conftest import optimal_gait
+
+ROBOT = biped.Robot.paper()
+SAMPLES = 25
+SPEED = 0.3
+
+
+@pytest.fixture(scope="module")
+def graph():
+    return StepGraph(biped.Biped(ROBOT, "rolling"), SAMPLES, PAPER_SAFETY, design=True)
+
+
+_DESIGNS: dict = {}
+
+
+def optimal_design(safety=PAPER_SAFETY) -> "biped.design.Design":
+    """The design optimum at 0.3 m/s (sthenic, default starts and seed), once per session."""
+    if safety not in _DESIGNS:
+        _DESIGNS[safety] = optimize_design(DesignProblem(ROBOT, SPEED, safety=safety))
+    return _DESIGNS[safety]
+
+
+def gait_at(radii, knee="rolling", speed=SPEED, criterion="sthenic"):
+    robot = dataclasses.replace(ROBOT, r1=radii[0], r2=radii[1])
+    return GaitProblem(biped.Biped(robot, knee), speed, criterion)
+
+
+def random_variables(problem, rng):
+    z = problem.first_guess() + 0.3 * SCALES * rng.standard_normal(21)
+    z[:2] = rng.uniform(0.05, 0.3, 2)
+    return z
+
+
+def numeric(problem, z):
+    step = build_step(problem.model, problem.speed, problem.to_parameters(z))
+    return evaluate_step(problem.model, step, SAMPLES)
+
+
+def test_design_graph_is_the_numeric_model_at_any_radii(graph):
+    """With the radii as symbols the graph gives, at random radii, the torques, wrench and
+    both criteria of the numeric model built with those radii (1e-12 relative)."""
+    function = graph.function()
+    rng = np.random.default_rng(11)
+    limits = radius_limits(ROBOT)
+    for _ in range(3):
+        radii = tuple(rng.uniform(0.0, limits))
+        problem = gait_at(radii)
+        z = random_variables(problem, rng)
+        out = function(z=z, speed=SPEED, radii=radii)
+        ev = numeric(problem, z)
+        scale = np.abs(ev.torques).max()
+        np.testing.assert_allclose(out["torques"].full().T, ev.torques, atol=1e-12 * scale)
+        np.testing.assert_allclose(out["wrench"].full().T, ev.wrench, rtol=1e-12, atol=1e-9)
+        assert float(out["sthenic"]) == pytest.approx(ev.sthenic, rel=1e-12)
+        assert float(out["energy"]) == pytest.approx(ev.energy, rel=1e-12)
+        # and the radii matter: the Table 1 robot's torques are far from these
+        other = numeric(gait_at((0.05, 0.05)), z)
+        assert np.abs(other.torques - ev.torques).max() > 1e-3
+
+
+@pytest.mark.parametrize("criterion", ["sthenic", "energy"])
+def test_criterion_derivative_in_the_radii_matches_finite_differences(graph, criterion):
+    """d criterion / d r1 and d r2 of the graph equal central finite differences of the
+    numeric model with the robot's radii changed (the gait's variables held)."""
+    expression = getattr(graph, criterion)
+    gradient = ca.Function(
+        "g", [graph.z, graph.speed, graph.radii], [ca.gradient(expression, graph.radii)]
+    )
+    rng = np.random.default_rng(5)
+    for radii in [(0.07, 0.11), (0.16, 0.02)]:
+        z = random_variables(gait_at(radii), rng)
+        exact = gradient(z, SPEED, radii).full().ravel()
+        assert np.abs(exact).max() > 1.0  # the radii move the criterion
+        for i in range(2):
+            h = 1e-6
+            up, down = list(radii), list(radii)
+            up[i] += h
+            down[i] -= h
+            difference = (
+                getattr(numeric(gait_at(up, criterion=criterion), z), criterion)
+                - getattr(numeric(gait_at(down, criterion=criterion), z), criterion)
+            ) / (2 * h)
+            assert difference == pytest.approx(exact[i], rel=1e-5, abs=1e-6 * np.abs(exact).max())
+
+
+def test_zero_radii_are_the_revolute_knee(graph):
+    """At r1 = r2 = 0 the design graph's criteria equal the revolute knee's numeric ones to
+    1e-12 for the same gait, and so they do with one radius 0 (a circle rolling on a point
+    turns about it: a hinge); 1 mm of both radii changes them far beyond that."""
+    function = graph.function()
+    problem = gait_at((0.0, 0.0), knee="revolute")
+    rng = np.random.default_rng(8)
+    for _ in range(3):
+        z = random_variables(problem, rng)
+        ev = numeric(problem, z)
+        out = function(z=z, speed=SPEED, radii=(0.0, 0.0))
+        assert float(out["sthenic"]) == pytest.approx(ev.sthenic, rel=1e-12)
+        assert float(out["energy"]) == pytest.approx(ev.energy, rel=1e-12)
+        for hinge in [(0.1, 0.0), (0.0, 0.1)]:
+            out = function(z=z, speed=SPEED, radii=hinge)
+            assert float(out["sthenic"]) == pytest.approx(ev.sthenic, rel=1e-12)
+        near = function(z=z, speed=SPEED, radii=(1e-3, 1e-3))
+        assert abs(float(near["sthenic"]) / ev.sthenic - 1.0) > 1e-6
+
+
+def test_design_beats_the_table_1_knee():
+    """The design optimum from its own starts is certified, within the bounds and at least
+    as good as the optimal gait of the Table 1 knee (5 cm radii) at the same speed, which
+    is one point of its design space; its gait file's robot carries the radii."""
+    design = optimal_design()
+    assert design.report.converged and design.certified
+    assert design.report.starts_at_best >= 2
+    limits = radius_limits(ROBOT)
+    assert all(0.0 <= r <= u for r, u in zip(design.radii, limits, strict=True))
+    assert (design.robot.r1, design.robot.r2) == design.radii
+    assert design.value <= optimal_gait("rolling").value * (1 + 1e-9)
+    assert design.value <= optimal_gait("revolute").value
+
+
+def test_designed_robot_passes_the_inverse_dynamics_crosscheck():
+    """The MJCF generated for the designed radii gives MuJoCo's inverse dynamics of the
+    designed gait the analytical torques and wrench to rounding; the Table 1 robot's MJCF
+    does not (the check tells the radii)."""
+    from validate.crosscheck import load_model, mujoco_inverse_dynamics
+    from validate.report import EXACT
+
+    design = optimal_design()
+    ev = design.optimum.evaluation
+    samples = slice(None, None, 10)
+    q, qd, qdd = ev.q[samples], ev.qd[samples], ev.qdd[samples]
+    model = biped.Biped(design.robot, "rolling")
+    mine = mujoco_inverse_dynamics(load_model(model, exact=True), model, q, qd, qdd)
+    assert np.abs(mine.torques - ev.torques[samples]).max() < EXACT
+    assert np.abs(mine.wrench - ev.wrench[samples]).max() < EXACT
+    table1 = biped.Biped(ROBOT, "rolling")
+    other = mujoco_inverse_dynamics(load_model(table1, exact=True), model, q, qd, qdd)
+    assert np.abs(other.torques - ev.torques[samples]).max() > 1e3 * EXACT
+
+
+def test_bad_design_input_is_refused():
+    """Radii bounds outside the segments, a bad speed or criterion: a clear error naming the
+    value and what is allowed."""
+    r1_max, r2_max = radius_limits(ROBOT)
+    assert r1_max == ROBOT.shank_com and r2_max == ROBOT.thigh_length - ROBOT.thigh_com
+    with pytest.raises(biped.BipedError, match=r"r1 = 0.3 m: allowed 0 to 0.1811 m"):
+        DesignProblem(ROBOT, SPEED, upper=(0.3, 0.1))
+    with pytest.raises(biped.BipedError, match=r"r2 = -0.01 m"):
+        check_radii(ROBOT, (0.05, -0.01))
+    with pytest.raises(biped.BipedError, match="upper bound of r2 = 0.0 m: allowed > 0"):
+        DesignProblem(ROBOT, SPEED, upper=(0.1, 0.0))
+    with pytest.raises(biped.BipedError, match="stance foot leaves the ground"):
+        DesignProblem(ROBOT, 5.0)
+    with pytest.raises(biped.BipedError, match="criterion = 'power'"):
+        DesignProblem(ROBOT, SPEED, "power")
+    with pytest.raises(biped.BipedError, match="clearance"):
+        DesignProblem(ROBOT, SPEED, safety=Safety(clearance=-1.0))
+
+
+def test_design_that_does_not_converge_fails_loudly(monkeypatch):
+    """With IPOPT cut to 3 iterations no start converges: the design's report carries
+    IPOPT's status and the design is not certified."""
+    from biped import design as design_module
+    from biped import solver
+
+    monkeypatch.setitem(solver.IPOPT_OPTIONS, "max_iter", 3)
+    design_module._solver.cache_clear()
+    try:
+        result = optimize_design(DesignProblem(ROBOT, SPEED), starts=1)
+        assert result.report.status == "Maximum_Iterations_Exceeded"
+        assert not result.report.converged and not result.certified
+    finally:
+        design_module._solver.cache_clear()
