@@ -1,7 +1,8 @@
 """Sweeps of certified optimal gaits over walking speed, both knees and both criteria.
 
 Every point (knee, criterion, speed) is solved in two stages, each point of a stage
-independent of the others, so the points run in parallel on all cores:
+independent of the others, so the points run in parallel (``biped.runner``: on all
+cores, or on the workers of a Dask cluster):
 
 1. independent: IPOPT from the point's own starts (``biped.optimize.optimize``); the result
    is kept in the hidden folder ``.independent/``;
@@ -21,12 +22,9 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import multiprocessing
-import os
-import signal
 import sys
 import time
-import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,6 +40,7 @@ from biped.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, op
 from biped.problem import VARIABLES, GaitProblem, check_speed
 from biped.provenance import version
 from biped.robot import Robot
+from biped.runner import ProgressBar, run_tasks
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
 MANIFEST = "sweep.json"
@@ -181,34 +180,6 @@ def _line(stage: str, point: Point, optimum: Optimum) -> str:
     )
 
 
-def _worker_init():
-    """Workers leave Ctrl-C to the main process, and stop cleanly when it terminates them:
-    SIGTERM raises SystemExit, so a file being written is removed, never left half-written."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
-    np.seterr(all="ignore")  # as in the command line: numpy's warnings stay off the terminal
-    warnings.simplefilter("ignore", RuntimeWarning)
-
-
-def _run(function, tasks, jobs, stream):
-    if not tasks:
-        return
-    if jobs == 1:
-        for task in tasks:
-            print(function(task), file=stream, flush=True)
-        return
-    pool = multiprocessing.get_context("spawn").Pool(jobs, initializer=_worker_init)
-    try:
-        for line in pool.imap(function, tasks):
-            print(line, file=stream, flush=True)
-        pool.close()
-    except BaseException:
-        pool.terminate()
-        raise
-    finally:
-        pool.join()
-
-
 def check_speeds(robot: Robot, speeds, knees) -> list[float]:
     """Sorted speeds, each walkable and with its own file name; raise a clear error if not."""
     speeds = sorted(float(s) for s in speeds)
@@ -233,10 +204,19 @@ def run_sweep(
     starts: int = DEFAULT_STARTS,
     safety: Safety = PAPER_SAFETY,
     jobs: int | None = None,
-    stream=sys.stderr,
+    stream=None,
+    dask: str | None = None,
+    progress: Callable[[int], ProgressBar] | None = None,
 ) -> list[Point]:
     """Certified optima of every (knee, criterion, speed) not yet in ``folder``; returns all
-    points. ``seed`` and ``starts`` go to ``biped.optimize.optimize``."""
+    points. ``seed`` and ``starts`` go to ``biped.optimize.optimize``.
+
+    The optimizations run through ``biped.runner.run_tasks``: ``jobs`` local processes
+    (default: all cores), or the workers of the Dask scheduler at ``dask`` (``tcp://HOST:PORT``).
+    A line per optimization goes to ``stream`` (default: ``sys.stderr``); ``progress(total)``,
+    if given, makes the bar advanced after each of the ``total`` optimizations (both
+    stages)."""
+    stream = sys.stderr if stream is None else stream
     if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
         raise BipedError(f"knees {list(knees)}, criteria {list(criteria)}: allowed each once")
     speeds = check_speeds(robot, speeds, knees)
@@ -260,11 +240,26 @@ def run_sweep(
         file=stream,
         flush=True,
     )
-    jobs = max(1, min(jobs or os.cpu_count() or 1, len(stage1) or 1))
     began = time.perf_counter()
-    _run(_solve_independent, [(settings, p, str(folder)) for p in stage1], jobs, stream)
-    tasks = [(settings, p, str(folder), _neighbours(p, speeds, knees)) for p in final]
-    _run(_solve_with_neighbours, tasks, jobs, stream)
+    stages = [
+        (_solve_independent, [(settings, p, str(folder)) for p in stage1]),
+        (
+            _solve_with_neighbours,
+            [(settings, p, str(folder), _neighbours(p, speeds, knees)) for p in final],
+        ),
+    ]
+    bar = progress(len(stage1) + len(final)) if progress is not None and final else None
+    if bar is not None:
+        bar.advance(0)  # drawn from the start
+    try:
+        for function, tasks in stages:
+            for line in run_tasks(
+                function, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar
+            ):
+                print(line, file=stream, flush=True)
+    finally:
+        if bar is not None:
+            bar.clear()
     summary = summarize(folder, points, settings)
     print(f"sweep: done in {time.perf_counter() - began:.1f} s; {summary}", file=stream, flush=True)
     return points

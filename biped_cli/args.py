@@ -243,3 +243,43 @@ class Distinct(argparse.Action):
         if repeated:
             raise argparse.ArgumentError(self, f"{repeated[0]!r} given twice: allowed each once")
         setattr(namespace, self.dest, list(values))
+
+
+DASK_SCHEMES = ("tcp", "tls")
+DASK_HELP = (
+    "run the optimizations on the workers of this running Dask scheduler (tcp://HOST:PORT) "
+    "instead of local processes; needs pip install '.[cluster]'"
+)
+
+
+def dask_address(text: str) -> str:
+    """A Dask scheduler's address, SCHEME://HOST:PORT (checked here, reached when used)."""
+    from urllib.parse import urlsplit
+
+    allowed = "allowed tcp://HOST:PORT or tls://HOST:PORT, a Dask scheduler's address"
+    try:
+        parts = urlsplit(text)
+        port = parts.port
+    except ValueError:
+        port = None
+        parts = None
+    if (
+        parts is None
+        or parts.scheme not in DASK_SCHEMES
+        or not parts.hostname
+        or port is None
+        or not 1 <= port <= 65535
+        or parts.path not in ("", "/")
+        or parts.query
+        or parts.fragment
+        or parts.username is not None
+    ):
+        raise argparse.ArgumentTypeError(f"{text!r}: {allowed}")
+    return text
+
+
+def add_dask(parser):
+    """``--dask ADDRESS``: run a command's optimizations on a Dask cluster."""
+    parser.add_argument(
+        "--dask", type=dask_address, default=None, metavar="ADDRESS", help=DASK_HELP
+    )

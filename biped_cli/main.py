@@ -110,6 +110,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     types.add_budget(sweep)
     sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    types.add_dask(sweep)
     sweep.set_defaults(run=cmd_sweep)
 
     val = commands.add_parser(
@@ -124,7 +125,8 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument(
         "--rrd",
         metavar="PATH",
-        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<gait>.rrd)",
+        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
+        "named from the gait file's folder and name; another gait's recording is refused)",
     )
     val.add_argument(
         "--json",

@@ -1,0 +1,239 @@
+"""The runner of many independent optimizations (``biped.runner``): the same results in this
+process, on a pool of processes and on a Dask cluster; a sweep on a two-worker Dask cluster
+writes the files of a local sweep; a progress bar on a terminal only; numpy's warnings off the
+terminal; errors and unreachable schedulers are one line."""
+
+import io
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import biped
+from biped import runner
+from biped.files import atomic_write_text
+from biped.sweep import INDEPENDENT, run_sweep
+from biped_cli import main
+
+SPEEDS = (0.275, 0.3)
+# A small sweep: one knee, one criterion, two speeds, one start (4 optimizations).
+SMALL = dict(knees=("revolute",), criteria=("sthenic",), starts=1)
+
+
+def overflowing_task(task):
+    """A task in the manner of a sweep's: writes its file whole, returns a line. numpy
+    overflows in ``expm1`` on the way (as the optimiser's exploration does)."""
+    folder, x = task
+    value = float(np.expm1(np.float64(x) * 1000.0))  # x > 0.71: inf, with a RuntimeWarning
+    atomic_write_text(Path(folder) / f"{x}.txt", f"{x * x!r} {value!r}")
+    return f"{x}: {x * x!r}"
+
+
+def failing_task(task):
+    if task == 2:
+        raise ValueError("task 2 fails")
+    return str(task)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A Dask cluster of two worker processes of one thread each, on this machine."""
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+    ) as local:
+        yield local.scheduler_address
+
+
+def _outputs(folder):
+    return {p.name: p.read_text() for p in sorted(Path(folder).iterdir())}
+
+
+@pytest.mark.parametrize("mode", ["in-process", "pool", "dask"])
+def test_every_mode_gives_the_same_results_and_no_warning(mode, tmp_path, capfd, request):
+    """The same lines and files in this process, on two processes and on Dask, each result
+    once; numpy's overflow warnings stay off stderr (the workers' stderr too)."""
+    tasks = [(str(tmp_path), x) for x in (0.5, 1.0, 1.5, 2.0, 2.5)]
+    where = {"in-process": dict(jobs=1), "pool": dict(jobs=2)}.get(mode)
+    if where is None:
+        where = dict(dask=request.getfixturevalue("cluster"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lines = list(runner.run_tasks(overflowing_task, tasks, stream=None, **where))
+    assert sorted(lines) == [f"{x}: {x * x!r}" for _, x in tasks]
+    with np.errstate(over="ignore"):
+        expected = {f"{x}.txt": f"{x * x!r} {float(np.expm1(x * 1000.0))!r}" for _, x in tasks}
+    assert _outputs(tmp_path) == expected
+    assert not [w for w in caught if issubclass(w.category, RuntimeWarning)]
+    assert "RuntimeWarning" not in capfd.readouterr().err
+
+
+def test_the_task_does_overflow(tmp_path):
+    """Called bare, the task makes numpy warn (so the test above can fail)."""
+    with pytest.warns(RuntimeWarning, match="overflow"):
+        overflowing_task((str(tmp_path), 1.0))
+
+
+class RecordingBar:
+    """A progress bar that records what is done to it, and what the consumer saw when."""
+
+    def __init__(self):
+        self.events = []
+
+    def advance(self, units=1, note=None):
+        self.events.append("advance")
+
+    def clear(self):
+        self.events.append("clear")
+
+
+def test_the_bar_is_cleared_before_each_result_and_advanced_after(tmp_path):
+    """Each result is yielded with the bar cleared (so it prints on a clean line), and the
+    bar advances once per task."""
+    bar = RecordingBar()
+    tasks = [(str(tmp_path), x) for x in (0.1, 0.2, 0.3)]
+    for _ in runner.run_tasks(overflowing_task, tasks, jobs=1, progress=bar):
+        bar.events.append("result")
+    assert bar.events == ["clear", "result", "advance"] * 3
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_failing_task_stops_the_run_with_its_error(jobs):
+    """An error of one task goes up to the caller (local workers are stopped)."""
+    with pytest.raises(ValueError, match="task 2 fails"):
+        list(runner.run_tasks(failing_task, range(6), jobs=jobs))
+
+
+def test_a_failing_task_on_dask_stops_the_run_with_its_error(cluster):
+    with pytest.raises(ValueError, match="task 2 fails"):
+        list(runner.run_tasks(failing_task, range(6), dask=cluster, stream=None))
+
+
+def test_an_unreachable_scheduler_is_one_error_naming_it(monkeypatch):
+    """No scheduler at the address: a BipedError naming the address and what is allowed."""
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 1.0)
+    with pytest.raises(biped.BipedError) as error:
+        list(runner.run_tasks(failing_task, [1], dask="tcp://127.0.0.1:9", stream=None))
+    message = str(error.value)
+    assert "'tcp://127.0.0.1:9' cannot be reached" in message and "dask scheduler" in message
+    assert "\n" not in message
+
+
+@pytest.mark.parametrize(
+    "address", ["localhost:8786", "tcp://:8786", "tcp://host:99999", "http://host:80", "tcp://h"]
+)
+def test_a_malformed_address_is_refused_naming_it(address, tmp_path, capsys):
+    """--dask takes tcp://HOST:PORT (or tls://): anything else exits 2 with one line."""
+    assert main(["sweep", "--dask", address, "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and repr(address) in err[0] and "tcp://HOST:PORT" in err[0]
+    assert not (tmp_path / "s").exists()
+
+
+def test_dask_missing_is_one_line_naming_the_extra(tmp_path, capsys, monkeypatch):
+    """--dask without dask.distributed installed: exit 2, one line naming the extra."""
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # import fails
+    argv = ["sweep", "--dask", "tcp://127.0.0.1:8786", "--out", str(tmp_path / "s")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "[cluster]" in err[0] and "dask.distributed" in err[0]
+    assert not (tmp_path / "s").exists()
+
+
+@pytest.fixture(scope="module")
+def local_sweep(tmp_path_factory):
+    """The small sweep on one process of this machine."""
+    folder = tmp_path_factory.mktemp("local")
+    run_sweep(folder, biped.Robot.paper(), SPEEDS, jobs=1, stream=io.StringIO(), **SMALL)
+    return folder
+
+
+def every_file(folder) -> dict:
+    """Every file of a sweep folder by relative path; gait files without what differs from
+    run to run (the solver's time, the provenance: versions and command line)."""
+    files = {}
+    for path in sorted(p for p in Path(folder).rglob("*") if p.is_file()):
+        name = str(path.relative_to(folder))
+        if path.name == "sweep.json":
+            files[name] = path.read_bytes()
+            continue
+        gait = json.loads(path.read_bytes())
+        gait["optimizer"].pop("seconds")
+        gait.pop("provenance")
+        files[name] = gait
+    return files
+
+
+def test_a_sweep_on_dask_writes_the_files_of_a_local_sweep(local_sweep, cluster, tmp_path):
+    """The same files, every number identical (JSON keeps every bit), both stages."""
+    log = io.StringIO()
+    run_sweep(tmp_path, biped.Robot.paper(), SPEEDS, dask=cluster, stream=log, **SMALL)
+    expected = every_file(local_sweep)
+    assert sorted(expected) == sorted(every_file(tmp_path))
+    assert len([n for n in expected if n.startswith(INDEPENDENT)]) == 2
+    assert every_file(tmp_path) == expected
+    assert f"dask: 2 tasks on {cluster}, 2 workers now" in log.getvalue()
+    assert "2 of 2 points certified" in log.getvalue()
+
+
+class Terminal(io.StringIO):
+    """stderr as a terminal shows it."""
+
+    def isatty(self):
+        return True
+
+
+def screen(text: str) -> list[str]:
+    """The lines a terminal shows after ``text``: a carriage return goes back to the start of
+    the line, ESC [K erases to its end."""
+    lines = []
+    for raw in text.split("\n"):
+        line, column = "", 0
+        for i, part in enumerate(raw.split("\r")):
+            column = 0 if i else column
+            for j, piece in enumerate(part.split("\x1b[K")):
+                if j:
+                    line = line[:column]
+                line = line[:column] + piece + line[column + len(piece) :]
+                column += len(piece)
+        lines.append(line)
+    return lines
+
+
+def test_screen_renders_a_bar_left_behind():
+    """A bar not erased stays on the screen (so the test below can fail)."""
+    assert screen("\rsweep  1/3 [#]\n") == ["sweep  1/3 [#]", ""]
+    assert screen("\rsweep  1/3 [#]\r\x1b[Kdone\n") == ["done", ""]
+
+
+def test_sweep_progress_bar_on_a_terminal_only(local_sweep, tmp_path, monkeypatch, capsys):
+    """On a terminal, `biped sweep` draws a bar from 0 to every optimization done and erases
+    it before each line of the log and at the end: the screen keeps the log alone. Piped, it
+    writes no bar (no carriage return, no escape)."""
+    for name in ("sweep.json", ".independent/revolute-sthenic-0.300.json"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_bytes((local_sweep / name).read_bytes())
+    argv = ["sweep", "--out", str(tmp_path), "--knees", "revolute", "--criteria", "sthenic"]
+    argv += ["--speeds", "0.275,0.3", "--starts", "1", "--jobs", "1"]
+    terminal = Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    assert main(argv) == 0
+    monkeypatch.undo()
+    shown = terminal.getvalue()
+    assert "\rsweep  0/3 [" in shown and "\rsweep  3/3 [" in shown  # 1 + 2 optimizations
+    log = screen(shown)
+    assert not [line for line in log if "sweep  " in line and "/3 [" in line]
+    assert [line[:13] for line in log if line.startswith("[")] == ["[independent "] + [
+        "[final       "
+    ] * 2
+    assert log[-2].startswith("sweep: done") and log[-1] == ""
+    capsys.readouterr()
+    for path in tmp_path.glob("*-*.json"):
+        path.unlink()
+    assert main(argv) == 0
+    piped = capsys.readouterr().err
+    assert "[final" in piped and "\r" not in piped and "\x1b" not in piped
