@@ -258,8 +258,9 @@ def optimize(
             neighbouring speed).
         nelder_mead_starts: IPOPT also starts from the paper's Nelder-Mead run with seeds
             ``seed``, ``seed + 1``, ...
-        method: ``"ipopt"`` or ``"nelder-mead"`` (the paper's method alone, from the first
-            guess, with ``max_restarts`` and ``evaluations_per_run``).
+        method: ``"ipopt"`` or ``"nelder-mead"`` (the paper's method alone, with
+            ``max_restarts`` and ``evaluations_per_run``, from the first guess with seed 0
+            and from the seed's perturbation of it otherwise).
     """
     check_method(method)
     if not isinstance(problem, GaitProblem):
@@ -332,7 +333,10 @@ def best_of(problem: GaitProblem, optima) -> Optimum:
 
 
 def _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began) -> Optimum:
-    start = problem.to_parameters(problem.first_guess())
+    # seed 0 starts from the first guess, seed k > 0 from its perturbation number k (as a
+    # designer would try a few first guesses); the seed drives the restarts too.
+    guesses = first_guesses(problem, 2, seed)
+    start = problem.to_parameters(guesses[0 if seed == 0 else 1][1])
     parameters, history, count, converged = nelder_mead(
         problem, start, np.random.default_rng(seed), max_restarts, evaluations_per_run
     )
