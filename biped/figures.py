@@ -4,25 +4,34 @@ Fig. 4: optimal sthenic criterion vs speed (left), energy of the same gaits (rig
 Figs. 5-7: torques, angles and |Fx| / Fz of the sthenic-optimal gaits at 0.3 m/s.
 Fig. 8: optimal energy criterion vs speed (left), sthenic criterion of the same gaits (right).
 comparison.md: our headline numbers beside the paper's.
+
+Each figure is built by a function returning a matplotlib ``Figure`` (``sweep_figures``;
+``time_figure`` with the panels ``TORQUE_PANELS``, ``ANGLE_PANELS``, ``GROUND_PANELS`` serves
+single gaits too); ``make_figures`` writes them as a set, all or none.
+
+No point hides the others: in Figs. 4 and 8 a gait whose optimum is not certified (the solver
+did not converge, or the optimum is infeasible) is a grey cross, out of the curves; a value off
+the bulk of its panel (beyond ``FENCE`` interquartile ranges outside the quartiles) is a
+triangle at the panel's edge with its value written beside it, and the axis spans the bulk.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from biped import gait_file  # noqa: E402
-from biped.dynamics import JOINTS  # noqa: E402
-from biped.errors import BipedError  # noqa: E402
-from biped.files import atomic_write_text  # noqa: E402
-from biped.gait import FREE_ANGLES  # noqa: E402
-from biped.kinematics import KNEES  # noqa: E402
-from biped.sweep import MANIFEST  # noqa: E402
+from biped import gait_file
+from biped.dynamics import JOINTS
+from biped.errors import BipedError
+from biped.files import atomic_set
+from biped.gait import FREE_ANGLES
+from biped.kinematics import ANGLES, BODY_DIRECTIONS, COORDINATES, KNEES
+from biped.robot import FOOT_FRICTION
+from biped.sweep import MANIFEST
 
 PAPER = {
     "sthenic_reduction": 0.17,
@@ -35,6 +44,17 @@ STYLE = {
     "revolute": dict(color="tab:blue", marker="o"),
     "rolling": dict(color="tab:red", marker="s"),
 }
+FLAGGED_COLOR = "0.35"
+# A value is off the bulk of its panel beyond FENCE interquartile ranges below the first
+# quartile or above the third (Tukey's "far out"), judged only with MIN_BULK values or more.
+FENCE = 3.0
+MIN_BULK = 5
+# Room around the bulk, a fraction of its span on each side.
+PAD = 0.08
+DPI = 120
+CRITERION_AXES = {"sthenic": "sthenic criterion C_Γ [N²·m·s]", "energy": "energy criterion C_E [J]"}
+CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
+TIME_AXIS = "normalised time t/T"
 
 
 def certified(gait: dict) -> bool:
@@ -43,20 +63,29 @@ def certified(gait: dict) -> bool:
     return gait["feasible"] and gait["optimizer"].get("status") == "converged"
 
 
-def load_sweep(folder: str | Path) -> dict:
-    """{(knee, criterion): [gait, ...] sorted by speed}, certified optima only."""
+def read_sweep(folder: str | Path) -> tuple[dict, list]:
+    """The certified optima as {(knee, criterion): [gait, ...] sorted by speed}, and the
+    gaits that are not certified (a list)."""
     folder = Path(folder)
     files = sorted(p for p in folder.glob("*.json") if p.name != MANIFEST)
     if not files:
         raise BipedError(f"sweep folder {str(folder)!r} has no gait files: run 'biped sweep'")
     series: dict = {}
+    flagged = []
     for path in files:
         gait = gait_file.read(path)
         if certified(gait):
             series.setdefault((gait["knee"], gait["criterion"]), []).append(gait)
+        else:
+            flagged.append(gait)
     for gaits in series.values():
         gaits.sort(key=lambda g: g["speed"])
-    return series
+    return series, flagged
+
+
+def load_sweep(folder: str | Path) -> dict:
+    """{(knee, criterion): [gait, ...] sorted by speed}, certified optima only."""
+    return read_sweep(folder)[0]
 
 
 def _curve(series, knee, criterion, cost):
@@ -64,24 +93,109 @@ def _curve(series, knee, criterion, cost):
     return np.array([g["speed"] for g in gaits]), np.array([g["costs"][cost] for g in gaits])
 
 
-def _criterion_figure(series, criterion, other, title, path):
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
-    units = {"sthenic": "sthenic criterion C_Γ [N²·m·s]", "energy": "energy criterion C_E [J]"}
-    for knee in KNEES:
-        for ax, cost in zip(axes, (criterion, other), strict=True):
+def off_bulk(values) -> np.ndarray:
+    """Which values (bool array) lie off the bulk: beyond ``FENCE`` interquartile ranges
+    outside the quartiles; none when fewer than ``MIN_BULK`` values are finite."""
+    values = np.asarray(values, dtype=float)
+    finite = values[np.isfinite(values)]
+    if finite.size < MIN_BULK:
+        return np.zeros(values.shape, dtype=bool)
+    q1, q3 = np.percentile(finite, [25.0, 75.0])
+    spread = FENCE * (q3 - q1)
+    return (values < q1 - spread) | (values > q3 + spread)
+
+
+def bulk_limits(values) -> tuple[float, float]:
+    """Axis limits (low, high) spanning the values on the bulk (``off_bulk``), with ``PAD``."""
+    values = np.asarray(values, dtype=float)
+    bulk = values[np.isfinite(values) & ~off_bulk(values)]
+    if bulk.size == 0:
+        return 0.0, 1.0
+    low, high = float(bulk.min()), float(bulk.max())
+    pad = PAD * max(high - low, 0.05 * max(abs(low), abs(high)), 1e-12)
+    return low - pad, high + pad
+
+
+def _mark_off_scale(ax, x, value, limits, color, text) -> None:
+    """A value outside the axis limits: a triangle at the edge, its value beside it."""
+    low, high = limits
+    above = value > high
+    edge = high if above else low
+    ax.plot(
+        [x],
+        [edge],
+        linestyle="none",
+        marker="^" if above else "v",
+        markersize=9,
+        color=color,
+        clip_on=False,
+    )
+    ax.annotate(
+        text,
+        xy=(x, edge),
+        xytext=(0, -16 if above else 16),
+        textcoords="offset points",
+        ha="center",
+        va="top" if above else "bottom",
+        fontsize=8,
+        color=color,
+        bbox=dict(boxstyle="round,pad=0.2", fc="white", ec=color, alpha=0.85),
+    )
+
+
+def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
+    """Fig. 4 or 8: the optimal ``criterion`` against the speed (left) and the ``other``
+    criterion of the same gaits (right), both knees; ``flagged``: gaits not certified."""
+    fig = Figure(figsize=(11, 4.4), layout="constrained")
+    axes = fig.subplots(1, 2)
+    crosses = [g for g in flagged if g["criterion"] == criterion]
+    for ax, cost in zip(axes, (criterion, other), strict=True):
+        unit = CRITERION_UNITS[cost]
+        everything = [g["costs"][cost] for k in KNEES for g in series.get((k, criterion), [])]
+        limits = bulk_limits(everything or [g["costs"][cost] for g in crosses])
+        for knee in KNEES:
             v, c = _curve(series, knee, criterion, cost)
-            ax.plot(v, c, label=LABELS[knee], **STYLE[knee])
+            outside = (c < limits[0]) | (c > limits[1])
+            ax.plot(v, np.where(outside, np.nan, c), label=LABELS[knee], **STYLE[knee])
+            for x, value in zip(v[outside], c[outside], strict=True):
+                text = f"{knee} {x:.3f} m/s:\n{value:.4g} {unit}, off scale"
+                _mark_off_scale(ax, x, value, limits, STYLE[knee]["color"], text)
+        for i, gait in enumerate(crosses):
+            x, value = gait["speed"], gait["costs"][cost]
+            status = gait["optimizer"].get("status")
+            why = "infeasible" if not gait["feasible"] else f"solver: {status}"
+            label = "not certified" if i == 0 else None
+            if limits[0] <= value <= limits[1]:
+                ax.plot(
+                    [x],
+                    [value],
+                    linestyle="none",
+                    marker="x",
+                    markersize=9,
+                    markeredgewidth=2,
+                    color=FLAGGED_COLOR,
+                    label=label,
+                )
+                ax.annotate(
+                    f"{gait['knee']}: not certified\n({why})",
+                    xy=(x, value),
+                    xytext=(6, 6),
+                    textcoords="offset points",
+                    fontsize=8,
+                    color=FLAGGED_COLOR,
+                )
+            else:
+                text = f"{gait['knee']} {x:.3f} m/s: {value:.4g} {unit},\nnot certified ({why})"
+                _mark_off_scale(ax, x, value, limits, FLAGGED_COLOR, text)
+        ax.set_ylim(*limits)
+        ax.set_xlabel("walking speed [m/s]")
+        ax.set_ylabel(CRITERION_AXES[cost])
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
     axes[0].set_title(f"optimal {criterion} criterion")
     axes[1].set_title(f"{other} criterion of the same gaits")
-    for ax, cost in zip(axes, (criterion, other), strict=True):
-        ax.set_xlabel("walking speed [m/s]")
-        ax.set_ylabel(units[cost])
-        ax.grid(alpha=0.3)
-        ax.legend()
     fig.suptitle(title)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig
 
 
 def _detail_gaits(series):
@@ -89,37 +203,159 @@ def _detail_gaits(series):
     for knee in KNEES:
         candidates = series.get((knee, "sthenic"), [])
         if not candidates:
-            raise BipedError(f"no feasible sthenic-optimal gait of the {knee} knee in the sweep")
+            raise BipedError(
+                f"no certified sthenic-optimal gait of the {knee} knee in the sweep: "
+                "figures need both knees"
+            )
         gaits[knee] = min(candidates, key=lambda g: abs(g["speed"] - DETAIL_SPEED))
     return gaits
 
 
-def _time_figure(gaits, title, path, columns, extract, ylabels):
-    rows = int(np.ceil(len(columns) / 3))
-    fig, axes = plt.subplots(rows, 3, figsize=(13, 3.2 * rows), constrained_layout=True)
-    axes = np.atleast_2d(axes)
-    for i, name in enumerate(columns):
-        ax = axes.flat[i]
+@dataclass(frozen=True)
+class Panel:
+    """One plot of a time figure: its title, y label and the values of a gait on its
+    samples (``values(gait)``, shape (N,)); ``decorate(ax, gaits)`` adds what the panel
+    needs beyond the curves (limits, reference lines, marks)."""
+
+    title: str
+    ylabel: str
+    values: Callable[[dict], np.ndarray]
+    decorate: Callable | None = None
+
+
+def joint_label(i: int, joint: str) -> str:
+    """'Γ2 stance knee' for the second joint."""
+    return f"Γ{i + 1} {joint.replace('_', ' ')}"
+
+
+def angle_label(angle: str) -> str:
+    """'stance shank q1' for q1: the body whose absolute angle it is, and its symbol."""
+    return f"{BODY_DIRECTIONS[ANGLES.index(angle)].replace('_', ' ')} {angle}"
+
+
+def _column(field: str, i: int):
+    return lambda gait: gait["samples"][field][:, i]
+
+
+def _degrees(k: int):
+    return lambda gait: np.degrees(gait["samples"]["q"][:, k])
+
+
+def friction_needed(gait: dict) -> np.ndarray:
+    """|Fx| / Fz on the samples: the least friction coefficient the stance foot needs."""
+    wrench = gait["samples"]["wrench"]
+    return np.abs(wrench[:, 0]) / wrench[:, 1]
+
+
+def _friction_marks(ax, gaits) -> None:
+    ax.axhline(
+        FOOT_FRICTION,
+        color="k",
+        linestyle="--",
+        linewidth=1.2,
+        label=f"μ = {FOOT_FRICTION:g}, the model's friction",
+    )
+    top = FOOT_FRICTION
+    for row, (knee, gait) in enumerate(gaits.items()):
+        ratio = friction_needed(gait)
+        i = int(np.argmax(ratio))
+        t = gait["samples"]["t"][i] / gait["period"]
+        ax.plot(
+            [t], [ratio[i]], marker="o", markersize=8, fillstyle="none", color=STYLE[knee]["color"]
+        )
+        ax.annotate(
+            f"largest |Fx|/Fz {ratio[i]:.3f}",
+            xy=(t, ratio[i]),
+            xytext=(-8, 8 + 12 * row),
+            textcoords="offset points",
+            ha="right",
+            fontsize=8,
+            color=STYLE[knee]["color"],
+        )
+        top = max(top, float(ratio[i]))
+    ax.set_ylim(0.0, 1.15 * top)
+    ax.legend(fontsize=8, loc="center left")
+
+
+def _sole_marks(ax, gaits) -> None:
+    robot = next(iter(gaits.values()))["robot"]
+    for x, name in ((-robot.foot_heel, "heel"), (robot.foot_length - robot.foot_heel, "toe")):
+        ax.axhline(x, color="0.4", linestyle=":", linewidth=1.0)
+        ax.annotate(
+            name, xy=(0.0, x), xytext=(2, 2), textcoords="offset points", fontsize=8, color="0.4"
+        )
+
+
+TORQUE_PANELS = tuple(
+    Panel(joint_label(i, joint), "torque [N·m]", _column("torques", i))
+    for i, joint in enumerate(JOINTS)
+)
+ANGLE_PANELS = tuple(
+    Panel(angle_label(angle), "angle from the vertical [°]", _degrees(COORDINATES.index(angle)))
+    for angle in FREE_ANGLES
+)
+GROUND_PANELS = (
+    Panel("|Fx| / Fz: friction needed", "ratio [1]", friction_needed, _friction_marks),
+    Panel("Fz: normal force", "force [N]", _column("wrench", 1)),
+    Panel(
+        "x_ZMP from the stance ankle", "position [m]", lambda g: g["samples"]["zmp"], _sole_marks
+    ),
+)
+
+
+def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
+    """One plot per panel over the step's normalised time, a curve per gait.
+
+    Args:
+        gaits: {knee: gait file content}, drawn in the knee's colour.
+    """
+    rows = int(np.ceil(len(panels) / columns))
+    fig = Figure(figsize=(4.4 * columns, 3.2 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, columns)).ravel()
+    for ax, panel in zip(axes, panels, strict=False):
         for knee, gait in gaits.items():
             s = gait["samples"]
             ax.plot(
                 s["t"] / gait["period"],
-                extract(s, i),
+                panel.values(gait),
                 color=STYLE[knee]["color"],
                 label=LABELS[knee],
             )
-        ax.set_title(name)
-        ax.set_xlabel("normalised time t/T")
-        ax.set_ylabel(ylabels)
+        if panel.decorate is not None:
+            panel.decorate(ax, gaits)
+        ax.set_title(panel.title)
+        ax.set_xlabel(TIME_AXIS)
+        ax.set_ylabel(panel.ylabel)
         ax.grid(alpha=0.3)
-    axes.flat[0].legend()
-    for ax in list(axes.flat)[len(columns) :]:
+    if panels and panels[0].decorate is None:
+        axes[0].legend(fontsize=8)
+    for ax in axes[len(panels) :]:
         ax.remove()
     speeds = ", ".join(f"{k} {g['speed']:.3f} m/s" for k, g in gaits.items())
     fig.suptitle(f"{title} ({speeds})")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig
+
+
+def sweep_figures(series: dict, flagged=()) -> dict:
+    """Figs. 4-8 of a sweep ({file name: Figure}); ``flagged``: gaits not certified."""
+    gaits = _detail_gaits(series)
+    return {
+        "fig4.png": criterion_figure(
+            series, "sthenic", "energy", "Fig. 4: sthenic optimisation", flagged
+        ),
+        "fig5.png": time_figure(
+            gaits, "Fig. 5: joint torques of the sthenic-optimal gaits", TORQUE_PANELS
+        ),
+        "fig6.png": time_figure(
+            gaits, "Fig. 6: absolute angles of the sthenic-optimal gaits", ANGLE_PANELS
+        ),
+        "fig7.png": time_figure(
+            gaits, "Fig. 7: ground reaction of the sthenic-optimal gaits", GROUND_PANELS
+        ),
+        "fig8.png": criterion_figure(
+            series, "energy", "sthenic", "Fig. 8: energy optimisation", flagged
+        ),
+    }
 
 
 def _minimum(series, knee, criterion):
@@ -244,54 +480,18 @@ def _minimum_per_step(series, knee) -> float:
 
 
 def make_figures(sweep_folder: str | Path, out_folder: str | Path) -> list[Path]:
-    """Write fig4.png ... fig8.png and comparison.md; returns their paths."""
-    series = load_sweep(sweep_folder)
+    """Write fig4.png ... fig8.png and comparison.md, all or none; returns their paths.
+
+    A sweep without a certified sthenic optimum of each knee is refused before anything is
+    written; the files are written into a staging folder and moved into ``out_folder`` only
+    once all are written, so an earlier set there stays whole.
+    """
+    series, flagged = read_sweep(sweep_folder)
+    figures = sweep_figures(series, flagged)
+    table = comparison_table(series)
     out = Path(out_folder)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [
-        _criterion_figure(
-            series, "sthenic", "energy", "Fig. 4: sthenic optimisation", out / "fig4.png"
-        ),
-        _criterion_figure(
-            series, "energy", "sthenic", "Fig. 8: energy optimisation", out / "fig8.png"
-        ),
-    ]
-    gaits = _detail_gaits(series)
-    paths.append(
-        _time_figure(
-            gaits,
-            "Fig. 5: torques of the sthenic-optimal gaits",
-            out / "fig5.png",
-            [f"Γ{i + 1} {name}" for i, name in enumerate(JOINTS)],
-            lambda s, i: s["torques"][:, i],
-            "[N·m]",
-        )
-    )
-    paths.append(
-        _time_figure(
-            gaits,
-            "Fig. 6: angles of the sthenic-optimal gaits",
-            out / "fig6.png",
-            list(FREE_ANGLES),
-            lambda s, i: s["q"][:, i + 1],
-            "[rad]",
-        )
-    )
-    paths.append(
-        _time_figure(
-            gaits,
-            "Fig. 7: ground reaction of the sthenic-optimal gaits",
-            out / "fig7.png",
-            ["|Fx| / Fz (friction needed)", "Fz [N]", "x_ZMP [m]"],
-            lambda s, i: [
-                np.abs(s["wrench"][:, 0]) / s["wrench"][:, 1],
-                s["wrench"][:, 1],
-                s["zmp"],
-            ][i],
-            "",
-        )
-    )
-    table = out / "comparison.md"
-    atomic_write_text(table, comparison_table(series))
-    paths.append(table)
-    return paths
+    with atomic_set(out, "figures") as staging:
+        for name, figure in figures.items():
+            figure.savefig(staging / name, dpi=DPI)
+        (staging / "comparison.md").write_text(table, encoding="utf-8")
+    return [out / name for name in figures] + [out / "comparison.md"]

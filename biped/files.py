@@ -7,12 +7,18 @@ any moment, sees the old file or the new one, never a part. The temporary file i
 ``.<name>.<random>.tmp``; it is removed on any exception, ``KeyboardInterrupt`` included. A
 process killed outright (SIGKILL, power loss) can leave one behind: ``clean_stale_temporaries``
 removes them before a run writes into the folder again.
+
+A set of files that belong together (the figures of a sweep, a page and its images) is written
+through ``atomic_set``: every file is written into a hidden staging folder first and moved into
+place only once all of them are written, so a failure or an interrupt while writing leaves the
+earlier set as it was.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -107,3 +113,41 @@ def clean_stale_temporaries(folder: str | Path) -> list[Path]:
             path.unlink(missing_ok=True)
             removed.append(path)
     return removed
+
+
+@contextlib.contextmanager
+def atomic_set(folder: str | Path, name: str = "set") -> Iterator[Path]:
+    """A staging folder to write a set of files through, all or none.
+
+    The body writes its files (and subfolders) into the staging folder, a hidden folder
+    ``.<name>.<random>.tmp`` inside ``folder``; when it returns, each file is flushed and
+    renamed to the same relative path under ``folder``. If the body raises, nothing is moved.
+    The staging folder is removed either way; staging folders of the same ``name`` left by a
+    killed run are removed first. ``folder`` is created if missing.
+
+    Only the renames, microseconds long, are not all-or-none: a process killed outright
+    between two of them leaves the set mixed.
+
+        with atomic_set("logs/figures", "figures") as staging:
+            figure.savefig(staging / "fig4.png")
+    """
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    for stale in folder.glob(f".{name}.*{TEMPORARY_SUFFIX}"):
+        if stale.is_dir() and not stale.is_symlink():
+            shutil.rmtree(stale, ignore_errors=True)
+    staging = Path(tempfile.mkdtemp(dir=folder, prefix=f".{name}.", suffix=TEMPORARY_SUFFIX))
+    try:
+        os.chmod(staging, 0o777 & ~_umask())
+        yield staging
+        files = sorted(p for p in staging.rglob("*") if p.is_file())
+        for path in files:
+            with open(path, "rb+") as handle:
+                os.fsync(handle.fileno())
+        for path in files:
+            target = folder / path.relative_to(staging)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(path, target)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    _fsync_folder(folder)

@@ -26,6 +26,9 @@ from biped.errors import ParameterError
 
 # Standard gravity [m/s²].
 STANDARD_GRAVITY = 9.81
+# Coefficient of sliding friction μ between the soles and the floor, the one the MuJoCo models
+# use (``validate.mjcf``): a gait whose stance foot needs |Fx| / Fz above it would slip.
+FOOT_FRICTION = 1.0
 
 # Plausible ranges, wide enough for any walking robot from a toy to twice human size; beyond
 # them the numbers are typos or overflow (a 1e308 kg trunk gives torques of inf and nan).

@@ -63,6 +63,21 @@ def test_mass_properties_match_robot(knee):
 
 
 @pytest.mark.parametrize("knee", biped.KNEES)
+def test_soles_and_floor_have_the_robot_modules_friction(knee):
+    """The friction coefficient of the soles and the floor is biped.robot.FOOT_FRICTION, the
+    one the figures draw (MuJoCo takes the larger of the two geoms' coefficients)."""
+    from biped.robot import FOOT_FRICTION
+
+    model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
+    colliding = [
+        g for g in range(model.ngeom) if model.geom_contype[g] or model.geom_conaffinity[g]
+    ]
+    assert colliding and model.geom("floor").id in colliding
+    for g in colliding:
+        assert model.geom_friction[g, 0] == FOOT_FRICTION
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
 def test_scene_steps_without_warnings(knee):
     """The scene loads and steps (robot held at home by its motors' zero torque falling)."""
     model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))

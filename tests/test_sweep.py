@@ -5,12 +5,13 @@ come from them."""
 import io
 import json
 
+import numpy as np
 import pytest
 
 import biped
 from biped import gait_file
 from biped import sweep as sweep_module
-from biped.figures import make_figures
+from biped.figures import LABELS, make_figures
 from biped.sweep import INDEPENDENT, MANIFEST, run_sweep
 
 SPEEDS = (0.275, 0.3)
@@ -144,3 +145,163 @@ def test_figures_leave_out_uncertified_optima(sweep, tmp_path):
 def test_module_names_no_temporary_leftovers():
     """The stage folder is hidden and not a gait file of the sweep."""
     assert INDEPENDENT.startswith(".") and sweep_module.MANIFEST.endswith(".json")
+
+
+def _pixels(figure) -> np.ndarray:
+    """The figure drawn (H, W, 3), as PNG would show it."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(figure)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba())[..., :3]
+
+
+def _texts(figure) -> set:
+    from matplotlib.text import Text
+
+    return {t.get_text() for t in figure.findobj(Text) if t.get_text()}
+
+
+def _panel(figure, title):
+    return next(ax for ax in figure.axes if ax.get_title() == title)
+
+
+def test_each_figure_is_drawn_with_its_labels(sweep):
+    """Every figure has ink (an empty figure has none) and its labels: torques and angles
+    named by joint, angles in degrees (the curve under 'stance shank q1' is q1 in degrees),
+    the model's friction coefficient and the largest |Fx| / Fz of each knee in Fig. 7."""
+    from matplotlib.figure import Figure
+
+    from biped.dynamics import JOINTS
+    from biped.figures import FOOT_FRICTION, read_sweep, sweep_figures
+
+    folder, _ = sweep
+    series, flagged = read_sweep(folder)
+    figures = sweep_figures(series, flagged)
+    assert sorted(figures) == ["fig4.png", "fig5.png", "fig6.png", "fig7.png", "fig8.png"]
+    assert _pixels(Figure()).std() == 0.0
+    for name, figure in figures.items():
+        pixels = _pixels(figure)
+        colours = np.unique(pixels.astype(np.int32) @ np.array([1 << 16, 1 << 8, 1]))
+        assert pixels.std() > 20 and len(colours) > 50, name
+    for name in ("fig4.png", "fig8.png"):
+        assert {"walking speed [m/s]", "sthenic criterion C_Γ [N²·m·s]"} <= _texts(figures[name])
+    torques = _texts(figures["fig5.png"])
+    assert {f"Γ{i + 1} {j.replace('_', ' ')}" for i, j in enumerate(JOINTS)} <= torques
+    assert {"Γ2 stance knee", "Γ5 swing knee", "torque [N·m]"} <= torques
+    angles = figures["fig6.png"]
+    names = ["swing foot qp2", "stance shank q1", "stance thigh q2", "swing thigh q3"]
+    assert {*names, "swing shank q4", "trunk q5", "angle from the vertical [°]"} <= _texts(angles)
+    gait = next(g for g in series[("rolling", "sthenic")] if g["speed"] == 0.3)
+    for title, k in (("stance shank q1", 2), ("swing thigh q3", 4), ("trunk q5", 6)):
+        drawn = [line.get_ydata() for line in _panel(angles, title).get_lines()]
+        assert any(np.allclose(y, np.degrees(gait["samples"]["q"][:, k])) for y in drawn), title
+    ground = figures["fig7.png"]
+    texts = _texts(ground)
+    assert f"μ = {FOOT_FRICTION:g}, the model's friction" in texts
+    friction = _panel(ground, "|Fx| / Fz: friction needed")
+    assert any(np.allclose(line.get_ydata(), FOOT_FRICTION) for line in friction.get_lines())
+    for knee in biped.KNEES:
+        gait = next(g for g in series[(knee, "sthenic")] if g["speed"] == 0.3)
+        wrench = gait["samples"]["wrench"]
+        largest = np.max(np.abs(wrench[:, 0]) / wrench[:, 1])
+        assert f"largest |Fx|/Fz {largest:.3f}" in texts
+        assert friction.get_ylim()[1] > max(largest, FOOT_FRICTION)
+
+
+def _synthetic_series(outlier=None):
+    """Both knees' optima at 13 speeds, smooth criteria; ``outlier``: (knee, index, factor)
+    multiplies one gait's energy."""
+    speeds = np.linspace(0.15, 0.45, 13)
+    series = {}
+    for knee in biped.KNEES:
+        for criterion in ("sthenic", "energy"):
+            series[(knee, criterion)] = [
+                {
+                    "knee": knee,
+                    "criterion": criterion,
+                    "speed": float(v),
+                    "feasible": True,
+                    "optimizer": {"status": "converged"},
+                    "costs": {
+                        "sthenic": 30.0 + 40.0 * (v - 0.3) ** 2 + (knee == "rolling"),
+                        "energy": 10.0 + 5.0 * v + 0.2 * (knee == "rolling"),
+                    },
+                }
+                for v in speeds
+            ]
+    if outlier is not None:
+        knee, index, factor = outlier
+        series[(knee, "sthenic")][index]["costs"]["energy"] *= factor
+    return series
+
+
+def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
+    """An energy 30 times the others' (one gait) is drawn at the panel's edge with its value
+    written, and the axis spans the other gaits, so the knees' curves stay apart; without
+    it, every point is on the axis and nothing is marked."""
+    from biped.figures import criterion_figure
+
+    series = _synthetic_series(("rolling", 12, 30.0))
+    value = series[("rolling", "sthenic")][12]["costs"]["energy"]
+    figure = criterion_figure(series, "sthenic", "energy", "Fig. 4")
+    energy = _panel(figure, "energy criterion of the same gaits")
+    others = [g["costs"]["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]][:-1]
+    low, high = energy.get_ylim()
+    assert high < value and low <= min(others) and max(others) <= high
+    assert max(others) - min(others) > 0.5 * (high - low)  # the bulk fills the axis
+    assert f"rolling 0.450 m/s:\n{value:.4g} J, off scale" in _texts(figure)
+    plain = criterion_figure(_synthetic_series(), "sthenic", "energy", "Fig. 4")
+    assert not [t for t in _texts(plain) if "off scale" in t]
+    low, high = _panel(plain, "energy criterion of the same gaits").get_ylim()
+    everything = [g["costs"]["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]]
+    assert low <= min(everything) and sorted(everything)[-2] <= high
+
+
+def test_a_gait_not_certified_is_marked_apart_from_the_curves():
+    """A gait whose solver did not converge is a labelled cross, not a point of a curve."""
+    from biped.figures import criterion_figure
+
+    series = _synthetic_series()
+    gait = dict(series[("revolute", "sthenic")].pop(4))
+    gait["optimizer"] = {"status": "Maximum_Iterations_Exceeded"}
+    figure = criterion_figure(series, "sthenic", "energy", "Fig. 4", flagged=[gait])
+    texts = _texts(figure)
+    assert "revolute: not certified\n(solver: Maximum_Iterations_Exceeded)" in texts
+    assert "not certified" in texts  # the legend
+    panel = _panel(figure, "optimal sthenic criterion")
+    curve = next(line for line in panel.get_lines() if line.get_label() == LABELS["revolute"])
+    assert gait["speed"] not in list(curve.get_xdata())
+
+
+def test_figures_are_written_all_or_none(sweep, tmp_path, monkeypatch):
+    """A sweep lacking a knee is refused before anything is written, and a failure while
+    writing the set leaves none of it: an earlier complete set in the folder stays as it was,
+    with no staging folder left behind."""
+    from matplotlib.figure import Figure
+
+    folder, _ = sweep
+    out = tmp_path / "figures"
+    make_figures(folder, out)
+    before = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in out.iterdir()}
+    assert len(before) == 6
+    rolling = tmp_path / "rolling-only"
+    rolling.mkdir()
+    for path in folder.glob("rolling-*.json"):
+        (rolling / path.name).write_bytes(path.read_bytes())
+    with pytest.raises(biped.BipedError, match="revolute knee"):
+        make_figures(rolling, out)
+    saved = Figure.savefig
+    calls = [0]
+
+    def fail_on_the_third(self, *args, **kwargs):
+        calls[0] += 1
+        if calls[0] == 3:
+            raise OSError("disk full")
+        return saved(self, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", fail_on_the_third)
+    with pytest.raises(OSError, match="disk full"):
+        make_figures(folder, out)
+    after = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in out.iterdir()}
+    assert after == before

@@ -33,6 +33,7 @@ from pathlib import Path
 
 from biped.files import atomic_write_text
 from biped.kinematics import check_knee
+from biped.robot import FOOT_FRICTION as SLIDING_FRICTION
 from biped.robot import Robot
 
 SIDES = ("left", "right")
@@ -53,7 +54,7 @@ KNEE_SOLIMP = "0.9999 0.99999 0.0001 0.5 2"
 # Foot box: width and sole thickness [m]; friction (sliding, torsional, rolling).
 FOOT_WIDTH = 0.10
 SOLE_THICKNESS = 0.02
-FOOT_FRICTION = "1.0 0.02 0.0001"
+FOOT_FRICTION = f"{SLIDING_FRICTION!r} 0.02 0.0001"  # μ from biped.robot
 # Stiff foot contact: the gaits clear the ground by millimetres, so the stance foot must not
 # sink into it (default contacts let the loaded heel sink by about 1.5 mm, these by 0.5 mm).
 FOOT_SOLREF = "0.004 1"
