@@ -15,6 +15,8 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
                seconds, seed, history (each start), variables (the solver's variables)},
     provenance {package, version, python, platform, numpy, scipy, casadi, mujoco, command}
         (``biped.provenance``: what produced the file),
+    units {path: unit} of every number above and below ("costs.sthenic": "N²·m·s",
+        ``biped.units``),
     samples {t, q, qd, qdd, torques, wrench, zmp}
 
 The samples run from t = 0 to t = T inclusive on both spline pieces; t = T/2 appears twice,
@@ -41,6 +43,7 @@ from biped.optimize import Optimum, check_speed
 from biped.problem import VARIABLES
 from biped.provenance import provenance as make_provenance
 from biped.robot import Robot
+from biped.units import gait_units
 
 FORMAT = "biped-gait/2"  # 2: safety margins recorded
 # Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
@@ -89,6 +92,7 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None =
             "variables": dict(zip(VARIABLES, map(_finite_or_none, optimum.variables), strict=True)),
         },
         "provenance": dict(provenance) if provenance is not None else make_provenance(),
+        "units": gait_units(optimum.criterion),
         "samples": {
             "t": ev.t.tolist(),
             "q": ev.q.tolist(),

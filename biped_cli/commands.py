@@ -180,17 +180,20 @@ def cmd_figures(args) -> int:
 
 
 def _validate_and_record(
-    gait: dict, steps: int, rrd, video=None, gif=None, spawn=False, connect=None
+    gait: dict, steps: int, rrd, video=None, gif=None, spawn=False, connect=None, source=None
 ):
     """Every check of a gait read by ``gait_file.read``, its recording at ``rrd`` (also
     streamed to a viewer with ``spawn`` or ``connect``) and, if asked, the video of its walk
-    at ``video`` (MP4) and ``gif``.
+    at ``video`` (MP4) and ``gif``. ``source``: the gait file, named as the recording's owner
+    (``biped_cli.outputs``).
 
-    Returns the validation and its report (the checks as JSON, the recording's and video's
-    paths).
+    Returns the validation and its report (the checks as JSON with their ``units``, the
+    recording's and video's paths).
     """
+    from biped_cli.outputs import claim
     from validate.record import record
     from validate.report import as_json, validate
+    from validate.units import report_units
 
     result = validate(gait, steps=steps)
     written = record(
@@ -204,7 +207,15 @@ def _validate_and_record(
         spawn=spawn,
         connect=connect,
     )
-    report = {**as_json(result.checks), "recording": str(written), "provenance": provenance()}
+    if source is not None:
+        claim(written, source)
+    checks = as_json(result.checks)
+    report = {
+        **checks,
+        "units": report_units(checks),
+        "recording": str(written),
+        "provenance": provenance(),
+    }
     if video is not None or gif is not None:
         from validate.video import write_video
 
@@ -229,6 +240,7 @@ def cmd_validate(args) -> int:
     from pathlib import Path
 
     from biped import gait_file
+    from biped_cli.outputs import check_owner, output_name
     from biped_cli.progress import Progress
 
     if args.rrd and len(args.gait) > 1:
@@ -244,24 +256,25 @@ def cmd_validate(args) -> int:
     for path, gait in zip(args.gait, gaits, strict=True):
         check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
     recordings = [
-        Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / (Path(path).stem + ".rrd")
+        Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
         for path in args.gait
     ]
     duplicated = {str(p) for p in recordings if recordings.count(p) > 1}
     if duplicated:
         raise BipedError(
-            f"gaits of the same file name would share the recording {sorted(duplicated)[0]!r}: "
-            "allowed gait files with distinct names"
+            f"gait files in folders of the same name would share the recording "
+            f"{sorted(duplicated)[0]!r}: allowed gait files of distinct folder or file names"
         )
-    for rrd in recordings:
+    for rrd, path in zip(recordings, args.gait, strict=True):
         check_output(str(rrd), "--rrd")
+        check_owner(rrd, path)  # never another gait's recording
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:
         for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
             bar.update(note=path)
             try:
                 result, reports[path] = _validate_and_record(
-                    gait, args.steps, rrd, args.video, gif, args.spawn, args.connect
+                    gait, args.steps, rrd, args.video, gif, args.spawn, args.connect, path
                 )
             except BipedError as error:
                 raise BipedError(f"gait file {path!r}: {error}") from None
@@ -298,6 +311,7 @@ def cmd_pipeline(args) -> int:
     from biped import gait_file
     from biped.optimize import check_speed, optimize
     from biped.problem import GaitProblem
+    from biped_cli.outputs import check_owner
 
     robot = _robot(args.robot)
     out, recordings = Path(args.out), Path(args.recordings)
@@ -307,6 +321,9 @@ def cmd_pipeline(args) -> int:
         check_simulable(robot, knee, f"--robot {args.robot!r}" if args.robot else "robot")
     check_folder(args.out, "--out")
     check_folder(args.recordings, "--recordings")
+    for knee in args.knees:  # never another gait's recording
+        name = f"{knee}-{args.criterion}-{args.speed:.3f}"
+        check_owner(recordings / f"{name}.rrd", out / f"{name}.json", "--recordings")
     passed, costs, written, optima = True, {}, [], {}
     for knee in args.knees:
         name = f"{knee}-{args.criterion}-{args.speed:.3f}"
@@ -337,7 +354,11 @@ def cmd_pipeline(args) -> int:
         print(f"[{knee}] validating {args.steps} steps in MuJoCo...", flush=True)
         video = None if args.no_video else recordings / f"{name}.mp4"
         result, report = _validate_and_record(
-            gait_file.read(gait_path), args.steps, recordings / f"{name}.rrd", video
+            gait_file.read(gait_path),
+            args.steps,
+            recordings / f"{name}.rrd",
+            video,
+            source=gait_path,
         )
         for check in result.checks:
             print(f"[{knee}]   " + check.line())

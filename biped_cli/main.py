@@ -125,7 +125,8 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument(
         "--rrd",
         metavar="PATH",
-        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<gait>.rrd)",
+        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
+        "named from the gait file's folder and name; another gait's recording is refused)",
     )
     val.add_argument(
         "--json",

@@ -1,0 +1,143 @@
+"""Units of the numbers in the project's JSON files: a ``units`` map beside them.
+
+Gait files (``biped.gait_file``) and validation reports keep their key names; their ``units``
+object maps the path of each numeric field to its unit::
+
+    "costs.sthenic": "N²·m·s",
+    "samples.q": ["rad", "rad", "rad", "rad", "rad", "rad", "rad", "m", "m"],
+    "optimizer.history[].value": "N²·m·s"
+
+A path goes through objects by key, and ``[]`` stands for every element of a list of objects.
+A unit is a string in the notation the project prints (``N·m``, ``rad/s²``), ``"1"`` for a pure
+number (a count, a ratio) and ``"T"`` for a fraction of the gait's period; a list holds one
+unit per column of an array whose columns differ. Only numbers (and null, a figure that could
+not be measured) have units; texts, booleans and ``provenance`` have none.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from biped.criteria import CONSTRAINTS, CRITERIA
+from biped.gait import PARAMETERS
+from biped.kinematics import ANGLES, COORDINATES
+from biped.problem import VARIABLES
+from biped.robot import Robot
+
+PURE = "1"  # a count or a ratio
+PERIOD = "T"  # a fraction of the gait's period
+CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
+# Fields without units: what produced the file, and the map itself.
+SKIPPED = ("provenance", "units")
+
+
+def numeric_paths(content: dict, skip=SKIPPED) -> list[str]:
+    """Paths (see the module) of every number, array of numbers or null in ``content``,
+    leaving out the top-level fields ``skip``."""
+    paths: list[str] = []
+
+    def walk(value, path):
+        if isinstance(value, dict):
+            for key, item in value.items():
+                if not path and key in skip:
+                    continue
+                walk(item, f"{path}.{key}" if path else key)
+        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            for item in value:
+                walk(item, f"{path}[]")
+        elif _numeric(value):
+            paths.append(path)
+
+    walk(content, "")
+    return sorted(set(paths))
+
+
+def _numeric(value) -> bool:
+    if value is None:
+        return True
+    if isinstance(value, bool):
+        return False
+    if isinstance(value, (int, float)):
+        return True
+    if isinstance(value, (list, tuple)):
+        return bool(value) and all(_numeric(v) for v in value)
+    return hasattr(value, "dtype") and value.dtype.kind in "iuf"  # a numpy array
+
+
+def missing(content: dict, units: dict) -> list[str]:
+    """The numeric paths of ``content`` that ``units`` does not give."""
+    return [path for path in numeric_paths(content) if path not in units]
+
+
+def robot_unit(field: str) -> str:
+    """Unit of a ``biped.Robot`` field, from its name."""
+    if field.endswith("_mass"):
+        return "kg"
+    if field.endswith("_inertia"):
+        return "kg·m²"
+    if field == "gravity":
+        return "m/s²"
+    return "m"  # lengths, centres of mass, the heel, the knee radii
+
+
+def parameter_unit(name: str) -> str:
+    """Unit of a gait parameter (``biped.gait.PARAMETERS``) or solver variable
+    (``biped.problem.VARIABLES``)."""
+    if name in ("x_hip", "z_hip"):
+        return "m"
+    if name == "period":
+        return "s"
+    if name.startswith("end_rate_"):
+        return "rad/s"
+    if "_accel_" in name:
+        return "rad/s²"
+    return "rad"  # the trunk angle, the knee bends
+
+
+# Units of Ψ1..Ψ7 (``biped.criteria.CONSTRAINTS``), as their margins δ.
+CONSTRAINT_UNITS = dict(zip(CONSTRAINTS, ("N", "m", "m", "rad", "rad", "m", "m"), strict=True))
+
+
+def _per_coordinate(angle: str, length: str) -> list[str]:
+    return [angle if name in ANGLES else length for name in COORDINATES]
+
+
+def gait_units(criterion: str) -> dict:
+    """The ``units`` map of a gait file optimised for ``criterion``."""
+    value = CRITERION_UNITS[criterion]
+    rates = _per_coordinate("rad/s", "m/s")
+    units = {
+        "speed": "m/s",
+        "period": "s",
+        "step_length": "m",
+        "safety.clearance": "m",
+        "safety.zmp_margin": "m",
+        **{f"costs.{name}": CRITERION_UNITS[name] for name in CRITERIA},
+        "costs.energy_per_metre": "J/m",
+        **{f"robot.{f.name}": robot_unit(f.name) for f in dataclasses.fields(Robot)},
+        **{f"parameters.{name}": parameter_unit(name) for name in PARAMETERS},
+        **{f"constraints.{name}": unit for name, unit in CONSTRAINT_UNITS.items()},
+        "impact.impulse": ["N·s", "N·s", "N·m·s"],
+        "impact.trailing_foot_lift": "m/s",
+        "impact.qd_minus": rates,
+        "impact.qd_plus": rates,
+        "optimizer.starts": PURE,
+        "optimizer.starts_at_best": PURE,
+        "optimizer.iterations": PURE,
+        "optimizer.constraint_violation": "1 (the solver's scaled constraints)",
+        "optimizer.dual_infeasibility": "1 (IPOPT's measure)",
+        "optimizer.seconds": "s",
+        "optimizer.seed": PURE,
+        "optimizer.value": value,
+        "optimizer.history[].value": value,
+        "optimizer.history[].iterations": PURE,
+        **{f"optimizer.variables.{name}": parameter_unit(name) for name in VARIABLES},
+        "samples.t": "s",
+        "samples.q": _per_coordinate("rad", "m"),
+        "samples.qd": rates,
+        "samples.qdd": _per_coordinate("rad/s²", "m/s²"),
+        "samples.torques": "N·m",
+        "samples.wrench": ["N", "N", "N·m"],
+        "samples.zmp": "m",
+    }
+    return units

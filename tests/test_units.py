@@ -1,0 +1,74 @@
+"""The units map of gait files: a unit for every number, every column of a mixed array, and
+the robot's fields in the units its own documentation states."""
+
+import dataclasses
+import inspect
+import json
+import re
+
+import numpy as np
+import pytest
+
+from biped import Robot, gait_file
+from biped.units import PURE, gait_units, missing, numeric_paths
+from tests.conftest import small_optimum
+
+
+@pytest.fixture(scope="module")
+def gait(tmp_path_factory):
+    """A gait file's JSON content, as written."""
+    path = tmp_path_factory.mktemp("units") / "rolling.json"
+    gait_file.write_json(path, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
+    return json.loads(path.read_text())
+
+
+def _value(content, path):
+    """The values at a path ('optimizer.history[].value': one per list element)."""
+    values = [content]
+    for key in path.split("."):
+        many = key.endswith("[]")
+        values = [v[key.removesuffix("[]")] for v in values]
+        if many:
+            values = [item for v in values for item in v]
+    return values
+
+
+def test_every_number_of_a_gait_file_has_a_unit(gait):
+    """The units map names every numeric field (and no field the file lacks); a list of
+    units has one per column of its array; the keys of the figures are unchanged."""
+    units = gait["units"]
+    assert units == gait_units(gait["criterion"])
+    assert missing(gait, units) == []
+    assert set(units) == set(numeric_paths(gait))
+    for path, unit in units.items():
+        if isinstance(unit, list):
+            for value in _value(gait, path):
+                assert np.shape(value)[-1] == len(unit), path
+    assert units["costs.sthenic"] == "N²·m·s" and units["costs.energy"] == "J"
+    assert units["samples.q"] == ["rad"] * 7 + ["m", "m"]
+    assert units["samples.wrench"] == ["N", "N", "N·m"]
+    assert units["optimizer.history[].value"] == "N²·m·s"
+    assert units["optimizer.iterations"] == PURE
+    assert {"speed", "period", "step_length", "costs", "samples"} <= set(gait)
+
+
+def test_a_number_without_a_unit_is_found(gait):
+    """A field added without its unit, or a unit map missing one, is reported."""
+    changed = {**gait, "costs": {**gait["costs"], "peak_power": 12.0}}
+    assert missing(changed, gait["units"]) == ["costs.peak_power"]
+    units = dict(gait["units"])
+    del units["impact.impulse"]
+    assert missing(gait, units) == ["impact.impulse"]
+    assert "provenance.version" not in numeric_paths(gait) and "feasible" not in numeric_paths(gait)
+
+
+def test_robot_units_are_those_its_fields_document():
+    """Each Robot field's unit in the map is the one in brackets in its docstring."""
+    source = inspect.getsource(Robot)
+    stated = dict(re.findall(r"\n    (\w+): float(?: = [^\n]+)?\n    \"\"\"\[([^\]]+)\]", source))
+    fields = [f.name for f in dataclasses.fields(Robot)]
+    assert sorted(stated) == sorted(fields)
+    units = gait_units("energy")
+    for name in fields:
+        assert units[f"robot.{name}"] == stated[name], name
+    assert units["optimizer.value"] == "J"
