@@ -14,6 +14,7 @@ from biped.kinematics import KNEES
 from biped.provenance import command_line, version
 from biped.sweep import DEFAULT_SPEEDS
 from biped_cli import args as types
+from biped_cli import report
 from biped_cli.commands import (
     DEFAULT_FIGURES,
     DEFAULT_PIPELINE,
@@ -198,6 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
     fig.add_argument("--sweep", default=DEFAULT_SWEEP, metavar="DIR", help="sweep results")
     fig.add_argument("--out", default=DEFAULT_FIGURES, metavar="DIR", help="(default logs/figures)")
     fig.set_defaults(run=cmd_figures)
+    report.add_parser(commands)
     for command in commands.choices.values():  # after the command too: biped demo --debug
         command.add_argument(
             "--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP

@@ -1,0 +1,130 @@
+"""``biped report GAIT.json ... [--out DIR]``: one Markdown page per gait file, with figures.
+
+The page (``biped.page``) is named from the gait file's path as its recording is
+(``biped_cli.outputs``). Its validation is the report beside the gait file,
+``<gait>.report.json`` (``biped pipeline`` writes it; ``biped validate GAIT.json --json >
+GAIT.report.json`` too); its links are the recording and videos that report names, or the
+recording ``biped validate`` writes by default, each only if it exists and was made from this
+gait file as it is now.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from biped.errors import BipedError
+from biped_cli.args import check_folder
+from biped_cli.commands import DEFAULT_RECORDINGS
+
+DEFAULT_REPORTS = "logs/reports"
+
+
+def validation_path(gait_path: str | Path) -> Path:
+    """The validation report beside a gait file: ``<name>.report.json``."""
+    gait_path = Path(gait_path)
+    return gait_path.with_name(f"{gait_path.stem}.report.json")
+
+
+def read_validation(path: Path) -> dict | None:
+    """A validation report's content, None if there is none; BipedError if it is not one."""
+    if not path.exists():
+        return None
+    try:
+        content = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise BipedError(f"validation report {str(path)!r} cannot be read: {error}") from None
+    if not isinstance(content, dict) or not isinstance(content.get("passed"), bool):
+        raise BipedError(
+            f"validation report {str(path)!r} is not one: allowed the JSON of 'biped validate "
+            "--json' (with 'passed')"
+        )
+    return content
+
+
+def links(gait_path: Path, validation: dict | None) -> list:
+    """The recording and videos of a gait that exist and were made from it as it is now."""
+    from biped.page import Link
+    from biped_cli.outputs import belongs_to, output_name
+
+    found = []
+    recording = (validation or {}).get("recording")
+    if not isinstance(recording, str):
+        recording = str(Path(DEFAULT_RECORDINGS) / f"{output_name(gait_path)}.rrd")
+    videos = (validation or {}).get("video") or []
+    if not isinstance(videos, list):
+        videos = []
+    recording = Path(recording)
+    if recording.exists():
+        owned = belongs_to(recording, gait_path)
+        if owned is None:
+            found.append(Link("recording", recording, "no owner record: gait unchecked"))
+        elif owned:
+            found.append(Link("recording", recording, f"open with: rerun {recording}"))
+        owned_videos = owned is not False
+    else:
+        owned_videos = True  # a video named by the report, the recording gone
+    for video in videos:
+        if isinstance(video, str) and Path(video).exists() and owned_videos:
+            found.append(Link(f"video ({Path(video).suffix[1:]})", Path(video)))
+    return found
+
+
+def cmd_report(args) -> int:
+    """Write one Markdown page per gait file into --out, with its figures: the parameters by
+    name, the criteria and the tightest margin of each constraint (where in the step), the
+    torques, angles, ground reaction and constraints over the step; the verdict and figures
+    of its validation in MuJoCo when <gait>.report.json lies beside it; links to its recording
+    and video. All pages are written, or none.
+    """
+    from biped import gait_file
+    from biped.page import Page, write_pages
+    from biped_cli.outputs import output_name
+
+    check_folder(args.out, "--out")
+    pages = []
+    for path in args.gait:  # every input read and checked before any work
+        gait = gait_file.read(path)
+        validation_file = validation_path(path)
+        validation = read_validation(validation_file)
+        if validation is not None and not isinstance(validation.get("units"), dict):
+            from validate.units import report_units  # a report from before the units map
+
+            validation["units"] = report_units(validation)
+        pages.append(
+            Page(
+                name=output_name(path),
+                source=Path(path),
+                gait=gait,
+                validation=validation,
+                validation_source=validation_file if validation is not None else None,
+                links=links(Path(path), validation),
+            )
+        )
+    names = [page.name for page in pages]
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise BipedError(
+            f"gait files would share the page {repeated[0]!r}: allowed gait files of distinct "
+            "folder or file names"
+        )
+    for written in write_pages(pages, args.out):
+        print(f"wrote {written}")
+    return 0
+
+
+def add_parser(commands) -> None:
+    """Register ``biped report`` with the subcommands' parser."""
+    parser = commands.add_parser(
+        "report", help="one Markdown page per gait, with figures", description=cmd_report.__doc__
+    )
+    parser.add_argument(
+        "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
+    )
+    parser.add_argument(
+        "--out",
+        default=DEFAULT_REPORTS,
+        metavar="DIR",
+        help=f"pages and their figures (default {DEFAULT_REPORTS})",
+    )
+    parser.set_defaults(run=cmd_report)

@@ -1,0 +1,126 @@
+"""biped report: one page per gait with its figures, parameters, criteria, the constraints'
+tightest margins, the validation verdict beside it and links to its own recording only."""
+
+import json
+
+import numpy as np
+import pytest
+
+from biped import Robot, gait_file
+from biped.criteria import CONSTRAINTS
+from biped.gait import PARAMETERS
+from biped_cli import main
+from biped_cli.outputs import claim
+from tests.conftest import small_optimum
+
+NAME = "rolling-sthenic-0.300"
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    """A gait file in logs/pipeline with a validation report, an owned recording and a
+    video beside; its page written by 'biped report' into logs/reports."""
+    root = tmp_path_factory.mktemp("page")
+    gait_path = root / "logs/pipeline" / f"{NAME}.json"
+    gait_file.write_json(gait_path, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), 0))
+    recording = root / "logs/recordings" / f"{NAME}.rrd"
+    recording.parent.mkdir(parents=True)
+    recording.write_bytes(b"recording")
+    claim(recording, gait_path)
+    video = recording.with_suffix(".mp4")
+    video.write_bytes(b"video")
+    report = {
+        "forward": {"steps": 20, "max_slip": 0.0004, "fell": False, "passed": False},
+        "passed": False,
+        "units": {"forward.steps": "1", "forward.max_slip": "m"},
+        "recording": str(recording),
+        "video": [str(video)],
+    }
+    (root / "logs/pipeline" / f"{NAME}.report.json").write_text(json.dumps(report))
+    out = root / "logs/reports"
+    assert main(["report", str(gait_path), "--out", str(out)]) == 0
+    return gait_path, out, (out / f"pipeline-{NAME}.md").read_text()
+
+
+def test_page_states_the_gait_by_name_with_units(written):
+    """Every parameter by name with its unit, the criteria with theirs, and the tightest
+    margin of each constraint: the file's worst value, at the sample where Ψ is smallest."""
+    from biped.page import constraint_profile
+
+    gait_path, _, text = written
+    gait = gait_file.read(gait_path)
+    for name in PARAMETERS:
+        unit = "s" if name == "period" else "m" if name.endswith("_hip") else "rad"
+        assert f"| {name} | {gait['parameters'][name]:.6g} | {unit}" in text
+    assert f"| {gait['costs']['sthenic']:.5g} | N²·m·s |" in text
+    assert f"| {gait['costs']['energy']:.5g} | J |" in text
+    t_n, psi, _ = constraint_profile(gait)
+    for i, name in enumerate(CONSTRAINTS):
+        worst = gait["constraints"][name]
+        assert np.nanmin(psi[:, i]) == pytest.approx(worst, rel=1e-9, abs=1e-12)
+        at = t_n[int(np.nanargmin(psi[:, i]))]
+        assert f"| {worst:.4g} |" in text and f"| {at:.3f} |" in text
+
+
+def test_page_shows_the_validation_and_links_its_own_outputs(written):
+    """The verdict and figures (with units) of the report beside the gait, and relative links
+    to the recording and video that report names, the recording owned by this gait."""
+    _, out, text = written
+    assert "Validation in MuJoCo: **FAIL**" in text
+    assert "| max_slip | 0.0004 | m |" in text and "| fell | no |" in text
+    assert f"](../recordings/{NAME}.rrd)" in text and f"](../recordings/{NAME}.mp4)" in text
+    assert f"](../pipeline/{NAME}.json)" in text
+
+
+def test_page_figures_are_drawn_and_labelled(written):
+    """Each figure the page shows exists, has ink and its labels."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.text import Text
+    from PIL import Image
+
+    from biped.page import CONSTRAINT_MEANING, FIGURE_NAMES, gait_figures
+
+    gait_path, out, text = written
+    for name in FIGURE_NAMES:
+        assert f"(pipeline-{NAME}/{name})" in text
+        pixels = np.asarray(Image.open(out / f"pipeline-{NAME}" / name).convert("RGB"))
+        assert pixels.std() > 20, name
+    figure = gait_figures(gait_file.read(gait_path))["constraints.png"]
+    FigureCanvasAgg(figure).draw()
+    texts = {t.get_text() for t in figure.findobj(Text)}
+    assert set(CONSTRAINT_MEANING.values()) <= texts
+    assert sum(t.startswith("smallest ") for t in texts) == len(CONSTRAINTS)
+
+
+def test_page_links_no_recording_of_another_gait(written, tmp_path):
+    """A recording whose owner is another gait file is not linked; without a report beside
+    the gait, the page says it is not validated."""
+    from biped.page import Page, markdown
+    from biped_cli.report import links
+
+    gait_path, _, _ = written
+    copy = tmp_path / "sweep" / f"{NAME}.json"
+    copy.parent.mkdir()
+    copy.write_bytes(gait_path.read_bytes())
+    report = json.loads(gait_path.with_name(f"{NAME}.report.json").read_text())
+    assert links(copy, report) == []  # the recording and video are the pipeline gait's
+    assert [link.label for link in links(gait_path, report)] == ["recording", "video (mp4)"]
+    page = Page(f"sweep-{NAME}", copy, gait_file.read(copy))
+    text = markdown(page, tmp_path)
+    assert "Not validated in MuJoCo" in text and "- recording:" not in text
+
+
+def test_report_is_all_or_none(written, tmp_path, capsys):
+    """A bad gait file among good ones is refused (exit 2, one line naming it) before
+    anything is written: the earlier pages stay as they were."""
+    gait_path, out, _ = written
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    bad = tmp_path / "bad.json"
+    bad.write_text("{")
+    assert main(["report", str(gait_path), str(bad), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.json" in err and len(err.strip().splitlines()) == 1
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]
+    assert main(["report", str(gait_path), str(gait_path), "--out", str(out)]) == 2
+    assert "share the page" in capsys.readouterr().err
