@@ -110,14 +110,18 @@ def _constraint_panels(gait: dict) -> tuple:
             ax.plot(t_n, delta[:, i], color="0.4", linestyle=":", linewidth=1.2, label="δ")
             ax.plot([t_n[k]], [psi[k, i]], marker="o", markersize=8, fillstyle="none", color=color)
             side = "right" if t_n[k] > 0.7 else "left" if t_n[k] < 0.3 else "center"
+            low, high = ax.get_ylim()
+            below = psi[k, i] > (low + high) / 2  # the text inside the axes
             ax.annotate(
                 f"smallest {psi[k, i]:.3g} {CONSTRAINT_UNITS[name]}\nat t/T = {t_n[k]:.2f}",
                 xy=(t_n[k], psi[k, i]),
-                xytext=(0, 10),
+                xytext=(0, -12 if below else 12),
                 textcoords="offset points",
                 ha=side,
+                va="top" if below else "bottom",
                 fontsize=8,
                 color=color,
+                bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.8),
             )
 
         return Panel(
