@@ -37,6 +37,7 @@ import signal
 import sys
 import warnings
 from collections.abc import Callable, Iterable, Iterator
+from multiprocessing import resource_tracker
 from typing import Protocol, TextIO
 
 import numpy as np
@@ -146,6 +147,9 @@ def _start_pool(jobs: int):
     context = multiprocessing.get_context("spawn")
     if not hasattr(signal, "pthread_sigmask"):
         return context.Pool(jobs, initializer=_worker_init)
+    # The pool's locks start multiprocessing's resource tracker, which unblocks SIGINT after
+    # starting: start it first.
+    resource_tracker.ensure_running()
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         return context.Pool(jobs, initializer=_worker_init)

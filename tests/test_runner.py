@@ -5,7 +5,15 @@ terminal; errors and unreachable schedulers are one line."""
 
 import io
 import json
+import os
+import queue
+import random
+import re
+import signal
+import subprocess
 import sys
+import threading
+import time
 import warnings
 from pathlib import Path
 
@@ -237,3 +245,69 @@ def test_sweep_progress_bar_on_a_terminal_only(local_sweep, tmp_path, monkeypatc
     assert main(argv) == 0
     piped = capsys.readouterr().err
     assert "[final" in piped and "\r" not in piped and "\x1b" not in piped
+
+
+# `biped` as its console script runs it (`python -m biped` loads the package first).
+PROGRAM = "import sys; from biped_cli import main; sys.exit(main())"
+SIGNALS = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
+
+
+def _lines(stream, into: queue.Queue):
+    for line in stream:
+        into.put(line)
+    into.put(None)
+
+
+def test_signals_at_random_moments_leave_whole_files_and_resume_to_the_same(local_sweep, tmp_path):
+    """`biped sweep --jobs 2` stopped by real signals at seeded random moments (while it
+    loads, in either stage, while it sums up): Ctrl-C as a terminal sends it (to the whole
+    process group, workers included) and SIGTERM as `kill` does (to the program). Each stop
+    exits 130 / 143 with one line and no traceback, leaves no temporary file, and the run
+    that follows ends with every file of an uninterrupted sweep."""
+    out = tmp_path / "sweep"
+    argv = [sys.executable, "-c", PROGRAM, "sweep", "--out", str(out), "--jobs", "2"]
+    argv += ["--knees", "revolute", "--criteria", "sthenic", "--speeds", "0.275,0.3"]
+    argv += ["--starts", "1"]
+    rng = random.Random(20260611)
+    stopped = 0
+    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGINT, signal.SIGTERM):
+        # The moment: after a random number of the run's lines (0: while it loads), a random
+        # fraction of a second later.
+        after_lines, delay = rng.randrange(0, 4), rng.uniform(0.0, 1.5)
+        process = subprocess.Popen(
+            argv,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
+        lines: queue.Queue = queue.Queue()
+        reader = threading.Thread(target=_lines, args=(process.stderr, lines), daemon=True)
+        reader.start()
+        seen = []
+        while len(seen) < after_lines and (line := lines.get(timeout=120)) is not None:
+            seen.append(line)
+        time.sleep(delay)
+        if process.poll() is None:
+            if signum == signal.SIGINT:
+                os.killpg(process.pid, signal.SIGINT)
+            else:
+                process.send_signal(signal.SIGTERM)
+        process.wait(timeout=120)
+        reader.join(timeout=10)
+        while not lines.empty() and (line := lines.get_nowait()) is not None:
+            seen.append(line)
+        err = "".join(seen)
+        assert "Traceback" not in err and "Error" not in err and "Warning" not in err, err
+        if process.returncode == -signum:  # ended by the signal's own default action:
+            assert "sweep: done" in err, err  # only after the work, while Python shuts down
+        elif process.returncode != 0:  # stopped before the end
+            stopped += 1
+            assert process.returncode == 128 + signum, err
+            last = err.strip().splitlines()[-1]
+            assert re.fullmatch(rf"biped( sweep)?: interrupted \({SIGNALS[signum]}\)", last), err
+        assert not [p for p in tmp_path.rglob("*") if p.name.endswith(".tmp")]
+    assert stopped >= 2  # the signals did stop runs
+    done = subprocess.run(argv, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert every_file(out) == every_file(local_sweep)
