@@ -178,14 +178,14 @@ class Design:
         return self.optimum.problem.model.robot
 
     def at_bounds(self) -> list[str]:
-        """Radii at a bound (within 1e-6 m), e.g. ``["r1 = 0.181 m (upper)"]``."""
+        """The radii at a bound (within 1e-6 m), e.g. ``["r1 at its upper bound"]``."""
         found = []
         for name, value, low, high in zip(
             RADII, self.radii, self.problem.lower, self.problem.upper, strict=True
         ):
             for bound, side in ((low, "lower"), (high, "upper")):
                 if abs(value - bound) <= 1e-6:
-                    found.append(f"{name} = {bound:.4g} m ({side})")
+                    found.append(f"{name} at its {side} bound")
         return found
 
     def to_dict(self) -> dict:
@@ -286,3 +286,116 @@ def optimize_design(
     )
     optimum = checked(problem.gait_problem(radii), best.variables, report)
     return Design(problem, radii, optimum)
+
+
+@dataclass
+class Comparison:
+    """The designed knee beside the revolute knee and the rolling knee of the robot's own
+    radii (Table 1's), each the optimal gait at the same speed, criterion and margins.
+
+    Attributes:
+        problem: the design problem.
+        revolute: optimal gait of the revolute knee.
+        reference: optimal gait of the rolling knee at the robot's own radii.
+        design: optimal radii and gait.
+    """
+
+    problem: DesignProblem
+    revolute: Optimum
+    reference: Optimum
+    design: Design
+
+    def rows(self) -> list[tuple[str, tuple | None, Optimum]]:
+        """(label, radii or None, optimum) of the three knees."""
+        return [
+            ("revolute", None, self.revolute),
+            ("rolling, Table 1 radii", self.problem.reference_radii, self.reference),
+            ("rolling, optimal radii", self.design.radii, self.design.optimum),
+        ]
+
+    @property
+    def certified(self) -> bool:
+        return all(optimum.certified for _, _, optimum in self.rows())
+
+    def gains(self) -> dict:
+        """[%] Change of the criterion: the design against the revolute knee and against
+        the Table 1 radii, the Table 1 radii against the revolute knee."""
+        design, revolute, reference = self.design.value, self.revolute.value, self.reference.value
+        return {
+            "design_vs_revolute": 100.0 * (design / revolute - 1.0),
+            "design_vs_table1": 100.0 * (design / reference - 1.0),
+            "table1_vs_revolute": 100.0 * (reference / revolute - 1.0),
+        }
+
+    def table(self) -> str:
+        """The three knees in a text table: radii, both criteria of the gait optimal for
+        the problem's criterion, its change against the revolute knee."""
+        criterion = self.problem.criterion
+        head = (
+            f"{'knee':24}{'r1 [m]':>9}{'r2 [m]':>9}{'sthenic [N²·m·s]':>18}{'energy [J]':>12}"
+            f"{f'{criterion} vs revolute':>22}"
+        )
+        lines = [head]
+        for label, radii, optimum in self.rows():
+            r1, r2 = ("-", "-") if radii is None else (f"{radii[0]:.4f}", f"{radii[1]:.4f}")
+            change = 100.0 * (optimum.value / self.revolute.value - 1.0)
+            status = "" if optimum.certified else "  NOT CERTIFIED"
+            lines.append(
+                f"{label:24}{r1:>9}{r2:>9}{optimum.evaluation.sthenic:18.4f}"
+                f"{optimum.evaluation.energy:12.4f}"
+                f"{'' if radii is None else f'{change:+.2f} %':>22}{status}"
+            )
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The comparison as JSON (``design`` block of a gait file)."""
+        knees = []
+        for label, radii, optimum in self.rows():
+            knees.append(
+                {
+                    "knee": label,
+                    "radii": None if radii is None else dict(zip(RADII, radii, strict=True)),
+                    "sthenic": optimum.evaluation.sthenic,
+                    "energy": optimum.evaluation.energy,
+                    "status": optimum.report.status,
+                    "certified": optimum.certified,
+                }
+            )
+        return {**self.design.to_dict(), "compared": knees, "gains_percent": self.gains()}
+
+
+def compare(
+    problem: DesignProblem,
+    seed: int = 0,
+    starts: int = DEFAULT_STARTS,
+    revolute: Optimum | None = None,
+    reference: Optimum | None = None,
+) -> Comparison:
+    """The optimal radii of ``problem`` beside the revolute knee and the robot's own radii.
+
+    Each optimum also starts from the others' gaits (the variables mean the same for every
+    knee): the Table 1 knee from the revolute optimum, the design from both, then the
+    revolute and Table 1 knees again from the design's gait, so that each of the three is
+    the best of every start. Optima given (``revolute``, ``reference``: e.g. gaits already
+    written) are kept as they are.
+    """
+    from biped.optimize import best_of, optimize
+
+    ref = problem.reference_radii
+    hinge, rolling = problem.gait_problem(ref, "revolute"), problem.gait_problem(ref)
+    fixed = {"revolute": revolute is not None, "reference": reference is not None}
+    if revolute is None:
+        revolute = optimize(hinge, seed=seed, starts=starts)
+    if reference is None:
+        reference = optimize(rolling, seed=seed, starts=starts, given=[revolute.variables])
+    given = [(o.variables, ref) for o in (reference, revolute) if np.all(np.isfinite(o.variables))]
+    design = optimize_design(problem, seed=seed, starts=starts, given=given)
+    again = [design.optimum.variables]
+    if not fixed["revolute"]:
+        more = optimize(hinge, seed=seed, starts=0, given=again + [reference.variables])
+        revolute = best_of(hinge, [revolute, more])
+    if not fixed["reference"]:
+        reference = best_of(
+            rolling, [reference, optimize(rolling, seed=seed, starts=0, given=again)]
+        )
+    return Comparison(problem, revolute, reference, design)

@@ -370,6 +370,10 @@ def cmd_pipeline(args) -> int:
         )
         written.append((knee, gait_path, report_path, rrd))
         passed = passed and result.passed
+    if getattr(args, "design", False):  # --design: the knee radii optimised too
+        from biped_cli.design import pipeline_design
+
+        passed = pipeline_design(args, robot, optima, out, recordings) and passed
     if len(costs) == 2:
         revolute, rolling = costs["revolute"], costs["rolling"]
         changes = ", ".join(

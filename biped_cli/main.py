@@ -14,7 +14,7 @@ from biped.kinematics import KNEES
 from biped.provenance import command_line, version
 from biped.sweep import DEFAULT_SPEEDS
 from biped_cli import args as types
-from biped_cli import report
+from biped_cli import design, report
 from biped_cli.commands import (
     DEFAULT_FIGURES,
     DEFAULT_PIPELINE,
@@ -191,6 +191,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     types.add_budget(pipe)
     pipe.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+    pipe.add_argument(
+        "--design",
+        action="store_true",
+        help="also optimise the rolling knee's radii with the gait, validate the designed "
+        "gait and compare revolute, Table 1 radii and optimal radii in one table",
+    )
     pipe.set_defaults(run=cmd_pipeline)
 
     fig = commands.add_parser(
@@ -199,6 +205,7 @@ def build_parser() -> argparse.ArgumentParser:
     fig.add_argument("--sweep", default=DEFAULT_SWEEP, metavar="DIR", help="sweep results")
     fig.add_argument("--out", default=DEFAULT_FIGURES, metavar="DIR", help="(default logs/figures)")
     fig.set_defaults(run=cmd_figures)
+    design.add_parsers(commands)
     report.add_parser(commands)
     for command in commands.choices.values():  # after the command too: biped demo --debug
         command.add_argument(

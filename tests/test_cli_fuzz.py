@@ -55,7 +55,9 @@ def _stand_in(*args, **kwargs):
 
 @pytest.fixture
 def no_work(monkeypatch):
-    """The optimiser, the sweep, the figures and the MuJoCo validation stop the command."""
+    """The optimiser, the sweep, the design map, the figures and the MuJoCo validation stop
+    the command."""
+    import biped.design_map
     import biped.figures
     import biped.optimize
     import biped.sweep
@@ -64,6 +66,7 @@ def no_work(monkeypatch):
     for module, name in [
         (biped.optimize, "optimize"),
         (biped.sweep, "run_sweep"),
+        (biped.design_map, "run_design_map"),
         (biped.figures, "make_figures"),
         (validate.report, "validate"),
     ]:

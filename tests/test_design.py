@@ -191,3 +191,130 @@ def test_design_that_does_not_converge_fails_loudly(monkeypatch):
         assert not result.report.converged and not result.certified
     finally:
         design_module._solver.cache_clear()
+
+
+@pytest.fixture(scope="module")
+def designed(tmp_path_factory):
+    """``biped design --speed 0.3`` (one start each): its exit status, output and file."""
+    import contextlib
+    import io
+
+    from biped_cli import main
+
+    path = tmp_path_factory.mktemp("design") / "design.json"
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(["design", "--speed", "0.3", "--starts", "1", "--out", str(path)])
+    return code, out.getvalue(), err.getvalue(), path
+
+
+def test_design_command_writes_the_designed_robot_and_compares(designed):
+    """'biped design' exits 0, writes a gait file whose robot holds the optimal radii and
+    prints the revolute knee, the Table 1 radii and the optimal radii with the changes
+    against the revolute knee, each computed from the printed criteria."""
+    from biped import gait_file
+
+    code, out, err, path = designed
+    assert code == 0, err
+    gait = gait_file.read(path)
+    radii = gait["design"]["radii"]
+    assert (gait["robot"].r1, gait["robot"].r2) == (radii["r1"], radii["r2"])
+    assert gait["knee"] == "rolling" and gait["optimizer"]["status"] == "converged"
+    rows = {line[:24].strip(): line.split() for line in out.splitlines()[1:4]}
+    assert set(rows) == {"revolute", "rolling, Table 1 radii", "rolling, optimal radii"}
+    revolute = float(rows["revolute"][3])
+    for label in ("rolling, Table 1 radii", "rolling, optimal radii"):
+        sthenic, change = float(rows[label][-4]), float(rows[label][-2])
+        assert change == pytest.approx(100 * (sthenic / revolute - 1), abs=0.01)
+    design = float(rows["rolling, optimal radii"][-4])
+    assert design == pytest.approx(gait["costs"]["sthenic"], rel=1e-4)
+    assert design <= float(rows["rolling, Table 1 radii"][-4]) <= revolute
+    assert revolute == pytest.approx(optimal_gait("revolute").evaluation.sthenic, rel=1e-6)
+    assert f"r1 = {radii['r1']:.4f} m" in out and "vs Table 1 radii" in out
+
+
+def test_designed_gait_passes_validation_on_its_own_robot_only(designed):
+    """The designed gait walks 20 steps in MuJoCo on the MJCF of its radii and passes every
+    check; played on the Table 1 robot, the inverse-dynamics check fails."""
+    from biped import gait_file
+    from validate.report import check_inverse_dynamics, validate
+
+    gait = gait_file.read(designed[3])
+    result = validate(gait, steps=20)
+    assert result.passed, [check.line() for check in result.checks]
+    wrong = biped.Biped(ROBOT, "rolling")
+    assert not check_inverse_dynamics(wrong, gait).passed
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["design", "--speed", "0.3", "--max-r1", "0.3"], "--max-r1 0.3 m: allowed > 0 and <="),
+        (["design", "--speed", "0.3", "--max-r2", "-0.1"], "--max-r2 -0.1 m"),
+        (["design", "--speed", "9"], "speed = 9.0 m/s"),
+        (["design", "--speed", "0.3", "--clearance", "-1"], "clearance = '-1'"),
+        (["design-map", "--r1", "0.5,0.1"], "r1 = 0.5 m: allowed 0 to 0.1811 m"),
+        (["design-map", "--r2", "0:0.1:0"], "COUNT = 0"),
+        (["design-map", "--r1", "-0.1"], "allowed radii >= 0 m"),
+        (["design-map", "--speeds", "0.3,9"], "speed = 9.0 m/s"),
+    ],
+)
+def test_bad_design_options_are_one_line_and_exit_2(tmp_path, capsys, argv, needle):
+    """Bad radii bounds, grids or speeds: one line on stderr naming the value, exit 2,
+    before any work."""
+    from biped_cli import main
+
+    out = ["--out", str(tmp_path / ("d.json" if argv[0] == "design" else "map"))]
+    assert main(argv + out) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], lines
+    assert not (tmp_path / "map" / "design-map.json").exists()
+
+
+def test_design_command_that_does_not_converge_exits_1(tmp_path, monkeypatch, capsys):
+    """With IPOPT cut to 3 iterations 'biped design' exits 1 naming IPOPT's status and
+    writes no file."""
+    from biped import design as design_module
+    from biped import solver
+    from biped_cli import main
+
+    monkeypatch.setitem(solver.IPOPT_OPTIONS, "max_iter", 3)
+    design_module._solver.cache_clear()
+    solver._solver.cache_clear()
+    try:
+        path = tmp_path / "design.json"
+        assert main(["design", "--speed", "0.3", "--starts", "1", "--out", str(path)]) == 1
+        assert "Maximum_Iterations_Exceeded" in capsys.readouterr().err
+        assert not path.exists()
+    finally:
+        design_module._solver.cache_clear()
+        solver._solver.cache_clear()
+
+
+def test_pipeline_with_design_compares_three_knees_in_one_table(tmp_path, capsys):
+    """'biped pipeline --design': the design's gait file (its robot with the optimal radii)
+    and validation report are written beside the knees', and one table sets the revolute
+    knee (the pipeline's own optimum), the Table 1 radii and the optimal radii side by
+    side; the exit status is the verdict of every check."""
+    import json
+
+    from biped import gait_file
+    from biped_cli import main
+
+    out, rrd = tmp_path / "pipeline", tmp_path / "recordings"
+    argv = ["pipeline", "--knees", "revolute", "--steps", "2", "--starts", "1", "--no-video"]
+    code = main(argv + ["--design", "--out", str(out), "--recordings", str(rrd)])
+    printed = capsys.readouterr().out
+    table = [line for line in printed.splitlines() if line.startswith("[design] ")]
+    labels = [line[9:33].strip() for line in table]
+    assert {"revolute", "rolling, Table 1 radii", "rolling, optimal radii"} <= set(labels)
+    gait = gait_file.read(out / "design-sthenic-0.300.json")
+    radii = gait["design"]["radii"]
+    assert (gait["robot"].r1, gait["robot"].r2) == (radii["r1"], radii["r2"])
+    revolute = gait_file.read(out / "revolute-sthenic-0.300.json")
+    compared = {knee["knee"]: knee for knee in gait["design"]["compared"]}
+    assert compared["revolute"]["sthenic"] == revolute["costs"]["sthenic"]
+    report = json.loads((out / "design-sthenic-0.300.report.json").read_text())
+    assert report["inverse_dynamics"]["passed"] and report["impact"]["passed"]
+    knee_report = json.loads((out / "revolute-sthenic-0.300.report.json").read_text())
+    assert code == (0 if report["passed"] and knee_report["passed"] else 1)

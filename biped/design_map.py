@@ -1,0 +1,571 @@
+"""Design maps: the optimal gait's criterion over a grid of knee radii (r1, r2), at one or
+several speeds, with the joint optimum of radii and gait (``biped.design``).
+
+At each speed the map holds, each an independent optimization:
+
+- ``grid``: the optimal gait of the rolling knee at every (r1, r2) of the grid
+  (``biped.optimize.optimize`` from its own starts);
+- ``revolute``: the optimal gait of the revolute knee, the map's reference contour (the
+  grid's rows r1 = 0 and r2 = 0 are hinges too: a circle rolling on a point turns about it);
+- ``table1``: the rolling knee at the robot's own radii (Table 1: 5 cm);
+- ``design``: the radii and gait optimised together, in a second stage that also starts
+  from the best grid point and the Table 1 and revolute gaits at that speed.
+
+The optimizations run through ``biped.runner.run_tasks``: local processes, or the workers of
+a Dask cluster. Each writes its result as one small JSON file (``biped.files``: whole or not
+at all), so a map stopped at any moment and run again ends with the files of an
+uninterrupted run; the folder's ``design-map.json`` records what shapes the numbers and
+resuming with any of it changed is refused. Points whose solver did not converge, or whose
+optimum is infeasible, are kept with their status and left out of the figures.
+
+Figures (``draw``): per speed, ``map-<speed>.png``, the criterion over (r1, r2) with the
+joint optimum and the Table 1 point marked and the revolute knee's value as a contour; with
+several speeds, ``speeds.png``, the optimal radii and the gains against the revolute knee as
+functions of speed; ``summary.csv``, one line per speed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from biped.criteria import PAPER_SAFETY, Safety
+from biped.design import RADII, DesignProblem, check_radii, optimize_design
+from biped.errors import BipedError
+from biped.files import atomic_path, atomic_write_text, clean_stale_temporaries
+from biped.optimize import DEFAULT_STARTS, optimize
+from biped.problem import VARIABLES
+from biped.provenance import version
+from biped.robot import Robot
+from biped.runner import ProgressBar, run_tasks
+
+MANIFEST = "design-map.json"
+MAP_FORMAT = "biped-design-map/1"
+KINDS = ("grid", "revolute", "table1", "design")
+# Grid points per radius by default, from 0 to the radius's upper bound.
+DEFAULT_GRID = 10
+
+
+@dataclass(frozen=True)
+class MapPoint:
+    """One optimization of a map: ``kind`` (``KINDS``) at ``speed`` [m/s], with radii
+    (r1, r2) [m] for the grid."""
+
+    kind: str
+    speed: float
+    radii: tuple | None = None
+
+    def filename(self) -> str:
+        if self.kind == "grid":
+            r1, r2 = self.radii
+            return f"grid-{self.speed:.3f}-r1-{r1:.4f}-r2-{r2:.4f}.json"
+        return f"{self.kind}-{self.speed:.3f}.json"
+
+    def label(self) -> str:
+        if self.kind == "grid":
+            return f"r1 {self.radii[0]:.4f} m, r2 {self.radii[1]:.4f} m"
+        return self.kind
+
+
+@dataclass(frozen=True)
+class MapSettings:
+    """What shapes a map's numbers, recorded in its folder."""
+
+    robot: Robot
+    criterion: str
+    safety: Safety
+    speeds: tuple
+    r1: tuple
+    r2: tuple
+    upper: tuple
+    seed: int
+    starts: int
+
+    def problem(self, speed: float) -> DesignProblem:
+        return DesignProblem(self.robot, speed, self.criterion, self.safety, upper=self.upper)
+
+    def to_dict(self) -> dict:
+        return {
+            "format": MAP_FORMAT,
+            "robot": self.robot.to_dict(),
+            "criterion": self.criterion,
+            "safety": dataclasses.asdict(self.safety),
+            "speeds": list(self.speeds),
+            "r1": list(self.r1),
+            "r2": list(self.r2),
+            "upper": list(self.upper),
+            "seed": self.seed,
+            "starts": self.starts,
+            "method": "ipopt",
+            "version": version(),
+            "casadi": version("casadi"),
+        }
+
+    @classmethod
+    def from_dict(cls, content: dict) -> MapSettings:
+        return cls(
+            robot=Robot.from_mapping(content["robot"], source="robot"),
+            criterion=content["criterion"],
+            safety=Safety(**content["safety"]),
+            speeds=tuple(content["speeds"]),
+            r1=tuple(content["r1"]),
+            r2=tuple(content["r2"]),
+            upper=tuple(content["upper"]),
+            seed=int(content["seed"]),
+            starts=int(content["starts"]),
+        )
+
+
+def radius_grid(robot: Robot, values, name: str) -> tuple:
+    """Sorted distinct radii [m] of a grid, each within the design bounds, distinct at the
+    files' 0.1 mm resolution; a clear error otherwise."""
+    index = RADII.index(name)
+    values = sorted(float(v) for v in values)
+    if not values:
+        raise BipedError(f"{name} grid is empty: allowed one radius or more")
+    for value in values:
+        radii = [0.0, 0.0]
+        radii[index] = value
+        check_radii(robot, radii)
+    names = [f"{v:.4f}" for v in values]
+    for a, b in zip(names, names[1:], strict=False):
+        if a == b:
+            raise BipedError(f"{name} = {a} m appears twice at 0.1 mm resolution: allowed distinct")
+    return tuple(values)
+
+
+def _check_manifest(folder: Path, settings: MapSettings) -> None:
+    """Write the folder's manifest, or refuse a folder made with other settings."""
+    path = folder / MANIFEST
+    wanted = settings.to_dict()
+    if path.exists():
+        try:
+            found = json.loads(path.read_text())
+        except (OSError, ValueError, UnicodeDecodeError) as error:
+            raise BipedError(f"{path}: unreadable design-map record ({error})") from None
+        for key, value in wanted.items():
+            if found.get(key) != value:
+                raise BipedError(
+                    f"{path}: this folder's map was made with {key} = {found.get(key)!r}, "
+                    f"this run has {value!r}: allowed only the same settings, choose another "
+                    f"--out folder"
+                )
+        return
+    if any(folder.glob("*.json")):
+        raise BipedError(
+            f"{folder} holds JSON files but no {MANIFEST}: allowed an empty folder or a "
+            f"design map's, choose another --out folder"
+        )
+    atomic_write_text(path, json.dumps(wanted, indent=1))
+
+
+def read_point(folder: Path, point: MapPoint) -> dict | None:
+    """The result saved for ``point``, or None if missing or unreadable (then run again)."""
+    path = Path(folder) / point.filename()
+    try:
+        content = json.loads(path.read_text())
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    if not isinstance(content, dict) or content.get("point") != _point_dict(point):
+        return None
+    return content
+
+
+def _point_dict(point: MapPoint) -> dict:
+    return {
+        "kind": point.kind,
+        "speed": point.speed,
+        "radii": None if point.radii is None else list(point.radii),
+    }
+
+
+def _save(folder: Path, point: MapPoint, optimum, radii, report_seconds: float) -> dict:
+    report = optimum.report
+    content = {
+        "point": _point_dict(point),
+        "knee": optimum.knee,
+        "radii": None if radii is None else list(radii),
+        "value": optimum.value if np.isfinite(optimum.value) else None,
+        "sthenic": optimum.evaluation.sthenic,
+        "energy": optimum.evaluation.energy,
+        "feasible": optimum.feasible,
+        "status": report.status,
+        "certified": optimum.certified,
+        "starts": report.starts,
+        "starts_at_best": report.starts_at_best,
+        "seconds": report_seconds,
+        "variables": dict(
+            zip(VARIABLES, (v if np.isfinite(v) else None for v in optimum.variables), strict=True)
+        ),
+    }
+    atomic_write_text(Path(folder) / point.filename(), json.dumps(content, indent=1))
+    return content
+
+
+def _line(point: MapPoint, content: dict) -> str:
+    status = (
+        "certified"
+        if content["certified"]
+        else (
+            "NOT CONVERGED: " + content["status"]
+            if content["status"] != "converged"
+            else "INFEASIBLE"
+        )
+    )
+    value = content["value"]
+    radii = content["radii"]
+    where = "" if radii is None else f" at r1 {radii[0]:.4f} m, r2 {radii[1]:.4f} m"
+    return (
+        f"[{point.kind:8} {point.speed:.3f} m/s] {point.label():30} "
+        f"C = {value if value is not None else float('nan'):12.6f}{where}  {status}  "
+        f"{content['starts_at_best']}/{content['starts']} starts at best  "
+        f"{content['seconds']:5.1f} s"
+    )
+
+
+def _variables(content: dict) -> np.ndarray | None:
+    values = [content["variables"][name] for name in VARIABLES]
+    return None if any(v is None for v in values) else np.array(values, float)
+
+
+def solve_point(task) -> str:
+    """One optimization of a map (a task of ``biped.runner.run_tasks``): writes its file and
+    returns a line saying what it found."""
+    settings, point, folder = task
+    problem = settings.problem(point.speed)
+    began = time.perf_counter()
+    if point.kind == "design":
+        given = []
+        for content in _stage_one(Path(folder), settings, point.speed):
+            variables = _variables(content)
+            if variables is not None:
+                given.append((variables, content["radii"] or problem.reference_radii))
+        design = optimize_design(problem, seed=settings.seed, starts=settings.starts, given=given)
+        optimum, radii = design.optimum, design.radii
+    else:
+        if point.kind == "grid":
+            radii, knee = point.radii, "rolling"
+        elif point.kind == "table1":
+            radii, knee = problem.reference_radii, "rolling"
+        else:
+            radii, knee = None, "revolute"
+        gait = problem.gait_problem(radii or problem.reference_radii, knee)
+        optimum = optimize(gait, seed=settings.seed, starts=settings.starts)
+    content = _save(folder, point, optimum, radii, time.perf_counter() - began)
+    return _line(point, content)
+
+
+def _stage_one(folder: Path, settings: MapSettings, speed: float) -> list[dict]:
+    """The first-stage results at ``speed`` that start the design: the best certified grid
+    point, the Table 1 and revolute gaits."""
+    found = []
+    grid = [
+        read_point(folder, MapPoint("grid", speed, (r1, r2)))
+        for r1 in settings.r1
+        for r2 in settings.r2
+    ]
+    certified = [c for c in grid if c is not None and c["certified"]]
+    if certified:
+        found.append(min(certified, key=lambda c: c["value"]))
+    for kind in ("table1", "revolute"):
+        content = read_point(folder, MapPoint(kind, speed))
+        if content is not None and content["certified"]:
+            found.append(content)
+    return found
+
+
+def map_points(settings: MapSettings) -> tuple[list[MapPoint], list[MapPoint]]:
+    """(first stage, second stage) points of a map."""
+    first, second = [], []
+    for speed in settings.speeds:
+        first += [MapPoint("revolute", speed), MapPoint("table1", speed)]
+        first += [MapPoint("grid", speed, (r1, r2)) for r1 in settings.r1 for r2 in settings.r2]
+        second.append(MapPoint("design", speed))
+    return first, second
+
+
+def run_design_map(
+    folder,
+    robot: Robot,
+    speeds,
+    r1=None,
+    r2=None,
+    criterion: str = "sthenic",
+    safety: Safety = PAPER_SAFETY,
+    upper=None,
+    seed: int = 0,
+    starts: int = DEFAULT_STARTS,
+    jobs: int | None = None,
+    dask: str | None = None,
+    stream=sys.stderr,
+    progress: Callable[[int], ProgressBar] | None = None,
+) -> MapSettings:
+    """Every optimization of the map not yet in ``folder``; returns its settings.
+
+    Args:
+        speeds: walking speeds [m/s].
+        r1, r2: the grid's radii [m] (default ``DEFAULT_GRID`` from 0 to the upper bound).
+        upper: the design's upper bounds of (r1, r2) [m] (default ``radius_limits``).
+        jobs, dask: where the optimizations run (``biped.runner.run_tasks``).
+        progress: ``progress(total)`` makes a bar advanced after each optimization.
+    """
+    speeds = sorted(float(s) for s in speeds)
+    names = [f"{s:.3f}" for s in speeds]
+    if len(set(names)) != len(names):
+        raise BipedError("speeds appear twice at 1 mm/s resolution: allowed distinct speeds")
+    problem = DesignProblem(robot, speeds[0], criterion, safety, upper=upper)
+    for speed in speeds[1:]:
+        problem = dataclasses.replace(problem, speed=speed)  # each speed checked
+    upper = problem.upper
+    r1 = np.linspace(0.0, upper[0], DEFAULT_GRID) if r1 is None else r1
+    r2 = np.linspace(0.0, upper[1], DEFAULT_GRID) if r2 is None else r2
+    settings = MapSettings(
+        robot,
+        criterion,
+        safety,
+        tuple(speeds),
+        radius_grid(robot, r1, "r1"),
+        radius_grid(robot, r2, "r2"),
+        tuple(upper),
+        int(seed),
+        int(starts),
+    )
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    _check_manifest(folder, settings)
+    clean_stale_temporaries(folder)
+    first, second = map_points(settings)
+    todo = [[p for p in stage if read_point(folder, p) is None] for stage in (first, second)]
+    total = len(first) + len(second)
+    remaining = sum(map(len, todo))
+    print(
+        f"design map: {total} optimizations in {folder}, {total - remaining} already done, "
+        f"{remaining} to run",
+        file=stream,
+        flush=True,
+    )
+    bar = progress(remaining) if progress is not None and remaining else None
+    began = time.perf_counter()
+    try:
+        for stage in todo:
+            tasks = [(settings, point, str(folder)) for point in stage]
+            for line in run_tasks(
+                solve_point, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar
+            ):
+                print(line, file=stream, flush=True)
+    finally:
+        if bar is not None:
+            bar.clear()
+    print(
+        f"design map: done in {time.perf_counter() - began:.1f} s; {summarize(folder, settings)}",
+        file=stream,
+        flush=True,
+    )
+    return settings
+
+
+def load(folder) -> tuple[MapSettings, dict]:
+    """The settings of the map in ``folder`` and its results {MapPoint: content}."""
+    folder = Path(folder)
+    try:
+        settings = MapSettings.from_dict(json.loads((folder / MANIFEST).read_text()))
+    except (OSError, ValueError, UnicodeDecodeError, KeyError, TypeError, BipedError) as error:
+        raise BipedError(
+            f"{folder / MANIFEST}: no design map there ({error}): run 'biped design-map'"
+        ) from None
+    first, second = map_points(settings)
+    results = {}
+    for point in first + second:
+        content = read_point(folder, point)
+        if content is not None:
+            results[point] = content
+    return settings, results
+
+
+def summarize(folder, settings: MapSettings) -> str:
+    """How many optimizations are certified, and which are not."""
+    first, second = map_points(settings)
+    bad = []
+    for point in first + second:
+        content = read_point(Path(folder), point)
+        if content is None:
+            bad.append(f"{point.filename()} missing")
+        elif not content["certified"]:
+            bad.append(f"{point.filename()} {content['status']}")
+    total = len(first) + len(second)
+    text = f"{total - len(bad)} of {total} optimizations certified (converged and feasible)"
+    return text + ("; NOT: " + ", ".join(bad[:5]) + (" ..." if len(bad) > 5 else "") if bad else "")
+
+
+@dataclass(frozen=True)
+class SpeedSummary:
+    """The map's answer at one speed: optimal radii and criteria (None where the
+    optimization was not certified)."""
+
+    speed: float
+    radii: tuple | None
+    design: float | None
+    table1: float | None
+    revolute: float | None
+    best_grid: float | None
+
+    def gain(self, value: float | None) -> float | None:
+        """[%] Change of ``value`` against the revolute knee."""
+        if value is None or self.revolute is None:
+            return None
+        return 100.0 * (value / self.revolute - 1.0)
+
+
+def speed_summaries(settings: MapSettings, results: dict) -> list[SpeedSummary]:
+    def value(point):
+        content = results.get(point)
+        return content["value"] if content is not None and content["certified"] else None
+
+    summaries = []
+    for speed in settings.speeds:
+        design = results.get(MapPoint("design", speed))
+        certified = design is not None and design["certified"]
+        grid = [
+            value(MapPoint("grid", speed, (r1, r2))) for r1 in settings.r1 for r2 in settings.r2
+        ]
+        grid = [v for v in grid if v is not None]
+        summaries.append(
+            SpeedSummary(
+                speed,
+                tuple(design["radii"]) if certified else None,
+                design["value"] if certified else None,
+                value(MapPoint("table1", speed)),
+                value(MapPoint("revolute", speed)),
+                min(grid) if grid else None,
+            )
+        )
+    return summaries
+
+
+def summary_csv(settings: MapSettings, results: dict) -> str:
+    criterion = settings.criterion
+    lines = [
+        f"speed [m/s],r1 [m],r2 [m],{criterion} design,{criterion} table1,{criterion} revolute,"
+        f"best grid,design vs revolute [%],table1 vs revolute [%]"
+    ]
+
+    def text(value, digits=6):
+        return "" if value is None else f"{value:.{digits}f}"
+
+    for s in speed_summaries(settings, results):
+        r1, r2 = s.radii if s.radii is not None else (None, None)
+        lines.append(
+            ",".join(
+                [
+                    f"{s.speed:.3f}",
+                    text(r1, 4),
+                    text(r2, 4),
+                    text(s.design),
+                    text(s.table1),
+                    text(s.revolute),
+                    text(s.best_grid),
+                    text(s.gain(s.design), 3),
+                    text(s.gain(s.table1), 3),
+                ]
+            )
+        )
+    return "\n".join(lines) + "\n"
+
+
+def draw(folder, out=None) -> list[Path]:
+    """The map's figures and summary in ``out`` (default: the map's folder)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    settings, results = load(folder)
+    out = Path(folder if out is None else out)
+    out.mkdir(parents=True, exist_ok=True)
+    unit = "N²·m·s" if settings.criterion == "sthenic" else "J"
+    written = []
+    summaries = speed_summaries(settings, results)
+    r1, r2 = np.array(settings.r1), np.array(settings.r2)
+    table1 = settings.problem(settings.speeds[0]).reference_radii
+    for summary in summaries:
+        values = np.full((len(r2), len(r1)), np.nan)
+        for i, a in enumerate(r1):
+            for j, b in enumerate(r2):
+                content = results.get(MapPoint("grid", summary.speed, (a, b)))
+                if content is not None and content["certified"]:
+                    values[j, i] = content["value"]
+        fig, ax = plt.subplots(figsize=(6.4, 5.2))
+        if np.isfinite(values).sum() >= 4 and len(r1) > 1 and len(r2) > 1:
+            filled = ax.contourf(100 * r1, 100 * r2, values, levels=16, cmap="viridis")
+            fig.colorbar(filled, ax=ax, label=f"optimal {settings.criterion} criterion [{unit}]")
+            if summary.revolute is not None:
+                low, high = np.nanmin(values), np.nanmax(values)
+                if low < summary.revolute < high:
+                    line = ax.contour(
+                        100 * r1,
+                        100 * r2,
+                        values,
+                        levels=[summary.revolute],
+                        colors="white",
+                        linestyles="--",
+                    )
+                    ax.clabel(line, fmt={summary.revolute: "revolute knee"}, fontsize=8)
+        ax.scatter(100 * np.repeat(r1, len(r2)), 100 * np.tile(r2, len(r1)), s=4, c="k")
+        ax.plot(100 * table1[0], 100 * table1[1], "s", color="tab:orange", label="Table 1 radii")
+        if summary.radii is not None:
+            ax.plot(
+                100 * summary.radii[0],
+                100 * summary.radii[1],
+                "*",
+                color="tab:red",
+                markersize=14,
+                label="joint optimum",
+            )
+        revolute = "n/a" if summary.revolute is None else f"{summary.revolute:.4g} {unit}"
+        ax.set_title(
+            f"{settings.criterion} at {summary.speed:.3f} m/s (revolute knee {revolute})",
+            fontsize=10,
+        )
+        ax.set_xlabel("r1, shank circle [cm]")
+        ax.set_ylabel("r2, thigh circle [cm]")
+        ax.legend(loc="lower left", fontsize=8)
+        path = out / f"map-{summary.speed:.3f}.png"
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=120, format="png")
+        plt.close(fig)
+        written.append(path)
+    if len(summaries) > 1:
+        speeds = [s.speed for s in summaries]
+        fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
+        for index, name in enumerate(RADII):
+            radii = [np.nan if s.radii is None else 100 * s.radii[index] for s in summaries]
+            left.plot(speeds, radii, "o-", label=f"optimal {name}")
+            left.axhline(100 * settings.upper[index], color=f"C{index}", ls=":", lw=1)
+        left.set_xlabel("speed [m/s]")
+        left.set_ylabel("radius [cm] (dotted: upper bound)")
+        left.legend()
+        for label, pick in (
+            ("optimal radii", lambda s: s.design),
+            ("Table 1 radii", lambda s: s.table1),
+        ):
+            gains = [s.gain(pick(s)) for s in summaries]
+            right.plot(speeds, [np.nan if g is None else g for g in gains], "o-", label=label)
+        right.axhline(0.0, color="k", lw=0.8)
+        right.set_xlabel("speed [m/s]")
+        right.set_ylabel(f"{settings.criterion} vs revolute knee [%]")
+        right.legend()
+        fig.tight_layout()
+        path = out / "speeds.png"
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=120, format="png")
+        plt.close(fig)
+        written.append(path)
+    written.append(atomic_write_text(out / "summary.csv", summary_csv(settings, results)))
+    return written

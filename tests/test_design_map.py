@@ -1,0 +1,86 @@
+"""Design maps: hinges on the axes, the joint optimum below every grid point, resume and
+settings like a sweep, figures and summary from the files."""
+
+import json
+
+import pytest
+
+import biped
+from biped.design_map import (
+    MANIFEST,
+    MapPoint,
+    draw,
+    load,
+    run_design_map,
+    speed_summaries,
+)
+
+ROBOT = biped.Robot.paper()
+SPEED = 0.3
+GRID = {"r1": [0.0, 0.12], "r2": [0.15]}
+
+
+@pytest.fixture(scope="module")
+def small_map(tmp_path_factory):
+    """A 2 x 1 map at 0.3 m/s, one start per optimization, in this process."""
+    folder = tmp_path_factory.mktemp("map") / "map"
+    log = folder.parent / "log.txt"
+    with open(log, "w") as stream:
+        run_design_map(folder, ROBOT, [SPEED], **GRID, starts=1, jobs=1, stream=stream)
+    return folder
+
+
+def test_map_axes_are_hinges_and_the_joint_optimum_is_lowest(small_map):
+    """Every optimization is certified; the grid point r1 = 0 (a rolling circle on a point)
+    has the revolute knee's optimum; the joint optimum is at or below every grid point, the
+    Table 1 radii and the revolute knee (it starts from them)."""
+    settings, results = load(small_map)
+    assert len(results) == 5 and all(c["certified"] for c in results.values())
+    revolute = results[MapPoint("revolute", SPEED)]["value"]
+    hinge = results[MapPoint("grid", SPEED, (0.0, 0.15))]["value"]
+    rolling = results[MapPoint("grid", SPEED, (0.12, 0.15))]["value"]
+    assert hinge == pytest.approx(revolute, rel=1e-6)
+    assert abs(rolling / revolute - 1) > 1e-3  # the radii matter away from the axes
+    design = results[MapPoint("design", SPEED)]
+    others = [c["value"] for p, c in results.items() if p.kind != "design"]
+    assert design["value"] <= min(others) * (1 + 1e-9)
+    (summary,) = speed_summaries(settings, results)
+    assert summary.radii == tuple(design["radii"])
+    assert summary.gain(summary.design) == pytest.approx(100 * (design["value"] / revolute - 1))
+
+
+def test_map_resumes_and_refuses_other_settings(small_map):
+    """Run again, nothing is recomputed and no file changes; another seed is refused naming
+    it; a point file removed is the only one run again, to the same numbers."""
+    before = {p.name: p.read_bytes() for p in small_map.glob("*.json")}
+    log = small_map.parent / "again.txt"
+    with open(log, "w") as stream:
+        run_design_map(small_map, ROBOT, [SPEED], **GRID, starts=1, jobs=1, stream=stream)
+    assert "0 to run" in log.read_text()
+    assert {p.name: p.read_bytes() for p in small_map.glob("*.json")} == before
+    with pytest.raises(biped.BipedError, match="seed = 0, this run has 1"):
+        run_design_map(small_map, ROBOT, [SPEED], **GRID, seed=1, starts=1, jobs=1)
+    removed = small_map / MapPoint("table1", SPEED).filename()
+    removed.unlink()
+    with open(log, "w") as stream:
+        run_design_map(small_map, ROBOT, [SPEED], **GRID, starts=1, jobs=1, stream=stream)
+    assert "1 to run" in log.read_text()
+
+    def numbers(data: bytes) -> dict:  # all but the wall time
+        return {k: v for k, v in json.loads(data).items() if k != "seconds"}
+
+    assert numbers(removed.read_bytes()) == numbers(before[removed.name])
+
+
+def test_map_figures_and_summary(small_map):
+    """The map's figure and summary.csv are written; the summary's gain is the design's
+    criterion against the revolute knee's, both read from the point files."""
+    written = draw(small_map)
+    names = {path.name for path in written}
+    assert names == {"map-0.300.png", "summary.csv"}
+    assert all(path.stat().st_size > 0 for path in written)
+    row = (small_map / "summary.csv").read_text().splitlines()[1].split(",")
+    design = json.loads((small_map / MapPoint("design", SPEED).filename()).read_text())
+    revolute = json.loads((small_map / MapPoint("revolute", SPEED).filename()).read_text())
+    assert float(row[7]) == pytest.approx(100 * (design["value"] / revolute["value"] - 1), abs=1e-3)
+    assert json.loads((small_map / MANIFEST).read_text())["r1"] == GRID["r1"]
