@@ -21,6 +21,10 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
 
 The samples run from t = 0 to t = T inclusive on both spline pieces; t = T/2 appears twice,
 left and right limits, because the accelerations (and torques) jump at the knot.
+
+``read`` checks the format and names the bad field; ``read_consistent`` also recomputes what
+the parameters determine (period, step length, samples, costs, constraints, ``feasible``,
+impact) and refuses a file whose figures are not those of its parameters, naming the field.
 """
 
 from __future__ import annotations
@@ -33,12 +37,12 @@ from pathlib import Path
 import numpy as np
 
 from biped.criteria import CONSTRAINTS, CRITERIA, Safety
-from biped.dynamics import Biped
+from biped.dynamics import JOINTS, Biped
 from biped.errors import BipedError
 from biped.files import atomic_write_text
 from biped.gait import PARAMETERS
 from biped.impact import trailing_foot_lift
-from biped.kinematics import KNEES
+from biped.kinematics import COORDINATES, KNEES
 from biped.optimize import Optimum, check_speed
 from biped.problem import VARIABLES
 from biped.provenance import provenance as make_provenance
@@ -226,3 +230,136 @@ def read(path: str | Path) -> dict:
     if not math.isclose(t[-1], period, rel_tol=1e-6):
         raise bad(f"samples.t ends at {t[-1]!r} s, allowed the period {period!r} s")
     return content
+
+
+# Consistency: the derived fields of a gait file against those recomputed from its parameters.
+# A file keeps every bit of its numbers (JSON), so only the rounding of another CPU or numpy
+# build (1e-13 of a field's size or so) may separate them; an edited figure differs by far
+# more. Allowed difference: CONSISTENCY_RTOL × the field's largest magnitude (at least 1 in
+# its unit, so fields near zero are not held to nothing).
+CONSISTENCY_RTOL = 1e-9
+# Names of the columns of the sample arrays, for the messages.
+_COLUMNS = {
+    "q": COORDINATES,
+    "qd": COORDINATES,
+    "qdd": COORDINATES,
+    "torques": JOINTS,
+    "wrench": ("Fx", "Fz", "Cy"),
+}
+
+
+def _unit(units: dict, field: str, column: int | None = None) -> str:
+    unit = units.get(field, "")
+    if isinstance(unit, list):
+        unit = unit[column] if column is not None else ""
+    return f" {unit}" if unit and unit != "1" else ""
+
+
+def _mismatch(found, expected) -> tuple[int, float] | None:
+    """The flat index and size of the largest difference beyond the tolerance, or None."""
+    found, expected = np.asarray(found, dtype=float), np.asarray(expected, dtype=float)
+    tolerance = CONSISTENCY_RTOL * max(float(np.max(np.abs(expected), initial=0.0)), 1.0)
+    difference = np.abs(found - expected).ravel()
+    worst = int(np.argmax(difference))
+    return (worst, float(difference[worst])) if difference[worst] > tolerance else None
+
+
+def check_consistency(gait: dict, source: str = "gait") -> None:
+    """Raise a ``BipedError`` naming the first field of ``gait`` (as ``read`` returns it) that
+    does not belong to its parameters, recomputed as ``to_dict`` computes them (no MuJoCo):
+    period and step length, the samples on the check grid, the costs, the constraints,
+    ``feasible`` and the impact. ``source`` names the file in the message."""
+    from biped.criteria import evaluate_step
+    from biped.gait import build_step
+    from biped.optimize import CHECK_SAMPLES_PER_HALF
+
+    def bad(what):
+        return BipedError(f"{source} is inconsistent: {what}")
+
+    model = Biped(gait["robot"], gait["knee"])
+    try:
+        step = build_step(model, gait["speed"], parameters(gait))
+    except BipedError as error:
+        raise bad(f"its parameters build no step ({error})") from None
+    evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF, safety=gait["safety"])
+    units = gait_units(gait["criterion"])
+    for key in ("period", "step_length"):
+        expected = getattr(step, key)
+        if _mismatch(gait[key], expected):
+            raise bad(f"{key} = {gait[key]!r}{_unit(units, key)}, its parameters give {expected!r}")
+    samples = gait["samples"]
+    for key in SAMPLE_FIELDS:
+        expected = getattr(evaluation, key)
+        field = f"samples.{key}"
+        if samples[key].shape != expected.shape:
+            raise bad(
+                f"{field} has shape {samples[key].shape}, the parameters' samples "
+                f"{expected.shape}: {field} do not belong to the parameters"
+            )
+        found = _mismatch(samples[key], expected)
+        if found:
+            index, size = found
+            row, column = divmod(index, expected.shape[1]) if expected.ndim == 2 else (index, None)
+            where = f"t = {evaluation.t[row]:.4f} s" + (
+                f", {_COLUMNS[key][column]}" if column is not None else ""
+            )
+            raise bad(
+                f"{field} do not belong to the parameters (off by {size:.3g}"
+                f"{_unit(units, field, column)} at {where})"
+            )
+    costs = {
+        "sthenic": evaluation.sthenic,
+        "energy": evaluation.energy,
+        "energy_per_metre": evaluation.energy / step.step_length,
+    }
+    constraints = dict(zip(CONSTRAINTS, map(float, evaluation.worst), strict=True))
+    for group, expected_values in (("costs", costs), ("constraints", constraints)):
+        stored = gait.get(group)
+        if not isinstance(stored, dict):
+            raise bad(f"{group} missing")
+        for name, expected in expected_values.items():
+            field = f"{group}.{name}"
+            value = stored.get(name)
+            if not _finite_number(value) or _mismatch(value, expected):
+                raise bad(
+                    f"{field} = {value!r}{_unit(units, field)}, its parameters give "
+                    f"{expected!r}{_unit(units, field)}"
+                )
+    if gait["feasible"] != evaluation.feasible:
+        violated = ", ".join(f"{k} = {v:.3g}" for k, v in evaluation.violations().items())
+        raise bad(
+            f"feasible = {str(gait['feasible']).lower()}, its parameters give "
+            f"{str(evaluation.feasible).lower()}" + (f" (Ψ < 0: {violated})" if violated else "")
+        )
+    impact = gait.get("impact")
+    if impact is not None:
+        qd_plus, impulse = model.impact(*step.end)
+        expected_impact = {
+            "impulse": step.impulse,
+            "qd_minus": step.end[1],
+            "qd_plus": step.start[1],
+            "trailing_foot_lift": trailing_foot_lift(model, step.end[0], qd_plus),
+        }
+        for name, expected in expected_impact.items():
+            field = f"impact.{name}"
+            try:
+                found = _mismatch(impact[name], expected)
+            except (KeyError, TypeError, ValueError):
+                raise bad(f"{field} is not the {np.shape(expected)} numbers it should be") from None
+            if found:
+                raise bad(f"{field} does not belong to the parameters (off by {found[1]:.3g})")
+        lift = expected_impact["trailing_foot_lift"]
+        consistent = bool(step.impulse[1] > 0 and np.all(lift >= 0))
+        if impact.get("consistent") is not consistent:
+            raise bad(
+                f"impact.consistent = {impact.get('consistent')!r}, its parameters give "
+                f"{str(consistent).lower()}"
+            )
+
+
+def read_consistent(path: str | Path) -> dict:
+    """``read``, then ``check_consistency``: a gait file whose derived fields (samples, costs,
+    constraints, feasible, impact) are those of its parameters."""
+    gait = read(path)
+    check_consistency(gait, f"gait file {str(path)!r}")
+    return gait

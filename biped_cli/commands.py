@@ -172,8 +172,13 @@ def cmd_sweep(args) -> int:
 
 def cmd_figures(args) -> int:
     """PNG figures reproducing the paper's Figs. 4-8 and a comparison table (markdown)."""
+    from pathlib import Path
+
+    from biped import gait_file
     from biped.figures import make_figures
 
+    for gait in sorted(Path(args.sweep).glob("*-*.json")):  # each its parameters' gait
+        gait_file.read_consistent(gait)
     for path in make_figures(args.sweep, args.out):
         print(f"wrote {path}")
     return 0
@@ -234,7 +239,8 @@ def cmd_validate(args) -> int:
     of pressure in the foot and on the gait's ZMP). Prints a table per gait (or JSON with
     --json) and writes a rerun recording per gait (--spawn, --connect: also to a viewer) and,
     with --video, the video of the walk; exits 0 only when every check of every gait passes,
-    1 otherwise.
+    1 otherwise. A gait file whose samples, costs, constraints or feasibility are not those
+    of its parameters is refused before any work (exit 2, naming the field).
     """
     import json
     from pathlib import Path
@@ -252,7 +258,8 @@ def cmd_validate(args) -> int:
     if args.video:
         check_output(args.video, "--video")
     gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
-    gaits = [gait_file.read(path) for path in args.gait]  # all readable before any work
+    # all readable, and each file's samples, costs and constraints its parameters', before any work
+    gaits = [gait_file.read_consistent(path) for path in args.gait]
     for path, gait in zip(args.gait, gaits, strict=True):
         check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
     recordings = [
