@@ -34,6 +34,7 @@ from biped.errors import BipedError
 from biped.gait import Step, build_step
 from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
 from biped.problem import (  # noqa: F401 (re-exported)
+    FIRST_GUESS_PERIOD,
     SCALES,
     GaitProblem,
     bounds,
@@ -44,8 +45,10 @@ from biped.problem import (  # noqa: F401 (re-exported)
 from biped.solver import CONVERGED, solver_for
 
 METHODS = ("ipopt", "nelder-mead")
-# Starts of IPOPT by default: the first guess and this many perturbed guesses, minus one.
+# Starts of IPOPT by default (``first_guesses``).
 DEFAULT_STARTS = 3
+# Step periods [s] of the first guesses, in order; starts beyond these are perturbations.
+GUESS_PERIODS = (FIRST_GUESS_PERIOD, 0.8, 0.45)
 # Standard deviation of the perturbed starts, in units of ``SCALES``.
 PERTURBATION = 1.0
 # Two starts reach the same optimum when their values agree to this, relative.
@@ -222,7 +225,9 @@ def check_method(method: str) -> str:
 
 
 def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[str, np.ndarray]]:
-    """The default first guess and ``starts - 1`` perturbations of it, in the bounds."""
+    """``starts`` first guesses in the bounds: the default first guess, then first guesses of
+    other step periods (``GUESS_PERIODS``: the step length a gait settles on is its largest
+    choice, and the basins of the optima follow it), then perturbations of the default."""
     if isinstance(starts, bool) or not isinstance(starts, int) or starts < 0:
         raise BipedError(f"starts = {starts!r}: allowed an integer >= 0")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -230,11 +235,17 @@ def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[st
     guess = problem.first_guess()
     lower, upper = bounds()
     rng = np.random.default_rng(seed)
-    result = [("first guess", guess)] if starts else []
-    for _ in range(starts - 1):
-        z = guess + PERTURBATION * SCALES * rng.standard_normal(guess.shape)
-        z[:2] = np.abs(z[:2])  # the knee bends stay bends
-        result.append(("perturbed", np.clip(z, lower, upper)))
+    result = []
+    for k in range(starts):
+        if k == 0:
+            result.append(("first guess", guess))
+        elif k < len(GUESS_PERIODS):
+            period = GUESS_PERIODS[k]
+            result.append((f"first guess T = {period:g} s", problem.first_guess(period)))
+        else:
+            z = guess + PERTURBATION * SCALES * rng.standard_normal(guess.shape)
+            z[:2] = np.abs(z[:2])  # the knee bends stay bends
+            result.append(("perturbed", np.clip(z, lower, upper)))
     return result
 
 
@@ -271,6 +282,8 @@ def optimize(
     solver = solver_for(problem)
     candidates = first_guesses(problem, starts, seed)
     candidates += [("given", np.asarray(z, dtype=float)) for z in given]
+    if problem.criterion == "energy" and starts > 0:
+        candidates += _sthenic_start(problem, seed, starts)
     for k in range(nelder_mead_starts):
         parameters, *_ = nelder_mead(
             problem,
@@ -304,6 +317,14 @@ def optimize(
         value=best.value,
     )
     return checked(problem, best.variables, report)
+
+
+def _sthenic_start(problem: GaitProblem, seed: int, starts: int) -> list:
+    """The sthenic optimum of the same problem, a start of the energy criterion: its
+    landscape has basins of short fast steps (3-7 times the minimum) that no first guess
+    escapes, and the gait of least torque lies in the basin of least energy."""
+    sthenic = optimize(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
+    return [("sthenic optimum", sthenic.variables)] if sthenic.report.converged else []
 
 
 def _at_best(history, value: float) -> int:
