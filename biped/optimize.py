@@ -243,10 +243,16 @@ def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[st
             period = GUESS_PERIODS[k]
             result.append((f"first guess T = {period:g} s", problem.first_guess(period)))
         else:
-            z = guess + PERTURBATION * SCALES * rng.standard_normal(guess.shape)
-            z[:2] = np.abs(z[:2])  # the knee bends stay bends
-            result.append(("perturbed", np.clip(z, lower, upper)))
+            result.append(("perturbed", perturbed(guess, rng)))
     return result
+
+
+def perturbed(guess, rng: np.random.Generator) -> np.ndarray:
+    """``guess`` (variables) perturbed by ``PERTURBATION`` x ``SCALES``, in the bounds."""
+    lower, upper = bounds()
+    z = guess + PERTURBATION * SCALES * rng.standard_normal(np.shape(guess))
+    z[:2] = np.abs(z[:2])  # the knee bends stay bends
+    return np.clip(z, lower, upper)
 
 
 def optimize(
@@ -356,8 +362,10 @@ def best_of(problem: GaitProblem, optima) -> Optimum:
 def _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began) -> Optimum:
     # seed 0 starts from the first guess, seed k > 0 from its perturbation number k (as a
     # designer would try a few first guesses); the seed drives the restarts too.
-    guesses = first_guesses(problem, 2, seed)
-    start = problem.to_parameters(guesses[0 if seed == 0 else 1][1])
+    guess = problem.first_guess()
+    if seed != 0:
+        guess = perturbed(guess, np.random.default_rng(seed))
+    start = problem.to_parameters(guess)
     parameters, history, count, converged = nelder_mead(
         problem, start, np.random.default_rng(seed), max_restarts, evaluations_per_run
     )
