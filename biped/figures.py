@@ -30,6 +30,7 @@ from biped.errors import BipedError
 from biped.files import atomic_set
 from biped.gait import FREE_ANGLES
 from biped.kinematics import ANGLES, BODY_DIRECTIONS, COORDINATES, KNEES
+from biped.paper_method import spread_lines
 from biped.robot import FOOT_FRICTION
 from biped.sweep import MANIFEST
 
@@ -488,7 +489,11 @@ def make_figures(sweep_folder: str | Path, out_folder: str | Path) -> list[Path]
     """
     series, flagged = read_sweep(sweep_folder)
     figures = sweep_figures(series, flagged)
-    table = comparison_table(series)
+    certified_values = {
+        key: {round(g["speed"], 6): g["costs"][key[1]] for g in gaits}
+        for key, gaits in series.items()
+    }
+    table = "\n".join([comparison_table(series), *spread_lines(sweep_folder, certified_values)])
     out = Path(out_folder)
     with atomic_set(out, "figures") as staging:
         for name, figure in figures.items():

@@ -144,6 +144,8 @@ def cmd_sweep(args) -> int:
     Each point is saved as it completes; run the same command again to resume. A progress
     bar is drawn on stderr when it is a terminal.
     """
+    from biped.paper_method import SPEED as PAPER_METHOD_SPEED
+    from biped.paper_method import run_paper_method
     from biped.runner import check_dask
     from biped.sweep import run_sweep
     from biped_cli.progress import Progress
@@ -166,6 +168,18 @@ def cmd_sweep(args) -> int:
         dask=args.dask,
         progress=lambda total: Progress(total, "sweep"),
     )
+    if args.paper_seeds:  # at the sweep's speed nearest the paper's optima
+        run_paper_method(
+            args.out,
+            robot,
+            speed=float(min(args.speeds, key=lambda v: abs(v - PAPER_METHOD_SPEED))),
+            seeds=args.paper_seeds,
+            knees=args.knees,
+            criteria=args.criteria,
+            safety=safety(args),
+            jobs=args.jobs,
+            dask=args.dask,
+        )
     print(f"sweep results in {args.out}")
     return 0
 

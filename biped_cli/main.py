@@ -112,6 +112,14 @@ def build_parser() -> argparse.ArgumentParser:
     types.add_budget(sweep)
     sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     types.add_dask(sweep)
+    sweep.add_argument(
+        "--paper-seeds",
+        type=types.bounded(0, 100),
+        default=5,
+        metavar="N",
+        help="also run the paper's Nelder-Mead from N seeds at the speed nearest 0.3 m/s, "
+        "for every knee and criterion, for comparison.md (default 5; 0: none)",
+    )
     sweep.set_defaults(run=cmd_sweep)
 
     val = commands.add_parser(
