@@ -100,12 +100,13 @@ def test_validate_several_gaits(gait_path, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["validate", str(gait_path), str(other), "--rrd", "x.rrd"]) == 2
     assert "--rrd" in capsys.readouterr().err
-    # Two files of one name would write one recording: refused before any work.
-    twin = tmp_path / "twin"
-    twin.mkdir()
+    # Two files of one name in folders of one name would write one recording (named from
+    # the folder and the file): refused before any work.
+    twin = tmp_path / "twin" / gait_path.parent.name
+    twin.mkdir(parents=True)
     shutil.copy(gait_path, twin / gait_path.name)
     assert main(["validate", str(gait_path), str(twin / gait_path.name)]) == 2
-    assert "same file name" in capsys.readouterr().err
+    assert "would share the recording" in capsys.readouterr().err
     code = main(["validate", str(gait_path), str(other), "--steps", "1", "--json"])
     content = json.loads(capsys.readouterr().out)
     assert set(content) == {str(gait_path), str(other)}
