@@ -191,6 +191,7 @@ def cmd_figures(args) -> int:
     from biped import gait_file
     from biped.figures import make_figures
 
+    check_folder(args.out, "--out")
     for gait in sorted(Path(args.sweep).glob("*-*.json")):  # each its parameters' gait
         gait_file.read_consistent(gait)
     for path in make_figures(args.sweep, args.out):
