@@ -47,11 +47,14 @@ from biped.errors import BipedError
 from biped.optimize import (
     AGREEMENT,
     DEFAULT_STARTS,
+    GUESS_PERIODS,
     PERTURBATION,
     Optimum,
     Report,
     Start,
     checked,
+    first_guesses,
+    optimize,
 )
 from biped.problem import SCALES, GaitProblem, bounds, check_criterion, check_speed
 from biped.robot import Robot
@@ -215,20 +218,21 @@ def solver_for(problem: DesignProblem) -> Solver:
 
 
 def design_starts(problem: DesignProblem, starts: int, seed: int) -> list[tuple]:
-    """(kind, z, radii) of the first guess at the robot's radii and ``starts − 1`` random
-    starts: radii uniform in the bounds, the gait's first guess there perturbed as in
-    ``biped.optimize.first_guesses``."""
+    """(kind, z, radii) of ``starts`` starts: the gait's first guesses at the robot's radii
+    (``biped.optimize.first_guesses``: the default, then other step periods), then random
+    starts, radii uniform in the bounds and the gait's first guess there perturbed."""
     if isinstance(starts, bool) or not isinstance(starts, int) or starts < 0:
         raise BipedError(f"starts = {starts!r}: allowed an integer >= 0")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise BipedError(f"seed = {seed!r}: allowed an integer >= 0")
+    radii = problem.reference_radii
+    guesses = min(starts, len(GUESS_PERIODS))
+    result = [
+        (kind, z, radii) for kind, z in first_guesses(problem.gait_problem(radii), guesses, seed)
+    ]
     rng = np.random.default_rng(seed)
     lower, upper = bounds()
-    result = []
-    if starts:
-        radii = problem.reference_radii
-        result.append(("first guess", problem.gait_problem(radii).first_guess(), radii))
-    for _ in range(starts - 1):
+    for _ in range(starts - guesses):
         radii = tuple(float(r) for r in rng.uniform(problem.lower, problem.upper))
         z = problem.gait_problem(radii).first_guess()
         z = z + PERTURBATION * SCALES * rng.standard_normal(z.shape)
@@ -255,6 +259,10 @@ def optimize_design(
     candidates = design_starts(problem, starts, seed)
     for z, radii in given:
         candidates.append(("given", np.asarray(z, dtype=float), check_radii(problem.robot, radii)))
+    if problem.criterion == "energy" and starts > 0:  # as biped.optimize: least torque first
+        sthenic = optimize_design(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
+        if sthenic.report.converged:
+            candidates.append(("sthenic optimum", sthenic.optimum.variables, sthenic.radii))
     if not candidates:
         raise BipedError("no start: allowed starts >= 1 or given starts")
     solutions = [(kind, solver.solve(problem, z, radii)) for kind, z, radii in candidates]
@@ -286,6 +294,38 @@ def optimize_design(
     )
     optimum = checked(problem.gait_problem(radii), best.variables, report)
     return Design(problem, radii, optimum)
+
+
+class _HeldRadii:
+    """The design graph with the knee radii held: a gait solver for every radius without a
+    new graph (``biped.optimize.optimize``'s ``solvers``)."""
+
+    def __init__(self, problem: DesignProblem, radii):
+        self.problem, self.radii = problem, radii
+
+    def __call__(self, gait: GaitProblem):
+        design = solver_for(dataclasses.replace(self.problem, criterion=gait.criterion))
+        return _HeldSolver(design, self.radii)
+
+
+@dataclass(frozen=True)
+class _HeldSolver:
+    design: Solver
+    radii: tuple
+
+    def solve(self, gait: GaitProblem, start):
+        return self.design.solve(gait, start, self.radii, hold_radii=True)
+
+
+def optimize_at(
+    problem: DesignProblem, radii, seed: int = 0, starts: int = DEFAULT_STARTS, given=()
+) -> Optimum:
+    """The optimal gait of ``problem``'s robot with the radii held at ``radii`` (r1, r2) [m]:
+    ``biped.optimize.optimize`` (same starts, same report) on the design graph, so that a
+    map of many radii builds one graph per process."""
+    radii = check_radii(problem.robot, radii)
+    gait = problem.gait_problem(radii)
+    return optimize(gait, seed=seed, starts=starts, given=given, solvers=_HeldRadii(problem, radii))
 
 
 @dataclass
@@ -379,7 +419,7 @@ def compare(
     the best of every start. Optima given (``revolute``, ``reference``: e.g. gaits already
     written) are kept as they are.
     """
-    from biped.optimize import best_of, optimize
+    from biped.optimize import best_of
 
     ref = problem.reference_radii
     hinge, rolling = problem.gait_problem(ref, "revolute"), problem.gait_problem(ref)

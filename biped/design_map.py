@@ -4,7 +4,8 @@ several speeds, with the joint optimum of radii and gait (``biped.design``).
 At each speed the map holds, each an independent optimization:
 
 - ``grid``: the optimal gait of the rolling knee at every (r1, r2) of the grid
-  (``biped.optimize.optimize`` from its own starts);
+  (``biped.design.optimize_at``: ``biped.optimize.optimize``'s starts on the design graph
+  with the radii held, one graph per process for every radius);
 - ``revolute``: the optimal gait of the revolute knee, the map's reference contour (the
   grid's rows r1 = 0 and r2 = 0 are hinges too: a circle rolling on a point turns about it);
 - ``table1``: the rolling knee at the robot's own radii (Table 1: 5 cm);
@@ -37,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.criteria import PAPER_SAFETY, Safety
-from biped.design import RADII, DesignProblem, check_radii, optimize_design
+from biped.design import RADII, DesignProblem, check_radii, optimize_at, optimize_design
 from biped.errors import BipedError
 from biped.files import atomic_path, atomic_write_text, clean_stale_temporaries
 from biped.optimize import DEFAULT_STARTS, optimize
@@ -249,14 +250,13 @@ def solve_point(task) -> str:
                 given.append((variables, content["radii"] or problem.reference_radii))
         design = optimize_design(problem, seed=settings.seed, starts=settings.starts, given=given)
         optimum, radii = design.optimum, design.radii
-    else:
-        if point.kind == "grid":
-            radii, knee = point.radii, "rolling"
-        elif point.kind == "table1":
-            radii, knee = problem.reference_radii, "rolling"
-        else:
-            radii, knee = None, "revolute"
-        gait = problem.gait_problem(radii or problem.reference_radii, knee)
+    elif point.kind == "grid":  # one design graph per process serves every radius
+        radii = point.radii
+        optimum = optimize_at(problem, radii, seed=settings.seed, starts=settings.starts)
+    else:  # the references, as 'biped optimize' finds them
+        radii = problem.reference_radii if point.kind == "table1" else None
+        knee = "rolling" if point.kind == "table1" else "revolute"
+        gait = problem.gait_problem(problem.reference_radii, knee)
         optimum = optimize(gait, seed=settings.seed, starts=settings.starts)
     content = _save(folder, point, optimum, radii, time.perf_counter() - began)
     return _line(point, content)

@@ -233,7 +233,6 @@ def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[st
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise BipedError(f"seed = {seed!r}: allowed an integer >= 0")
     guess = problem.first_guess()
-    lower, upper = bounds()
     rng = np.random.default_rng(seed)
     result = []
     for k in range(starts):
@@ -264,6 +263,7 @@ def optimize(
     method: str = "ipopt",
     max_restarts: int = MAX_RESTARTS,
     evaluations_per_run: int = EVALUATIONS_PER_RUN,
+    solvers=None,
 ) -> Optimum:
     """The best gait of ``problem``.
 
@@ -278,6 +278,9 @@ def optimize(
         method: ``"ipopt"`` or ``"nelder-mead"`` (the paper's method alone, with
             ``max_restarts`` and ``evaluations_per_run``, from the first guess with seed 0
             and from the seed's perturbation of it otherwise).
+        solvers: ``solvers(problem)`` gives what solves a problem from a start,
+            ``.solve(problem, z)`` (default ``biped.solver.solver_for``; ``biped.design``
+            gives its graph with the knee radii held, which serves every radius).
     """
     check_method(method)
     if not isinstance(problem, GaitProblem):
@@ -285,11 +288,11 @@ def optimize(
     began = time.perf_counter()
     if method == "nelder-mead":
         return _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began)
-    solver = solver_for(problem)
+    solver = (solver_for if solvers is None else solvers)(problem)
     candidates = first_guesses(problem, starts, seed)
     candidates += [("given", np.asarray(z, dtype=float)) for z in given]
     if problem.criterion == "energy" and starts > 0:
-        candidates += _sthenic_start(problem, seed, starts)
+        candidates += _sthenic_start(problem, seed, starts, solvers)
     for k in range(nelder_mead_starts):
         parameters, *_ = nelder_mead(
             problem,
@@ -325,11 +328,13 @@ def optimize(
     return checked(problem, best.variables, report)
 
 
-def _sthenic_start(problem: GaitProblem, seed: int, starts: int) -> list:
+def _sthenic_start(problem: GaitProblem, seed: int, starts: int, solvers=None) -> list:
     """The sthenic optimum of the same problem, a start of the energy criterion: its
     landscape has basins of short fast steps (3-7 times the minimum) that no first guess
     escapes, and the gait of least torque lies in the basin of least energy."""
-    sthenic = optimize(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
+    sthenic = optimize(
+        dataclasses.replace(problem, criterion="sthenic"), seed, starts, solvers=solvers
+    )
     return [("sthenic optimum", sthenic.variables)] if sthenic.report.converged else []
 
 

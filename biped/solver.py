@@ -140,10 +140,11 @@ class Solver:
         self.ubx = np.concatenate([upper, np.full(self.slacks, np.inf)])
         self.n_constraints = g.shape[0]
 
-    def solve(self, problem, start, radii=None) -> Solution:
+    def solve(self, problem, start, radii=None, hold_radii: bool = False) -> Solution:
         """IPOPT from the variables ``start`` (21,), clipped into the bounds, at
         ``problem.speed``; with radii as variables, from the knee radii ``radii`` (r1, r2) [m]
-        clipped into theirs."""
+        clipped into theirs, or held at them (``hold_radii``: the gait alone optimised, IPOPT
+        treating the radii as parameters)."""
         began = time.perf_counter()
         z0 = np.clip(np.asarray(start, dtype=float), self.lower, self.upper)
         x0 = z0 / SCALES
@@ -152,20 +153,27 @@ class Solver:
             if radii is None:
                 raise BipedError("radii = None: allowed the knee radii (r1, r2) to start from")
             low, high = self.radius_bounds
-            r0 = np.clip(np.asarray(radii, dtype=float), low, high)
+            r0 = np.asarray(radii, dtype=float)
+            if not hold_radii:  # held radii may lie beyond the design's bounds
+                r0 = np.clip(r0, low, high)
             x0 = np.concatenate([x0, r0 / RADIUS_SCALE])
             inputs.append(r0)
         if self.slacks:
             power = np.asarray(self.evaluate(*inputs)[2]).T.ravel()
             x0 = np.concatenate([x0, np.abs(power) if np.all(np.isfinite(power)) else 0.0])
-        result = self.nlp(x0=x0, p=problem.speed, lbx=self.lbx, ubx=self.ubx, lbg=0.0, ubg=np.inf)
+        lbx, ubx = self.lbx, self.ubx
+        if self.design and hold_radii:
+            held = slice(N_VARIABLES, N_VARIABLES + 2)
+            lbx, ubx = lbx.copy(), ubx.copy()
+            lbx[held] = ubx[held] = r0 / RADIUS_SCALE
+        result = self.nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
         stats = self.nlp.stats()
         x = np.asarray(result["x"]).ravel()
         g = np.asarray(result["g"]).ravel()
         violation = max(
             float(np.max(np.maximum(-g, 0.0), initial=0.0)),
-            float(np.max(np.maximum(self.lbx - x, 0.0), initial=0.0)),
-            float(np.max(np.maximum(x - self.ubx, 0.0), initial=0.0)),
+            float(np.max(np.maximum(lbx - x, 0.0), initial=0.0)),
+            float(np.max(np.maximum(x - ubx, 0.0), initial=0.0)),
         )
         iterations = stats.get("iterations") or {}
         dual = iterations.get("inf_du") or [float("nan")]

@@ -13,6 +13,7 @@ from biped.criteria import PAPER_SAFETY, Safety, evaluate_step
 from biped.design import (
     DesignProblem,
     check_radii,
+    optimize_at,
     optimize_design,
     radius_limits,
 )
@@ -136,6 +137,23 @@ def test_design_beats_the_table_1_knee():
     assert (design.robot.r1, design.robot.r2) == design.radii
     assert design.value <= optimal_gait("rolling").value * (1 + 1e-9)
     assert design.value <= optimal_gait("revolute").value
+
+
+def test_design_graph_with_radii_held_finds_the_gait_optimum_of_those_radii():
+    """The design graph with the radii held (the map's solver, one graph for every radius)
+    reaches the optimum 'biped optimize' finds for the robot built with those radii; held
+    at other radii, it does not."""
+    from biped.optimize import optimize
+
+    problem = DesignProblem(ROBOT, SPEED)
+    radii = (0.12, 0.2)
+    held = optimize_at(problem, radii, starts=1)
+    own = optimize(gait_at(radii), starts=1)
+    assert held.certified and own.certified
+    assert held.value == pytest.approx(own.value, rel=1e-8)
+    assert (held.problem.model.robot.r1, held.problem.model.robot.r2) == radii
+    other = optimize_at(problem, (0.05, 0.05), starts=1)
+    assert abs(other.value / own.value - 1) > 1e-3
 
 
 def test_designed_robot_passes_the_inverse_dynamics_crosscheck():
