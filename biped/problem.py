@@ -51,8 +51,10 @@ ACCEL_BOUND = 500.0  # [rad/s²]
 # [m] Least height of the hip above the ankles at the start of the step, far below any
 # walking posture: it keeps the two circles of (*) meeting.
 MIN_HIP_HEIGHT = 0.3
-# Slowest speed optimised [m/s]: below it a step of the longest period is under 1 mm.
-MIN_SPEED = 1e-3 / _UPPER["period"]
+# Slowest walking speed [m/s]: a step lasts a few seconds at most, so slower gaits take
+# steps of a few centimetres down to nothing (1e-9 m/s: a 0.0000 m step), which is not
+# walking. The fastest depends on the robot (``max_walking_speed``, √(g·leg length)).
+MIN_SPEED = 0.01
 # One unit of each variable in the solvers' scaled space (comparable changes of the gait).
 SCALES = np.array([0.03, 0.03, 0.03] + [0.3] * 5 + [2.0] * 12 + [0.05])
 # Duration of a step in the first guess [s].
@@ -96,7 +98,7 @@ def check_speed(model: Biped, speed: float) -> float:
     if not MIN_SPEED <= speed <= high:
         raise BipedError(
             f"speed = {speed!r} m/s: allowed {MIN_SPEED:.3g} <= speed <= {high:.3g} m/s "
-            f"(slower, a step of at most {_UPPER['period']:g} s is under a millimetre; faster "
+            f"(slower, a step of at most {_UPPER['period']:g} s is a few centimetres; faster "
             f"than √(g·leg length), the stance foot leaves the ground)"
         )
     return float(speed)

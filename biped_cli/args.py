@@ -9,12 +9,9 @@ import numpy as np
 
 from biped.criteria import MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
 from biped.errors import BipedError
+from biped.problem import MIN_SPEED
 
 ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
-# Slowest walking speed [m/s]: a step lasts a few seconds at most, so slower gaits take steps
-# of a few centimetres down to nothing (1e-9 m/s: a 0.0000 m step), which is not walking. The
-# fastest depends on the robot (``biped.optimize.check_speed``, √(g·leg length)).
-MIN_SPEED = 0.01
 SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower steps are mm long)"
 # Most speeds of a sweep: each is an optimisation per knee and criterion.
 MAX_SPEEDS = 1000

@@ -226,6 +226,7 @@ def test_sweep_progress_bar_on_a_terminal_only(local_sweep, tmp_path, monkeypatc
         (tmp_path / name).parent.mkdir(exist_ok=True)
         (tmp_path / name).write_bytes((local_sweep / name).read_bytes())
     argv = ["sweep", "--out", str(tmp_path), "--knees", "revolute", "--criteria", "sthenic"]
+    argv += ["--paper-seeds", "0"]
     argv += ["--speeds", "0.275,0.3", "--starts", "1", "--jobs", "1"]
     terminal = Terminal()
     monkeypatch.setattr(sys, "stderr", terminal)
@@ -266,6 +267,7 @@ def test_signals_at_random_moments_leave_whole_files_and_resume_to_the_same(loca
     that follows ends with every file of an uninterrupted sweep."""
     out = tmp_path / "sweep"
     argv = [sys.executable, "-c", PROGRAM, "sweep", "--out", str(out), "--jobs", "2"]
+    argv += ["--paper-seeds", "0"]
     argv += ["--knees", "revolute", "--criteria", "sthenic", "--speeds", "0.275,0.3"]
     argv += ["--starts", "1"]
     rng = random.Random(20260611)
