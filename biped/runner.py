@@ -31,10 +31,12 @@ the files of an uninterrupted run.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import signal
 import sys
+import threading
 import warnings
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing import resource_tracker
@@ -136,37 +138,66 @@ def _in_process(function: Callable, tasks: list) -> Iterator:
         yield result
 
 
-def _start_pool(jobs: int):
-    """A pool of ``jobs`` spawned workers deaf to Ctrl-C from their first instruction.
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """Ctrl-C and SIGTERM received in the block take effect when it ends (their handlers run
+    then), so that what the block starts is not cut in the middle. Main thread only."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    handlers = {s: h for s, h in handlers.items() if callable(h)}
+    received: list[int] = []
+    for number in handlers:
+        signal.signal(number, lambda signum, frame: received.append(signum))
+    try:
+        yield
+    finally:
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
+    for number in received[:1]:
+        handlers[number](number, None)
+
+
+def _start_pool(jobs: int, pools: list) -> None:
+    """Append to ``pools`` a pool of ``jobs`` spawned workers deaf to Ctrl-C from their first
+    instruction.
 
     A terminal's Ctrl-C reaches every process of its group, and a worker still importing
-    would print a traceback. The workers are started with SIGINT blocked (a new process
-    inherits the signal mask; ``_worker_init`` then ignores it); a Ctrl-C meanwhile waits and
-    reaches this process once the pool is started.
+    would print a traceback: the workers start with SIGINT blocked (a new process inherits
+    the signal mask of the thread that starts it; ``_worker_init`` then ignores SIGINT). A
+    Ctrl-C or SIGTERM received meanwhile (by any thread of this process) takes effect once
+    the pool is started and in ``pools``, never between a worker's start and its first
+    instructions (that worker would print a traceback).
     """
     context = multiprocessing.get_context("spawn")
-    if not hasattr(signal, "pthread_sigmask"):
-        return context.Pool(jobs, initializer=_worker_init)
-    # The pool's locks start multiprocessing's resource tracker, which unblocks SIGINT after
-    # starting: start it first.
-    resource_tracker.ensure_running()
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        return context.Pool(jobs, initializer=_worker_init)
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+    with _signals_deferred():
+        if not hasattr(signal, "pthread_sigmask"):
+            pools.append(context.Pool(jobs, initializer=_worker_init))
+            return
+        # The pool's locks start multiprocessing's resource tracker, which unblocks SIGINT
+        # after starting: start it first.
+        resource_tracker.ensure_running()
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            pools.append(context.Pool(jobs, initializer=_worker_init))
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
-    pool = _start_pool(jobs)
+    pools: list = []  # the pool, once started
     try:
-        yield from pool.imap_unordered(function, tasks)
-        pool.close()
+        _start_pool(jobs, pools)
+        yield from pools[0].imap_unordered(function, tasks)
+        pools[0].close()
     except BaseException:  # Ctrl-C, SIGTERM, an error of a task, the caller stopping early
-        pool.terminate()
+        for pool in pools:
+            pool.terminate()
         raise
     finally:
-        pool.join()
+        for pool in pools:
+            pool.join()
 
 
 def _connect(address: str):

@@ -31,6 +31,7 @@ import numpy as np
 from biped.criteria import Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
+from biped.interrupts import kept_interrupts
 from biped.problem import N_VARIABLES, SCALES, GaitProblem, bounds
 from biped.robot import Robot
 from biped.symbolic import StepGraph
@@ -81,6 +82,30 @@ class Solution:
         return self.status in CONVERGED
 
 
+@functools.cache
+def one_blas_thread() -> bool:
+    """Run IPOPT's linear solver (MUMPS, on the OpenBLAS that CasADi ships) on one thread;
+    returns whether that library was found.
+
+    With several threads its sums come in an order that depends on the thread count, and an
+    optimum's last digits with it (1e-11 of the criterion): a pool worker, a Dask worker
+    (started with ``OPENBLAS_NUM_THREADS=1``) and this process would write different files.
+    On one thread every process gives every bit the same; the problems are small, so more
+    threads are not faster, and a sweep's workers share the cores anyway.
+    """
+    import ctypes
+    from pathlib import Path
+
+    # The file named as the library's SONAME: the one MUMPS loads (the wheel holds copies
+    # under other names, which would load as other instances).
+    path = Path(ca.__file__).parent / "libcasadi-tp-openblas.so.0"
+    try:
+        ctypes.CDLL(str(path)).openblas_set_num_threads(1)
+    except (OSError, AttributeError):  # another platform's or build's CasADi
+        return False
+    return True
+
+
 class Solver:
     """IPOPT on one problem family (every speed): ``solve(problem, start)``.
 
@@ -98,6 +123,7 @@ class Solver:
         samples_per_half: int,
         radius_bounds=None,
     ):
+        one_blas_thread()
         design = radius_bounds is not None
         self.graph = graph = StepGraph(model, samples_per_half, safety, design=design)
         self.criterion = criterion
@@ -166,7 +192,8 @@ class Solver:
             held = slice(N_VARIABLES, N_VARIABLES + 2)
             lbx, ubx = lbx.copy(), ubx.copy()
             lbx[held] = ubx[held] = r0 / RADIUS_SCALE
-        result = self.nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
+        with kept_interrupts():  # CasADi stops at Ctrl-C but swallows it: raised again
+            result = self.nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
         stats = self.nlp.stats()
         x = np.asarray(result["x"]).ravel()
         g = np.asarray(result["g"]).ravel()

@@ -34,7 +34,11 @@ _handled = (
     "--multiprocessing-fork" not in sys.orig_argv
     and threading.current_thread() is threading.main_thread()
 )
-_previous = {n: signal.signal(n, _end_while_loading) for n in _INTERRUPTS} if _handled else {}
+_previous = {
+    number: signal.signal(number, _end_while_loading)
+    for number in _INTERRUPTS
+    if _handled and signal.getsignal(number) is not signal.SIG_IGN  # ignored stays ignored
+}
 try:
     from biped_cli.main import build_parser, main
 finally:

@@ -253,6 +253,12 @@ PROGRAM = "import sys; from biped_cli import main; sys.exit(main())"
 SIGNALS = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
 
 
+def _ctrl_c_default():
+    """In the child: Ctrl-C as in a terminal, whatever this process inherited (a shell's
+    background job ignores it)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _lines(stream, into: queue.Queue):
     for line in stream:
         into.put(line)
@@ -282,6 +288,7 @@ def test_signals_at_random_moments_leave_whole_files_and_resume_to_the_same(loca
             stderr=subprocess.PIPE,
             text=True,
             start_new_session=True,
+            preexec_fn=_ctrl_c_default,
         )
         lines: queue.Queue = queue.Queue()
         reader = threading.Thread(target=_lines, args=(process.stderr, lines), daemon=True)
@@ -295,7 +302,11 @@ def test_signals_at_random_moments_leave_whole_files_and_resume_to_the_same(loca
                 os.killpg(process.pid, signal.SIGINT)
             else:
                 process.send_signal(signal.SIGTERM)
-        process.wait(timeout=120)
+        try:
+            process.wait(timeout=120)
+        finally:  # a run that does not stop fails the test, and leaves no process behind
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGKILL)
         reader.join(timeout=10)
         while not lines.empty() and (line := lines.get_nowait()) is not None:
             seen.append(line)
@@ -313,3 +324,18 @@ def test_signals_at_random_moments_leave_whole_files_and_resume_to_the_same(loca
     done = subprocess.run(argv, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert every_file(out) == every_file(local_sweep)
+
+
+def test_the_solver_runs_blas_on_one_thread():
+    """IPOPT's linear solver uses CasADi's OpenBLAS on one thread once a solver is built, so
+    this process, pool workers and Dask workers (OPENBLAS_NUM_THREADS=1) sum alike."""
+    import ctypes
+
+    import casadi
+
+    from biped.problem import GaitProblem
+    from biped.solver import solver_for
+
+    solver_for(GaitProblem(biped.Biped(biped.Robot.paper(), "revolute"), 0.3))
+    library = ctypes.CDLL(str(Path(casadi.__file__).parent / "libcasadi-tp-openblas.so.0"))
+    assert library.openblas_get_num_threads() == 1

@@ -1,0 +1,121 @@
+"""Ctrl-C and SIGTERM during an IPOPT solve stop the program: CasADi stops the solver when a
+signal's handler raises but swallows the exception (``biped.interrupts`` raises it again),
+and its notice of the swallowed exception stays off the terminal."""
+
+import io
+import os
+import signal
+import sys
+import threading
+
+import pytest
+
+import biped
+from biped.interrupts import kept_interrupts
+from biped.problem import GaitProblem
+from biped.solver import Solver, solver_for
+from biped_cli import main
+
+# CasADi's notice, in the pieces it writes.
+NOTICE = ("CasADi - ", "2026-01-01", ' WARNING("', "KeyboardInterruptException", '") [', "x.cpp]\n")
+
+
+@pytest.fixture(autouse=True)
+def ctrl_c():
+    """Ctrl-C raises KeyboardInterrupt in this process, as in a terminal (a shell's background
+    job inherits it ignored)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+class Stopped(BaseException):
+    """A handler's exception, as the command line's ``Terminated``."""
+
+
+def swallowing_solver(signum):
+    """What CasADi does: the signal's handler raises inside, the solver catches it, writes
+    its notice in pieces and returns a status."""
+    try:
+        os.kill(os.getpid(), signum)
+        for _ in range(1000):  # the handler runs between two bytecodes
+            pass
+    except BaseException:
+        for piece in NOTICE:
+            sys.stderr.write(piece)
+        return "NonIpopt_Exception_Thrown"
+    return "Solve_Succeeded"
+
+
+def test_a_swallowed_interrupt_is_raised_again(monkeypatch):
+    """Without the guard the interrupt is lost (the solver returns a status); with it, the
+    handler's own exception goes up after the solver returns, and CasADi's notice is not
+    written (other lines on stderr are)."""
+    assert swallowing_solver(signal.SIGINT) == "NonIpopt_Exception_Thrown"
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    with pytest.raises(KeyboardInterrupt), kept_interrupts():
+        sys.stderr.write("a line of our own\n")
+        swallowing_solver(signal.SIGINT)
+    assert err.getvalue() == "a line of our own\n"
+
+    def stop(signum, frame):
+        raise Stopped
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        with pytest.raises(Stopped), kept_interrupts():
+            swallowing_solver(signal.SIGTERM)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_handler_that_returns_lets_the_solver_go_on():
+    """A handler that does not raise (it only takes note) stops nothing."""
+    noted = []
+    previous = signal.signal(signal.SIGTERM, lambda *_: noted.append(1))
+    try:
+        with kept_interrupts():
+            assert swallowing_solver(signal.SIGTERM) == "Solve_Succeeded"
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert noted == [1]
+
+
+def test_ctrl_c_stops_a_real_ipopt_solve(capfd):
+    """Ctrl-C 50 ms into IPOPT's solve (about a second from the first guess) raises
+    KeyboardInterrupt when the solver returns; nothing of CasADi's on stderr."""
+    problem = GaitProblem(biped.Biped(biped.Robot.paper(), "rolling"), 0.3)
+    solver = solver_for(problem)
+    capfd.readouterr()
+    timer = threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        solver.solve(problem, problem.first_guess())
+    timer.join()
+    assert "CasADi" not in capfd.readouterr().err
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_biped_optimize_stops_at_a_signal_during_the_solve(signum, tmp_path, capsys, monkeypatch):
+    """`biped optimize` signalled 50 ms into its first IPOPT solve exits 130 / 143 with one
+    line, writing nothing (the interrupt lost, it would go on to its other starts and write
+    the gait)."""
+    solve = Solver.solve
+    signalled = []
+
+    def solve_and_signal(self, *args, **kwargs):
+        if not signalled:
+            signalled.append(threading.Timer(0.05, os.kill, (os.getpid(), signum)))
+            signalled[0].start()
+        return solve(self, *args, **kwargs)
+
+    monkeypatch.setattr(Solver, "solve", solve_and_signal)
+    out = tmp_path / "gait.json"
+    argv = ["optimize", "--knee", "rolling", "--speed", "0.3", "--starts", "3"]
+    assert main([*argv, "--out", str(out)]) == 128 + signum
+    signalled[0].join()
+    name = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}[signum]
+    assert capsys.readouterr().err.splitlines()[-1] == f"biped optimize: interrupted ({name})"
+    assert not list(tmp_path.iterdir())
