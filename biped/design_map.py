@@ -504,19 +504,24 @@ def draw(folder, out=None) -> list[Path]:
         fig, ax = plt.subplots(figsize=(6.4, 5.2))
         if np.isfinite(values).sum() >= 4 and len(r1) > 1 and len(r2) > 1:
             filled = ax.contourf(100 * r1, 100 * r2, values, levels=16, cmap="viridis")
-            fig.colorbar(filled, ax=ax, label=f"optimal {settings.criterion} criterion [{unit}]")
-            if summary.revolute is not None:
-                low, high = np.nanmin(values), np.nanmax(values)
-                if low < summary.revolute < high:
-                    line = ax.contour(
-                        100 * r1,
-                        100 * r2,
-                        values,
-                        levels=[summary.revolute],
-                        colors="white",
-                        linestyles="--",
-                    )
-                    ax.clabel(line, fmt={summary.revolute: "revolute knee"}, fontsize=8)
+            bar = fig.colorbar(
+                filled, ax=ax, label=f"optimal {settings.criterion} criterion [{unit}]"
+            )
+            low, high = np.nanmin(values), np.nanmax(values)
+            if summary.revolute is not None and low <= summary.revolute <= high:
+                # where the rolling knee costs what the revolute knee does (on the axes
+                # r1 = 0 and r2 = 0 it is a hinge: there exactly)
+                ax.contour(
+                    100 * r1,
+                    100 * r2,
+                    values,
+                    levels=[summary.revolute],
+                    colors="k",
+                    linestyles="--",
+                    linewidths=1.2,
+                )
+                bar.ax.axhline(summary.revolute, color="k", ls="--", lw=1.5)
+                ax.plot([], [], "k--", label="revolute knee's value")
         ax.scatter(100 * np.repeat(r1, len(r2)), 100 * np.tile(r2, len(r1)), s=4, c="k")
         ax.plot(100 * table1[0], 100 * table1[1], "s", color="tab:orange", label="Table 1 radii")
         if summary.radii is not None:
@@ -533,6 +538,12 @@ def draw(folder, out=None) -> list[Path]:
             f"{settings.criterion} at {summary.speed:.3f} m/s (revolute knee {revolute})",
             fontsize=10,
         )
+        for axis, grid, bound in (
+            (ax.set_xlim, r1, settings.upper[0]),
+            (ax.set_ylim, r2, settings.upper[1]),
+        ):
+            top = 100 * max(grid.max(), bound)
+            axis(-0.03 * top, 1.04 * top)
         ax.set_xlabel("r1, shank circle [cm]")
         ax.set_ylabel("r2, thigh circle [cm]")
         ax.legend(loc="lower left", fontsize=8)

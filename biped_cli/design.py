@@ -222,6 +222,12 @@ def cmd_design(args) -> int:
     print(comparison.table())
     print(_radii_line(comparison))
     print(f"design: {design.report.summary()}")
+    if design.report.converged and not design.report.confirmed:
+        print(
+            "warning: the best design was reached by a single start; more --starts may find "
+            "a better one",
+            file=sys.stderr,
+        )
     if not design.report.converged or not design.optimum.feasible:
         reason = (
             f"the solver did not converge ({design.report.status})"
