@@ -116,9 +116,36 @@ def test_a_failing_task_stops_the_run_with_its_error(jobs):
         list(runner.run_tasks(failing_task, range(6), jobs=jobs))
 
 
+def sleeping_task(seconds):
+    time.sleep(seconds)
+    return f"slept {seconds} s"
+
+
 def test_a_failing_task_on_dask_stops_the_run_with_its_error(cluster):
     with pytest.raises(ValueError, match="task 2 fails"):
         list(runner.run_tasks(failing_task, range(6), dask=cluster, stream=None))
+
+
+def _scheduler_tasks(dask_scheduler):
+    return len(dask_scheduler.tasks)
+
+
+def test_an_interrupted_dask_run_cancels_its_tasks(cluster):
+    """Stopped after its first result (as by Ctrl-C in the caller), a run on Dask cancels
+    the tasks it submitted and closes its client: the scheduler forgets them all."""
+    from dask.distributed import Client
+
+    tasks = [0.0, 3.0, 3.0, 3.0, 3.0, 3.0]
+    with Client(cluster) as observer:
+        results = runner.run_tasks(sleeping_task, tasks, dask=cluster, stream=None)
+        assert next(results) == "slept 0.0 s"
+        assert observer.run_on_scheduler(_scheduler_tasks) > 0  # the others wait or run
+        results.close()  # what a KeyboardInterrupt in the caller's loop does
+        for _ in range(100):
+            if observer.run_on_scheduler(_scheduler_tasks) == 0:
+                break
+            time.sleep(0.1)
+        assert observer.run_on_scheduler(_scheduler_tasks) == 0
 
 
 def test_an_unreachable_scheduler_is_one_error_naming_it(monkeypatch):
