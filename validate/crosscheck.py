@@ -30,6 +30,7 @@ import numpy as np
 from biped.dynamics import Biped
 from validate.mapping import Mapping, mapping
 from validate.mjcf import robot_xml
+from validate.model import JOINT_ORDER, ModelError
 
 
 def load_model(biped: Biped, exact: bool = False) -> mujoco.MjModel:
@@ -87,11 +88,24 @@ class InverseDynamics:
 
 
 def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, stance="left"):
-    """Solve τ = Bᵀu + J_cᵀλ + J_eqᵀμ sample by sample (see the module docstring)."""
+    """Solve τ = Bᵀu + J_cᵀλ + J_eqᵀμ sample by sample (see the module docstring).
+
+    Raises ModelError when the system is not square (a rolling knee without its two
+    equalities leaves its hinges free: no unique solution).
+    """
     mapped: Mapping = mapping(model, stance, biped.radii)
     data = mujoco.MjData(model)
-    moments = actuator_moments(model)
+    motors = np.array([model.actuator(name).id for name in JOINT_ORDER])
+    gears = model.actuator_gear[motors, 0]
+    moments = actuator_moments(model)[motors]
     j_eq = equality_jacobian(model)
+    unknowns = len(motors) + 3 + model.neq
+    if unknowns != model.nv:
+        raise ModelError(
+            f"the model has {model.nv} degrees of freedom for 6 motors, 3 ground reactions "
+            f"and {model.neq} equalities: its inverse dynamics needs {model.nv - 9} "
+            "equalities (one per rolling knee: knee_lower = (r2 / r1) knee_upper)"
+        )
     site = model.site(f"{stance}_ankle").id
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
     qpos, qvel, qacc = (mapped.qpos(x) for x in (q, qd, qdd))
@@ -107,10 +121,17 @@ def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, sta
         mujoco.mj_jacSite(model, data, jacp, jacr, site)
         contact = np.stack([jacp[0], jacp[2], -jacr[1]])
         system = np.concatenate([moments, contact, j_eq]).T
-        solution = np.linalg.solve(system, tau)
-        torques[k] = solution[: model.nu][mapped.actuator_order]
-        wrench[k] = solution[model.nu : model.nu + 3]
-        coupling[k] = solution[model.nu + 3 :]
+        try:
+            solution = np.linalg.solve(system, tau)
+        except np.linalg.LinAlgError:
+            raise ModelError(
+                "MuJoCo's model gives a singular inverse dynamics (motors, ground and "
+                "equalities do not determine its motion)"
+            ) from None
+        # Paper's sign: Γ = -(MuJoCo's joint torque) = -gear u.
+        torques[k] = -(gears * solution[:6])[mapped.columns]
+        wrench[k] = solution[6:9]
+        coupling[k] = solution[9:]
     hp = biped.robot.ankle_height
     zmp = (torques[:, 0] - hp * wrench[:, 0]) / wrench[:, 1]
     return InverseDynamics(torques, wrench, zmp, coupling)

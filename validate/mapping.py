@@ -21,6 +21,7 @@ import numpy as np
 
 from biped.kinematics import NQ, Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH
 from validate.mjcf import SIDES
+from validate.model import JOINT_ORDER
 
 # Paper torque order Γ1..Γ6 as (role, joint).
 TORQUES = (
@@ -44,6 +45,7 @@ class Mapping:
     qpos_from_q: np.ndarray  # (nq, 9)
     actuator_order: np.ndarray  # index of the actuator carrying Γ1..Γ6
     stance: str
+    columns: np.ndarray = None  # index in ``validate.model.JOINT_ORDER`` of Γ1..Γ6's joint
 
     def qpos(self, q):
         return np.asarray(q) @ self.qpos_from_q.T
@@ -76,5 +78,7 @@ def mapping(model: mujoco.MjModel, stance: str, radii=(0.0, 0.0)) -> Mapping:
         r = row(f"{side}_ankle")
         r[foot], r[shank] = 1.0, -1.0
     roles = {"stance": stance, "swing": swing}
-    order = np.array([model.actuator(f"{roles[role]}_{joint}").id for role, joint in TORQUES])
-    return Mapping(qpos_from_q=matrix, actuator_order=order, stance=stance)
+    names = [f"{roles[role]}_{joint}" for role, joint in TORQUES]
+    order = np.array([model.actuator(name).id for name in names])
+    columns = np.array([JOINT_ORDER.index(name) for name in names])
+    return Mapping(qpos_from_q=matrix, actuator_order=order, stance=stance, columns=columns)

@@ -40,26 +40,35 @@ SIDES = ("left", "right")
 # Near-massless knee link of the rolling knee (MuJoCo needs mass on a moving body) [kg, kg·m²].
 KNEE_LINK_MASS = 1e-6
 KNEE_LINK_INERTIA = 1e-10
-# Armature on the rolling-knee hinges [kg·m²]: with a stiff equality, it keeps the coupling
-# tight under load. It enters MuJoCo's mass matrix; the cross-check removes it.
-KNEE_ARMATURE = 1e-3
+# Armature on the rolling-knee hinges [kg·m²] (a knee drive's rotor, 0.01 kg·m² on the knee's
+# flexion): with a stiff equality, it keeps the coupling tight under load and through the
+# landings (0.8 mrad at most over a walk at the 2 ms step, 4.6 mrad with 1e-3). It enters
+# MuJoCo's mass matrix; the cross-check removes it, the forward simulation's motors turn it.
+KNEE_ARMATURE = 0.02
 # Armature on the ankles [kg·m²], the rotor inertia of an ankle drive seen through its
 # gearbox. Without it the foot (0.002 kg·m² about the ankle) under a stiff joint feedback
 # oscillates at about 1000 rad/s, beyond what a 1 ms explicit step resolves, and rocks itself
 # across the floor. It enters MuJoCo's mass matrix; the cross-check removes it.
 ANKLE_ARMATURE = 0.02
-# Equality constraint of the rolling knee: stiff and hard (solimp close to 1).
-KNEE_SOLREF = "0.002 1"
+# Equality constraint of the rolling knee: stiff and hard (solimp close to 1); its time
+# constant is the shortest MuJoCo allows at the time step (2 steps).
+KNEE_SOLREF = "0.004 1"
 KNEE_SOLIMP = "0.9999 0.99999 0.0001 0.5 2"
-# Foot box: width and sole thickness [m]; friction (sliding, torsional, rolling).
+# Foot box (drawn): width and sole thickness [m]; friction (sliding, torsional, rolling).
 FOOT_WIDTH = 0.10
 SOLE_THICKNESS = 0.02
 FOOT_FRICTION = f"{SLIDING_FRICTION!r} 0.02 0.0001"  # μ from biped.robot
-# Stiff foot contact: the gaits clear the ground by millimetres, so the stance foot must not
-# sink into it (default contacts let the loaded heel sink by about 1.5 mm, these by 0.5 mm).
+# The sole touches the floor at its heel and its toe: two small spheres on the sole's
+# bottom ends (the motion is planar: the sole is the segment between them). Two contact
+# points per foot instead of a box's four make the physics step cheaper, and any centre of
+# pressure along the sole is still a split of the normal force between them. Radius [m].
+SOLE_CONTACT_RADIUS = 0.002
+# Stiff contact, the same on the soles and the floor (MuJoCo averages the two geoms'
+# parameters): the gaits clear the ground by about a millimetre, so the stance foot must not
+# sink into it. The time constant is the shortest MuJoCo allows at the time step (2 steps).
 FOOT_SOLREF = "0.004 1"
 FOOT_SOLIMP = "0.99 0.999 0.0005 0.5 2"
-TIMESTEP = 0.001  # [s]
+TIMESTEP = 0.002  # [s]
 # Elliptic friction cones with a high impedance ratio: MuJoCo's soft friction then holds a
 # loaded foot with little creep (the gaits need |Fx| / Fz of about 0.1 at most).
 IMPRATIO = 50.0
@@ -173,9 +182,12 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
             f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
             f'{pad}      <joint name="{side}_ankle" armature="{_f(ANKLE_ARMATURE)}"/>',
             f"{pad}      {_inertial(-r.foot_com, r.foot_mass, r.foot_inertia)}",
-            f'{pad}      <geom name="{side}_sole" class="collision" type="box" '
-            f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
-            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}"/>',
+            *(
+                f'{pad}      <geom name="{side}_{end}_contact" class="collision" type="sphere" '
+                f'size="{_f(SOLE_CONTACT_RADIUS)}" '
+                f'pos="{_f(x)} 0 {_f(-r.ankle_height + SOLE_CONTACT_RADIUS)}"/>'
+                for end, x in (("heel", -r.foot_heel), ("toe", r.foot_length - r.foot_heel))
+            ),
             f'{pad}      <geom class="visual" type="box" '
             f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
             f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}" material="{side}"/>',
@@ -279,7 +291,8 @@ def scene_xml(knee: str) -> str:
             "  <worldbody>",
             '    <light name="sun" type="directional" dir="0.3 0.6 -1" diffuse="0.6 0.6 0.6"/>',
             '    <geom name="floor" type="plane" size="0 0 0.05" material="grid" '
-            f'friction="{FOOT_FRICTION}" contype="0" conaffinity="1"/>',
+            f'friction="{FOOT_FRICTION}" solref="{FOOT_SOLREF}" solimp="{FOOT_SOLIMP}" '
+            'contype="0" conaffinity="1"/>',
             "  </worldbody>",
             "</mujoco>",
             "",

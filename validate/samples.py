@@ -1,0 +1,114 @@
+"""The gait as a gait file stores it: its samples as functions of time.
+
+What MuJoCo plays is the file, not the parameters it came from: the torques Γ(t), the motion
+q(t) and the start state are read from ``samples`` (``biped.gait_file``), interpolated on each
+spline piece separately (the accelerations and torques jump at the knot t = T/2, where the
+file holds both limits):
+
+    q(t), q̇(t)     cubic Hermite through (q, q̇), resp. (q̇, q̈), at the samples: the file holds
+                  the derivatives, so the interpolation is exact to O(h⁴) between samples
+    q̈(t), Γ(t)     linear between samples
+
+A time outside [0, T] is taken modulo T: the gait repeats every step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from biped.dynamics import Biped
+from biped.errors import BipedError
+from biped.robot import Robot
+
+FIELDS = ("q", "qd", "qdd", "torques", "wrench", "zmp")
+
+
+@dataclass(frozen=True)
+class GaitSamples:
+    """A gait file's samples (``biped.gait_file``) over one step.
+
+    Attributes:
+        period: T [s].
+        step_length: S [m], the hip's advance over the step.
+        t: (N,) sample times from 0 to T, T/2 twice (left and right limits) [s].
+        q, qd, qdd: (N, 9) coordinates, velocities, accelerations (paper's order).
+        torques: (N, 6) Γ1..Γ6 [N·m].
+        wrench: (N, 3) ground wrench on the stance foot [Fx, Fz, Cy] [N, N, N·m].
+        zmp: (N, 1) x of the ZMP from the stance ankle [m].
+    """
+
+    period: float
+    step_length: float
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    torques: np.ndarray
+    wrench: np.ndarray
+    zmp: np.ndarray
+
+    @classmethod
+    def from_gait(cls, gait: dict) -> GaitSamples:
+        """The samples of a gait file's content (``gait_file.read`` or ``gait_file.to_dict``)."""
+        samples = gait["samples"]
+        arrays = {key: np.asarray(samples[key], dtype=float) for key in ("t", *FIELDS)}
+        arrays["zmp"] = arrays["zmp"].reshape(-1, 1)
+        return cls(period=float(gait["period"]), step_length=float(gait["step_length"]), **arrays)
+
+    def pieces(self) -> tuple[slice, slice]:
+        """Rows of the left piece [0, T/2] and of the right piece [T/2, T]."""
+        knot = np.flatnonzero(np.isclose(self.t, 0.5 * self.period, rtol=0.0, atol=1e-12))
+        if len(knot) == 0:
+            raise BipedError("samples.t has no sample at T/2: allowed the knot at T/2 twice")
+        return slice(0, knot[0] + 1), slice(knot[-1], None)
+
+    def at(self, name: str, t) -> np.ndarray:
+        """One field (``FIELDS``) at times ``t`` (M,): (M, width)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        outside = (t < 0.0) | (t > self.period)
+        t = np.where(outside, np.mod(t, self.period), t)
+        values = getattr(self, name)
+        out = np.empty((len(t), values.shape[1]))
+        left, right = self.pieces()
+        on_left = t < 0.5 * self.period
+        for rows, mask in ((left, on_left), (right, ~on_left)):
+            if not mask.any():
+                continue
+            times = self.t[rows]
+            if name in ("q", "qd"):
+                slope = self.qd if name == "q" else self.qdd
+                out[mask] = _hermite(times, values[rows], slope[rows], t[mask])
+            else:
+                for column in range(values.shape[1]):
+                    out[mask, column] = np.interp(t[mask], times, values[rows, column])
+        return out
+
+    def start(self) -> tuple[np.ndarray, np.ndarray]:
+        """(q, q̇) at t = 0: the state just after the landing that starts the step."""
+        return self.q[0].copy(), self.qd[0].copy()
+
+    def end(self) -> tuple[np.ndarray, np.ndarray]:
+        """(q, q̇⁻) at t = T: the state just before the landing that ends the step."""
+        return self.q[-1].copy(), self.qd[-1].copy()
+
+
+def _hermite(times, values, slopes, t) -> np.ndarray:
+    """Cubic Hermite interpolation (M, width) through values and slopes at ``times``."""
+    k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
+    h = (times[k + 1] - times[k])[:, None]
+    s = ((t - times[k])[:, None]) / h
+    h00 = (1 + 2 * s) * (1 - s) ** 2
+    h10 = s * (1 - s) ** 2
+    h01 = s**2 * (3 - 2 * s)
+    h11 = s**2 * (s - 1)
+    return h00 * values[k] + h10 * h * slopes[k] + h01 * values[k + 1] + h11 * h * slopes[k + 1]
+
+
+def gait_biped(gait: dict) -> Biped:
+    """The analytical robot of a gait file's content (its robot as read, or as a mapping)."""
+    robot = gait["robot"]
+    if not isinstance(robot, Robot):
+        robot = Robot.from_mapping(robot, source="robot")
+    return Biped(robot, gait["knee"])
