@@ -69,3 +69,10 @@ def optimal_gait(knee: str):
     if knee not in _OPTIMA:
         _OPTIMA[knee] = optimize(GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3))
     return _OPTIMA[knee]
+
+
+def gait_content(optimum, robot=None) -> dict:
+    """The content of the gait file of ``optimum`` (``gait_file.to_dict``, seed 0), in memory."""
+    from biped import gait_file
+
+    return gait_file.to_dict(optimum, robot or biped.Robot.paper(), seed=0)

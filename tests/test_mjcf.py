@@ -218,3 +218,83 @@ def test_rolling_knee_discs_are_drawn(knee):
         for disc in (thigh, shank):
             assert disc.size[1] > max(THIGH_RADIUS, SHANK_RADIUS)
             assert model.geom_group[disc.id] == 2  # shown by default
+
+
+def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
+    """The committed scene of ``gait``'s knee at 1/``factor`` of its time step, each sole a box
+    on the floor (four contact points) instead of its heel and toe points, the contacts and
+    the knee equality as stiff as that step allows: the physics the committed model's cheaper
+    settings (2 ms, two points a sole) stand for."""
+    from validate import mjcf
+    from validate.model import model_spec
+    from validate.samples import gait_biped
+
+    spec = model_spec(gait, gait_biped(gait))
+    step = mjcf.TIMESTEP / factor
+    spec.option.timestep = step
+    for side in mjcf.SIDES:
+        for end in ("heel", "toe"):
+            spec.delete(spec.geom(f"{side}_{end}_contact"))
+        spec.body(f"{side}_foot").add_geom(
+            name=f"{side}_sole",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[ROBOT.foot_length / 2, mjcf.FOOT_WIDTH / 2, mjcf.SOLE_THICKNESS / 2],
+            pos=[
+                ROBOT.foot_length / 2 - ROBOT.foot_heel,
+                0.0,
+                -ROBOT.ankle_height + mjcf.SOLE_THICKNESS / 2,
+            ],
+            friction=[float(v) for v in mjcf.FOOT_FRICTION.split()],
+            condim=3,
+            contype=1,
+            conaffinity=0,
+        )
+    for geom in spec.geoms:
+        if geom.contype or geom.conaffinity:
+            geom.solref = [2 * step, 1.0]
+            geom.solimp = [float(v) for v in mjcf.FOOT_SOLIMP.split()]
+    for equality in spec.equalities:
+        equality.solref = [2 * step, 1.0]
+    return spec
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_cheaper_settings_leave_the_physics(knee):
+    """The committed model's 2 ms step and two contact points a sole against the same robot
+    at 0.5 ms with box soles: the same inverse dynamics (the rigid bodies are one robot, to
+    1e-9 N·m), and the same 10-step walk of the optimal gait: both walk, the distance within
+    1 % of the finer model's, step durations within 2 % of a period, the swing foot's
+    clearance within 0.2 mm, the centre of pressure within 0.5 mm RMS of the gait's ZMP,
+    the stance foot's slip under 1 mm."""
+    from tests.conftest import gait_content, optimal_gait
+    from validate.checks import MAX_SLIP, walk_figures, walks
+    from validate.contact import ground_reaction
+    from validate.crosscheck import mujoco_inverse_dynamics, rigid_copy
+    from validate.model import compile_spec, model_spec
+    from validate.samples import GaitSamples, gait_biped
+    from validate.simulate import Walker
+
+    optimum = optimal_gait(knee)
+    gait = gait_content(optimum)
+    model = gait_biped(gait)
+    samples = GaitSamples.from_gait(gait)
+    specs = {"committed": model_spec(gait, model), "fine": fine_spec(gait)}
+    torques, figures = {}, {}
+    for name, spec in specs.items():
+        exact = rigid_copy(compile_spec(spec))
+        result = mujoco_inverse_dynamics(exact, model, samples.q, samples.qd, samples.qdd)
+        torques[name] = result.torques
+        walker = Walker(gait, spec)
+        sim = walker.walk(10)
+        figures[name] = walk_figures(
+            model, samples, sim, optimum.costs()["energy"], ground_reaction(sim)
+        )
+        assert walks(figures[name], 10), (name, figures[name])
+        assert figures[name]["max_slip"] < MAX_SLIP
+    np.testing.assert_allclose(torques["committed"], torques["fine"], atol=1e-9)
+    np.testing.assert_allclose(torques["committed"], samples.torques, atol=1e-6)
+    ours, fine = figures["committed"], figures["fine"]
+    assert ours["distance"] == pytest.approx(fine["distance"], rel=0.01)
+    np.testing.assert_allclose(ours["step_duration_range"], fine["step_duration_range"], atol=0.02)
+    assert ours["swing_clearance"] == pytest.approx(fine["swing_clearance"], abs=2e-4)
+    assert abs(ours["zmp_rms_error"] - fine["zmp_rms_error"]) < 5e-4

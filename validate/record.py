@@ -39,9 +39,10 @@ import rerun.blueprint as rrb
 
 from biped.dynamics import JOINTS, Biped
 from biped.files import atomic_path
+from validate.contact import SAMPLE_EVERY
 from validate.mapping import mapping
 from validate.mjcf import HIP_OFFSET, SIDES
-from validate.report import SAMPLE_EVERY
+from validate.samples import GaitSamples
 from validate.simulate import Simulation, reference_along
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
@@ -211,7 +212,7 @@ def gait_qpos(biped: Biped, sim: Simulation, q: np.ndarray) -> np.ndarray:
     for j, stance in enumerate(sim.stances):
         rows = slice(starts[j], starts[j + 1])
         qpos[rows] = mapping(model, stance, biped.radii).qpos(q[rows])
-        qpos[rows, rootx] += sim.sensor(f"{stance}_ankle_pos")[starts[j], 0]
+        qpos[rows, rootx] += sim.ankle_x(stance)[starts[j]]
     return qpos
 
 
@@ -228,7 +229,9 @@ def _body_poses(model: mujoco.MjModel, qpos: np.ndarray, bodies: list) -> tuple:
     return positions, quaternions
 
 
-def summary(biped: Biped, step, sim: Simulation, checks=(), gait: dict | None = None) -> str:
+def summary(
+    biped: Biped, step: GaitSamples, sim: Simulation, checks=(), gait: dict | None = None
+) -> str:
     """Markdown: the gait's parameters and criteria, then every check with its verdict."""
     lines = [f"# {biped.knee} knee, {'PASS' if all(c.passed for c in checks) else 'FAIL'}"]
     if not checks:
@@ -259,7 +262,7 @@ def summary(biped: Biped, step, sim: Simulation, checks=(), gait: dict | None = 
             lines += [f"### {check.name}: {'PASS' if check.passed else 'FAIL'}", ""]
             lines += ["| figure | value |", "|---|---|"]
             lines += [f"| {name} | {_value(value)} |" for name, value in check.figures.items()]
-            lines += [""]
+            lines += [""] + [f"- {note}" for note in check.notes] + [""] * bool(check.notes)
     return "\n".join(lines)
 
 
@@ -276,7 +279,7 @@ def _value(value) -> str:
 def record(
     path: str | Path,
     biped: Biped,
-    step,
+    step: GaitSamples,
     sim: Simulation,
     contact: dict,
     checks=(),
@@ -287,6 +290,7 @@ def record(
     """Write the recording of a validation to ``path`` (.rrd), atomically.
 
     Args:
+        step: the gait file's samples (``validate.samples.GaitSamples``), drawn as the ghost.
         contact: MuJoCo's stance-foot force (N, 2) and centre of pressure (N,) as
             ``{"force": ..., "cop": ...}`` (NaN where not sampled or in double support).
         checks: the validation's checks (``validate.report.Check``), for the summary.
@@ -296,7 +300,7 @@ def record(
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    q_ref, torques, wrench, zmp = reference_along(biped, step, sim)
+    q_ref, torques, wrench, zmp = reference_along(step, sim)
     steady = sim.phase >= LANDING * step.period
     ranges = {
         torque_series_path(i, joint): torque_range(torques[:, i], steady)
@@ -342,11 +346,11 @@ def _log_torques(rec, biped: Biped, sim: Simulation, torques, ranges: dict, stea
     model = sim.model
     time_column = [rr.TimeColumn("time", duration=sim.time)]
     stance_of = sim.stance_of()
-    feedforward, feedback = sim.motors(), sim.feedback()  # JOINT_ORDER = motor order
+    feedforward, feedback = sim.feedforward(), sim.feedback()  # JOINT_ORDER
     parts = {"feedforward": np.zeros_like(torques), "feedback": np.zeros_like(torques)}
     for stance in SIDES:
         rows = stance_of == stance
-        order = mapping(model, stance, biped.radii).actuator_order
+        order = mapping(model, stance, biped.radii).columns
         parts["feedforward"][rows] = feedforward[np.ix_(rows, order)]
         parts["feedback"][rows] = feedback[np.ix_(rows, order)]
     landing = np.flatnonzero(~steady)[::5]
@@ -444,7 +448,7 @@ def _log_world(rec, biped: Biped, sim: Simulation, contact, q_ref, zmp) -> None:
     frames = np.arange(0, len(sim.time), FRAME_EVERY)
     frame_time = [rr.TimeColumn("time", duration=sim.time[frames])]
     # Floor: a slab under the walk, lines across it every 0.5 m.
-    start, end = float(sim.qpos[:, 0].min()) - 1.0, float(sim.qpos[:, 0].max()) + 1.0
+    start, end = float(sim.hip_x().min()) - 1.0, float(sim.hip_x().max()) + 1.0
     rec.log(
         "world/ground",
         rr.Boxes3D(
@@ -488,7 +492,7 @@ def _log_world(rec, biped: Biped, sim: Simulation, contact, q_ref, zmp) -> None:
     ankle_x = np.zeros(len(sim.time))
     for side in SIDES:
         rows = stance_of == side
-        ankle_x[rows] = sim.sensor(f"{side}_ankle_pos")[rows, 0]
+        ankle_x[rows] = sim.ankle_x(side)[rows]
     sampled = np.arange(0, len(sim.time), SAMPLE_EVERY)
     single = np.isfinite(contact["cop"][sampled])
     rows = sampled[single]

@@ -1,95 +1,154 @@
-"""Forward simulation of a gait in MuJoCo with contact, legs alternating every step.
+"""Forward simulation of a gait file in MuJoCo with contact, legs alternating every step.
 
-Control, per joint, at every physics step:
+What is played is the file: the motors apply the torques of its samples (``validate.samples``)
+and the joints follow the motion of its samples. Control, per joint, at every physics step:
 
-    u = Γ(τ) + kp (θ_ref(τ) - θ) + kv (θ̇_ref(τ) ṡ - θ̇)
+    u = Γ(τ) + J_r θ̈(τ) ṡ²  +  kp (θ_ref(τ) - θ) + kv (θ̇_ref(τ) ṡ - θ̇)
+        feedforward             feedback
 
-where the gait's time τ is not the clock but the phase of the step: the hip's advance over the
-stance ankle, x_H - x_ankle, mapped through the gait's own x_H(τ) (increasing over a step), and
-ṡ = ẋ_H / ẋ_H,ref(τ) the rate at which the robot goes through it. A robot a little late or
-early is then driven along the gait's path, not pulled back towards a clock; this is what a
-time reference cannot do for a walker, whose forward motion over its stance foot is an
-inverted pendulum.
+where Γ(τ) is the file's torque and J_r θ̈ what the joint's own drive takes to turn its rotor
+(MuJoCo's armature, ``Layout.rotor_inertia``: the paper's robot has no rotors, its torques are
+those at the joints). The gait's time τ is not the clock but the phase of the step: the hip's
+advance over the stance ankle, x_H - x_ankle, mapped through the gait's own x_H(τ) (increasing
+over a step), and ṡ = ẋ_H / ẋ_H,ref(τ) the rate at which the robot goes through it. A robot a
+little late or early is then driven along the gait's path, not pulled back towards a clock;
+this is what a time reference cannot do for a walker, whose forward motion over its stance
+foot is an inverted pendulum.
 
-The phase is read from the state every ``RESYNC`` (10 ms) and carried forward at the hip's
-speed in between, so MuJoCo runs each 10 ms on its own (``mujoco.rollout``, no Python in the
-loop) with the feedback closed at every physics step by its servos.
+The phase is read from the state every ``RESYNC`` and carried forward at the hip's speed in
+between, so MuJoCo runs each stretch on its own (``mujoco.rollout``, no Python in the loop)
+with the feedback closed at every physics step by its servos (``validate.model.with_servos``).
 
-The stance ankle carries the feedforward torque Γ1 alone, no feedback: its torque places the
-centre of pressure under the foot, and a servo there (kp = 1000 N·m/rad against a pendulum
-of m g l ≈ 600 N·m/rad) would move the centre of pressure by centimetres for a few
-hundredths of a radian, roll the foot and trip the robot. The five other joints track their
-reference with ``KP``, ``KV``. The feedback lives in MuJoCo position and velocity actuators
-(``validate.mjcf.robot_xml(servos=...)``): Python sets the references and the feedforward,
-MuJoCo computes the feedback inside its implicit integration step.
+The stance ankle has no servo: its torque places the centre of pressure under the foot, and a
+servo there (kp = 1000 N·m/rad against a pendulum of m g l ≈ 600 N·m/rad) would move the
+centre of pressure by centimetres for a few hundredths of a radian, roll the foot and trip the
+robot. It carries the file's Γ1 and the ankle strategy of a walker, a torque on the speed:
 
-A step ends when the swing foot, after leaving the ground, touches it again past mid-step
-(its touch sensor); the legs then swap roles. If the foot is late, the reference holds the
-end posture; if it has not landed after ``STEP_TIMEOUT`` periods, or the hip has dropped to
-a quarter below its height, the walk ends.
+    u_ankle = Γ1(τ) + J_r θ̈1 ṡ²  +  K (ẋ_H - ẋ_H,ref(τ))        K = ``SPEED_GAIN``
+
+(a robot a little fast moves its centre of pressure forward by K Δẋ / F_z, 3 mm for 1 cm/s,
+and slows down). The gait's orbit is not stable on its own: played with the phase alone, the
+optimal gaits lose speed step after step in MuJoCo (1.3 T a step after 10 steps) and their
+swing foot, clearing the ground by a millimetre, ends up scuffing it. The five other joints
+track their reference with ``KP``, ``KV`` (times ``WalkSettings.kp_scale``, ``kv_scale``).
+
+A step ends when the swing foot, after leaving the ground, touches it in the landing window
+(the last ``1 - LANDING_WINDOW`` of the step, by phase); the legs then swap roles. A foot
+late for the floor keeps coming down: past the end of the step the references go on at the
+step's end rates. A touch between the lift-off (the first ``LIFT_WINDOW`` of the step) and
+the landing window is a scuff: the step goes on (``validate.contact`` reports it). If the
+foot has not landed after ``STEP_TIMEOUT`` periods, or the hip has dropped below ``FALLEN``
+of its height, the walk ends.
+
+``Walker`` prepares a gait on a model once; ``Walker.walk`` runs it under ``WalkSettings``
+(gains, friction, a push): the robustness of a gait is many walks of one walker.
 """
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 from mujoco import rollout
 
-from biped.dynamics import Biped, zmp_from
+from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.gait import Step, angles_at
 from biped.kinematics import XH, ZH
+from validate.layout import Layout
 from validate.mapping import mapping, other
-from validate.mjcf import SIDES, scene_model
+from validate.mjcf import SIDES
+from validate.model import JOINT_ORDER, model_spec, with_servos
+from validate.samples import GaitSamples, gait_biped
 
-JOINT_ORDER = tuple(f"{side}_{joint}" for side in SIDES for joint in ("hip", "knee", "ankle"))
+__all__ = ["JOINT_ORDER", "Push", "Simulation", "WalkSettings", "Walker", "simulate"]
+
 # Joint-space feedback gains of the five tracked joints: stiffness [N·m/rad], damping
 # [N·m·s/rad]. The stance ankle has none (see the module docstring).
 KP = 1000.0
 KV = 40.0
 # A step waits for the swing foot at most this many periods.
 STEP_TIMEOUT = 2.0
-# Normal force [N] of the touch sensor that counts as a touchdown.
+# Normal force [N] of the touch sensor that counts as a touch of the ground.
 TOUCH_THRESHOLD = 1.0
+# Fraction of the step (by phase) from which a touch of the swing foot is its landing: the
+# gait's swing foot is then within a few millimetres of the ground, coming down.
+LANDING_WINDOW = 0.9
+# Fraction of the step (by phase) during which the trailing foot leaves the floor: a touch
+# then is the lift-off, not a scuff (the gait's foot is 2 mm up at its end).
+LIFT_WINDOW = 0.05
 # Points of the phase table (hip advance over one step).
 PHASE_POINTS = 2001
 # The phase rate ṡ is kept in this range (a robot stopped or thrown forward is not tracked
 # by scaling its reference rates further).
 RATE_RANGE = (0.25, 4.0)
+# Gain [N·s] of the stance ankle's torque on the hip's speed error (the ankle strategy).
+SPEED_GAIN = 200.0
 # Period [s] at which the controller reads the phase from the state.
-RESYNC = 0.01
+RESYNC = 0.02
 # Height of the hip, as a fraction of its height at the ends of the step, below which the
 # robot has fallen and the simulation stops (a walk keeps it within a few per cent).
 FALLEN = 0.75
 
 
+@dataclass(frozen=True)
+class Push:
+    """A shove on the trunk: a constant horizontal force on its centre of mass during one
+    reading period ``RESYNC`` (longer if a landing cuts that period short), of ``impulse``
+    in all.
+
+    Attributes:
+        impulse: [N·s] forward (> 0) or backward (< 0).
+        time: [s] from the start of the walk; the push starts at the first reading of the
+            phase at or after it (within ``RESYNC``).
+    """
+
+    impulse: float
+    time: float
+
+
+@dataclass(frozen=True)
+class WalkSettings:
+    """How a gait is walked (the defaults are the validation's walk).
+
+    Attributes:
+        kp_scale: the servos' stiffness is ``KP`` times this.
+        kv_scale: the servos' damping is ``KV`` times this.
+        friction: sliding friction coefficient of the soles and the floor (None: the
+            model's, ``biped.robot.FOOT_FRICTION``).
+        push: a shove on the trunk (None: none).
+    """
+
+    kp_scale: float = 1.0
+    kv_scale: float = 1.0
+    friction: float | None = None
+    push: Push | None = None
+
+    @property
+    def kp(self) -> float:
+        return KP * self.kp_scale
+
+    @property
+    def kv(self) -> float:
+        return KV * self.kv_scale
+
+
 def joint_matrix(model: mujoco.MjModel) -> np.ndarray:
-    """S (6, nq): the six actuated joint coordinates (knee flexion for the rolling knee) from
-    qpos, in ``JOINT_ORDER``; also maps qvel (nq = nv for these models)."""
-    matrix = np.zeros((6, model.nq))
-    for row, name in enumerate(JOINT_ORDER):
-        if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) >= 0:
-            matrix[row, model.joint(name).qposadr[0]] = 1.0
-        else:  # rolling knee: the flexion is split over two hinges
-            for part in ("upper", "lower"):
-                matrix[row, model.joint(f"{name}_{part}").qposadr[0]] = 1.0
-    return matrix
+    """S (6, nq): the six actuated joint coordinates from qpos, in ``JOINT_ORDER``."""
+    return Layout(model).joints
 
 
-def set_gains(model: mujoco.MjModel, stance: str, kp: float, kv: float) -> None:
+def set_gains(model: mujoco.MjModel, layout: Layout, stance: str, kp: float, kv: float):
     """Feedback gains of one step: ``kp``, ``kv`` on every joint but the stance ankle."""
-    for side in SIDES:
-        for joint in ("hip", "knee", "ankle"):
-            free = joint == "ankle" and side == stance
-            stiffness, damping = (0.0, 0.0) if free else (kp, kv)
-            position = model.actuator(f"{side}_{joint}_position").id
-            velocity = model.actuator(f"{side}_{joint}_velocity").id
-            model.actuator_gainprm[position, 0] = stiffness
-            model.actuator_biasprm[position, 1] = -stiffness
-            model.actuator_gainprm[velocity, 0] = damping
-            model.actuator_biasprm[velocity, 2] = -damping
+    for row, name in enumerate(JOINT_ORDER):
+        free = name == f"{stance}_ankle"
+        stiffness, damping = (0.0, 0.0) if free else (kp, kv)
+        position, velocity = layout.positions[row], layout.velocities[row]
+        model.actuator_gainprm[position, 0] = stiffness
+        model.actuator_biasprm[position, 1] = -stiffness
+        model.actuator_gainprm[velocity, 0] = damping
+        model.actuator_biasprm[velocity, 2] = -damping
 
 
 @dataclass(frozen=True)
@@ -100,8 +159,9 @@ class PhaseTable:
         advance: (N,) x [m], from the start of the step to its end.
         tau: (N,) the gait's time at each x [s].
         speed: (N,) planned ẋ_H at each x [m/s].
-        controls: stance side -> (N, 18) feedforward torques of the six motors, then joint
-            references and reference rates in ``JOINT_ORDER`` (MuJoCo's joint coordinates).
+        controls: stance side -> (N, 24) in ``JOINT_ORDER``: the file's torques of the six
+            motors (as their controls), joint references, reference rates, and what each
+            motor adds per unit ṡ² to turn its rotor (``Layout.rotor_inertia`` θ̈_ref).
     """
 
     advance: np.ndarray
@@ -110,30 +170,35 @@ class PhaseTable:
     controls: dict
 
 
-def phase_table(biped: Biped, step: Step, model: mujoco.MjModel, points: int = PHASE_POINTS):
-    """Tabulate the gait against the hip's advance; raises if the hip does not advance."""
-    tau = np.linspace(0.0, step.period, 4 * points)
-    angles, rates, accel = angles_at(step, tau / step.period)
-    q, qd, *_ = biped.single_support(angles, rates, accel)
-    if not np.all(qd[:, XH] > 0.0):
+def phase_table(
+    samples: GaitSamples, layout: Layout, radii, points: int = PHASE_POINTS
+) -> PhaseTable:
+    """Tabulate the file's gait against the hip's advance; raises if the hip does not advance."""
+    tau = np.linspace(0.0, samples.period, 4 * points)
+    x_hip = samples.at("q", tau)[:, XH]
+    speed = samples.at("qd", tau)[:, XH]
+    if not np.all(speed > 0.0):
         raise BipedError(
-            f"the hip's speed falls to {qd[:, XH].min():.3g} m/s during the step: a phase "
+            f"the hip's speed falls to {speed.min():.3g} m/s during the step: a phase "
             "needs a hip moving forward throughout (allowed > 0)"
         )
-    advance = np.linspace(q[0, XH], q[-1, XH], points)
-    tau = np.interp(advance, q[:, XH], tau)
-    angles, rates, accel = angles_at(step, tau / step.period)
-    q, qd, _, torques, _, _ = biped.single_support(angles, rates, accel)
-    select = joint_matrix(model)
+    advance = np.linspace(x_hip[0], x_hip[-1], points)
+    tau = np.interp(advance, x_hip, tau)
+    q, qd, qdd = (samples.at(name, tau) for name in ("q", "qd", "qdd"))
+    torques = samples.at("torques", tau)
     controls = {}
     for side in SIDES:
-        mapped = mapping(model, side, biped.radii)
-        table = np.zeros((points, 18))
-        table[:, mapped.actuator_order] = torques
-        table[:, 6:12] = mapped.qpos(q) @ select.T
-        table[:, 12:18] = mapped.qpos(qd) @ select.T
+        mapped = mapping(layout.model, side, radii)
+        table = np.zeros((points, 24))
+        # Motor controls: MuJoCo's joint torque -Γ, per unit of gear (validate.mjcf: gear -1).
+        table[:, mapped.columns] = -torques
+        table[:, :6] /= layout.gears
+        table[:, 6:12] = layout.joint_angles(mapped.qpos(q))
+        table[:, 12:18] = layout.joint_angles(mapped.qpos(qd))
+        table[:, 18:24] = layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
+        table[:, 18:24] /= layout.gears
         controls[side] = table
-    return PhaseTable(advance, tau, qd[:, XH], controls)
+    return PhaseTable(advance, tau, speed=qd[:, XH], controls=controls)
 
 
 @dataclass
@@ -143,69 +208,172 @@ class Simulation:
     MuJoCo computed at it."""
 
     model: mujoco.MjModel
+    layout: Layout
     time: np.ndarray  # (N,) [s]
     qpos: np.ndarray  # (N, nq)
     qvel: np.ndarray  # (N, nv)
-    ctrl: np.ndarray  # (N, nu) feedforward torques, joint references, reference rates
+    ctrl: np.ndarray  # (N, nu) motor controls, joint references, reference rates
     sensors: np.ndarray  # (N, nsensordata)
     phase: np.ndarray  # (N,) the gait's time τ the controller followed [s]
+    speed_torque: np.ndarray = None  # (N,) the stance ankle's torque on the speed [N·m]
     step_starts: list = field(default_factory=list)  # index of each step's first state
     stances: list = field(default_factory=list)  # stance side of each step
     landed: list = field(default_factory=list)  # whether each step ended on a touchdown
     warnings: int = 0  # MuJoCo warnings raised during the simulation
-    kp: float = KP
-    kv: float = KV
+    settings: WalkSettings = WalkSettings()
+    pushed: float = 0.0  # impulse given by the push [N·s]
+
+    @property
+    def kp(self) -> float:
+        return self.settings.kp
+
+    @property
+    def kv(self) -> float:
+        return self.settings.kv
 
     def sensor(self, name: str) -> np.ndarray:
         """Readings (N, dim) of a named sensor."""
         sensor = self.model.sensor(name)
         return self.sensors[:, sensor.adr[0] : sensor.adr[0] + sensor.dim[0]]
 
+    def step_slices(self) -> list[slice]:
+        """Rows of each step."""
+        ends = self.step_starts[1:] + [len(self.time)]
+        return [slice(a, b) for a, b in zip(self.step_starts, ends, strict=True)]
+
     def stance_of(self) -> np.ndarray:
         """Stance side (N,) of every state."""
         return np.repeat(self.stances, np.diff(self.step_starts + [len(self.time)]))
 
+    # -------------------------------------------------------------- named quantities (N,)
+    def hip_x(self) -> np.ndarray:
+        return self.layout.hip_x(self.qpos)
+
+    def hip_height(self) -> np.ndarray:
+        return self.layout.hip_height(self.qpos)
+
+    def trunk_angle(self) -> np.ndarray:
+        return self.layout.trunk_angle(self.qpos)
+
+    def hip_speed(self) -> np.ndarray:
+        return self.layout.hip_speed(self.qvel)
+
+    def ankle_x(self, side: str) -> np.ndarray:
+        return self.layout.ankle(self.sensors, side)[:, 0]
+
+    def heel(self, side: str) -> np.ndarray:
+        """(N, 3) [m]."""
+        return self.layout.heel(self.sensors, side)
+
+    def toe(self, side: str) -> np.ndarray:
+        """(N, 3) [m]."""
+        return self.layout.toe(self.sensors, side)
+
+    def touch(self, side: str) -> np.ndarray:
+        """Normal force [N] on a sole."""
+        return self.layout.touch(self.sensors, side)
+
+    def stance_foot_slip(self, settle: int = 0) -> np.ndarray:
+        """Travel [m] of each step's stance sole on the ground (the spread of its middle's
+        x) after its first ``settle`` states: a foot rolling on its sole barely moves its
+        middle, a foot sliding moves it by the slide."""
+        slips = []
+        for rows, stance in zip(self.step_slices(), self.stances, strict=True):
+            middle = 0.5 * (self.heel(stance)[rows, 0] + self.toe(stance)[rows, 0])
+            slips.append(float(np.ptp(middle[settle:])) if len(middle) > settle else 0.0)
+        return np.array(slips)
+
+    # -------------------------------------------------------------- torques (N, 6)
     def motors(self) -> np.ndarray:
-        """Feedforward torques (N, 6) the motors applied, in ``JOINT_ORDER``."""
-        low, high = self.model.actuator_ctrlrange[:6].T
-        return np.clip(self.ctrl[:, :6], low, high)
+        """Torques (N, 6) the motors applied, in the paper's sign (Γ), in ``JOINT_ORDER``."""
+        layout = self.layout
+        low, high = self.model.actuator_ctrlrange[layout.motors].T
+        limited = self.model.actuator_ctrllimited[layout.motors].astype(bool)
+        u = self.ctrl[:, layout.motors]
+        u = np.where(limited, np.clip(u, low, high), u)
+        return -u * layout.gears
+
+    def _speed_feedback(self) -> np.ndarray:
+        """(N, 6) the stance ankle's torque on the speed, in its column."""
+        torque = np.zeros((len(self.time), 6))
+        for side in SIDES:
+            rows = self.stance_of() == side
+            torque[rows, JOINT_ORDER.index(f"{side}_ankle")] = self.speed_torque[rows]
+        return torque
+
+    def feedforward(self) -> np.ndarray:
+        """The motors' torques (N, 6) less the ankle's torque on the speed: the file's torques
+        and the rotors' (paper's sign, ``JOINT_ORDER``)."""
+        return self.motors() - self._speed_feedback()
 
     def feedback(self) -> np.ndarray:
-        """Torques (N, 6) of the position and velocity servos, in the paper's sign
-        (conjugate to θ of eq. 32, like the motors' Γ), in ``JOINT_ORDER``."""
-        select = joint_matrix(self.model)
+        """Torques (N, 6) of the position and velocity servos and of the stance ankle on the
+        speed, in the paper's sign, in ``JOINT_ORDER``. The damping acts on the velocity at
+        the end of each physics step (MuJoCo integrates it implicitly): reading it at the
+        start would add h kv θ̈, an apparent inertia of 0.08 kg·m² at 2 ms and
+        kv = 40 N·m·s/rad."""
+        layout = self.layout
         stiffness = np.full((len(self.time), 6), self.kp)
         damping = np.full((len(self.time), 6), self.kv)
-        for i, side in enumerate(SIDES):
+        for side in SIDES:
             free = self.stance_of() == side
-            stiffness[free, 3 * i + 2] = damping[free, 3 * i + 2] = 0.0
-        servo = stiffness * (self.ctrl[:, 6:12] - self.qpos @ select.T)
-        servo += damping * (self.ctrl[:, 12:18] - self.qvel @ select.T)
-        return -servo  # the servos act on MuJoCo's joint angle, minus θ
+            column = JOINT_ORDER.index(f"{side}_ankle")
+            stiffness[free, column] = damping[free, column] = 0.0
+        rates = layout.joint_angles(self.qvel)
+        after = np.vstack([rates[1:], rates[-1:]])
+        ends = [start - 1 for start in self.step_starts[1:]]  # gains change at a step's end
+        after[ends] = rates[ends]
+        servo = stiffness * (self.ctrl[:, layout.positions] - layout.joint_angles(self.qpos))
+        servo += damping * (self.ctrl[:, layout.velocities] - after)
+        # The servos act on MuJoCo's joint angle, minus θ; the stance ankle's speed torque.
+        return -servo + self._speed_feedback()
+
+
+class Walker:
+    """A gait file prepared for walking on one MuJoCo model.
+
+    Args:
+        gait: the gait file's content (``biped.gait_file.read`` or ``to_dict``).
+        model: the scene to walk on (``validate.model.model_spec``: a file, or by default the
+            committed model of the gait's knee for Table 1, the generated one otherwise);
+            a spec, or a path.
+    """
+
+    def __init__(self, gait: dict, model: mujoco.MjSpec | str | None = None):
+        self.gait = gait
+        self.biped: Biped = gait_biped(gait)
+        self.samples = GaitSamples.from_gait(gait)
+        spec = model if isinstance(model, mujoco.MjSpec) else model_spec(gait, self.biped, model)
+        self.model = with_servos(spec, self.biped.knee, KP, KV)
+        self.layout = Layout(self.model)
+        self.table = phase_table(self.samples, self.layout, self.biped.radii)
+
+    @property
+    def period(self) -> float:
+        return self.samples.period
+
+    def walk(self, steps: int = 20, settings: WalkSettings = WalkSettings()) -> Simulation:
+        """Play ``steps`` steps of the gait from its start state, left leg in stance first."""
+        return _walk(self, steps, settings)
 
 
 def simulate(
-    biped: Biped,
-    step: Step,
-    steps: int = 20,
-    kp: float = KP,
-    kv: float = KV,
-    feedforward: float = 1.0,
-):
-    """Play ``steps`` steps of the gait from its start state, left leg in stance first.
+    gait: dict, steps: int = 20, settings: WalkSettings = WalkSettings(), model=None
+) -> Simulation:
+    """``Walker(gait, model).walk(steps, settings)``."""
+    return Walker(gait, model).walk(steps, settings)
 
-    Args:
-        feedforward: scale of the gait's torques in the control (1: the gait's own; other
-            values show what the check of a walk detects of wrong torques).
-    """
-    model = scene_model(biped.robot, biped.knee, servos=(kp, kv))
+
+def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
+    model = copy.deepcopy(walker.model)  # gains and friction change in it
+    if settings.friction is not None:
+        collides = (model.geom_contype != 0) | (model.geom_conaffinity != 0)
+        model.geom_friction[collides, 0] = settings.friction
+    layout = Layout(model)
     data = mujoco.MjData(model)
-    table = phase_table(biped, step, model)
-    if feedforward != 1.0:
-        for controls in table.controls.values():
-            controls[:, :6] *= feedforward
-    q0, qd0 = step.start
-    start = mapping(model, "left", biped.radii)
+    table, samples = walker.table, walker.samples
+    q0, qd0 = samples.start()
+    start = mapping(model, "left", walker.biped.radii)
     data.qpos[:] = start.qpos(q0)
     data.qvel[:] = start.qpos(qd0)
     mujoco.mj_forward(model, data)
@@ -214,107 +382,154 @@ def simulate(
     mujoco.mj_getState(model, data, state, spec)
     sensors = data.sensordata.copy()
     data.warning.number[:] = 0
-    nq, nv = model.nq, model.nv
 
     dt = model.opt.timestep
     chunk = max(1, round(RESYNC / dt))
-    capacity = int(np.ceil(steps * STEP_TIMEOUT * step.period / dt)) + chunk
-    log = {
-        "state": np.empty((capacity, state.size)),
-        "ctrl": np.empty((capacity, model.nu)),
-        "sensors": np.empty((capacity, model.nsensordata)),
-        "phase": np.empty(capacity),
-    }
-    result = Simulation(model, *(None,) * 6, kp=kp, kv=kv)
-    x0, span = table.advance[0], table.advance[-1] - table.advance[0]
+    period = samples.period
+    capacity = int(np.ceil(steps * STEP_TIMEOUT * period / dt)) + chunk
+    log_state = np.empty((capacity, state.size))
+    log_ctrl = np.empty((capacity, model.nu))
+    log_sensors = np.empty((capacity, model.nsensordata))
+    log_where = np.empty(capacity)  # position in the phase table
+    log_speed = np.empty(capacity)
+    result = Simulation(model, layout, *(None,) * 6, settings=settings)
+    x0, x_end = table.advance[0], table.advance[-1]
     last = len(table.advance) - 1
-    ankle = {side: model.sensor(f"{side}_ankle_pos").adr[0] for side in SIDES}
-    touch = {side: model.sensor(f"{side}_touch").adr[0] for side in SIDES}
-    floor = FALLEN * min(q0[ZH], step.end[0][ZH])
+    per_metre = last / (x_end - x0)  # table rows per metre of hip advance
+    speeds = table.speed.tolist()
+    end_speed = speeds[-1]
+    landing_row = LANDING_WINDOW * last
+    floor = FALLEN * min(q0[ZH], samples.end()[0][ZH])
     ticks = np.arange(chunk) * dt
+    columns = np.concatenate([layout.motors, layout.positions, layout.velocities])
     state = state[None]
     out_state = np.empty((1, chunk, state.size))
     out_sensors = np.empty((1, chunk, model.nsensordata))
+    controls_in = np.zeros((1, chunk, model.nu))
+    push = settings.push
+    remaining = 0.0 if push is None else float(push.impulse)  # impulse still to give [N·s]
+    # A push goes in as an applied force on the trunk (xfrc_applied) beside the controls.
+    only_controls = int(mujoco.mjtState.mjSTATE_CTRL)
+    with_force = int(mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_XFRC_APPLIED)
+    pushed_in = np.zeros((1, chunk, model.nu + 6 * model.nbody))
+    hip_x_at, hip_speed_at = layout.state_index("hip_x"), layout.state_index("hip_speed")
+    hip_height_at = layout.state_index("hip_height")
     k = 0
-    for j in range(steps):
-        stance = SIDES[j % 2]
-        controls = table.controls[stance]
-        set_gains(model, stance, kp, kv)
-        result.step_starts.append(k)
-        result.stances.append(stance)
-        began, landed, fallen, lifted = state[0, 0], False, False, False
-        landing = touch[other(stance)]
-        while state[0, 0] - began < STEP_TIMEOUT * step.period and k < capacity - chunk:
-            # The phase now, and as it goes on at the hip's present speed (the stance ankle's
-            # position is the reading of one physics step before: the foot is on the ground).
-            hip_speed = state[0, 1 + nq]
-            advance = state[0, 1] - sensors[ankle[stance]] + hip_speed * ticks
-            where = np.clip((advance - x0) / span, 0.0, 1.0) * last
-            i = np.minimum(where.astype(int), last - 1)
-            w = (where - i)[:, None]
-            rows = controls[i] * (1.0 - w) + controls[i + 1] * w
-            rate = hip_speed / (
-                table.speed[i[0]] * (1.0 - w[0, 0]) + table.speed[i[0] + 1] * w[0, 0]
-            )
-            rows[:, 12:18] *= min(max(rate, RATE_RANGE[0]), RATE_RANGE[1])
-            rows[where >= last, 12:18] = 0.0  # past the end of the step: hold the posture
-            rollout.rollout(
-                [model],
-                [data],
-                state,
-                rows[None],
-                nstep=chunk,
-                initial_warmstart=data.qacc_warmstart[None],
-                state=out_state,
-                sensordata=out_sensors,
-                skip_checks=True,
-            )
-            result.warnings += int(data.warning.number.sum())  # reset by every rollout
-            states, readings = out_state[0], out_sensors[0]
-            # states[r]: the state after physics step r; readings[r]: the sensors computed
-            # before it, at the state the step started from.
-            n = chunk
-            contact = readings[:, landing] > TOUCH_THRESHOLD
-            # A touchdown: the swing foot, off the ground since some time in this step, touches
-            # it past mid-step (a foot that never lifts does not make steps).
-            aloft = lifted | np.logical_or.accumulate(~contact)
-            down = np.flatnonzero((where > 0.5 * last) & contact & aloft)
-            lifted = bool(aloft[-1])
-            if len(down):
-                n, landed = down[0] + 1, True
-            bad = ~np.isfinite(states[:n, 2]) | (states[:n, 2] < floor)
-            if bad.any():
-                n, fallen, landed = int(np.argmax(bad)) + 1, True, False
-            log["state"][k] = state[0]
-            log["state"][k + 1 : k + n] = states[: n - 1]
-            log["ctrl"][k : k + n] = rows[:n]
-            log["sensors"][k : k + n] = readings[:n]
-            log["phase"][k : k + n] = (
-                table.tau[i[:n]] * (1.0 - w[:n, 0]) + table.tau[i[:n] + 1] * w[:n, 0]
-            )
-            k += n
-            state, sensors = states[n - 1 : n].copy(), readings[n - 1]
-            if landed or fallen:
+    with rollout.Rollout(nthread=0) as runner:
+        for j in range(steps):
+            stance = SIDES[j % 2]
+            controls = table.controls[stance]
+            set_gains(model, layout, stance, settings.kp, settings.kv)
+            result.step_starts.append(k)
+            result.stances.append(stance)
+            began, landed, fallen, lifted = state[0, 0], False, False, False
+            ankle_at = layout.sensor_index(stance, "ankle_pos")
+            touch_at = layout.sensor_index(other(stance), "touch")
+            ankle_column = JOINT_ORDER.index(f"{stance}_ankle")
+            ankle_gear = float(layout.gears[ankle_column])
+            while state[0, 0] - began < STEP_TIMEOUT * period and k < capacity - chunk:
+                # The phase now, and as it goes on at the hip's present speed (the stance
+                # ankle's position is the reading of one physics step before: the foot is
+                # on the ground).
+                hip_speed = float(state[0, hip_speed_at])
+                here = float(state[0, hip_x_at]) - float(sensors[ankle_at])
+                advance = ticks * hip_speed
+                advance += here
+                where = advance - x0
+                where *= per_metre
+                np.clip(where, 0.0, last, out=where)
+                i = where.astype(np.intp)
+                np.minimum(i, last - 1, out=i)
+                w = where - i
+                rows = controls[i]
+                rows += (controls[i + 1] - rows) * w[:, None]
+                if advance[-1] > x_end:
+                    # Past the end of the step the reference goes on at the end's rates: the
+                    # swing foot keeps coming down to the floor.
+                    beyond = np.maximum(advance - x_end, 0.0) / end_speed
+                    rows[:, 6:12] += rows[:, 12:18] * beyond[:, None]
+                a, b = int(i[0]), float(w[0])
+                planned = speeds[a] + (speeds[a + 1] - speeds[a]) * b
+                rate = min(max(hip_speed / planned, RATE_RANGE[0]), RATE_RANGE[1])
+                rows[:, 12:18] *= rate
+                rows[:, :6] += rows[:, 18:24] * (rate * rate)
+                # The ankle strategy: the stance ankle's torque grows with the hip's excess
+                # speed (its centre of pressure moves forward and slows the robot down).
+                speed_torque = SPEED_GAIN * (hip_speed - planned)
+                rows[:, ankle_column] -= speed_torque / ankle_gear
+                controls_in[0][:, columns] = rows[:, :18]
+                pushing = remaining != 0.0 and state[0, 0] >= push.time
+                if pushing:  # the rest of the push's impulse over this reading period
+                    force = remaining / (chunk * dt)
+                    pushed_in[0][:, : model.nu] = controls_in[0]
+                    pushed_in[0][:, model.nu + 6 * layout.trunk] = force
+                runner.rollout(
+                    [model],
+                    [data],
+                    state,
+                    pushed_in if pushing else controls_in,
+                    control_spec=with_force if pushing else only_controls,
+                    nstep=chunk,
+                    initial_warmstart=data.qacc_warmstart[None],
+                    state=out_state,
+                    sensordata=out_sensors,
+                    skip_checks=True,
+                )
+                if data.warning.number.any():  # reset by every rollout
+                    result.warnings += int(data.warning.number.sum())
+                states, readings = out_state[0], out_sensors[0]
+                # states[r]: the state after physics step r; readings[r]: the sensors
+                # computed before it, at the state the step started from.
+                n = chunk
+                contact = readings[:, touch_at] > TOUCH_THRESHOLD
+                # A landing: the swing foot, off the ground since some time in this step,
+                # touches it in the landing window (a foot that never lifts makes no steps).
+                if lifted:
+                    aloft = True
+                else:
+                    aloft = np.logical_or.accumulate(~contact)
+                    lifted = bool(aloft[-1])
+                if where[-1] >= landing_row and contact.any():
+                    down = np.flatnonzero((where >= landing_row) & contact & aloft)
+                    if len(down):
+                        n, landed = int(down[0]) + 1, True
+                heights = states[:n, hip_height_at]
+                if not heights.min() >= floor:  # below the floor, or not finite
+                    n, fallen, landed = int(np.argmax(~(heights >= floor))) + 1, True, False
+                if pushing:
+                    result.pushed += force * n * dt
+                    remaining = 0.0 if n == chunk else remaining - force * n * dt
+                log_state[k] = state[0]
+                log_state[k + 1 : k + n] = states[: n - 1]
+                log_ctrl[k : k + n] = controls_in[0, :n]
+                log_sensors[k : k + n] = readings[:n]
+                log_where[k : k + n] = where[:n]
+                log_speed[k : k + n] = speed_torque
+                k += n
+                state, sensors = states[n - 1 : n].copy(), readings[n - 1]
+                if landed or fallen:
+                    break
+            result.landed.append(landed)
+            if not landed:
                 break
-        result.landed.append(landed)
-        if not landed:
-            break
-    states = log["state"][:k]
+    states = log_state[:k]
     result.time = states[:, 0]
-    result.qpos = states[:, 1 : 1 + nq]
-    result.qvel = states[:, 1 + nq : 1 + nq + nv]
-    result.ctrl = log["ctrl"][:k]
-    result.sensors = log["sensors"][:k]
-    result.phase = log["phase"][:k]
+    result.qpos = layout.state_qpos(states)
+    result.qvel = layout.state_qvel(states)
+    result.ctrl = log_ctrl[:k]
+    result.sensors = log_sensors[:k]
+    result.phase = np.interp(log_where[:k], np.arange(last + 1), table.tau)
+    result.speed_torque = log_speed[:k]
     return result
 
 
-def reference_along(biped: Biped, step: Step, sim: Simulation):
-    """The gait at the phase the controller followed at every simulation state.
+def reference_along(samples: GaitSamples, sim: Simulation):
+    """The gait file's samples at the phase the controller followed, at every simulation
+    state.
 
     Returns:
-        q (N, 9), torques (N, 6), wrench (N, 3) and ZMP (N,) of the analytical gait.
+        q (N, 9), torques (N, 6), wrench (N, 3) and ZMP (N,) of the gait.
     """
-    angles, rates, accel = angles_at(step, sim.phase / step.period)
-    q, _, _, torques, wrench, _ = biped.single_support(angles, rates, accel)
-    return q, torques, wrench, zmp_from(torques, wrench, biped.robot.ankle_height)
+    fields = ("q", "torques", "wrench", "zmp")
+    q, torques, wrench, zmp = (samples.at(name, sim.phase) for name in fields)
+    return q, torques, wrench, zmp[:, 0]

@@ -25,7 +25,6 @@ import numpy as np
 
 from biped.dynamics import Biped
 from biped.files import atomic_path
-from biped.gait import angles_at
 from validate.mapping import mapping
 from validate.mjcf import SIDES
 from validate.simulate import Simulation
@@ -109,8 +108,7 @@ class WalkRenderer:
         sim = self.sim
         j = self.step_of(k)
         stance = sim.stances[j]
-        angles, rates, accel = angles_at(self.step, np.array([sim.phase[k] / self.step.period]))
-        q = self.biped.single_support(angles, rates, accel)[0][0]
+        q = self.step.at("q", sim.phase[k : k + 1])[0]
         qpos = self.maps[stance].qpos(q)
         qpos[self.model.joint("rootx").qposadr[0]] += self.ankle_x[stance][sim.step_starts[j]]
         return qpos

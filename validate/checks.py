@@ -1,0 +1,424 @@
+"""The checks of a gait file against MuJoCo, each a ``validate.report.Check``.
+
+model             the MJCF is the gait's robot where the harness relies on it (the rolling
+                  knee's equalities and their ratio r2 / r1); its mass beside the gait's
+inverse_dynamics  the file's Γ, F_e, ZMP against MuJoCo's dynamics of the model along the
+                  file's motion (1e-6)
+impact            the file's start velocities and impulse against MuJoCo's impact map
+                  (mass matrix and foot Jacobian) applied to the file's end state (1e-6)
+feedforward       each step replayed against the clock with the file's torques
+                  (``validate.replay``): the share of each joint's torque its servo had to
+                  add, below ``FEEDFORWARD_SHARE`` for every joint
+forward           the file walked in MuJoCo with contact (``validate.simulate``): every step
+                  lands and advances the hip by ``STEP_ADVANCE`` of the step length at
+                  least, no fall, no slip of the stance foot (``MAX_SLIP``), the stance foot
+                  flat (tilt below ``MAX_FOOT_TILT``), no scuff of the swing foot before its
+                  landing window, no MuJoCo warning; ground reaction, centre of pressure,
+                  velocity jump at touchdown, feedback, energy, clearance and the
+                  rolling-knee equality reported beside the gait's
+gains             the same walk at kp × ``GAIN_SCALES``: the range of gains it walks over
+
+A model the harness cannot use as the gait's robot (``validate.model.ModelError``: a rolling
+knee without its equalities) fails the checks that need it, with the reason as a note.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from biped.dynamics import JOINTS, Biped
+from validate import contact
+from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
+from validate.mapping import mapping, other
+from validate.model import ModelError, model_problems
+from validate.replay import replay_model, replay_step
+from validate.samples import GaitSamples
+from validate.simulate import KP, Simulation, Walker, WalkSettings, reference_along
+
+# Agreement of two exact rigid-body models of one robot.
+EXACT = 1e-6
+# Largest share of a joint's torque its servo may add in the replay (``validate.replay``):
+# the optimal gaits need 0.025 at most, a joint 20 % off 0.09 or more.
+FEEDFORWARD_SHARE = 0.05
+MAX_SLIP = 1e-3  # [m] stance-foot travel during its stance, after the landing settles
+# Largest tilt [rad] of the stance foot: a loaded sole on the soft floor tilts by a
+# fraction of a milliradian; 0.01 rad lifts the far end of a 26 cm sole by 2.6 mm.
+MAX_FOOT_TILT = 0.01
+# Fall: hip lower than this fraction of its planned minimum, or trunk beyond this angle.
+HIP_DROP = 0.9
+TRUNK_LIMIT = 0.5  # [rad]
+# A step counts only if the hip advances by this fraction of the step length in it (a robot
+# shuffling in place makes short "steps" that land).
+STEP_ADVANCE = 0.5
+# Fraction of a step after touchdown left out of the comparisons with the gait: MuJoCo's
+# soft landing takes that long to settle.
+LANDING = 0.1
+# Time after a landing's first contact at which its velocity jump is read [s].
+JUMP_WINDOW = 0.02
+# A walk whose swing foot clears the floor by less than this [m] is decided by scuffing:
+# the verdict would change with a millimetre of tracking error.
+SCUFF_MARGIN = 1e-3
+# Scales of the servos' stiffness KP (the damping stays) of the gains check.
+GAIN_SCALES = (0.5, 2.0)
+
+
+@dataclass
+class Check:
+    """One check of a gait.
+
+    Attributes:
+        name: its key in the report (``inverse_dynamics``, ``forward``, ...).
+        passed: the verdict.
+        figures: name -> value (numbers, booleans, [low, high] pairs; NaN: not measured).
+        notes: sentences that go with the verdict.
+        shown: the figures ``line`` prints (None: all).
+    """
+
+    name: str
+    passed: bool
+    figures: dict
+    notes: list = field(default_factory=list)
+    shown: tuple | None = None
+
+    def line(self) -> str:
+        names = self.figures if self.shown is None else self.shown
+        values = ", ".join(f"{k} {_fmt(self.figures[k])}" for k in names if k in self.figures)
+        text = f"{'PASS' if self.passed else 'FAIL'}  {self.name:17} {values}".rstrip()
+        return "; ".join([text, *self.notes])
+
+
+def _fmt(value) -> str:
+    if value is None or (isinstance(value, float) and np.isnan(value)):
+        return "n/a"
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (list, tuple)):
+        return "-".join(f"{v:.3g}" for v in value)
+    return f"{value:.3g}"
+
+
+def _rms(values) -> float:
+    """Root mean square; NaN for no values."""
+    return float(np.sqrt(np.mean(np.square(values)))) if np.size(values) else float("nan")
+
+
+def _median(values) -> float:
+    """Median; NaN for no values (a walk too short to measure)."""
+    return float(np.median(values)) if np.size(values) else float("nan")
+
+
+def _model_failure(name: str, error: Exception) -> Check:
+    return Check(name, False, {}, notes=[f"model error: {error}"])
+
+
+def check_model(model: mujoco.MjModel, biped: Biped) -> Check:
+    """The model is the gait's robot where the harness relies on it; masses reported."""
+    problems = model_problems(model, biped)
+    trunk = model.body("trunk").id
+    mass = float(model.body_subtreemass[trunk])
+    figures = {"mass_difference": mass - biped.robot.total_mass, "problems": len(problems)}
+    return Check("model", not problems, figures, notes=problems)
+
+
+def check_inverse_dynamics(model: mujoco.MjModel, biped: Biped, samples: GaitSamples) -> Check:
+    try:
+        result = mujoco_inverse_dynamics(
+            rigid_copy(model), biped, samples.q, samples.qd, samples.qdd
+        )
+    except ModelError as error:
+        return _model_failure("inverse_dynamics", error)
+    zmp = samples.zmp[:, 0]
+    figures = {
+        "max_torque_error": float(np.abs(result.torques - samples.torques).max()),
+        "max_wrench_error": float(np.abs(result.wrench - samples.wrench).max()),
+        "max_zmp_error": float(np.abs(result.zmp - zmp).max()),
+    }
+    if result.coupling.size:
+        figures["max_knee_coupling"] = float(np.abs(result.coupling).max())
+    passed = max(figures["max_torque_error"], figures["max_wrench_error"]) < EXACT
+    return Check("inverse_dynamics", passed and figures["max_zmp_error"] < EXACT, figures)
+
+
+def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait: dict) -> Check:
+    """MuJoCo's impact map of the file's end state against the file's start velocities (the
+    legs swapped: the new stance leg is the old swing leg) and its impulse."""
+    exact = rigid_copy(model)
+    q, qd_minus = samples.end()
+    mj_qd_plus, mj_impulse = mujoco_impact(exact, biped, q, qd_minus)
+    start = mapping(exact, "right", biped.radii).qpos(samples.qd[0])
+    figures = {
+        "max_velocity_error": float(np.abs(mj_qd_plus - start).max()),
+        "normal_impulse": float(mj_impulse[1]),
+        "landing_speed": float(np.linalg.norm(biped.point_jacobian(q, "swing_ankle") @ qd_minus)),
+    }
+    impulse = (gait.get("impact") or {}).get("impulse")
+    notes = []
+    if impulse is not None:
+        figures["max_impulse_error"] = float(np.abs(mj_impulse - np.asarray(impulse)).max())
+    else:
+        notes.append("the gait file has no impact.impulse to compare")
+    passed = figures["max_velocity_error"] < EXACT and figures.get("max_impulse_error", 0) < EXACT
+    return Check("impact", passed and impulse is not None, figures, notes)
+
+
+def check_feedforward(spec: mujoco.MjSpec, biped: Biped, samples: GaitSamples) -> Check:
+    """Both stance sides replayed; each joint's worst share (``validate.replay``)."""
+    model = replay_model(spec, biped.knee)
+    replays = [replay_step(model, samples, biped, stance) for stance in ("left", "right")]
+    shares = np.max([r.shares() for r in replays], axis=0)
+    feedback = np.max([r.feedback_rms() for r in replays], axis=0)
+    torques = np.max([r.torque_rms() for r in replays], axis=0)
+    figures = {"max_feedback_share": float(shares.max())}
+    for name, values in (("feedback_share", shares), ("feedback_rms", feedback)):
+        figures |= {f"{name}_{joint}": float(v) for joint, v in zip(JOINTS, values, strict=True)}
+    figures |= {f"torque_rms_{joint}": float(v) for joint, v in zip(JOINTS, torques, strict=True)}
+    passed = bool(shares.max() < FEEDFORWARD_SHARE)
+    notes = []
+    if not passed:
+        worst = [j for j, v in zip(JOINTS, shares, strict=True) if v >= FEEDFORWARD_SHARE]
+        notes.append(
+            "the file's torques are not its motion's at " + ", ".join(worst) + " (servo share "
+            f">= {FEEDFORWARD_SHARE:g})"
+        )
+    shown = ("max_feedback_share",) + tuple(f"feedback_share_{joint}" for joint in JOINTS)
+    return Check("feedforward", passed, figures, notes, shown=shown)
+
+
+def touchdown_jumps(biped: Biped, sim: Simulation, steps: int, window: float = JUMP_WINDOW):
+    """Relative error (per landing) of the velocity jump MuJoCo's walk shows at touchdown
+    against the analytical impact map (eqs. 21-24) applied to MuJoCo's state just before it.
+
+    MuJoCo's jump is measured ``window`` seconds after the first contact of the landing foot:
+    its soft contact spreads the impact over milliseconds during which gravity and the
+    servos also act, so the agreement is approximate by nature (reported, not checked).
+    """
+    model = sim.model
+    touch_ahead = int(round(window / model.opt.timestep))
+    errors = []
+    for j in range(min(steps, len(sim.stances) - 1)):
+        stance, end = sim.stances[j], sim.step_starts[j + 1]
+        touch = sim.touch(other(stance))[:end]
+        onset = end - 1
+        while onset > 0 and touch[onset - 1] > 0.0:
+            onset -= 1
+        if onset + touch_ahead >= len(sim.time):
+            break
+        to_paper = np.linalg.pinv(mapping(model, stance, biped.radii).qpos_from_q)
+        q, qd_minus = to_paper @ sim.qpos[onset - 1], to_paper @ sim.qvel[onset - 1]
+        qd_plus, _ = biped.impact(q, qd_minus)
+        seen = to_paper @ sim.qvel[onset - 1 + touch_ahead] - qd_minus
+        errors.append(
+            np.linalg.norm(seen - (qd_plus - qd_minus)) / np.linalg.norm(qd_plus - qd_minus)
+        )
+    return np.array(errors)
+
+
+def walk_figures(
+    biped: Biped, samples: GaitSamples, sim: Simulation, energy: float, reaction=None
+) -> dict:
+    """Figures of a forward simulation (see the module docstring); those of the ground
+    reaction (``validate.contact.ground_reaction``) only when it is given."""
+    model, robot, period = sim.model, biped.robot, samples.period
+    steps_run = sim.step_slices()
+    settle = int(contact.SETTLE * period / model.opt.timestep)
+    slips = sim.stance_foot_slip(settle)
+    slides = []
+    for rows, stance in zip(steps_run, sim.stances, strict=True):
+        middle = 0.5 * (sim.heel(stance)[rows, 0] + sim.toe(stance)[rows, 0])
+        slides.append(float(np.ptp(middle[:settle])) if len(middle) else 0.0)
+    tilt = contact.foot_tilt(sim, period)
+    scuffs = contact.scuffs(sim, period)
+    clearance = contact.clearance(biped, samples, sim)
+    advance = contact.advances(sim) / samples.step_length
+    q_ref, torques_ref, wrench_ref, zmp_ref = reference_along(samples, sim)
+    planned_hip = q_ref[:, 8].min()
+    hip, trunk = sim.hip_height(), sim.trunk_angle()
+    # Steps walked: leading steps that land, advance the hip, with the stance foot still and
+    # flat, hip and trunk held.
+    walked = 0
+    for j, rows in enumerate(steps_run):
+        upright = hip[rows].min() >= HIP_DROP * planned_hip and np.abs(trunk[rows]).max() <= (
+            TRUNK_LIMIT
+        )
+        if not (
+            sim.landed[j]
+            and upright
+            and advance[j] >= STEP_ADVANCE
+            and slips[j] < MAX_SLIP
+            and tilt.tilt[j] < MAX_FOOT_TILT
+        ):
+            break
+        walked += 1
+    shuffled = bool(np.any(np.array(sim.landed) & (advance < STEP_ADVANCE)))
+    starts = sim.step_starts + [len(sim.time)]
+    durations = np.diff(sim.time[starts[:-1]].tolist() + [sim.time[-1] + model.opt.timestep])
+    if reaction is None:  # not computed: its figures are not measured
+        nan = np.full(len(sim.time), np.nan)
+        reaction = {"force": np.stack([nan, nan], axis=1), "cop": nan}
+    # Comparisons with the gait over the steps walked (at least the first): after a fall
+    # they would only measure the fall. The landing transient of the soft contact is left
+    # out of them (its impact is not the rigid one of the gait).
+    end = starts[max(walked, 1)]
+    force, cop = reaction["force"][:end], reaction["cop"][:end]
+    steady = sim.phase[:end] >= LANDING * period
+    wrench_ref, zmp_ref = wrench_ref[:end], zmp_ref[:end]
+    single = ~np.isnan(cop)
+    compared = single & steady
+    weight = robot.total_mass * robot.gravity
+    feedforward, feedback = sim.feedforward()[:end], sim.feedback()[:end]
+    rates = -sim.layout.joint_angles(sim.qvel[:end])  # θ̇ of eq. (32), JOINT_ORDER
+    power = np.abs((feedforward + feedback) * rates).sum(axis=1)
+    ff_square, fb_square = np.sum(feedforward[steady] ** 2), np.sum(feedback[steady] ** 2)
+    counted = slice(0, max(walked, 1))
+    figures = {
+        "steps": walked,
+        "fell": bool(
+            not all(sim.landed)
+            or hip.min() < HIP_DROP * planned_hip
+            or np.abs(trunk).max() > TRUNK_LIMIT
+            or shuffled
+        ),
+        "max_slip": float(slips.max()),
+        "step_duration_range": [
+            float(durations[counted].min() / period),
+            float(durations[counted].max() / period),
+        ],
+        "step_advance_range": [float(advance[counted].min()), float(advance[counted].max())],
+        "max_landing_slide": float(max(slides)),
+        "max_foot_tilt": float(tilt.tilt.max()),
+        "max_heel_lift": float(tilt.heel_lift.max()),
+        "max_toe_lift": float(tilt.toe_lift.max()),
+        "scuff_steps": len(scuffs.steps),
+        "scuff_duration": float(scuffs.duration.sum()),
+        "scuff_depth": float(scuffs.depth.max()),
+        "swing_clearance": float(np.nanmin(clearance.walk[counted])),
+        "gait_swing_clearance": clearance.gait,
+        "zmp_rms_error": _rms(cop[compared] - zmp_ref[compared]),
+        "zmp_relative_error": _rms(cop[compared] - zmp_ref[compared])
+        / _rms(torques_ref[:end][compared, 0] / wrench_ref[compared, 1]),
+        "touchdown_jump_error": _median(touchdown_jumps(biped, sim, max(walked, 1))),
+        "ground_force_rms_error": _rms((force[compared] - wrench_ref[compared, :2]) / weight),
+        "feedforward_rms": _rms(feedforward[steady]),
+        "feedback_rms": _rms(feedback[steady]),
+        "feedback_share": float(np.sqrt(fb_square / max(ff_square + fb_square, 1e-12))),
+        "landing_feedback_rms": _rms(feedback[~steady]),
+        "energy_per_step": float(np.trapezoid(power, sim.time[:end]) / max(walked, 1)),
+        "analytic_energy_per_step": float(energy),
+        "warnings": int(sim.warnings),
+        "distance": float(sim.hip_x()[-1] - sim.hip_x()[0]),
+        "seconds_simulated": float(sim.time[-1] - sim.time[0]),
+    }
+    if biped.knee == "rolling":
+        worst = 0.0
+        for k in range(model.neq):
+            j1, j2 = model.eq_obj1id[k], model.eq_obj2id[k]
+            a, b = model.jnt_qposadr[j1], model.jnt_qposadr[j2]
+            worst = max(
+                worst, float(np.abs(sim.qpos[:, a] - model.eq_data[k, 1] * sim.qpos[:, b]).max())
+            )
+        figures["max_knee_equality_violation"] = worst
+    return figures
+
+
+def scuff_notes(sim: Simulation, period: float, figures: dict, steps: int) -> list:
+    """What the swing foot's clearance says of a walk of ``walk_figures``: its scuffs, and
+    whether they alone fail it, or how near it came to scuffing (``SCUFF_MARGIN``)."""
+    scuffs = contact.scuffs(sim, period)
+    if scuffs.steps:
+        j = scuffs.steps[0]
+        decided = walks({**figures, "scuff_steps": 0}, steps)
+        return [
+            ("decided by scuffing: " if decided else "")
+            + f"the swing foot scuffed the floor in {len(scuffs.steps)} steps (first: step "
+            f"{j + 1} at {scuffs.first_phase[j]:.2f} T, {scuffs.duration.sum() * 1e3:.0f} ms "
+            f"in all, {scuffs.depth.max() * 1e3:.2f} mm deep)"
+        ]
+    if figures["swing_clearance"] < SCUFF_MARGIN:
+        return [
+            f"decided by scuffing: the swing foot cleared the floor by "
+            f"{figures['swing_clearance'] * 1e3:.2f} mm (the gait by "
+            f"{figures['gait_swing_clearance'] * 1e3:.2f} mm)"
+        ]
+    return []
+
+
+def walks(figures: dict, steps: int) -> bool:
+    """The walk of ``walk_figures`` is a walk of ``steps`` steps."""
+    return (
+        figures["steps"] >= steps
+        and not figures["fell"]
+        and figures["max_slip"] < MAX_SLIP
+        and figures["max_foot_tilt"] < MAX_FOOT_TILT
+        and figures["scuff_steps"] == 0
+        and figures["warnings"] == 0
+    )
+
+
+def check_forward(walker: Walker, steps: int, energy: float):
+    """Walk at the default gains and check; returns (check, simulation, ground reaction)."""
+    began = time.perf_counter()
+    sim = walker.walk(steps)
+    wall = time.perf_counter() - began
+    reaction = contact.ground_reaction(sim)
+    figures = walk_figures(walker.biped, walker.samples, sim, energy, reaction)
+    figures["real_time_factor"] = figures["seconds_simulated"] / wall
+    notes = scuff_notes(sim, walker.period, figures, steps)
+    shown = (
+        "steps",
+        "fell",
+        "max_slip",
+        "max_foot_tilt",
+        "scuff_steps",
+        "swing_clearance",
+        "step_advance_range",
+        "feedback_share",
+        "zmp_rms_error",
+        "warnings",
+        "real_time_factor",
+    )
+    check = Check("forward", walks(figures, steps), figures, notes, shown=shown)
+    return check, sim, reaction
+
+
+def _key(scale: float) -> str:
+    """A gain scale in a figure's name: 0.5 -> '0_5' (a key without dots)."""
+    return f"{scale:g}".replace(".", "_")
+
+
+def check_gains(walker: Walker, steps: int, energy: float, forward: Check) -> Check:
+    """The walk at kp × ``GAIN_SCALES`` beside the default's."""
+    results = {1.0: walks(forward.figures, steps)}
+    clearances = {1.0: forward.figures["swing_clearance"]}
+    notes = []
+    for scale in GAIN_SCALES:
+        sim = walker.walk(steps, WalkSettings(kp_scale=scale))
+        figures = walk_figures(walker.biped, walker.samples, sim, energy)
+        results[scale] = walks(figures, steps)
+        clearances[scale] = figures["swing_clearance"]
+        notes += [
+            f"kp × {scale:g}: {note}" for note in scuff_notes(sim, walker.period, figures, steps)
+        ]
+    scales = sorted(results)
+    walked = [s for s in scales if results[s]]
+    figures = {f"walks_at_kp_x{_key(scale)}": results[scale] for scale in scales}
+    figures |= {f"swing_clearance_at_kp_x{_key(scale)}": clearances[scale] for scale in scales}
+    figures["kp"] = KP
+    if results[1.0]:  # the range around the default over which it walks
+        low = high = scales.index(1.0)
+        while low > 0 and results[scales[low - 1]]:
+            low -= 1
+        while high < len(scales) - 1 and results[scales[high + 1]]:
+            high += 1
+        figures["kp_scale_range"] = [scales[low], scales[high]]
+    else:
+        figures["kp_scale_range"] = [float("nan"), float("nan")]
+    passed = len(walked) == len(scales)
+    if not passed:
+        notes.insert(0, "walks at kp × " + (", ".join(f"{s:g}" for s in walked) or "none"))
+    return Check("gains", passed, figures, notes)

@@ -1,0 +1,171 @@
+"""What MuJoCo's walk did with its feet, read from a simulation after the fact.
+
+    ground_reaction   the stance foot's ground force and centre of pressure (single support)
+    foot_tilt         the stance foot's tilt and the lift of its heel and toe, each step
+    scuffs            the swing foot's touches of the floor before its landing window
+    clearance         how high the swing foot passes over the floor, in MuJoCo and in the gait
+    advances          how far the hip goes forward in each step
+
+A foot is a rigid sole between its heel and toe sites (``validate.mjcf``): its tilt is the
+angle of the heel-to-toe segment from the floor, and a heel or toe lifts when its site rises
+above the floor. A flat, loaded sole sits a fraction of a millimetre in the soft floor; a
+foot that rolls on its toe or heel edge (the centre of pressure at the edge, which a ZMP
+outside the sole means in a simulator) tilts and lifts its other end.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from biped.dynamics import Biped
+from validate.mapping import other
+from validate.samples import GaitSamples
+from validate.simulate import LANDING_WINDOW, LIFT_WINDOW, TOUCH_THRESHOLD, Simulation
+
+# Post-process every this many simulation states for the ground reaction.
+SAMPLE_EVERY = 5
+# Fraction of a step after its landing during which the stance foot settles (impact
+# transient): left out of the foot's slip and tilt.
+SETTLE = 0.05
+
+
+def ground_reaction(sim: Simulation) -> dict:
+    """Stance-foot force (N, 2) [Fx, Fz] [N] and centre of pressure (N,) [m, from the stance
+    ankle] in single support every ``SAMPLE_EVERY`` states (NaN elsewhere)."""
+    model, layout = sim.model, sim.layout
+    data = mujoco.MjData(model)
+    force = np.full((len(sim.time), 2), np.nan)
+    cop = np.full(len(sim.time), np.nan)
+    frame = np.zeros(6)
+    stance_of = sim.stance_of()
+    for k in range(0, len(sim.time), SAMPLE_EVERY):
+        data.qpos[:], data.qvel[:], data.ctrl[:] = sim.qpos[k], sim.qvel[k], sim.ctrl[k]
+        mujoco.mj_forward(model, data)
+        stance = stance_of[k]
+        swing_geoms = layout.foot_geoms[other(stance)]
+        ankle_x = layout.ankle(sim.sensors[k], stance)[0]
+        f_sum, moment, swing_touch = np.zeros(3), 0.0, False
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            if contact.geom1 in swing_geoms or contact.geom2 in swing_geoms:
+                swing_touch = True
+                continue
+            if contact.efc_address < 0:
+                continue
+            mujoco.mj_contactForce(model, data, i, frame)
+            world = contact.frame.reshape(3, 3).T @ frame[:3]
+            f_sum += world
+            moment += (contact.pos[0] - ankle_x) * world[2]
+        if not swing_touch and f_sum[2] > 0.0:
+            force[k] = f_sum[[0, 2]]
+            cop[k] = moment / f_sum[2]
+    return {"force": force, "cop": cop}
+
+
+def _settled(sim: Simulation, period: float) -> list[slice]:
+    """Rows of each step after its first ``SETTLE`` of the period."""
+    skip = int(SETTLE * period / sim.model.opt.timestep)
+    return [slice(min(rows.start + skip, rows.stop), rows.stop) for rows in sim.step_slices()]
+
+
+@dataclass
+class FootTilt:
+    """The stance foot in each step, after it settles.
+
+    Attributes:
+        tilt: (steps,) largest |angle| of the sole from the floor [rad].
+        heel_lift, toe_lift: (steps,) highest the heel, resp. toe, rises above the floor [m].
+    """
+
+    tilt: np.ndarray
+    heel_lift: np.ndarray
+    toe_lift: np.ndarray
+
+
+def foot_tilt(sim: Simulation, period: float) -> FootTilt:
+    tilt, heel_lift, toe_lift = [], [], []
+    for rows, stance in zip(_settled(sim, period), sim.stances, strict=True):
+        heel, toe = sim.heel(stance)[rows], sim.toe(stance)[rows]
+        if not len(heel):
+            tilt.append(0.0), heel_lift.append(0.0), toe_lift.append(0.0)
+            continue
+        angle = np.arctan2(toe[:, 2] - heel[:, 2], toe[:, 0] - heel[:, 0])
+        tilt.append(float(np.abs(angle).max()))
+        heel_lift.append(float(heel[:, 2].max()))
+        toe_lift.append(float(toe[:, 2].max()))
+    return FootTilt(np.array(tilt), np.array(heel_lift), np.array(toe_lift))
+
+
+@dataclass
+class Scuffs:
+    """Touches of the floor by the swing foot between its lift-off (``LIFT_WINDOW``) and its
+    landing window (``LANDING_WINDOW``).
+
+    Attributes:
+        steps: indices of the steps with a scuff.
+        duration: (steps,) time the swing foot spent on the floor in each step [s].
+        depth: (steps,) deepest its heel or toe went into the floor in each step [m].
+        first_phase: (steps,) fraction of the step at its first scuff (NaN: none).
+    """
+
+    steps: list
+    duration: np.ndarray
+    depth: np.ndarray
+    first_phase: np.ndarray
+
+
+def scuffs(sim: Simulation, period: float) -> Scuffs:
+    dt = sim.model.opt.timestep
+    duration, depth, first = [], [], []
+    for rows, stance in zip(sim.step_slices(), sim.stances, strict=True):
+        swing = other(stance)
+        touching = sim.touch(swing)[rows] > TOUCH_THRESHOLD
+        phase = sim.phase[rows] / period
+        scuff = touching & (phase >= LIFT_WINDOW) & (phase < LANDING_WINDOW)
+        lowest = np.minimum(sim.heel(swing)[rows, 2], sim.toe(swing)[rows, 2])
+        duration.append(float(scuff.sum() * dt))
+        depth.append(float(max(0.0, -lowest[scuff].min())) if scuff.any() else 0.0)
+        first.append(float(phase[np.argmax(scuff)]) if scuff.any() else float("nan"))
+    duration = np.array(duration)
+    return Scuffs(
+        steps=[int(j) for j in np.flatnonzero(duration > 0.0)],
+        duration=duration,
+        depth=np.array(depth),
+        first_phase=np.array(first),
+    )
+
+
+@dataclass
+class Clearance:
+    """How high the lowest point of the swing sole passes over the floor between its lift-off
+    and its landing window (phase ``LIFT_WINDOW`` to ``LANDING_WINDOW``) [m].
+
+    Attributes:
+        walk: (steps,) in MuJoCo, each step.
+        gait: in the gait file.
+    """
+
+    walk: np.ndarray
+    gait: float
+
+
+def clearance(biped: Biped, samples: GaitSamples, sim: Simulation) -> Clearance:
+    walk = []
+    for rows, stance in zip(sim.step_slices(), sim.stances, strict=True):
+        swing = other(stance)
+        phase = sim.phase[rows] / samples.period
+        window = (phase >= LIFT_WINDOW) & (phase < LANDING_WINDOW)
+        lowest = np.minimum(sim.heel(swing)[rows, 2], sim.toe(swing)[rows, 2])
+        walk.append(float(lowest[window].min()) if window.any() else float("nan"))
+    t = np.linspace(LIFT_WINDOW, LANDING_WINDOW, 400) * samples.period
+    feet = biped.points(samples.at("q", t), ["swing_heel", "swing_toe"])[..., 1]
+    return Clearance(walk=np.array(walk), gait=float(feet.min()))
+
+
+def advances(sim: Simulation) -> np.ndarray:
+    """(steps,) how far the hip goes forward in each step [m]."""
+    hip = sim.hip_x()
+    return np.array([hip[rows.stop - 1] - hip[rows.start] for rows in sim.step_slices()])

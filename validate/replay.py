@@ -1,0 +1,152 @@
+"""Replay of one step of a gait file in MuJoCo: do the file's torques make the file's motion?
+
+The step is played from the file's start state, on the floor, against the clock: every
+motor applies the file's torque Γ(t) (and what its rotor takes, ``Layout.rotor_inertia``),
+and a servo on every joint, the stance ankle included, holds the joint on the file's motion
+θ(t). When the torques are the motion's, the motion needs nothing more and the servos stay
+idle; when a joint's torque is off, that joint's servo supplies what is missing. The figure
+of a joint is the share of its torque its servo had to add:
+
+    share_i = rms(u_fb,i) / rms(u_ff,i + u_fb,i)        over the step, less its ends
+
+0.2 for a torque 20 % too small or too large, 1 for a joint without its torque. The exact
+torques leave what the simulator's own physics adds: the servos are stiff against the links
+but not against the whole robot leaning on its stance foot (gravity's 600 N·m/rad about the
+ankle), and the soles are stiff springs, not a rigid floor. To keep that small the replay
+runs at ``TIMESTEP`` (0.25 ms) with the contact as stiff as that step allows (``SOLREF``):
+shares of 0.02 at most for the optimal gaits, against 0.1 or more for a joint 20 % off.
+
+The window leaves out the first ``WINDOW[0]`` of the step (the contact settles under the
+stance foot, which starts exactly on the floor) and the last ``1 - WINDOW[1]`` (the swing foot
+comes down to the floor, where the landing belongs to the walk).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from biped.dynamics import JOINTS, Biped
+from validate.layout import Layout
+from validate.mapping import mapping
+from validate.model import JOINT_ORDER, with_servos
+from validate.samples import GaitSamples
+from validate.simulate import KP, KV
+
+# Physics step of the replay [s] and the contact's time constant and damping ratio there
+# (the shortest MuJoCo allows: two steps).
+TIMESTEP = 0.00025
+SOLREF = (2 * TIMESTEP, 1.0)
+# Part of the step compared, as fractions of the period.
+WINDOW = (0.05, 0.95)
+
+
+@dataclass
+class Replay:
+    """One step replayed; arrays in the paper's joint order (``biped.dynamics.JOINTS``:
+    stance ankle, knee, hip, swing hip, knee, ankle) and the paper's torque sign.
+
+    Attributes:
+        stance: the model's stance side.
+        time: (M,) the gait's time at each physics step [s].
+        feedforward: (M, 6) torques of the motors: the file's and the rotors' [N·m].
+        feedback: (M, 6) torques of the servos [N·m].
+        angle_error: (M, 6) joint angle less the file's [rad].
+        compared: (M,) the rows inside ``WINDOW``.
+    """
+
+    stance: str
+    time: np.ndarray
+    feedforward: np.ndarray
+    feedback: np.ndarray
+    angle_error: np.ndarray
+    compared: np.ndarray
+
+    def shares(self) -> np.ndarray:
+        """(6,) the share of each joint's torque its servo added (see the module)."""
+        fb, total = self.feedback[self.compared], (self.feedforward + self.feedback)[self.compared]
+        return _rms(fb) / np.maximum(_rms(total), 1e-12)
+
+    def feedback_rms(self) -> np.ndarray:
+        """(6,) RMS of each servo's torque [N·m]."""
+        return _rms(self.feedback[self.compared])
+
+    def torque_rms(self) -> np.ndarray:
+        """(6,) RMS of each joint's torque in the file [N·m] (motors less rotors)."""
+        return _rms(self.feedforward[self.compared])
+
+
+def _rms(values) -> np.ndarray:
+    return np.sqrt(np.mean(np.square(values), axis=0))
+
+
+def replay_model(spec: mujoco.MjSpec, knee: str) -> mujoco.MjModel:
+    """The model of ``spec`` with servos on every joint, at ``TIMESTEP``, its contacts at
+    ``SOLREF``."""
+    model = with_servos(spec, knee, KP, KV)
+    model.opt.timestep = TIMESTEP
+    model.geom_solref[:] = SOLREF
+    return model
+
+
+def replay_step(
+    model: mujoco.MjModel, samples: GaitSamples, biped: Biped, stance: str = "left"
+) -> Replay:
+    """Replay one step of ``samples`` on ``model`` (``replay_model``) with ``stance`` the
+    stance side."""
+    layout = Layout(model)
+    mapped = mapping(model, stance, biped.radii)
+    h = model.opt.timestep
+    period = samples.period
+    n = int(np.floor(WINDOW[1] * period / h))
+    t = np.arange(n) * h
+    middle = t + 0.5 * h  # the controls act over each step: the torques at its middle
+    q, qd = samples.at("q", t), samples.at("qd", t)
+    torques, qdd = samples.at("torques", middle), samples.at("qdd", middle)
+    to_joint = mapped.columns  # paper joint i -> column of JOINT_ORDER
+    # Motors: MuJoCo's joint torque -Γ plus the rotor's J_r θ̈_mj, per unit of gear.
+    joint_torque = np.zeros((n, 6))
+    joint_torque[:, to_joint] = -torques
+    joint_torque += layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
+    controls = np.zeros((1, n, model.nu))
+    controls[0][:, layout.motors] = joint_torque / layout.gears
+    controls[0][:, layout.positions] = layout.joint_angles(mapped.qpos(q))
+    controls[0][:, layout.velocities] = layout.joint_angles(mapped.qpos(qd))
+
+    data = mujoco.MjData(model)
+    data.qpos[:] = mapped.qpos(q[0])
+    data.qvel[:] = mapped.qpos(qd[0])
+    mujoco.mj_forward(model, data)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state, spec)
+    states = np.empty((1, n, state.size))
+    rollout.rollout(model, data, state, controls, nstep=n, state=states)
+    after = states[0]
+    before = np.vstack([state, after[:-1]])
+    angles = layout.joint_angles(layout.state_qpos(before))
+    rates_after = layout.joint_angles(layout.state_qvel(after))  # implicit damping
+    kp = model.actuator_gainprm[layout.positions, 0]
+    kv = model.actuator_gainprm[layout.velocities, 0]
+    servo = kp * (controls[0][:, layout.positions] - angles)
+    servo += kv * (controls[0][:, layout.velocities] - rates_after)
+    motors = controls[0][:, layout.motors] * layout.gears
+    rotor = layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
+    # Paper's sign and order: Γ = -(MuJoCo's joint torque).
+    feedforward = -(motors - rotor)[:, to_joint]
+    feedback = -servo[:, to_joint]
+    error = (angles - controls[0][:, layout.positions])[:, to_joint]
+    return Replay(
+        stance=stance,
+        time=t,
+        feedforward=feedforward,
+        feedback=feedback,
+        angle_error=-error,
+        compared=t >= WINDOW[0] * period,
+    )
+
+
+__all__ = ["JOINTS", "JOINT_ORDER", "Replay", "replay_model", "replay_step"]
