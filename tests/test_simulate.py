@@ -8,6 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from biped.kinematics import ZH
 from tests.conftest import gait_content, optimal_gait, small_optimum
 from validate import contact
 from validate.checks import MAX_FOOT_TILT, MAX_SLIP, scuff_notes, walk_figures, walks
@@ -86,7 +87,7 @@ def test_fall_ends_the_simulation():
     walker = Walker(gait)
     sim = walker.walk(3, WalkSettings(kp_scale=0.0, kv_scale=0.0))
     assert len(sim.landed) <= 2 and not sim.landed[-1]
-    assert sim.hip_height()[-1] == pytest.approx(FALLEN * walker.samples.q[0, 8], abs=0.01)
+    assert sim.hip_height()[-1] == pytest.approx(FALLEN * walker.samples.q[0, ZH], abs=0.01)
     figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
     assert figures["fell"] and figures["steps"] == 0
 

@@ -1,4 +1,4 @@
-"""The checks of a gait file against MuJoCo, each a ``validate.report.Check``.
+"""The checks of a gait file against MuJoCo, each a ``Check``: a verdict, figures and notes.
 
 model             the MJCF is the gait's robot where the harness relies on it (the rolling
                   knee's equalities and their ratio r2 / r1); its mass beside the gait's
@@ -31,6 +31,7 @@ import mujoco
 import numpy as np
 
 from biped.dynamics import JOINTS, Biped
+from biped.kinematics import ZH
 from validate import contact
 from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
 from validate.mapping import mapping, other
@@ -88,7 +89,9 @@ class Check:
         names = self.figures if self.shown is None else self.shown
         values = ", ".join(f"{k} {_fmt(self.figures[k])}" for k in names if k in self.figures)
         text = f"{'PASS' if self.passed else 'FAIL'}  {self.name:17} {values}".rstrip()
-        return "; ".join([text, *self.notes])
+        if not self.notes:
+            return text
+        return f"{text}{'; ' if values else '  '}{'; '.join(self.notes)}"
 
 
 def _fmt(value) -> str:
@@ -237,7 +240,7 @@ def walk_figures(
     clearance = contact.clearance(biped, samples, sim)
     advance = contact.advances(sim) / samples.step_length
     q_ref, torques_ref, wrench_ref, zmp_ref = reference_along(samples, sim)
-    planned_hip = q_ref[:, 8].min()
+    planned_hip = q_ref[:, ZH].min()
     hip, trunk = sim.hip_height(), sim.trunk_angle()
     # Steps walked: leading steps that land, advance the hip, with the stance foot still and
     # flat, hip and trunk held.

@@ -70,6 +70,8 @@ def model_spec(gait: dict, biped: Biped, path: str | Path | None = None) -> mujo
         source = "the model generated from the gait's robot"
     else:
         source = f"model {str(path)!r}"
+        if Path(path).suffix.lower() != ".xml" or not Path(path).is_file():
+            raise BipedError(f"{source} is not an MJCF file: allowed an existing .xml file")
         try:
             spec = mujoco.MjSpec.from_file(str(path))
         except (ValueError, OSError) as error:  # MuJoCo's parse errors are ValueErrors
