@@ -200,12 +200,21 @@ def cmd_figures(args) -> int:
 
 
 def _validate_and_record(
-    gait: dict, steps: int, rrd, video=None, gif=None, spawn=False, connect=None, source=None
+    gait: dict,
+    steps: int,
+    rrd,
+    video=None,
+    gif=None,
+    spawn=False,
+    connect=None,
+    source=None,
+    model=None,
 ):
-    """Every check of a gait read by ``gait_file.read``, its recording at ``rrd`` (also
-    streamed to a viewer with ``spawn`` or ``connect``) and, if asked, the video of its walk
-    at ``video`` (MP4) and ``gif``. ``source``: the gait file, named as the recording's owner
-    (``biped_cli.outputs``).
+    """Every check of a gait (``gait_file.read`` or ``gait_file.to_dict``: in memory) on
+    ``model`` (an MJCF path; None: ``validate.model.model_spec``'s default), its recording at
+    ``rrd`` (also streamed to a viewer with ``spawn`` or ``connect``) and, if asked, the video
+    of its walk at ``video`` (MP4) and ``gif``. ``source``: the gait file, named as the
+    recording's owner (``biped_cli.outputs``).
 
     Returns the validation and its report (the checks as JSON with their ``units``, the
     recording's and video's paths).
@@ -215,7 +224,7 @@ def _validate_and_record(
     from validate.report import as_json, validate
     from validate.units import report_units
 
-    result = validate(gait, steps=steps)
+    result = validate(gait, steps=steps, model=model)
     written = record(
         rrd,
         result.biped,
@@ -249,9 +258,13 @@ def _validate_and_record(
 def cmd_validate(args) -> int:
     """Cross-check gait files in MuJoCo and record each for rerun.
 
-    Checks: analytical inverse dynamics and impact against MuJoCo's dynamics of the MJCF, and
-    a forward walk with contact over --steps steps (every step lands, no fall, no slip, centre
-    of pressure in the foot and on the gait's ZMP). Prints a table per gait (or JSON with
+    Checks, on the MJCF of --model (default: the committed model of the gait's knee for the
+    Table 1 robot, the one generated from the gait's robot otherwise): the model is the
+    gait's robot; the file's torques, ground wrench, ZMP and impact against MuJoCo's
+    dynamics; each step replayed with the file's torques (the share of every joint's torque
+    its servo had to add); a forward walk with contact over --steps steps (every step lands
+    and advances, no fall, no slip, the stance foot flat, no scuff of the swing foot); the
+    same walk at half and twice the servo stiffness. Prints a table per gait (or JSON with
     --json) and writes a rerun recording per gait (--spawn, --connect: also to a viewer) and,
     with --video, the video of the walk; exits 0 only when every check of every gait passes,
     1 otherwise. A gait file whose samples, costs, constraints or feasibility are not those
@@ -277,6 +290,15 @@ def cmd_validate(args) -> int:
     gaits = [gait_file.read_consistent(path) for path in args.gait]
     for path, gait in zip(args.gait, gaits, strict=True):
         check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
+    if args.model is not None:  # a model each gait can be played on, before any work
+        from validate.model import model_spec
+        from validate.samples import gait_biped
+
+        for path, gait in zip(args.gait, gaits, strict=True):
+            try:
+                model_spec(gait, gait_biped(gait), args.model)
+            except BipedError as error:
+                raise BipedError(f"--model, gait file {path!r}: {error}") from None
     recordings = [
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
         for path in args.gait
@@ -296,7 +318,15 @@ def cmd_validate(args) -> int:
             bar.update(note=path)
             try:
                 result, reports[path] = _validate_and_record(
-                    gait, args.steps, rrd, args.video, gif, args.spawn, args.connect, path
+                    gait,
+                    args.steps,
+                    rrd,
+                    args.video,
+                    gif,
+                    args.spawn,
+                    args.connect,
+                    path,
+                    args.model,
                 )
             except BipedError as error:
                 raise BipedError(f"gait file {path!r}: {error}") from None
@@ -376,7 +406,7 @@ def cmd_pipeline(args) -> int:
         print(f"[{knee}] validating {args.steps} steps in MuJoCo...", flush=True)
         video = None if args.no_video else recordings / f"{name}.mp4"
         result, report = _validate_and_record(
-            gait_file.read(gait_path),
+            gait,  # in memory: the file written is this content
             args.steps,
             recordings / f"{name}.rrd",
             video,

@@ -165,6 +165,12 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="also stream the recording to a running rerun viewer (default its local address)",
     )
+    val.add_argument(
+        "--model",
+        metavar="PATH",
+        help="MJCF to play the gaits on (default: mjcf/scene_<knee>.xml when the gait's robot is "
+        "Table 1, the model generated from the gait's robot otherwise)",
+    )
     val.set_defaults(run=cmd_validate)
 
     pipe = commands.add_parser(

@@ -113,3 +113,119 @@ def test_validate_several_gaits(gait_path, tmp_path, capsys, monkeypatch):
     assert code == (0 if all(r["passed"] for r in content.values()) else 1)
     for report in content.values():
         assert (tmp_path / report["recording"]).stat().st_size > 0
+
+
+def _run(args, capsys):
+    """``biped`` with ``args``: (exit status, stdout, stderr)."""
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope="module")
+def heavy_gait(tmp_path_factory):
+    """The optimal revolute gait at 0.3 m/s of a robot whose trunk is 10 % heavier."""
+    import dataclasses
+
+    from biped import Biped
+    from biped.optimize import optimize
+    from biped.problem import GaitProblem
+
+    paper = Robot.paper()
+    robot = dataclasses.replace(paper, trunk_mass=1.1 * paper.trunk_mass)
+    optimum = optimize(GaitProblem(Biped(robot, "revolute"), 0.3))
+    path = tmp_path_factory.mktemp("heavy") / "heavy.json"
+    return gait_file.write_json(path, gait_file.to_dict(optimum, robot, seed=0))
+
+
+def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_path, capsys):
+    """A gait made for a trunk 10 % heavier, played on the committed Table 1 model (--model):
+    its torques are not those of that robot's motion, and the replay of its steps fails at
+    the joints that carry the trunk, beside inverse dynamics; on the model of its own robot
+    (the default) the same replay passes."""
+    from validate.mjcf import FOLDER
+
+    rrd = str(tmp_path / "heavy.rrd")
+    model = str(FOLDER / "scene_revolute.xml")
+    args = ["validate", str(heavy_gait), "--steps", "1", "--json", "--rrd", rrd]
+    code, out, _ = _run([*args, "--model", model], capsys)
+    table_1 = json.loads(out)
+    assert code == 1 and not table_1["passed"]
+    assert not table_1["feedforward"]["passed"] and not table_1["inverse_dynamics"]["passed"]
+    assert table_1["model"]["mass_difference"] == pytest.approx(-0.1 * Robot.paper().trunk_mass)
+    stance = [table_1["feedforward"][f"feedback_share_stance_{j}"] for j in ("knee", "hip")]
+    assert min(stance) > 0.1
+    _, out, _ = _run(args, capsys)
+    own = json.loads(out)
+    assert own["feedforward"]["passed"] and own["inverse_dynamics"]["passed"]
+
+
+def test_a_rolling_gait_on_the_revolute_model_is_refused(gait_path, tmp_path, capsys):
+    """--model of the other knee: one line naming the model and both knees, exit 2, before
+    any work (no recording)."""
+    from validate.mjcf import FOLDER
+
+    rrd = tmp_path / "refused.rrd"
+    model = str(FOLDER / "scene_revolute.xml")
+    code, _, err = _run(["validate", str(gait_path), "--model", model, "--rrd", str(rrd)], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "revolute knee" in err and "rolling knee" in err and "scene_revolute.xml" in err
+    assert not rrd.exists()
+    code, _, err = _run(["validate", str(gait_path), "--model", str(tmp_path / "no.xml")], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "no.xml" in err
+
+
+def _rolling_model(folder, change) -> str:
+    """The committed rolling-knee scene copied to ``folder`` with its robot file changed by
+    ``change(text) -> text``; returns the scene's path."""
+    from validate.mjcf import FOLDER
+
+    folder.mkdir(parents=True, exist_ok=True)
+    robot = (FOLDER / "biped_rolling.xml").read_text()
+    (folder / "biped_rolling.xml").write_text(change(robot))
+    (folder / "scene_rolling.xml").write_text((FOLDER / "scene_rolling.xml").read_text())
+    return str(folder / "scene_rolling.xml")
+
+
+def test_model_errors_are_fail_lines(gait_path, tmp_path, capsys):
+    """A rolling-knee model without its knee equalities, or with another ratio r2 / r1, is not
+    the gait's robot: the model check and inverse dynamics print FAIL lines naming why, exit
+    1, no traceback."""
+    import re
+
+    missing = _rolling_model(
+        tmp_path / "missing", lambda text: re.sub(r"<equality>.*?</equality>", "", text, flags=re.S)
+    )
+    ratio = _rolling_model(
+        tmp_path / "ratio", lambda text: text.replace('polycoef="0 1 ', 'polycoef="0 1.2 ')
+    )
+    cases = (
+        (missing, "no equality", "degrees of freedom"),  # the system is not square
+        (ratio, "knee_lower = 1.2 knee_upper", "max_torque_error"),  # another robot's torques
+    )
+    for model, reason, inverse in cases:
+        rrd = str(tmp_path / f"{reason[:2]}.rrd")
+        code, out, err = _run(
+            ["validate", str(gait_path), "--steps", "1", "--model", model, "--rrd", rrd], capsys
+        )
+        assert code == 1 and "Traceback" not in err, err
+        lines = {
+            line.split()[1]: line
+            for line in out.splitlines()
+            if line[:4].strip() and "  " in line[:2]
+        }
+        assert lines["model"].startswith("  FAIL") and reason in lines["model"]
+        assert (
+            lines["inverse_dynamics"].startswith("  FAIL") and inverse in lines["inverse_dynamics"]
+        )
+
+
+def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
+    """Each check is an object with ``passed`` and ``notes``; every number has its unit."""
+    from biped.units import missing
+
+    code, content, _ = report
+    for name in ("model", "inverse_dynamics", "impact", "feedforward", "forward", "gains"):
+        assert isinstance(content[name]["passed"], bool), name
+        assert isinstance(content[name]["notes"], list), name
+    assert missing(content, content["units"]) == []
