@@ -146,17 +146,21 @@ def test_pipeline_refuses_a_file_as_output_folder(capsys):
     assert len(err) == 1 and "allowed a folder" in err[0]
 
 
-def test_pipeline_writes_gait_report_and_recording(tmp_path, capsys):
+def test_pipeline_writes_gait_report_and_recording(tmp_path, capsys, monkeypatch):
     """One knee, a small budget and 2 steps: the gait file, its report and its recording are
-    written where the command says, and the exit status is the report's verdict."""
+    written where the command says, and the exit status is the report's verdict; the gait is
+    validated in memory (its file is never read back)."""
     import json
 
     from biped import gait_file
 
+    read = gait_file.read
+    monkeypatch.setattr(gait_file, "read", lambda *a, **k: pytest.fail("gait file read back"))
     out, rrd = tmp_path / "pipeline", tmp_path / "recordings"
     argv = ["pipeline", "--knees", "rolling", "--steps", "2", *FAST, "--out", str(out)]
     code = main(argv + ["--recordings", str(rrd)])
     printed = capsys.readouterr().out
+    monkeypatch.setattr(gait_file, "read", read)
     gait = gait_file.read(out / "rolling-sthenic-0.300.json")
     assert gait["knee"] == "rolling" and gait["speed"] == 0.3
     report = json.loads((out / "rolling-sthenic-0.300.report.json").read_text())
