@@ -1,7 +1,12 @@
-"""MuJoCo beside the analytical model: inverse dynamics per sample, and the forward
-validation's speed (simulated seconds per wall second).
+"""MuJoCo beside the analytical model: inverse dynamics per sample, the forward walk's speed
+(simulated seconds per wall second) on the committed models and on the previous model
+settings in the same process, and the time of each part of a validation.
 
     python benchmarks/bench_mujoco.py
+
+The previous settings are the committed models as they were before the model was made
+cheaper: 1 ms step, each sole a box touching the floor at four corners, the floor's default
+contact parameters, knee equality at 2 ms with 1e-3 kg·m² of armature on the knee hinges.
 """
 
 import os
@@ -17,12 +22,70 @@ from bench_dynamics import random_states  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
 import biped  # noqa: E402
+from biped import gait_file  # noqa: E402
 from biped.optimize import optimize  # noqa: E402
 from biped.problem import GaitProblem  # noqa: E402
+from validate import mjcf  # noqa: E402
 from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
-from validate.simulate import simulate  # noqa: E402
+from validate.model import model_spec  # noqa: E402
+from validate.report import validate  # noqa: E402
+from validate.samples import gait_biped  # noqa: E402
+from validate.simulate import Walker  # noqa: E402
 
 SAMPLES = 1000
+STEPS = 20
+REPEATS = 5
+
+
+def previous_settings(spec: mujoco.MjSpec, robot: biped.Robot) -> mujoco.MjSpec:
+    """The committed model with the settings it had before (see the module docstring)."""
+    spec = spec.copy()
+    spec.option.timestep = 0.001
+    for side in mjcf.SIDES:
+        for end in ("heel", "toe"):
+            spec.delete(spec.geom(f"{side}_{end}_contact"))
+        spec.body(f"{side}_foot").add_geom(
+            name=f"{side}_sole",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[robot.foot_length / 2, mjcf.FOOT_WIDTH / 2, mjcf.SOLE_THICKNESS / 2],
+            pos=[
+                robot.foot_length / 2 - robot.foot_heel,
+                0.0,
+                -robot.ankle_height + mjcf.SOLE_THICKNESS / 2,
+            ],
+            friction=[float(v) for v in mjcf.FOOT_FRICTION.split()],
+            solref=[0.004, 1.0],
+            solimp=[float(v) for v in mjcf.FOOT_SOLIMP.split()],
+            condim=3,
+            contype=1,
+            conaffinity=0,
+        )
+    floor = spec.geom("floor")
+    floor.solref, floor.solimp = [0.02, 1.0], [0.9, 0.95, 0.001, 0.5, 2.0]  # MuJoCo's default
+    for equality in spec.equalities:
+        equality.solref = [0.002, 1.0]
+    for joint in spec.joints:
+        if joint.name.endswith(("_knee_upper", "_knee_lower")):
+            joint.armature = 1e-3
+    return spec
+
+
+def walk_times(walker: Walker):
+    """Median wall times [s] of the walk and of MuJoCo stepping its model through the same
+    controls in one call (the floor of any controller), the seconds simulated, the number of
+    physics steps and the steps walked."""
+    walls, floors = [], []
+    for _ in range(REPEATS):
+        began = time.perf_counter()
+        sim = walker.walk(STEPS)
+        walls.append(time.perf_counter() - began)
+        data = mujoco.MjData(sim.model)
+        state = np.concatenate([sim.time[:1], sim.qpos[0], sim.qvel[0]])
+        began = time.perf_counter()
+        rollout.rollout(sim.model, data, state, sim.ctrl)
+        floors.append(time.perf_counter() - began)
+    simulated = sim.time[-1] - sim.time[0] + sim.model.opt.timestep
+    return np.median(walls), np.median(floors), simulated, len(sim.ctrl), sum(sim.landed)
 
 
 def main():
@@ -44,38 +107,42 @@ def main():
             f"{knee:10}{analytic * 1e6:11.2f} µs{reference * 1e6:11.2f} µs"
             f"{reference / analytic:8.0f}x"
         )
-    print("\nforward validation, 20 steps of the optimal gait at 0.3 m/s (median of 3 runs)")
     print(
-        f"{'knee':10}{'simulated':>11}{'simulate':>11}{'x real':>8}{'physics':>10}{'x real':>8}"
-        f"{'per step':>11}"
+        f"\nforward walk, {STEPS} steps of the optimal gait at 0.3 m/s (median of {REPEATS} "
+        "runs), one thread"
     )
+    print(
+        f"{'knee':10}{'model':>10}{'step':>8}{'walked':>8}{'walk':>10}{'x real':>8}"
+        f"{'physics':>10}{'x real':>8}{'per step':>10}"
+    )
+    gaits = {}
     for knee in biped.KNEES:
-        model = biped.Biped(biped.Robot.paper(), knee)
-        optimum = optimize(GaitProblem(model, 0.3))
-        walls = []
-        for _ in range(3):
-            began = time.perf_counter()
-            sim = simulate(model, optimum.step, steps=20)
-            walls.append(time.perf_counter() - began)
-        simulated = sim.time[-1] - sim.time[0] + sim.model.opt.timestep
-        # The floor: MuJoCo stepping the same model through the same controls in one call
-        # (timing only: the gains do not alternate with the legs here).
-        data = mujoco.MjData(sim.model)
-        state = np.concatenate([sim.time[:1], sim.qpos[0], sim.qvel[0]])
-        physics = []
-        for _ in range(3):
-            began = time.perf_counter()
-            rollout.rollout(sim.model, data, state, sim.ctrl)
-            physics.append(time.perf_counter() - began)
-        wall, floor = np.median(walls), np.median(physics)
+        robot = biped.Robot.paper()
+        optimum = optimize(GaitProblem(biped.Biped(robot, knee), 0.3))
+        gait = gaits[knee] = gait_file.to_dict(optimum, robot, seed=0)
+        spec = model_spec(gait, gait_biped(gait))
+        factors = {}
+        for name, settings in (("committed", spec), ("previous", previous_settings(spec, robot))):
+            walker = Walker(gait, settings)
+            wall, floor, simulated, n, walked = walk_times(walker)
+            factors[name] = simulated / wall
+            print(
+                f"{knee:10}{name:>10}{walker.model.opt.timestep * 1e3:6.1f}ms{walked:8d}"
+                f"{wall:8.3f} s{simulated / wall:7.0f}x{floor:8.3f} s{simulated / floor:7.0f}x"
+                f"{floor / n * 1e6:8.1f} µs"
+            )
         print(
-            f"{knee:10}{simulated:9.2f} s{wall:9.3f} s{simulated / wall:7.0f}x"
-            f"{floor:8.3f} s{simulated / floor:7.0f}x{floor / len(sim.ctrl) * 1e6:8.1f} µs"
+            f"{knee:10}committed / previous: {factors['committed'] / factors['previous']:.2f}x "
+            "the walk's speed"
         )
-    print(
-        "target: 200 x real time; 'physics' is MuJoCo's own stepping at the model's 1 ms "
-        "step, the most any controller can reach on this machine"
-    )
+    print("target: 200 x real time for the committed walk on one core")
+    print("\nvalidation (every check: replay of both stances, walks at kp x 0.5, 1, 2)")
+    for knee, gait in gaits.items():
+        began = time.perf_counter()
+        result = validate(gait, steps=STEPS)
+        wall = time.perf_counter() - began
+        verdict = "PASS" if result.passed else "FAIL"
+        print(f"{knee:10}{wall:8.2f} s  {verdict}")
 
 
 if __name__ == "__main__":
