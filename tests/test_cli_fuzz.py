@@ -57,6 +57,7 @@ def _stand_in(*args, **kwargs):
 def no_work(monkeypatch):
     """The optimiser, the sweep, the design map, the figures and the MuJoCo validation stop
     the command."""
+    import biped.design
     import biped.design_map
     import biped.figures
     import biped.optimize
@@ -66,6 +67,7 @@ def no_work(monkeypatch):
     for module, name in [
         (biped.optimize, "optimize"),
         (biped.sweep, "run_sweep"),
+        (biped.design, "compare"),
         (biped.design_map, "run_design_map"),
         (biped.figures, "make_figures"),
         (validate.report, "validate"),
