@@ -72,3 +72,16 @@ def test_robot_units_are_those_its_fields_document():
     for name in fields:
         assert units[f"robot.{name}"] == stated[name], name
     assert units["optimizer.value"] == "J"
+
+
+def test_printed_check_lines_carry_the_units_of_their_figures():
+    from validate.checks import Check
+
+    line = Check(
+        "forward", True, {"steps": 20, "max_slip": 2.5e-4, "step_advance_range": [1.0, 1.01]}
+    ).line()
+    assert "steps 20," in line  # a count has no unit
+    assert "max_slip 0.00025 m," in line
+    assert line.endswith("step_advance_range 1-1.01 S")
+    # a figure of a check with no known unit prints bare, never with a guessed one
+    assert Check("other", False, {"max_slip": 1.0}).line().endswith("max_slip 1")

@@ -32,6 +32,7 @@ import numpy as np
 
 from biped.dynamics import JOINTS, Biped
 from biped.kinematics import ZH
+from biped.units import PURE
 from validate import contact
 from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
 from validate.mapping import mapping, other
@@ -39,6 +40,7 @@ from validate.model import ModelError, model_problems
 from validate.replay import replay_model, replay_step
 from validate.samples import GaitSamples
 from validate.simulate import KP, Simulation, Walker, WalkSettings, reference_along
+from validate.units import FIGURE_UNITS
 
 # Agreement of two exact rigid-body models of one robot.
 EXACT = 1e-6
@@ -87,11 +89,19 @@ class Check:
 
     def line(self) -> str:
         names = self.figures if self.shown is None else self.shown
-        values = ", ".join(f"{k} {_fmt(self.figures[k])}" for k in names if k in self.figures)
+        values = ", ".join(
+            f"{k} {_fmt(self.figures[k])}{_unit(self.name, k)}" for k in names if k in self.figures
+        )
         text = f"{'PASS' if self.passed else 'FAIL'}  {self.name:17} {values}".rstrip()
         if not self.notes:
             return text
         return f"{text}{'; ' if values else '  '}{'; '.join(self.notes)}"
+
+
+def _unit(check: str, name: str) -> str:
+    """The unit of a figure as printed after its value ("" for a count or a ratio)."""
+    unit = FIGURE_UNITS.get(check, {}).get(name, PURE)
+    return "" if unit == PURE else f" {unit}"
 
 
 def _fmt(value) -> str:
@@ -351,16 +361,40 @@ def scuff_notes(sim: Simulation, period: float, figures: dict, steps: int) -> li
     return []
 
 
+def walk_failures(figures: dict, steps: int) -> list[str]:
+    """Why the walk of ``walk_figures`` is not a walk of ``steps`` steps (empty: it is)."""
+    failures = []
+    if figures["steps"] < steps:
+        failures.append(f"walked {figures['steps']} of {steps} steps")
+    if figures["fell"]:
+        failures.append("fell")
+    if not figures["max_slip"] < MAX_SLIP:
+        failures.append(
+            f"stance foot slipped {figures['max_slip'] * 1e3:.3g} mm "
+            f"(allowed < {MAX_SLIP * 1e3:g} mm)"
+        )
+    if not figures["max_foot_tilt"] < MAX_FOOT_TILT:
+        failures.append(
+            f"stance foot tilted {figures['max_foot_tilt']:.3g} rad "
+            f"(allowed < {MAX_FOOT_TILT:g} rad)"
+        )
+    if figures["scuff_steps"] != 0:
+        failures.append(f"swing foot scuffed the floor in {figures['scuff_steps']} steps")
+    if figures["warnings"] != 0:
+        failures.append(f"{figures['warnings']} MuJoCo warnings")
+    return failures
+
+
 def walks(figures: dict, steps: int) -> bool:
     """The walk of ``walk_figures`` is a walk of ``steps`` steps."""
-    return (
-        figures["steps"] >= steps
-        and not figures["fell"]
-        and figures["max_slip"] < MAX_SLIP
-        and figures["max_foot_tilt"] < MAX_FOOT_TILT
-        and figures["scuff_steps"] == 0
-        and figures["warnings"] == 0
-    )
+    return not walk_failures(figures, steps)
+
+
+def walk_verdict(walker: Walker, sim: Simulation, steps: int) -> list[str]:
+    """The forward check's verdict on a walk of ``walker`` (``Walker.walk``): why it is not a
+    walk of ``steps`` steps (``walk_failures``; empty: it is)."""
+    figures = walk_figures(walker.biped, walker.samples, sim, energy=float("nan"))
+    return walk_failures(figures, steps)
 
 
 def check_forward(walker: Walker, steps: int, energy: float):
