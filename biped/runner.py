@@ -62,12 +62,15 @@ class ProgressBar(Protocol):
     def clear(self) -> None: ...
 
 
-def check_dask() -> None:
-    """Raise a one-line ``BipedError`` if dask.distributed is not installed."""
+def check_dask(address: str | None = None) -> None:
+    """Raise a one-line ``BipedError`` if dask.distributed is not installed or, given an
+    ``address``, if no scheduler answers there (checked before a command writes anything)."""
     try:
         import dask.distributed  # noqa: F401
     except ImportError:
         raise BipedError(MISSING_DASK) from None
+    if address is not None:
+        _connect(address).close()
 
 
 def run_tasks(

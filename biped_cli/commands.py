@@ -154,7 +154,7 @@ def cmd_sweep(args) -> int:
     if args.method != "ipopt":
         raise BipedError(f"--method {args.method!r}: allowed 'ipopt' for sweeps")
     if args.dask is not None:
-        check_dask()
+        check_dask(args.dask)
     run_sweep(
         args.out,
         robot,

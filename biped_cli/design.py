@@ -269,7 +269,7 @@ def cmd_design_map(args) -> int:
     problem = _problem(args, robot, float(args.speeds[0]))
     types.check_folder(args.out, "--out")
     if args.dask is not None:
-        check_dask()
+        check_dask(args.dask)
     run_design_map(
         args.out,
         robot,

@@ -158,6 +158,19 @@ def test_an_unreachable_scheduler_is_one_error_naming_it(monkeypatch):
     assert "\n" not in message
 
 
+@pytest.mark.parametrize("command", ["sweep", "design-map"])
+def test_an_unreachable_scheduler_is_refused_before_anything_is_written(
+    command, tmp_path, capsys, monkeypatch
+):
+    """No scheduler at --dask: exit 2 with one line, and no output folder is made."""
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 1.0)
+    argv = [command, "--dask", "tcp://127.0.0.1:9", "--out", str(tmp_path / "s")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "'tcp://127.0.0.1:9' cannot be reached" in err[0]
+    assert not (tmp_path / "s").exists()
+
+
 @pytest.mark.parametrize(
     "address", ["localhost:8786", "tcp://:8786", "tcp://host:99999", "http://host:80", "tcp://h"]
 )
