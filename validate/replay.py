@@ -12,9 +12,13 @@ of a joint is the share of its torque its servo had to add:
 0.2 for a torque 20 % too small or too large, 1 for a joint without its torque. The exact
 torques leave what the simulator's own physics adds: the servos are stiff against the links
 but not against the whole robot leaning on its stance foot (gravity's 600 N·m/rad about the
-ankle), and the soles are stiff springs, not a rigid floor. To keep that small the replay
-runs at ``TIMESTEP`` (0.25 ms) with the contact as stiff as that step allows (``SOLREF``):
-shares of 0.02 at most for the optimal gaits, against 0.1 or more for a joint 20 % off.
+ankle), and the soles are stiff springs, not a rigid floor. What they add falls with the
+physics step (halving it halves every servo's torque: MuJoCo's integration error), so the
+replay runs at ``TIMESTEP`` (62.5 µs) with the contact as stiff as that step allows
+(``SOLREF``): shares of 0.006 at most for the optimal gaits at 0.3 m/s and below 0.025 for
+the designed gaits with a 2 cm clearance (whose swing ankle carries 0.08 N·m RMS), against
+0.1 or more for any one joint 20 % off. At 0.25 ms the same exact torques reached 0.077 at
+that swing ankle.
 
 The window leaves out the first ``WINDOW[0]`` of the step (the contact settles under the
 stance foot, which starts exactly on the floor) and the last ``1 - WINDOW[1]`` (the swing foot
@@ -38,7 +42,7 @@ from validate.simulate import KP, KV
 
 # Physics step of the replay [s] and the contact's time constant and damping ratio there
 # (the shortest MuJoCo allows: two steps).
-TIMESTEP = 0.00025
+TIMESTEP = 0.0000625
 SOLREF = (2 * TIMESTEP, 1.0)
 # Part of the step compared, as fractions of the period.
 WINDOW = (0.05, 0.95)
