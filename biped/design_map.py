@@ -41,6 +41,7 @@ from biped.criteria import PAPER_SAFETY, Safety
 from biped.design import RADII, DesignProblem, check_radii, optimize_at, optimize_design
 from biped.errors import BipedError
 from biped.files import atomic_path, atomic_write_text, clean_stale_temporaries
+from biped.manifest import Manifest
 from biped.optimize import DEFAULT_STARTS, optimize
 from biped.problem import VARIABLES
 from biped.provenance import version
@@ -48,6 +49,7 @@ from biped.robot import Robot
 from biped.runner import ProgressBar, run_tasks
 
 MANIFEST = "design-map.json"
+_RECORD = Manifest(MANIFEST, "design-map record", "this folder's map was", "a design map's")
 MAP_FORMAT = "biped-design-map/1"
 KINDS = ("grid", "revolute", "table1", "design")
 # Grid points per radius by default, from 0 to the radius's upper bound.
@@ -140,31 +142,6 @@ def radius_grid(robot: Robot, values, name: str) -> tuple:
         if a == b:
             raise BipedError(f"{name} = {a} m appears twice at 0.1 mm resolution: allowed distinct")
     return tuple(values)
-
-
-def _check_manifest(folder: Path, settings: MapSettings) -> None:
-    """Write the folder's manifest, or refuse a folder made with other settings."""
-    path = folder / MANIFEST
-    wanted = settings.to_dict()
-    if path.exists():
-        try:
-            found = json.loads(path.read_text())
-        except (OSError, ValueError, UnicodeDecodeError) as error:
-            raise BipedError(f"{path}: unreadable design-map record ({error})") from None
-        for key, value in wanted.items():
-            if found.get(key) != value:
-                raise BipedError(
-                    f"{path}: this folder's map was made with {key} = {found.get(key)!r}, "
-                    f"this run has {value!r}: allowed only the same settings, choose another "
-                    f"--out folder"
-                )
-        return
-    if any(folder.glob("*.json")):
-        raise BipedError(
-            f"{folder} holds JSON files but no {MANIFEST}: allowed an empty folder or a "
-            f"design map's, choose another --out folder"
-        )
-    atomic_write_text(path, json.dumps(wanted, indent=1))
 
 
 def read_point(folder: Path, point: MapPoint) -> dict | None:
@@ -339,7 +316,7 @@ def run_design_map(
     )
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    _check_manifest(folder, settings)
+    _RECORD.claim(folder, settings.to_dict())
     clean_stale_temporaries(folder)
     first, second = map_points(settings)
     todo = [[p for p in stage if read_point(folder, p) is None] for stage in (first, second)]

@@ -28,8 +28,9 @@ from biped import gait_file
 from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.files import atomic_write_text, clean_stale_temporaries
+from biped.files import clean_stale_temporaries
 from biped.kinematics import KNEES
+from biped.manifest import Manifest
 from biped.optimize import optimize
 from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
 from biped.problem import GaitProblem, check_speed
@@ -39,6 +40,9 @@ from biped.runner import run_tasks
 
 FOLDER = "paper-method"
 SETTINGS = "settings.json"
+_RECORD = Manifest(
+    SETTINGS, "record of the paper's method", "these runs of the paper's method were"
+)
 FORMAT = "biped-paper-method/1"
 # The speed of the comparison: the paper's optimal speeds are 0.27 and 0.30 m/s.
 SPEED = 0.3
@@ -77,25 +81,6 @@ class Run:
         return f"{self.knee}-{self.criterion}-{speed:.3f}-seed{self.seed}.json"
 
 
-def _check_settings(folder: Path, settings: PaperMethod) -> None:
-    path = folder / SETTINGS
-    wanted = settings.to_dict()
-    if not path.exists():
-        atomic_write_text(path, json.dumps(wanted, indent=1))
-        return
-    try:
-        found = json.loads(path.read_text())
-    except (OSError, ValueError, UnicodeDecodeError) as error:
-        raise BipedError(f"{path}: unreadable record of the paper's method ({error})") from None
-    for key, value in wanted.items():
-        if found.get(key) != value:
-            raise BipedError(
-                f"{path}: these runs of the paper's method were made with {key} = "
-                f"{found.get(key)!r}, this run has {value!r}: allowed only the same settings, "
-                "choose another --out folder"
-            )
-
-
 def _solve(task) -> str:
     settings, run, folder = task
     problem = GaitProblem(
@@ -132,7 +117,7 @@ def run_paper_method(
     settings = PaperMethod(robot, safety, float(speed), seeds)
     folder = Path(sweep_folder) / FOLDER
     folder.mkdir(parents=True, exist_ok=True)
-    _check_settings(folder, settings)
+    _RECORD.claim(folder, settings.to_dict())
     clean_stale_temporaries(folder)
     runs = [Run(k, c, s) for c in criteria for k in knees for s in range(seeds)]
     todo = [r for r in runs if not (folder / r.filename(settings.speed)).exists()]

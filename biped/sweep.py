@@ -21,7 +21,6 @@ with their status and counted in the summary; they are not optimised again.
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 import time
 from collections.abc import Callable
@@ -34,8 +33,9 @@ from biped import gait_file
 from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.files import atomic_write_text, clean_stale_temporaries
+from biped.files import clean_stale_temporaries
 from biped.kinematics import KNEES
+from biped.manifest import Manifest
 from biped.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, optimize
 from biped.problem import VARIABLES, GaitProblem, check_speed
 from biped.provenance import version
@@ -44,6 +44,7 @@ from biped.runner import ProgressBar, run_tasks
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
 MANIFEST = "sweep.json"
+_RECORD = Manifest(MANIFEST, "sweep record", "this folder's sweep was", "a sweep's", "gait files")
 INDEPENDENT = ".independent"
 SWEEP_FORMAT = "biped-sweep/2"
 
@@ -80,31 +81,6 @@ class Settings:
             "version": version(),
             "casadi": version("casadi"),
         }
-
-
-def _check_manifest(folder: Path, settings: Settings) -> None:
-    """Write the folder's manifest, or refuse a folder made with other settings."""
-    path = folder / MANIFEST
-    wanted = settings.to_dict()
-    if path.exists():
-        try:
-            found = json.loads(path.read_text())
-        except (OSError, ValueError, UnicodeDecodeError) as error:
-            raise BipedError(f"{path}: unreadable sweep record ({error})") from None
-        for key, value in wanted.items():
-            if found.get(key) != value:
-                raise BipedError(
-                    f"{path}: this folder's sweep was made with {key} = {found.get(key)!r}, "
-                    f"this run has {value!r}: allowed only the same settings, choose another "
-                    f"--out folder"
-                )
-        return
-    if any(folder.glob("*.json")):
-        raise BipedError(
-            f"{folder} holds gait files but no {MANIFEST}: allowed an empty folder or a "
-            f"sweep's, choose another --out folder"
-        )
-    atomic_write_text(path, json.dumps(wanted, indent=1))
 
 
 def _problem(settings: Settings, point: Point) -> GaitProblem:
@@ -223,7 +199,7 @@ def run_sweep(
     settings = Settings(robot, safety, tuple(speeds), int(seed), int(starts))
     folder = Path(folder)
     (folder / INDEPENDENT).mkdir(parents=True, exist_ok=True)
-    _check_manifest(folder, settings)
+    _RECORD.claim(folder, settings.to_dict())
     for place in (folder, folder / INDEPENDENT):
         clean_stale_temporaries(place)
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
