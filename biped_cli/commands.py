@@ -255,6 +255,30 @@ def _validate_and_record(
     return result, report
 
 
+def read_gaits(paths: list, model: str | None = None) -> list[dict]:
+    """The gait files at ``paths`` (``biped validate``, ``biped robustness``), checked before
+    any work: each readable, its samples, costs and constraints its parameters', its knee
+    one MuJoCo can model, and ``model`` (an MJCF path, if given) one it can be played on.
+
+    Raises BipedError naming the file (and ``--model``).
+    """
+    from biped import gait_file
+
+    gaits = [gait_file.read_consistent(path) for path in paths]
+    for path, gait in zip(paths, gaits, strict=True):
+        check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
+    if model is not None:
+        from validate.model import model_spec
+        from validate.samples import gait_biped
+
+        for path, gait in zip(paths, gaits, strict=True):
+            try:
+                model_spec(gait, gait_biped(gait), model)
+            except BipedError as error:
+                raise BipedError(f"--model, gait file {path!r}: {error}") from None
+    return gaits
+
+
 def cmd_validate(args) -> int:
     """Cross-check gait files in MuJoCo and record each for rerun.
 
@@ -273,7 +297,6 @@ def cmd_validate(args) -> int:
     import json
     from pathlib import Path
 
-    from biped import gait_file
     from biped_cli.outputs import check_owner, output_name
     from biped_cli.progress import Progress
 
@@ -286,19 +309,7 @@ def cmd_validate(args) -> int:
     if args.video:
         check_output(args.video, "--video")
     gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
-    # all readable, and each file's samples, costs and constraints its parameters', before any work
-    gaits = [gait_file.read_consistent(path) for path in args.gait]
-    for path, gait in zip(args.gait, gaits, strict=True):
-        check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
-    if args.model is not None:  # a model each gait can be played on, before any work
-        from validate.model import model_spec
-        from validate.samples import gait_biped
-
-        for path, gait in zip(args.gait, gaits, strict=True):
-            try:
-                model_spec(gait, gait_biped(gait), args.model)
-            except BipedError as error:
-                raise BipedError(f"--model, gait file {path!r}: {error}") from None
+    gaits = read_gaits(args.gait, args.model)
     recordings = [
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
         for path in args.gait

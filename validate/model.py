@@ -54,14 +54,20 @@ def knee_of(model: mujoco.MjModel) -> str:
     )
 
 
+def committed_model(biped: Biped) -> Path | None:
+    """The committed scene of ``biped``'s knee (``mjcf/scene_<knee>.xml``) when its robot is
+    Table 1 (``Robot.paper()``); None for another robot (its model is generated)."""
+    return FOLDER / f"scene_{biped.knee}.xml" if biped.robot == Robot.paper() else None
+
+
 def model_spec(gait: dict, biped: Biped, path: str | Path | None = None) -> mujoco.MjSpec:
     """The MJCF to play ``gait`` on (see the module docstring), as a spec to add to.
 
     Raises BipedError naming the file if it cannot be read or compiled, or if its knee is not
     the gait's.
     """
-    if path is None and biped.robot == Robot.paper():
-        path = FOLDER / f"scene_{biped.knee}.xml"
+    if path is None:
+        path = committed_model(biped)
     if path is None:
         spec = mujoco.MjSpec.from_string(
             scene_xml(biped.knee),
