@@ -34,22 +34,27 @@ def speed(text: str) -> float:
     return value
 
 
-def speeds(text: str) -> np.ndarray:
-    """'0.15:0.45:13' (start:stop:count) or '0.2,0.3' (a list)."""
+def number_list(text: str, name: str, limit: int, unit: str) -> np.ndarray:
+    """'START:STOP:COUNT' (COUNT from 1 to ``limit``) or 'V1,V2,...' as an array; ``name``
+    and ``unit`` name them in the message of a malformed one."""
     try:
         if ":" in text:
             start, stop, count = text.split(":")
-            if not 1 <= int(count) <= MAX_SPEEDS:
+            if not 1 <= int(count) <= limit:
                 raise argparse.ArgumentTypeError(
-                    f"speeds = {text!r}: COUNT = {count}, allowed 1 to {MAX_SPEEDS}"
+                    f"{name} = {text!r}: COUNT = {count}, allowed 1 to {limit}"
                 )
-            values = np.linspace(float(start), float(stop), int(count))
-        else:
-            values = np.array([float(v) for v in text.split(",")])
+            return np.linspace(float(start), float(stop), int(count))
+        return np.array([float(v) for v in text.split(",")])
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"speeds = {text!r}: allowed START:STOP:COUNT or a comma-separated list"
+            f"{name} = {text!r}: allowed START:STOP:COUNT or a comma-separated list{unit}"
         ) from None
+
+
+def speeds(text: str) -> np.ndarray:
+    """'0.15:0.45:13' (start:stop:count) or '0.2,0.3' (a list)."""
+    values = number_list(text, "speeds", MAX_SPEEDS, "")
     if values.size == 0 or not np.all(np.isfinite(values) & (values > 0)):
         raise argparse.ArgumentTypeError(f"speeds = {text!r}: allowed speeds > 0 m/s")
     if values.size > MAX_SPEEDS:

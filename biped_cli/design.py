@@ -23,20 +23,7 @@ CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
 def radii(text: str) -> np.ndarray:
     """Grid radii [m]: 'START:STOP:COUNT' or 'R1,R2,...', each >= 0 (the bounds of the
     robot are checked later)."""
-    try:
-        if ":" in text:
-            start, stop, count = text.split(":")
-            if not 1 <= int(count) <= MAX_GRID:
-                raise argparse.ArgumentTypeError(
-                    f"radii = {text!r}: COUNT = {count}, allowed 1 to {MAX_GRID}"
-                )
-            values = np.linspace(float(start), float(stop), int(count))
-        else:
-            values = np.array([float(v) for v in text.split(",")])
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"radii = {text!r}: allowed START:STOP:COUNT or a comma-separated list [m]"
-        ) from None
+    values = types.number_list(text, "radii", MAX_GRID, " [m]")
     if values.size == 0 or values.size > MAX_GRID or not np.all(np.isfinite(values)):
         raise argparse.ArgumentTypeError(
             f"radii = {text!r}: allowed 1 to {MAX_GRID} finite radii [m]"
