@@ -39,27 +39,8 @@ REPEATS = 5
 
 def previous_settings(spec: mujoco.MjSpec, robot: biped.Robot) -> mujoco.MjSpec:
     """The committed model with the settings it had before (see the module docstring)."""
-    spec = spec.copy()
+    spec = mjcf.with_box_soles(spec, robot, solref=(0.004, 1.0))
     spec.option.timestep = 0.001
-    for side in mjcf.SIDES:
-        for end in ("heel", "toe"):
-            spec.delete(spec.geom(f"{side}_{end}_contact"))
-        spec.body(f"{side}_foot").add_geom(
-            name=f"{side}_sole",
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[robot.foot_length / 2, mjcf.FOOT_WIDTH / 2, mjcf.SOLE_THICKNESS / 2],
-            pos=[
-                robot.foot_length / 2 - robot.foot_heel,
-                0.0,
-                -robot.ankle_height + mjcf.SOLE_THICKNESS / 2,
-            ],
-            friction=[float(v) for v in mjcf.FOOT_FRICTION.split()],
-            solref=[0.004, 1.0],
-            solimp=[float(v) for v in mjcf.FOOT_SOLIMP.split()],
-            condim=3,
-            contype=1,
-            conaffinity=0,
-        )
     floor = spec.geom("floor")
     floor.solref, floor.solimp = [0.02, 1.0], [0.9, 0.95, 0.001, 0.5, 2.0]  # MuJoCo's default
     for equality in spec.equalities:

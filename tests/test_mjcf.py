@@ -229,26 +229,9 @@ def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
     from validate.model import model_spec
     from validate.samples import gait_biped
 
-    spec = model_spec(gait, gait_biped(gait))
+    spec = mjcf.with_box_soles(model_spec(gait, gait_biped(gait)), ROBOT)
     step = mjcf.TIMESTEP / factor
     spec.option.timestep = step
-    for side in mjcf.SIDES:
-        for end in ("heel", "toe"):
-            spec.delete(spec.geom(f"{side}_{end}_contact"))
-        spec.body(f"{side}_foot").add_geom(
-            name=f"{side}_sole",
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[ROBOT.foot_length / 2, mjcf.FOOT_WIDTH / 2, mjcf.SOLE_THICKNESS / 2],
-            pos=[
-                ROBOT.foot_length / 2 - ROBOT.foot_heel,
-                0.0,
-                -ROBOT.ankle_height + mjcf.SOLE_THICKNESS / 2,
-            ],
-            friction=[float(v) for v in mjcf.FOOT_FRICTION.split()],
-            condim=3,
-            contype=1,
-            conaffinity=0,
-        )
     for geom in spec.geoms:
         if geom.contype or geom.conaffinity:
             geom.solref = [2 * step, 1.0]

@@ -258,6 +258,38 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
     return "\n".join(lines)
 
 
+def with_box_soles(spec, robot: Robot, solref=None):
+    """A copy of the model ``spec`` (``mujoco.MjSpec``) whose soles touch the floor as boxes
+    (four contact points each) instead of at their heel and toe points: the finer contact
+    the committed models' two points a sole stand for (the benchmark and the test of their
+    settings compare the two). ``solref`` (time constant, damping ratio): the boxes' contact
+    (None: MuJoCo's default)."""
+    import mujoco
+
+    spec = spec.copy()
+    for side in SIDES:
+        for end in ("heel", "toe"):
+            spec.delete(spec.geom(f"{side}_{end}_contact"))
+        sole = spec.body(f"{side}_foot").add_geom(
+            name=f"{side}_sole",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[robot.foot_length / 2, FOOT_WIDTH / 2, SOLE_THICKNESS / 2],
+            pos=[
+                robot.foot_length / 2 - robot.foot_heel,
+                0.0,
+                -robot.ankle_height + SOLE_THICKNESS / 2,
+            ],
+            friction=[float(v) for v in FOOT_FRICTION.split()],
+            solimp=[float(v) for v in FOOT_SOLIMP.split()],
+            condim=3,
+            contype=1,
+            conaffinity=0,
+        )
+        if solref is not None:
+            sole.solref = list(solref)
+    return spec
+
+
 def scene_model(robot: Robot, knee: str, servos=None):
     """Compiled MuJoCo model of the scene (floor and robot) from ``robot``, in memory."""
     import mujoco
