@@ -14,7 +14,7 @@ from biped.kinematics import KNEES
 from biped.provenance import command_line, version
 from biped.sweep import DEFAULT_SPEEDS
 from biped_cli import args as types
-from biped_cli import design, report
+from biped_cli import design, report, robustness
 from biped_cli.commands import (
     DEFAULT_FIGURES,
     DEFAULT_PIPELINE,
@@ -221,6 +221,7 @@ def build_parser() -> argparse.ArgumentParser:
     fig.set_defaults(run=cmd_figures)
     design.add_parsers(commands)
     report.add_parser(commands)
+    robustness.add_parser(commands)
     for command in commands.choices.values():  # after the command too: biped demo --debug
         command.add_argument(
             "--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP

@@ -55,14 +55,15 @@ def _stand_in(*args, **kwargs):
 
 @pytest.fixture
 def no_work(monkeypatch):
-    """The optimiser, the sweep, the design map, the figures and the MuJoCo validation stop
-    the command."""
+    """The optimiser, the sweep, the design map, the figures, the MuJoCo validation and the
+    robustness map stop the command."""
     import biped.design
     import biped.design_map
     import biped.figures
     import biped.optimize
     import biped.sweep
     import validate.report
+    import validate.robustness
 
     for module, name in [
         (biped.optimize, "optimize"),
@@ -71,6 +72,7 @@ def no_work(monkeypatch):
         (biped.design_map, "run_design_map"),
         (biped.figures, "make_figures"),
         (validate.report, "validate"),
+        (validate.robustness, "robustness_map"),
     ]:
         monkeypatch.setattr(module, name, _stand_in)
 

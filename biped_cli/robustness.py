@@ -1,0 +1,228 @@
+"""``biped robustness GAIT.json ... [--out DIR]``: the robustness map of gait files in MuJoCo
+(``validate.robustness``), written per gait as JSON and as a figure.
+
+The files are named from the gait file's path as its recording is (``biped_cli.outputs``):
+``logs/robustness/<folder>-<gait>.json`` and ``.png``, written together, all or none.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+from biped.errors import BipedError
+from biped_cli import args as types
+
+DEFAULT_ROBUSTNESS = "logs/robustness"
+# Most bisections of one limit (each halves its uncertainty).
+MAX_ITERATIONS = 30
+# What the printed lines call each limit, and how they show its values: factor, unit, sign.
+SHOWN = {
+    "push_forward": ("push forward", 1.0, "N·s", "+"),
+    "push_backward": ("push backward", 1.0, "N·s", "+"),
+    "friction": ("friction μ", 1.0, "", ""),
+    "trunk_mass_heavier": ("trunk mass heavier", 100.0, "%", "+"),
+    "trunk_mass_lighter": ("trunk mass lighter", 100.0, "%", "+"),
+    "kp_scale_low": ("kp scale low", 1.0, "x", ""),
+    "kp_scale_high": ("kp scale high", 1.0, "x", ""),
+}
+
+
+def add_parser(commands) -> None:
+    """Register ``robustness`` on the ``biped`` subcommands."""
+    from validate.robustness import RobustnessSettings
+
+    default = RobustnessSettings()
+    parser = commands.add_parser(
+        "robustness",
+        help="robustness map of gaits in MuJoCo: pushes, friction, trunk mass, gains",
+        description=cmd_robustness.__doc__,
+    )
+    parser.add_argument(
+        "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
+    )
+    parser.add_argument(
+        "--steps",
+        type=types.steps,
+        default=default.steps,
+        help=f"steps of every walk, 2 to {types.MAX_STEPS} (default {default.steps})",
+    )
+    parser.add_argument(
+        "--push-step",
+        type=types.positive,
+        default=default.push_step,
+        metavar="N",
+        help=f"the pushes act at mid-step of step N, before the last (default {default.push_step})",
+    )
+    parser.add_argument(
+        "--iterations",
+        type=types.bounded(1, MAX_ITERATIONS),
+        default=default.iterations,
+        metavar="N",
+        help=f"bisections of each limit, 1 to {MAX_ITERATIONS} (default {default.iterations})",
+    )
+    parser.add_argument(
+        "--jobs",
+        type=types.jobs,
+        default=default.jobs,
+        help=f"processes walking the limits side by side (default {default.jobs})",
+    )
+    parser.add_argument(
+        "--model",
+        metavar="PATH",
+        help="MJCF to play the gaits on (default: mjcf/scene_<knee>.xml when the gait's robot is "
+        "Table 1, the model generated from the gait's robot otherwise)",
+    )
+    parser.add_argument(
+        "--out",
+        default=DEFAULT_ROBUSTNESS,
+        metavar="DIR",
+        help=f"folder of the maps (default {DEFAULT_ROBUSTNESS}): <folder>-<gait>.json and .png",
+    )
+    parser.set_defaults(run=cmd_robustness)
+
+
+def _settings(args):
+    from validate.robustness import RobustnessSettings
+
+    if args.steps < 2:
+        raise BipedError(
+            f"--steps {args.steps}: allowed 2 to {types.MAX_STEPS} (a push, then a step)"
+        )
+    if args.push_step >= args.steps:
+        raise BipedError(
+            f"--push-step {args.push_step}: allowed 1 to {args.steps - 1}, a step before the "
+            f"last of --steps {args.steps} (the walk goes on after the push)"
+        )
+    return RobustnessSettings(args.steps, args.push_step, args.iterations, args.jobs)
+
+
+def model_source(gait: dict, model: str | None) -> str:
+    """What the map's walks were played on: ``model`` as given, the committed model, or the
+    one generated from the gait's robot."""
+    from validate.mjcf import FOLDER
+    from validate.model import committed_model
+    from validate.samples import gait_biped
+
+    if model is not None:
+        return model
+    committed = committed_model(gait_biped(gait))
+    if committed is None:
+        return "generated from the gait's robot (validate.mjcf)"
+    return str(committed.relative_to(FOLDER.parent))
+
+
+def _value(name: str, value: float | None) -> str:
+    _, factor, unit, sign = SHOWN[name]
+    if value is None:
+        return "n/a"
+    text = f"{factor * value:{sign if value else ''}.3g}"
+    return f"{text} {unit}".rstrip() if unit != "x" else f"{text} x"
+
+
+def lines(content: dict) -> list[str]:
+    """The printed lines of a map's JSON content (its limits, their brackets and why the
+    first failing walk failed)."""
+    walk = content["walk"]
+    out = [
+        f"  walks of {walk['steps']} steps; pushes at mid-step {walk['push_step']} "
+        f"({walk['push_time']:.3f} s); {walk['iterations']} bisections per limit"
+    ]
+    for name, limit in content["limits"].items():
+        label = SHOWN[name][0]
+        near, far = limit["bracket"]
+        bracket = f"bracket {_value(name, near)} to {_value(name, far)}"
+        if limit["bracketed"]:
+            detail = f"fails at {_value(name, limit['fails_at'])}; {bracket}"
+            why = ": " + ", ".join(limit["failures"])
+        else:
+            detail = f"{bracket}: its end walks too, the limit lies beyond"
+            why = ""
+        out.append(f"  {label:19} {_value(name, limit['limit']):>11}  ({detail}){why}")
+    return out
+
+
+def cmd_robustness(args) -> int:
+    """Map how far each gait still walks in MuJoCo from its nominal conditions: the largest
+    forward and backward push on the trunk [N·s] at mid-step of --push-step, the lowest
+    friction coefficient, the trunk-mass error of the model (heavier, lighter), and the range
+    of the servos' stiffness; each by bisection (--iterations) between the nominal walk and
+    a stated bracket end, every walk --steps steps long and judged as the forward check of
+    'biped validate' judges it (steps land and advance, no fall, slip, foot tilt, scuff or
+    MuJoCo warning).
+
+    Writes per gait <out>/<folder>-<gait>.json (limits, brackets, tolerances, why the first
+    failing walk failed, a units map, provenance) and .png, together; a progress bar on a
+    terminal. Exits 1 if a gait's nominal walk fails (no map is written for it), 0 otherwise.
+    """
+    from biped.files import atomic_set
+    from biped.provenance import provenance
+    from biped_cli.commands import read_gaits
+    from biped_cli.outputs import output_name
+    from biped_cli.progress import Progress
+    from validate import robustness
+    from validate.robustness_figure import DPI, robustness_figure
+
+    settings = _settings(args)
+    gaits = read_gaits(args.gait, args.model)
+    types.check_folder(args.out, "--out")
+    names = [output_name(path) for path in args.gait]
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise BipedError(
+            f"gait files in folders of the same name would share the map {repeated[0]!r}: "
+            "allowed gait files of distinct folder or file names"
+        )
+    out, failed = Path(args.out), []
+    with Progress(len(gaits) * (1 + len(robustness.LIMITS)), "robustness") as bar:
+        for path, gait, name in zip(args.gait, gaits, names, strict=True):
+            bar.update(note=path)
+            began = time.perf_counter()
+            try:
+                result = robustness.robustness_map(gait, args.model, settings, progress=bar)
+            except BipedError as error:
+                raise BipedError(f"gait file {path!r}: {error}") from None
+            wall = time.perf_counter() - began
+            source = model_source(gait, args.model)
+            bar.clear()
+            print(
+                f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s, "
+                f"on {source}"
+            )
+            if not result.passed:
+                print(f"  FAIL  the nominal walk: {', '.join(result.nominal_failures)}; no map")
+                failed.append(path)
+                continue
+            content = {
+                "gait": str(path),
+                "knee": gait["knee"],
+                "criterion": gait["criterion"],
+                "speed": gait["speed"],
+                "model": source,
+                **result.to_dict(),
+            }
+            content["units"] = {"speed": "m/s", **content["units"]}
+            content["provenance"] = provenance()
+            title = f"{path}: {gait['knee']} knee, {gait['speed']} m/s"
+            figure = robustness_figure(content, title)
+            with atomic_set(out, f"robustness-{name}") as staging:  # both or neither
+                text = json.dumps(content, indent=1, allow_nan=False)
+                (staging / f"{name}.json").write_text(text, encoding="utf-8")
+                figure.savefig(staging / f"{name}.png", dpi=DPI)
+            for line in lines(content):
+                print(line)
+            print(
+                f"  wrote {out / (name + '.json')}, {out / (name + '.png')} ({result.walks} walks, "
+                f"{wall:.1f} s, {settings.jobs} process{'es' if settings.jobs > 1 else ''})",
+                flush=True,
+            )
+    if failed:
+        print(
+            f"biped robustness: the nominal walk fails for {', '.join(failed)}: no robustness "
+            "map for it",
+            file=sys.stderr,
+        )
+        return 1
+    return 0

@@ -1,0 +1,91 @@
+"""The figure of a robustness map (``validate.robustness``): one row per condition.
+
+Drawn from the map's JSON content (``RobustnessMap.to_dict``), so a map written earlier can
+be drawn again. Each row: the range the gait walks over (a bar from one limit to the other),
+the bisection's uncertainty beyond each limit up to the first value that failed (hatched),
+the bracket searched (grey line) and the nominal walk's value (black line).
+"""
+
+from __future__ import annotations
+
+from matplotlib.figure import Figure
+
+WALKS = "#2a9d8f"
+UNSURE = "#e9c46a"
+BRACKET = "0.6"
+DPI = 120
+
+# Rows: title, the limits at the low and the high end (None: the nominal value is that end),
+# the factor of the drawn values, the axis scale.
+ROWS = (
+    ("push on the trunk [N·s]", "push_backward", "push_forward", 1.0, "linear"),
+    ("friction coefficient μ", "friction", None, 1.0, "linear"),
+    ("trunk mass error [%]", "trunk_mass_lighter", "trunk_mass_heavier", 100.0, "linear"),
+    ("servo stiffness kp / kp₀", "kp_scale_low", "kp_scale_high", 1.0, "log"),
+)
+
+
+def _nominal(content: dict, name: str) -> float:
+    return content["limits"][name]["bracket"][0]
+
+
+def robustness_figure(content: dict, title: str) -> Figure:
+    """The figure of a map's JSON content whose nominal walk walked."""
+    limits = content["limits"]
+    figure = Figure(figsize=(8.0, 6.0), layout="constrained")
+    axes = figure.subplots(len(ROWS), 1)
+    for ax, (label, low, high, factor, scale) in zip(axes, ROWS, strict=True):
+        nominal = factor * _nominal(content, low)
+        ends = []
+        for name in (low, high):
+            if name is None:  # the nominal value is that end: not searched
+                ends.append(None)
+                continue
+            limit = limits[name]
+            fails = limit["fails_at"]
+            ends.append(
+                (
+                    factor * limit["limit"],
+                    None if fails is None else factor * fails,
+                    factor * limit["bracket"][1],
+                )
+            )
+        searched = [end for end in ends if end is not None]
+        ends = [(nominal, None, nominal) if end is None else end for end in ends]
+        (low_walks, _, low_far), (high_walks, _, high_far) = ends
+        ax.set_xscale(scale)
+        ax.plot([low_far, high_far], [0, 0], color=BRACKET, linewidth=1, zorder=1)
+        ax.barh(0, high_walks - low_walks, left=low_walks, height=0.5, color=WALKS, zorder=2)
+        for walks, fails, _ in searched:
+            if fails is not None:
+                start, stop = sorted((walks, fails))
+                ax.barh(
+                    0,
+                    stop - start,
+                    left=start,
+                    height=0.5,
+                    color=UNSURE,
+                    hatch="///",
+                    edgecolor="0.3",
+                    zorder=2,
+                )
+            ax.annotate(
+                f"{walks:.3g}" if fails is not None else f"≥ {walks:.3g} (bracket end walks)",
+                (walks, 0.3),
+                ha="center",
+                va="bottom",
+                fontsize=8,
+            )
+        ax.axvline(nominal, color="k", linewidth=1.5, zorder=3)
+        ax.annotate(f"nominal {nominal:g}", (nominal, -0.3), ha="center", va="top", fontsize=8)
+        ax.set_ylim(-0.8, 0.8)
+        ax.set_yticks([])
+        ax.set_title(label, fontsize=9, loc="left")
+    walk = content["walk"]
+    figure.suptitle(
+        f"{title}\nwalks of {walk['steps']} steps, pushes at mid-step {walk['push_step']} "
+        f"({walk['push_time']:.3f} s), {walk['iterations']} bisections per limit\n"
+        "green: walks; hatched: up to the first failing value; grey: bracket searched",
+        fontsize=9,
+    )
+    return figure
