@@ -379,7 +379,8 @@ def walk_failures(figures: dict, steps: int) -> list[str]:
             f"(allowed < {MAX_FOOT_TILT:g} rad)"
         )
     if figures["scuff_steps"] != 0:
-        failures.append(f"swing foot scuffed the floor in {figures['scuff_steps']} steps")
+        scuffed = figures["scuff_steps"]
+        failures.append(f"swing foot scuffed the floor in {scuffed} step{'s' * (scuffed != 1)}")
     if figures["warnings"] != 0:
         failures.append(f"{figures['warnings']} MuJoCo warnings")
     return failures
