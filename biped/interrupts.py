@@ -4,7 +4,9 @@ CasADi checks for signals while IPOPT iterates and stops the solver when a signa
 handler raises (KeyboardInterrupt for Ctrl-C, the command line's ``Terminated`` for SIGTERM),
 but it swallows the exception: the solve returns with a status such as
 ``NonIpopt_Exception_Thrown`` and the program would go on to the next start, the next point,
-as if nothing had been asked. ``kept_interrupts`` remembers the signal and, once the solver
+as if nothing had been asked. It does the same while it builds a graph: CasADi asks Python for
+each operand's shape, and a handler that raises during that call loses its exception there
+(the build goes on to its end). ``kept_interrupts`` remembers the signal and, once the solver
 has returned, calls its handler again, so the same exception goes up as it would anywhere
 else:
 

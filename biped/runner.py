@@ -124,13 +124,28 @@ def _quietly(function: Callable, task):
         return function(task)
 
 
+# How long a worker that swallowed its SIGTERM's SystemExit runs on before it is raised again [s].
+EXIT_AGAIN_AFTER = 1.0
+
+
 def _worker_init():
     """Workers leave Ctrl-C to the main process, and stop cleanly when it terminates them:
     SIGTERM raises SystemExit, so a file being written is removed, never left half-written."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    signal.signal(signal.SIGTERM, _end_worker)
     np.seterr(all="ignore")  # as in the command line: numpy's warnings stay off the terminal
     warnings.simplefilter("ignore", RuntimeWarning)
+
+
+def _end_worker(signum, frame):
+    """SIGTERM in a worker: SystemExit. Code that calls back into Python can swallow it
+    (CasADi does, while it asks an operand's shape), and the worker would go on, then wait
+    for its next task forever: the pool's termination never ends. So the exit is raised
+    again every ``EXIT_AGAIN_AFTER`` seconds (SIGALRM) until the worker has ended."""
+    if hasattr(signal, "setitimer"):
+        signal.signal(signal.SIGALRM, _end_worker)
+        signal.setitimer(signal.ITIMER_REAL, EXIT_AGAIN_AFTER, EXIT_AGAIN_AFTER)
+    sys.exit(143)
 
 
 def _in_process(function: Callable, tasks: list) -> Iterator:

@@ -123,6 +123,12 @@ class Solver:
         samples_per_half: int,
         radius_bounds=None,
     ):
+        # CasADi calls back into Python for every operand's shape while it builds the graph;
+        # an interrupt whose handler raises there is swallowed: raised again after the build.
+        with kept_interrupts():
+            self._build(model, criterion, safety, samples_per_half, radius_bounds)
+
+    def _build(self, model, criterion, safety, samples_per_half, radius_bounds):
         one_blas_thread()
         design = radius_bounds is not None
         self.graph = graph = StepGraph(model, samples_per_half, safety, design=design)
@@ -171,6 +177,10 @@ class Solver:
         ``problem.speed``; with radii as variables, from the knee radii ``radii`` (r1, r2) [m]
         clipped into theirs, or held at them (``hold_radii``: the gait alone optimised, IPOPT
         treating the radii as parameters)."""
+        with kept_interrupts():  # CasADi stops at Ctrl-C but swallows it: raised again
+            return self._solve(problem, start, radii, hold_radii)
+
+    def _solve(self, problem, start, radii, hold_radii) -> Solution:
         began = time.perf_counter()
         z0 = np.clip(np.asarray(start, dtype=float), self.lower, self.upper)
         x0 = z0 / SCALES
@@ -192,8 +202,7 @@ class Solver:
             held = slice(N_VARIABLES, N_VARIABLES + 2)
             lbx, ubx = lbx.copy(), ubx.copy()
             lbx[held] = ubx[held] = r0 / RADIUS_SCALE
-        with kept_interrupts():  # CasADi stops at Ctrl-C but swallows it: raised again
-            result = self.nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
+        result = self.nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
         stats = self.nlp.stats()
         x = np.asarray(result["x"]).ravel()
         g = np.asarray(result["g"]).ravel()

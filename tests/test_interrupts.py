@@ -2,6 +2,7 @@
 signal's handler raises but swallows the exception (``biped.interrupts`` raises it again),
 and its notice of the swallowed exception stays off the terminal."""
 
+import contextlib
 import io
 import os
 import signal
@@ -95,6 +96,37 @@ def test_ctrl_c_stops_a_real_ipopt_solve(capfd):
         solver.solve(problem, problem.first_guess())
     timer.join()
     assert "CasADi" not in capfd.readouterr().err
+
+
+def test_ctrl_c_while_casadi_builds_the_graph_is_not_lost(monkeypatch):
+    """CasADi asks Python for each operand's shape while it builds the step's graph, and
+    swallows an exception raised there: a Ctrl-C whose handler runs at that moment (a sweep
+    worker's SIGTERM did, and the pool never ended) is lost without the guard, raised with it."""
+    import casadi as ca
+
+    shape = ca.SX.shape
+    calls = {"n": 0, "at": None}
+
+    def shape_then_ctrl_c(self):
+        calls["n"] += 1
+        if calls["n"] == calls["at"]:
+            signal.raise_signal(signal.SIGINT)  # the handler runs inside this call
+        return shape.fget(self)
+
+    monkeypatch.setattr(ca.SX, "shape", property(shape_then_ctrl_c))
+    model = biped.Biped(biped.Robot.paper(), "revolute")
+    calls["at"] = 20
+    with pytest.raises(KeyboardInterrupt):
+        Solver(model, "sthenic", GaitProblem(model, 0.3).safety, 4)
+    assert calls["n"] > calls["at"] + 1000  # the build went on past the interrupt: swallowed
+    calls["n"], calls["at"] = 0, 20  # and the same without the guard: lost
+    monkeypatch.setattr("biped.solver.kept_interrupts", _no_guard)
+    Solver(model, "sthenic", GaitProblem(model, 0.3).safety, 4)
+
+
+@contextlib.contextmanager
+def _no_guard():
+    yield
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])

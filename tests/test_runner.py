@@ -379,3 +379,41 @@ def test_the_solver_runs_blas_on_one_thread():
     solver_for(GaitProblem(biped.Biped(biped.Robot.paper(), "revolute"), 0.3))
     library = ctypes.CDLL(str(Path(casadi.__file__).parent / "libcasadi-tp-openblas.so.0"))
     assert library.openblas_get_num_threads() == 1
+
+
+def _swallowing_worker(lock, ready):
+    """A pool worker whose code swallows the SIGTERM's SystemExit (as CasADi does while it
+    calls back into Python), then waits for a task that never comes."""
+    runner._worker_init()
+    ready.set()
+    try:
+        while True:
+            time.sleep(0.01)
+    except BaseException:
+        pass
+    with lock:
+        pass
+
+
+@pytest.mark.skipif(not hasattr(signal, "setitimer"), reason="no interval timers")
+def test_a_worker_that_swallows_its_sigterm_still_ends():
+    """The pool terminates its workers with SIGTERM and waits for each; a worker that
+    swallowed the SystemExit and went on to wait for its next task kept `biped sweep` from
+    ending after Ctrl-C. The exit is raised again until the worker ends, with its status."""
+    import multiprocessing
+
+    context = multiprocessing.get_context("spawn")
+    lock, ready = context.Lock(), context.Event()
+    lock.acquire()  # held, as the pool holds its task queue's lock while it terminates
+    worker = context.Process(target=_swallowing_worker, args=(lock, ready))
+    worker.start()
+    try:
+        assert ready.wait(60)
+        worker.terminate()
+        worker.join(10 * runner.EXIT_AGAIN_AFTER)
+        assert not worker.is_alive()
+        assert worker.exitcode == 143
+    finally:
+        if worker.is_alive():
+            worker.kill()
+            worker.join()
