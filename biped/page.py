@@ -273,9 +273,12 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
         lines += [f"### {check}: {'PASS' if figures['passed'] else 'FAIL'}", ""]
         lines += ["| figure | value | unit |", "|---|---|---|"]
         for name, value in figures.items():
-            if name != "passed":
+            if name not in ("passed", "notes"):
                 lines += [f"| {name} | {_number(value)} | {units.get(f'{check}.{name}', '')} |"]
         lines += [""]
+        notes = figures.get("notes") or []
+        if notes:  # sentences, one a line (a list of figures is a range: "low to high")
+            lines += [f"- {note}" for note in notes] + [""]
     return lines
 
 

@@ -30,7 +30,14 @@ def written(tmp_path_factory):
     video = recording.with_suffix(".mp4")
     video.write_bytes(b"video")
     report = {
-        "forward": {"steps": 20, "max_slip": 0.0004, "fell": False, "passed": False},
+        "forward": {
+            "steps": 20,
+            "max_slip": 0.0004,
+            "fell": False,
+            "step_duration_range": [0.99, 1.02],
+            "passed": False,
+            "notes": ["the swing foot scuffed the floor", "kp × 2: decided by scuffing"],
+        },
         "passed": False,
         "units": {"forward.steps": "1", "forward.max_slip": "m"},
         "recording": str(recording),
@@ -68,6 +75,10 @@ def test_page_shows_the_validation_and_links_its_own_outputs(written):
     _, out, text = written
     assert "Validation in MuJoCo: **FAIL**" in text
     assert "| max_slip | 0.0004 | m |" in text and "| fell | no |" in text
+    assert "| step_duration_range | 0.99 to 1.02 |" in text  # a range
+    # notes are sentences, each on its own line, not a range
+    assert "- the swing foot scuffed the floor\n- kp × 2: decided by scuffing\n" in text
+    assert "| notes |" not in text and "floor to kp" not in text
     assert f"](../recordings/{NAME}.rrd)" in text and f"](../recordings/{NAME}.mp4)" in text
     assert f"](../pipeline/{NAME}.json)" in text
 
