@@ -280,7 +280,7 @@ def _friction_marks(ax, gaits) -> None:
 
 def _sole_marks(ax, gaits) -> None:
     robot = next(iter(gaits.values()))["robot"]
-    for x, name in ((-robot.foot_heel, "heel"), (robot.foot_length - robot.foot_heel, "toe")):
+    for name, x in robot.sole_edges().items():
         ax.axhline(x, color="0.4", linestyle=":", linewidth=1.0)
         ax.annotate(
             name, xy=(0.0, x), xytext=(2, 2), textcoords="offset points", fontsize=8, color="0.4"

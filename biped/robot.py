@@ -29,6 +29,9 @@ STANDARD_GRAVITY = 9.81
 # Coefficient of sliding friction μ between the soles and the floor, the one the MuJoCo models
 # use (``validate.mjcf``): a gait whose stance foot needs |Fx| / Fz above it would slip.
 FOOT_FRICTION = 1.0
+# The two ends of a sole, heel first (``Robot.sole_edges``): the ZMP's bounds (eq. 28), the
+# swing foot's points above the ground, the MJCF's contact points.
+SOLE_EDGES = ("heel", "toe")
 
 # Plausible ranges, wide enough for any walking robot from a toy to twice human size; beyond
 # them the numbers are typos or overflow (a 1e308 kg trunk gives torques of inf and nan).
@@ -226,6 +229,12 @@ class Robot:
     def total_mass(self) -> float:
         """[kg] Mass of the whole robot (two feet, two shanks, two thighs, trunk)."""
         return 2 * (self.foot_mass + self.shank_mass + self.thigh_mass) + self.trunk_mass
+
+    def sole_edges(self) -> dict[str, float]:
+        """[m] x of the heel and the toe from the ankle, by name (``SOLE_EDGES``)."""
+        return dict(
+            zip(SOLE_EDGES, (-self.foot_heel, self.foot_length - self.foot_heel), strict=True)
+        )
 
     @property
     def height(self) -> float:

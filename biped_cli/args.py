@@ -10,6 +10,7 @@ import numpy as np
 from biped.criteria import MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
 from biped.errors import BipedError
 from biped.problem import MIN_SPEED
+from validate import DEFAULT_STEPS
 
 ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
 SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower steps are mm long)"
@@ -17,7 +18,7 @@ SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower step
 MAX_SPEEDS = 1000
 # Most steps of a forward walk in MuJoCo: 1000 steps are about 10 simulated minutes.
 MAX_STEPS = 1000
-STEPS_HELP = f"steps to walk, 1 to {MAX_STEPS} (default 20)"
+STEPS_HELP = f"steps to walk, 1 to {MAX_STEPS} (default {DEFAULT_STEPS})"
 # Most worker processes of a sweep.
 MAX_JOBS = 256
 

@@ -29,6 +29,7 @@ from biped_cli.commands import (
     cmd_validate,
 )
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
+from validate import DEFAULT_STEPS
 
 ROBOT_HELP = types.ROBOT_HELP
 DEBUG_HELP = "on an error, print its traceback before the one-line message"
@@ -130,7 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument(
         "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
     )
-    val.add_argument("--steps", type=types.steps, default=20, help=types.STEPS_HELP)
+    val.add_argument("--steps", type=types.steps, default=DEFAULT_STEPS, help=types.STEPS_HELP)
     val.add_argument(
         "--rrd",
         metavar="PATH",
@@ -185,7 +186,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--knees", nargs="+", choices=KNEES, default=list(KNEES), action=types.Distinct
     )
     pipe.add_argument("--criterion", choices=CRITERIA, default="sthenic")
-    pipe.add_argument("--steps", type=types.steps, default=20, help=types.STEPS_HELP)
+    pipe.add_argument("--steps", type=types.steps, default=DEFAULT_STEPS, help=types.STEPS_HELP)
     pipe.add_argument(
         "--out",
         default=DEFAULT_PIPELINE,

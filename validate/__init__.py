@@ -8,6 +8,9 @@ so that videos render from a terminal or a CI job. Import it before ``mujoco``.
 import os
 import sys
 
+# Steps of a forward walk unless told otherwise (validate, pipeline, videos).
+DEFAULT_STEPS = 20
+
 if sys.platform.startswith("linux") and not (
     os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
 ):

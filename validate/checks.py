@@ -36,6 +36,7 @@ from biped.units import PURE
 from validate import contact
 from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
 from validate.mapping import mapping, other
+from validate.mjcf import SIDES
 from validate.model import ModelError, model_problems
 from validate.replay import replay_model, replay_step
 from validate.samples import GaitSamples
@@ -183,7 +184,7 @@ def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait
 def check_feedforward(spec: mujoco.MjSpec, biped: Biped, samples: GaitSamples) -> Check:
     """Both stance sides replayed; each joint's worst share (``validate.replay``)."""
     model = replay_model(spec, biped.knee)
-    replays = [replay_step(model, samples, biped, stance) for stance in ("left", "right")]
+    replays = [replay_step(model, samples, biped, stance) for stance in SIDES]
     shares = np.max([r.shares() for r in replays], axis=0)
     feedback = np.max([r.feedback_rms() for r in replays], axis=0)
     torques = np.max([r.torque_rms() for r in replays], axis=0)

@@ -29,7 +29,7 @@ import numpy as np
 
 from biped.dynamics import Biped
 from validate.mapping import Mapping, mapping
-from validate.mjcf import robot_xml
+from validate.mjcf import SIDES, robot_xml
 from validate.model import JOINT_ORDER, ModelError
 
 
@@ -45,7 +45,7 @@ def rigid_copy(model: mujoco.MjModel) -> mujoco.MjModel:
     """A copy without armature and with massless knee links: the analytical robot exactly."""
     exact = copy.deepcopy(model)
     exact.dof_armature[:] = 0.0
-    for side in ("left", "right"):
+    for side in SIDES:
         name = f"{side}_knee_link"
         if mujoco.mj_name2id(exact, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
             body = exact.body(name).id

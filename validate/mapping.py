@@ -54,7 +54,7 @@ class Mapping:
 def mapping(model: mujoco.MjModel, stance: str, radii=(0.0, 0.0)) -> Mapping:
     """The map for ``stance`` in {'left', 'right'}; ``radii`` (r1, r2) of a rolling knee."""
     if stance not in SIDES:
-        raise ValueError(f"stance = {stance!r}: allowed 'left', 'right'")
+        raise ValueError(f"stance = {stance!r}: allowed one of {SIDES}")
     swing = other(stance)
     matrix = np.zeros((model.nq, NQ))
 

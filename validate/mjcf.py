@@ -34,7 +34,7 @@ from pathlib import Path
 from biped.files import atomic_write_text
 from biped.kinematics import check_knee
 from biped.robot import FOOT_FRICTION as SLIDING_FRICTION
-from biped.robot import Robot
+from biped.robot import SOLE_EDGES, Robot
 
 SIDES = ("left", "right")
 # Near-massless knee link of the rolling knee (MuJoCo needs mass on a moving body) [kg, kg·m²].
@@ -186,7 +186,7 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
                 f'{pad}      <geom name="{side}_{end}_contact" class="collision" type="sphere" '
                 f'size="{_f(SOLE_CONTACT_RADIUS)}" '
                 f'pos="{_f(x)} 0 {_f(-r.ankle_height + SOLE_CONTACT_RADIUS)}"/>'
-                for end, x in (("heel", -r.foot_heel), ("toe", r.foot_length - r.foot_heel))
+                for end, x in r.sole_edges().items()
             ),
             f'{pad}      <geom class="visual" type="box" '
             f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
@@ -268,7 +268,7 @@ def with_box_soles(spec, robot: Robot, solref=None):
 
     spec = spec.copy()
     for side in SIDES:
-        for end in ("heel", "toe"):
+        for end in SOLE_EDGES:
             spec.delete(spec.geom(f"{side}_{end}_contact"))
         sole = spec.body(f"{side}_foot").add_geom(
             name=f"{side}_sole",

@@ -24,14 +24,14 @@ import numpy as np
 
 from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.robot import Robot
+from biped.robot import SOLE_EDGES, Robot
 from validate.mjcf import FOLDER, FOOT_FRICTION, SIDES, robot_xml, scene_xml
 
 # Names of the six actuated joints, in the order of every (N, 6) array of the validation.
 JOINT_ORDER = tuple(f"{side}_{joint}" for side in SIDES for joint in ("hip", "knee", "ankle"))
 # What the validation reads by name (as ``validate.mjcf`` writes it).
 BASE_JOINTS = ("rootx", "rootz", "rooty")
-SITES = ("ankle", "heel", "toe")  # per side
+SITES = ("ankle", *SOLE_EDGES)  # per side
 SENSORS = ("touch", "ankle_pos", "heel_pos", "toe_pos")  # per side
 # Largest relative error of a rolling-knee equality's ratio against r2 / r1.
 RATIO_TOLERANCE = 1e-9

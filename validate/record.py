@@ -39,6 +39,7 @@ import rerun.blueprint as rrb
 
 from biped.dynamics import JOINTS, Biped
 from biped.files import atomic_path
+from biped.robot import SOLE_EDGES
 from validate.contact import SAMPLE_EVERY
 from validate.mapping import mapping
 from validate.mjcf import HIP_OFFSET, SIDES
@@ -409,7 +410,7 @@ def _log_series(rec, biped: Biped, step, sim: Simulation, contact, wrench, zmp) 
         )
     rec.log("zmp/analytic", rr.SeriesLines(colors=ANALYTIC_COLOR, names="ZMP gait"), static=True)
     rec.log("zmp/mujoco", rr.SeriesLines(colors=MUJOCO_COLOR, names="CoP MuJoCo"), static=True)
-    for name in ("heel", "toe"):
+    for name in SOLE_EDGES:
         rec.log(f"zmp/{name}", rr.SeriesLines(colors=LANDING_COLOR, names=name), static=True)
     for i, name in enumerate(("Fx", "Fz")):
         rec.send_columns(
@@ -434,7 +435,7 @@ def _log_series(rec, biped: Biped, step, sim: Simulation, contact, wrench, zmp) 
         columns=rr.Scalars.columns(scalars=contact["cop"][sampled]),
     )
     robot = biped.robot
-    for name, value in (("heel", -robot.foot_heel), ("toe", robot.foot_length - robot.foot_heel)):
+    for name, value in robot.sole_edges().items():
         rec.send_columns(
             f"zmp/{name}",
             indexes=time_column,

@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 
 from biped.dynamics import Biped
+from validate import DEFAULT_STEPS
 from validate import checks as c
 from validate.checks import EXACT, Check
 from validate.model import compile_spec, model_spec
@@ -44,7 +45,9 @@ class Validation:
         return self.samples
 
 
-def validate(gait: dict, steps: int = 20, model: str | Path | mujoco.MjSpec | None = None):
+def validate(
+    gait: dict, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
+):
     """All checks of a gait file's content (``biped.gait_file.read`` or ``to_dict``) on
     ``model`` (``validate.model.model_spec``: by default the committed model of the gait's
     knee for Table 1, the model generated from the gait's robot otherwise).

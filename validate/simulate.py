@@ -56,6 +56,7 @@ from mujoco import rollout
 from biped.dynamics import Biped
 from biped.errors import BipedError
 from biped.kinematics import XH, ZH
+from validate import DEFAULT_STEPS
 from validate.layout import Layout
 from validate.mapping import mapping, other
 from validate.mjcf import SIDES
@@ -352,13 +353,15 @@ class Walker:
     def period(self) -> float:
         return self.samples.period
 
-    def walk(self, steps: int = 20, settings: WalkSettings = WalkSettings()) -> Simulation:
+    def walk(
+        self, steps: int = DEFAULT_STEPS, settings: WalkSettings = WalkSettings()
+    ) -> Simulation:
         """Play ``steps`` steps of the gait from its start state, left leg in stance first."""
         return _walk(self, steps, settings)
 
 
 def simulate(
-    gait: dict, steps: int = 20, settings: WalkSettings = WalkSettings(), model=None
+    gait: dict, steps: int = DEFAULT_STEPS, settings: WalkSettings = WalkSettings(), model=None
 ) -> Simulation:
     """``Walker(gait, model).walk(steps, settings)``."""
     return Walker(gait, model).walk(steps, settings)

@@ -25,6 +25,7 @@ import numpy as np
 
 from biped.dynamics import Biped
 from biped.files import atomic_path
+from validate import DEFAULT_STEPS
 from validate.mapping import mapping
 from validate.mjcf import SIDES
 from validate.simulate import Simulation
@@ -321,7 +322,9 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--at", type=float, default=2.0, help="time of --frame [s of simulation] (default 2)"
     )
-    parser.add_argument("--steps", type=int, default=20, help="steps walked (default 20)")
+    parser.add_argument(
+        "--steps", type=int, default=DEFAULT_STEPS, help=f"steps walked (default {DEFAULT_STEPS})"
+    )
     parser.add_argument("--no-ghost", action="store_true", help="leave out the gait's ghost")
     args = parser.parse_args(argv)
     if not (args.out or args.gif or args.frame):
