@@ -64,7 +64,12 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
             figure.savefig(tmp, format="png")
     """
     path = Path(path)
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMPORARY_SUFFIX)
+    try:
+        fd, name = tempfile.mkstemp(
+            dir=path.parent, prefix=f".{path.name}.", suffix=TEMPORARY_SUFFIX
+        )
+    except OSError as error:  # named by the file asked for, not its temporary one
+        raise OSError(error.errno, f"cannot write {str(path)!r}: {error.strerror}") from None
     tmp = Path(name)
     try:
         os.close(fd)

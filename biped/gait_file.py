@@ -148,7 +148,10 @@ def read(path: str | Path) -> dict:
         raise BipedError(f"gait file {str(path)!r} cannot be read: {error.strerror}") from None
     except (ValueError, RecursionError) as error:  # JSONDecodeError and UnicodeDecodeError too
         reason = "nested too deeply" if isinstance(error, RecursionError) else error
-        raise BipedError(f"gait file {str(path)!r} is not valid JSON: {reason}") from None
+        raise BipedError(
+            f"gait file {str(path)!r} is not valid JSON ({reason}): allowed a gait file "
+            "written by biped optimize, sweep, design or pipeline"
+        ) from None
 
     def bad(what):
         return BipedError(f"gait file {str(path)!r} is corrupt: {what}")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 
 import numpy as np
 
@@ -29,7 +28,7 @@ def speed(text: str) -> float:
     except ValueError:
         raise argparse.ArgumentTypeError(f"speed = {text!r} is not a number") from None
     if not (np.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"speed = {text!r} m/s: allowed > 0")
+        raise argparse.ArgumentTypeError(f"speed = {text!r} m/s: allowed a finite speed > 0")
     if value < MIN_SPEED:
         raise argparse.ArgumentTypeError(f"speed = {text!r} m/s: {SLOW}")
     return value
@@ -57,7 +56,7 @@ def speeds(text: str) -> np.ndarray:
     """'0.15:0.45:13' (start:stop:count) or '0.2,0.3' (a list)."""
     values = number_list(text, "speeds", MAX_SPEEDS, "")
     if values.size == 0 or not np.all(np.isfinite(values) & (values > 0)):
-        raise argparse.ArgumentTypeError(f"speeds = {text!r}: allowed speeds > 0 m/s")
+        raise argparse.ArgumentTypeError(f"speeds = {text!r}: allowed finite speeds > 0 m/s")
     if values.size > MAX_SPEEDS:
         raise argparse.ArgumentTypeError(f"speeds = {text!r}: allowed {MAX_SPEEDS} speeds at most")
     if np.any(values < MIN_SPEED):
@@ -88,8 +87,16 @@ def check_folder(path: str, option: str, of: str | None = None) -> None:
         existing = existing.parent
     if not existing.is_dir():
         raise BipedError(f"{option} {named!r}: {str(existing)!r} is a file, allowed a folder")
-    if not os.access(existing, os.W_OK):
-        raise BipedError(f"{option} {named!r}: folder {str(existing)!r} is not writable")
+    import tempfile
+
+    try:  # what a writer will do there (permissions alone miss /proc, read-only mounts)
+        with tempfile.TemporaryFile(dir=existing):
+            pass
+    except OSError as error:
+        raise BipedError(
+            f"{option} {named!r}: folder {str(existing)!r} is not writable "
+            f"({error.strerror}): allowed a folder this user can write in"
+        ) from None
 
 
 def budget(args) -> dict:
@@ -109,16 +116,21 @@ def safety(args) -> Safety:
     return Safety(clearance=args.clearance, zmp_margin=args.zmp_margin)
 
 
-def add_budget(parser):
+def add_budget(parser, sweep: bool = False):
     from biped.optimize import DEFAULT_STARTS, METHODS
     from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
 
     parser.add_argument(
         "--method",
-        choices=METHODS,
+        choices=("ipopt",) if sweep else METHODS,
         default="ipopt",
-        help="ipopt: exact derivatives, several starts, certified optima (default); "
-        "nelder-mead: the paper's penalty method alone, to see where it stops",
+        help="ipopt: exact derivatives, several starts, certified optima (default)"
+        + (
+            "; a sweep's points are certified optima, the paper's method runs beside them "
+            "(--paper-seeds)"
+            if sweep
+            else "; nelder-mead: the paper's penalty method alone, to see where it stops"
+        ),
     )
     parser.add_argument(
         "--starts",
@@ -278,6 +290,31 @@ def dask_address(text: str) -> str:
         or parts.username is not None
     ):
         raise argparse.ArgumentTypeError(f"{text!r}: {allowed}")
+    return text
+
+
+# URL schemes of a rerun viewer (rerun's own ``connect_grpc`` refuses others).
+VIEWER_SCHEMES = ("rerun", "rerun+http", "rerun+https")
+
+
+def viewer_url(text: str) -> str:
+    """A rerun viewer's URL, SCHEME://HOST[:PORT]/proxy; "" for rerun's local default."""
+    from urllib.parse import urlsplit
+
+    if text == "":
+        return text
+    try:
+        parts = urlsplit(text)
+        host = parts.hostname
+        _ = parts.port  # a malformed port raises
+    except ValueError:
+        parts, host = None, None
+    if parts is None or parts.scheme not in VIEWER_SCHEMES or not host:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: allowed a rerun viewer's URL such as rerun+http://127.0.0.1:9876/proxy "
+            f"(schemes {', '.join(s + '://' for s in VIEWER_SCHEMES)}), or nothing for its "
+            "local address"
+        )
     return text
 
 

@@ -151,8 +151,6 @@ def cmd_sweep(args) -> int:
     from biped_cli.progress import Progress
 
     robot = _robot(args.robot)
-    if args.method != "ipopt":
-        raise BipedError(f"--method {args.method!r}: allowed 'ipopt' for sweeps")
     if args.dask is not None:
         check_dask(args.dask)
     run_sweep(

@@ -110,7 +110,7 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument(
         "--jobs", type=types.jobs, default=None, help="processes (default: all cores)"
     )
-    types.add_budget(sweep)
+    types.add_budget(sweep, sweep=True)
     sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     types.add_dask(sweep)
     sweep.add_argument(
@@ -164,6 +164,7 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="?",
         const="",
         default=None,
+        type=types.viewer_url,
         help="also stream the recording to a running rerun viewer (default its local address)",
     )
     val.add_argument(
@@ -237,8 +238,15 @@ def main(argv: list[str] | None = None) -> int:
     name = ["biped"]  # the command, once parsed, names the error lines
 
     def run() -> int:
+        parser = build_parser()
         try:
-            args = build_parser().parse_args(argv)
+            args, unknown = parser.parse_known_args(argv)
+            if unknown:  # named by the command's own parser, which would have taken them
+                commands = next(a for a in parser._actions if a.dest == "command")
+                commands.choices[args.command].error(
+                    f"unrecognized arguments: {' '.join(unknown)} (see biped {args.command} "
+                    "--help for what is allowed)"
+                )
         except SystemExit as exit_:  # --help, --version, or a one-line argparse error
             return exit_.code if isinstance(exit_.code, int) else EXIT_BAD_INPUT
         name[0] = f"biped {args.command}"

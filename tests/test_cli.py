@@ -235,6 +235,15 @@ def test_pipeline_refuses_a_rolling_knee_mujoco_cannot_model(capsys, robot_files
         (["sweep", "--knees", "rolling", "rolling"], ["--knees", "'rolling' given twice"]),
         (["sweep", "--jobs", "1000000"], ["--jobs", "1 to 256"]),
         (["demo", "--hip-ahead", "inf"], ["--hip-ahead", "finite"]),
+        (["optimize", "--knee", "rolling", "--speed", "inf", "--out", "x.json"], ["inf", "finite"]),
+        (
+            ["validate", "x.json", "--connect", "notaurl"],
+            ["--connect", "'notaurl'", "rerun+http://"],
+        ),
+        (
+            ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "/proc/x.json"],
+            ["--out '/proc/x.json'", "not writable", "allowed"],
+        ),
     ],
 )
 def test_refused_values_are_named_with_what_is_allowed(capsys, argv, needles):

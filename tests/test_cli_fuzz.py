@@ -191,8 +191,9 @@ def test_no_traceback_escapes_the_cli(capsys, no_work, paths):
             assert len(lines) == 1 and lines[0].startswith("biped"), (argv, captured.err)
             assert "internal error" not in lines[0], (argv, lines[0])
         outcomes[code] = outcomes.get(code, 0) + 1
-    assert outcomes.get(2, 0) > TRIALS // 3 and outcomes.get(0, 0) > 0, outcomes
-    assert outcomes.get("work", 0) > 10, outcomes  # valid commands were drawn too
+    assert outcomes.get(2, 0) > TRIALS // 3, outcomes
+    # valid commands were drawn too: they start the work (only demo ends at once, with 0)
+    assert outcomes.get("work", 0) > 10, outcomes
 
 
 def test_the_stand_in_would_be_caught(capsys, no_work):

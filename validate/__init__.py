@@ -15,3 +15,6 @@ if sys.platform.startswith("linux") and not (
     os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
 ):
     os.environ.setdefault("MUJOCO_GL", "egl")
+# The rerun SDK's own log lines (a viewer that does not answer) stay off the terminal: what
+# fails reaches the user as one line of this package (``validate.record``).
+os.environ.setdefault("RUST_LOG", "off")

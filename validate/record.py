@@ -38,6 +38,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from biped.dynamics import JOINTS, Biped
+from biped.errors import BipedError
 from biped.files import atomic_path
 from biped.robot import SOLE_EDGES
 from validate.contact import SAMPLE_EVERY
@@ -331,14 +332,22 @@ def record(
         # A stream of its own: a viewer that does not answer delays the command by at most
         # VIEWER_TIMEOUT and never the file.
         live = rr.RecordingStream(APPLICATION, recording_id=recording_id)
-        if spawn:
-            live.spawn(default_blueprint=layout)
-        else:
-            live.connect_grpc(connect or None, default_blueprint=layout)
-        log_all(live)
-        live.flush(timeout_sec=VIEWER_TIMEOUT)
-        live.disconnect()
-        del live
+        try:
+            if spawn:
+                live.spawn(default_blueprint=layout)
+            else:
+                live.connect_grpc(connect or None, default_blueprint=layout)
+            log_all(live)
+            live.flush(timeout_sec=VIEWER_TIMEOUT)
+        except RuntimeError as error:  # rerun's way to say no viewer took it
+            where = "the viewer it started" if spawn else f"--connect {connect or 'default'!r}"
+            raise BipedError(
+                f"{where}: no rerun viewer took the recording ({error}); it is written to "
+                f"{str(path)!r}: allowed a running viewer (start one with 'rerun')"
+            ) from None
+        finally:
+            live.disconnect()
+            del live
     return path
 
 
