@@ -102,7 +102,6 @@ def _settings(args):
 def model_source(gait: dict, model: str | None) -> str:
     """What the map's walks were played on: ``model`` as given, the committed model, or the
     one generated from the gait's robot."""
-    from validate.mjcf import FOLDER
     from validate.model import committed_model
     from validate.samples import gait_biped
 
@@ -111,7 +110,7 @@ def model_source(gait: dict, model: str | None) -> str:
     committed = committed_model(gait_biped(gait))
     if committed is None:
         return "generated from the gait's robot (validate.mjcf)"
-    return str(committed.relative_to(FOLDER.parent))
+    return f"mjcf/{committed.name}"  # the committed model, wherever this copy keeps it
 
 
 def _value(name: str, value: float | None) -> str:

@@ -98,3 +98,43 @@ def test_mjcf_help_exits_0(capsys):
     with pytest.raises(SystemExit) as exit_info:
         mjcf.main(["--help"])
     assert exit_info.value.code == 0 and "--check" in capsys.readouterr().out
+
+
+def test_an_installed_copy_carries_the_committed_models(tmp_path):
+    """`pip install .` (not editable) installs no mjcf/ folder beside the packages: the wheel
+    carries the committed models as validate/models, and an installed copy finds them
+    there. (Without them the README's main job failed on a fresh machine: the pipeline
+    looked for site-packages/mjcf/scene_revolute.xml.)"""
+    import subprocess
+    import zipfile
+
+    built = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q"]
+        + ["-w", str(tmp_path / "wheel"), str(ROOT)],
+        capture_output=True,
+        text=True,
+    )
+    assert built.returncode == 0, built.stderr
+    (wheel,) = (tmp_path / "wheel").glob("*.whl")
+    with zipfile.ZipFile(wheel) as archive:
+        archive.extractall(tmp_path / "site")
+        names = set(archive.namelist())
+    committed = sorted(p.name for p in (ROOT / "mjcf").glob("*.xml"))
+    assert len(committed) == 4
+    assert {f"validate/models/{name}" for name in committed} <= names
+    assert not any(name.startswith("mjcf/") for name in names)
+    program = (
+        "import biped; from validate.model import committed_model; "
+        "print(committed_model(biped.Biped(biped.Robot.paper(), 'rolling')))"
+    )
+    found = subprocess.run(
+        [sys.executable, "-c", program],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={**__import__("os").environ, "PYTHONPATH": str(tmp_path / "site")},
+    )
+    assert found.returncode == 0, found.stderr
+    path = Path(found.stdout.strip())
+    assert path == tmp_path / "site" / "validate" / "models" / "scene_rolling.xml"
+    assert path.read_text() == (ROOT / "mjcf" / "scene_rolling.xml").read_text()

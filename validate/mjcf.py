@@ -88,7 +88,16 @@ THIGH_RADIUS, SHANK_RADIUS, DISC_HALF_WIDTH = 0.04, 0.032, 0.05
 CAMERA_DISTANCE, CAMERA_HEIGHT = 2.8, 0.25
 # Largest offscreen image [px] (width, height): the video's frames.
 OFFSCREEN = (1280, 720)
-FOLDER = Path(__file__).resolve().parent.parent / "mjcf"
+
+
+def _models_folder() -> Path:
+    """Where the committed models are: ``mjcf/`` of a source checkout (editable installs
+    too), else the copy an installed package carries (``validate/models``, pyproject.toml)."""
+    source = Path(__file__).resolve().parent.parent / "mjcf"
+    return source if source.is_dir() else Path(__file__).resolve().parent / "models"
+
+
+FOLDER = _models_folder()
 
 
 def _f(value: float) -> str:
