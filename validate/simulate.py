@@ -405,6 +405,9 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     floor = FALLEN * min(q0[ZH], samples.end()[0][ZH])
     ticks = np.arange(chunk) * dt
     columns = np.concatenate([layout.motors, layout.positions, layout.velocities])
+    if np.array_equal(columns, np.arange(len(columns))):  # as validate.model orders them
+        columns = slice(0, len(columns))
+    warning_counts = data.warning.number  # a view: every rollout resets it, then counts
     state = state[None]
     out_state = np.empty((1, chunk, state.size))
     out_sensors = np.empty((1, chunk, model.nsensordata))
@@ -440,7 +443,12 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
                 advance += here
                 where = advance - x0
                 where *= per_metre
-                np.clip(where, 0.0, last, out=where)
+                # ``where`` is monotonic over the reading period: its ends bound it
+                low, high = (
+                    (where[0], where[-1]) if where[0] <= where[-1] else (where[-1], where[0])
+                )
+                if low < 0.0 or high > last:
+                    np.clip(where, 0.0, last, out=where)
                 i = where.astype(np.intp)
                 np.minimum(i, last - 1, out=i)
                 w = where - i
@@ -478,8 +486,8 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
                     sensordata=out_sensors,
                     skip_checks=True,
                 )
-                if data.warning.number.any():  # reset by every rollout
-                    result.warnings += int(data.warning.number.sum())
+                if warning_counts.any():  # reset by every rollout
+                    result.warnings += int(warning_counts.sum())
                 states, readings = out_state[0], out_sensors[0]
                 # states[r]: the state after physics step r; readings[r]: the sensors
                 # computed before it, at the state the step started from.
