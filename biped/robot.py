@@ -29,8 +29,8 @@ STANDARD_GRAVITY = 9.81
 # Coefficient of sliding friction μ between the soles and the floor, the one the MuJoCo models
 # use (``validate.mjcf``): a gait whose stance foot needs |Fx| / Fz above it would slip.
 FOOT_FRICTION = 1.0
-# The two ends of a sole, heel first (``Robot.sole_edges``): the ZMP's bounds (eq. 28), the
-# swing foot's points above the ground, the MJCF's contact points.
+# The two ends of a sole, heel first (``Robot.sole_edges``), by the names the MJCF's contact
+# points and sites, the recording and the figures give them.
 SOLE_EDGES = ("heel", "toe")
 
 # Plausible ranges, wide enough for any walking robot from a toy to twice human size; beyond

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import tempfile
 
 import numpy as np
 
@@ -87,8 +88,6 @@ def check_folder(path: str, option: str, of: str | None = None) -> None:
         existing = existing.parent
     if not existing.is_dir():
         raise BipedError(f"{option} {named!r}: {str(existing)!r} is a file, allowed a folder")
-    import tempfile
-
     try:  # what a writer will do there (permissions alone miss /proc, read-only mounts)
         with tempfile.TemporaryFile(dir=existing):
             pass

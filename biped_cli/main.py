@@ -228,6 +228,7 @@ def build_parser() -> argparse.ArgumentParser:
         command.add_argument(
             "--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP
         )
+    parser.command_parsers = commands.choices  # each command's own parser, by name
     return parser
 
 
@@ -242,8 +243,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             args, unknown = parser.parse_known_args(argv)
             if unknown:  # named by the command's own parser, which would have taken them
-                commands = next(a for a in parser._actions if a.dest == "command")
-                commands.choices[args.command].error(
+                parser.command_parsers[args.command].error(
                     f"unrecognized arguments: {' '.join(unknown)} (see biped {args.command} "
                     "--help for what is allowed)"
                 )

@@ -1,6 +1,7 @@
 """Package layout and entry points: the analytical package stays free of the simulator."""
 
 import ast
+import os
 import sys
 import tomllib
 from pathlib import Path
@@ -132,7 +133,7 @@ def test_an_installed_copy_carries_the_committed_models(tmp_path):
         capture_output=True,
         text=True,
         cwd=tmp_path,
-        env={**__import__("os").environ, "PYTHONPATH": str(tmp_path / "site")},
+        env={**os.environ, "PYTHONPATH": str(tmp_path / "site")},
     )
     assert found.returncode == 0, found.stderr
     path = Path(found.stdout.strip())
