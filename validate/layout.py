@@ -7,6 +7,8 @@ through a ``Layout``: ``layout.hip_x(qpos)`` rather than ``qpos[:, 0]``. The nam
 
 from __future__ import annotations
 
+import copy
+
 import mujoco
 import numpy as np
 
@@ -115,6 +117,13 @@ class Layout:
     def _position(self, sensors, side: str, kind: str) -> np.ndarray:
         adr = self._sensor[side, kind]
         return np.asarray(sensors)[..., adr : adr + 3]
+
+    def of(self, model: mujoco.MjModel) -> Layout:
+        """This layout for ``model``, a copy of its model (the same names, ids and sizes;
+        other parameters, gains or friction, may differ)."""
+        layout = copy.copy(self)
+        layout.model = model
+        return layout
 
     # ------------------------------------------------------------ state vectors
     def state_index(self, name: str) -> int:

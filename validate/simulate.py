@@ -47,6 +47,7 @@ of its height, the walk ends.
 from __future__ import annotations
 
 import copy
+import functools
 from dataclasses import dataclass, field
 
 import mujoco
@@ -169,6 +170,16 @@ class PhaseTable:
     tau: np.ndarray
     speed: np.ndarray
     controls: dict
+
+    @functools.cached_property
+    def interpolants(self) -> dict:
+        """Stance side -> (48, N - 1): ``controls`` as columns (the first 24 rows, less the
+        last point) over each column's increments to the next point (the other 24): what
+        the walk interpolates, laid out for one gather."""
+        return {
+            side: np.ascontiguousarray(np.hstack([rows[:-1], np.diff(rows, axis=0)]).T)
+            for side, rows in self.controls.items()
+        }
 
 
 def phase_table(
@@ -372,7 +383,7 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     if settings.friction is not None:
         collides = (model.geom_contype != 0) | (model.geom_conaffinity != 0)
         model.geom_friction[collides, 0] = settings.friction
-    layout = Layout(model)
+    layout = walker.layout.of(model)
     data = mujoco.MjData(model)
     table, samples = walker.table, walker.samples
     q0, qd0 = samples.start()
@@ -381,20 +392,21 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     data.qvel[:] = start.qpos(qd0)
     mujoco.mj_forward(model, data)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state = np.empty(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, state, spec)
-    sensors = data.sensordata.copy()
-    data.warning.number[:] = 0
-
     dt = model.opt.timestep
     chunk = max(1, round(RESYNC / dt))
     period = samples.period
     capacity = int(np.ceil(steps * STEP_TIMEOUT * period / dt)) + chunk
-    log_state = np.empty((capacity, state.size))
-    log_ctrl = np.empty((capacity, model.nu))
+    # MuJoCo reads each reading period's controls from these logs and writes its states and
+    # sensors straight into them: row k holds the state at the k-th physics step, the
+    # sensors computed at it and the controls of the step that follows it.
+    log_state = np.empty((capacity, mujoco.mj_stateSize(model, spec)))
+    log_ctrl = np.zeros((capacity, model.nu))
     log_sensors = np.empty((capacity, model.nsensordata))
     log_where = np.empty(capacity)  # position in the phase table
     log_speed = np.empty(capacity)
+    mujoco.mj_getState(model, data, log_state[0], spec)
+    log_sensors[0] = data.sensordata
+    data.warning.number[:] = 0
     result = Simulation(model, layout, *(None,) * 6, settings=settings)
     x0, x_end = table.advance[0], table.advance[-1]
     last = len(table.advance) - 1
@@ -404,14 +416,15 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     landing_row = LANDING_WINDOW * last
     floor = FALLEN * min(q0[ZH], samples.end()[0][ZH])
     ticks = np.arange(chunk) * dt
+    last_tick = float(ticks[-1])
     columns = np.concatenate([layout.motors, layout.positions, layout.velocities])
     if np.array_equal(columns, np.arange(len(columns))):  # as validate.model orders them
         columns = slice(0, len(columns))
     warning_counts = data.warning.number  # a view: every rollout resets it, then counts
-    state = state[None]
-    out_state = np.empty((1, chunk, state.size))
-    out_sensors = np.empty((1, chunk, model.nsensordata))
-    controls_in = np.zeros((1, chunk, model.nu))
+    no_warnings = warning_counts.tobytes()
+    interpolants = table.interpolants
+    index = np.empty(chunk, dtype=np.intp)
+    weight = np.empty(chunk)
     push = settings.push
     remaining = 0.0 if push is None else float(push.impulse)  # impulse still to give [N·s]
     # A push goes in as an applied force on the trunk (xfrc_applied) beside the controls.
@@ -420,104 +433,107 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     pushed_in = np.zeros((1, chunk, model.nu + 6 * model.nbody))
     hip_x_at, hip_speed_at = layout.state_index("hip_x"), layout.state_index("hip_speed")
     hip_height_at = layout.state_index("hip_height")
+    warmstart = data.qacc_warmstart[None]
     k = 0
     with rollout.Rollout(nthread=0) as runner:
         for j in range(steps):
             stance = SIDES[j % 2]
-            controls = table.controls[stance]
+            interpolant = interpolants[stance]
             set_gains(model, layout, stance, settings.kp, settings.kv)
             result.step_starts.append(k)
             result.stances.append(stance)
-            began, landed, fallen, lifted = state[0, 0], False, False, False
+            began, landed, fallen, lifted = log_state[k, 0], False, False, False
             ankle_at = layout.sensor_index(stance, "ankle_pos")
             touch_at = layout.sensor_index(other(stance), "touch")
             ankle_column = JOINT_ORDER.index(f"{stance}_ankle")
             ankle_gear = float(layout.gears[ankle_column])
-            while state[0, 0] - began < STEP_TIMEOUT * period and k < capacity - chunk:
+            while log_state[k, 0] - began < STEP_TIMEOUT * period and k < capacity - chunk:
                 # The phase now, and as it goes on at the hip's present speed (the stance
                 # ankle's position is the reading of one physics step before: the foot is
                 # on the ground).
-                hip_speed = float(state[0, hip_speed_at])
-                here = float(state[0, hip_x_at]) - float(sensors[ankle_at])
-                advance = ticks * hip_speed
-                advance += here
-                where = advance - x0
+                now = log_state[k]
+                hip_speed = float(now[hip_speed_at])
+                here = float(now[hip_x_at]) - float(log_sensors[k - (k > 0), ankle_at])
+                where = log_where[k : k + chunk]
+                np.multiply(ticks, hip_speed, out=where)
+                where += here
+                where -= x0
                 where *= per_metre
                 # ``where`` is monotonic over the reading period: its ends bound it
-                low, high = (
-                    (where[0], where[-1]) if where[0] <= where[-1] else (where[-1], where[0])
-                )
+                first, final = float(where[0]), float(where[-1])
+                low, high = (first, final) if first <= final else (final, first)
                 if low < 0.0 or high > last:
                     np.clip(where, 0.0, last, out=where)
-                i = where.astype(np.intp)
-                np.minimum(i, last - 1, out=i)
-                w = where - i
-                rows = controls[i]
-                rows += (controls[i + 1] - rows) * w[:, None]
-                if advance[-1] > x_end:
+                index[:] = where  # truncated: where >= 0
+                if high >= last:
+                    np.minimum(index, last - 1, out=index)
+                np.subtract(where, index, out=weight)
+                # The table between its points, column by column (24, chunk).
+                gathered = interpolant.take(index, axis=1)
+                rows, step = gathered[:24], gathered[24:]
+                step *= weight
+                rows += step
+                if last_tick * hip_speed + here > x_end:  # the last of ``advance``, below
                     # Past the end of the step the reference goes on at the end's rates: the
                     # swing foot keeps coming down to the floor.
+                    advance = ticks * hip_speed
+                    advance += here
                     beyond = np.maximum(advance - x_end, 0.0) / end_speed
-                    rows[:, 6:12] += rows[:, 12:18] * beyond[:, None]
-                a, b = int(i[0]), float(w[0])
+                    rows[6:12] += rows[12:18] * beyond
+                a, b = int(index[0]), float(weight[0])
                 planned = speeds[a] + (speeds[a + 1] - speeds[a]) * b
                 rate = min(max(hip_speed / planned, RATE_RANGE[0]), RATE_RANGE[1])
-                rows[:, 12:18] *= rate
-                rows[:, :6] += rows[:, 18:24] * (rate * rate)
+                rows[12:18] *= rate
+                rows[:6] += rows[18:24] * (rate * rate)
                 # The ankle strategy: the stance ankle's torque grows with the hip's excess
                 # speed (its centre of pressure moves forward and slows the robot down).
                 speed_torque = SPEED_GAIN * (hip_speed - planned)
-                rows[:, ankle_column] -= speed_torque / ankle_gear
-                controls_in[0][:, columns] = rows[:, :18]
-                pushing = remaining != 0.0 and state[0, 0] >= push.time
+                rows[ankle_column] -= speed_torque / ankle_gear
+                block = log_ctrl[k : k + chunk]
+                block[:, columns] = rows[:18].T
+                pushing = remaining != 0.0 and now[0] >= push.time
                 if pushing:  # the rest of the push's impulse over this reading period
                     force = remaining / (chunk * dt)
-                    pushed_in[0][:, : model.nu] = controls_in[0]
+                    pushed_in[0][:, : model.nu] = block
                     pushed_in[0][:, model.nu + 6 * layout.trunk] = force
                 runner.rollout(
                     [model],
                     [data],
-                    state,
-                    pushed_in if pushing else controls_in,
+                    log_state[k : k + 1],
+                    pushed_in if pushing else block[None],
                     control_spec=with_force if pushing else only_controls,
                     nstep=chunk,
-                    initial_warmstart=data.qacc_warmstart[None],
-                    state=out_state,
-                    sensordata=out_sensors,
+                    initial_warmstart=warmstart,
+                    state=log_state[None, k + 1 : k + 1 + chunk],
+                    sensordata=log_sensors[None, k : k + chunk],
                     skip_checks=True,
                 )
-                if warning_counts.any():  # reset by every rollout
+                if warning_counts.tobytes() != no_warnings:  # reset by every rollout
                     result.warnings += int(warning_counts.sum())
-                states, readings = out_state[0], out_sensors[0]
-                # states[r]: the state after physics step r; readings[r]: the sensors
-                # computed before it, at the state the step started from.
+                # log_state[k + 1 + r]: the state after physics step r of this period;
+                # log_sensors[k + r]: the sensors computed before it, at the state it
+                # started from.
                 n = chunk
-                contact = readings[:, touch_at] > TOUCH_THRESHOLD
                 # A landing: the swing foot, off the ground since some time in this step,
                 # touches it in the landing window (a foot that never lifts makes no steps).
-                if lifted:
-                    aloft = True
-                else:
-                    aloft = np.logical_or.accumulate(~contact)
-                    lifted = bool(aloft[-1])
-                if where[-1] >= landing_row and contact.any():
-                    down = np.flatnonzero((where >= landing_row) & contact & aloft)
-                    if len(down):
-                        n, landed = int(down[0]) + 1, True
-                heights = states[:n, hip_height_at]
+                aloft = True
+                if not lifted or final >= landing_row:
+                    contact = log_sensors[k : k + chunk, touch_at] > TOUCH_THRESHOLD
+                    if not lifted:
+                        aloft = np.logical_or.accumulate(~contact)
+                        lifted = bool(aloft[-1])
+                    if final >= landing_row and contact.any():
+                        down = np.flatnonzero((where >= landing_row) & contact & aloft)
+                        if len(down):
+                            n, landed = int(down[0]) + 1, True
+                heights = log_state[k + 1 : k + 1 + n, hip_height_at]
                 if not heights.min() >= floor:  # below the floor, or not finite
                     n, fallen, landed = int(np.argmax(~(heights >= floor))) + 1, True, False
                 if pushing:
                     result.pushed += force * n * dt
                     remaining = 0.0 if n == chunk else remaining - force * n * dt
-                log_state[k] = state[0]
-                log_state[k + 1 : k + n] = states[: n - 1]
-                log_ctrl[k : k + n] = controls_in[0, :n]
-                log_sensors[k : k + n] = readings[:n]
-                log_where[k : k + n] = where[:n]
                 log_speed[k : k + n] = speed_torque
                 k += n
-                state, sensors = states[n - 1 : n].copy(), readings[n - 1]
                 if landed or fallen:
                     break
             result.landed.append(landed)
