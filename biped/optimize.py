@@ -264,6 +264,7 @@ def optimize(
     max_restarts: int = MAX_RESTARTS,
     evaluations_per_run: int = EVALUATIONS_PER_RUN,
     solvers=None,
+    sthenic: Optimum | None = None,
 ) -> Optimum:
     """The best gait of ``problem``.
 
@@ -281,6 +282,9 @@ def optimize(
         solvers: ``solvers(problem)`` gives what solves a problem from a start,
             ``.solve(problem, z)`` (default ``biped.solver.solver_for``; ``biped.design``
             gives its graph with the knee radii held, which serves every radius).
+        sthenic: for the energy criterion, the sthenic optimum of the same problem with
+            the same ``seed`` and ``starts``, if already known (a sweep's): it starts the
+            energy criterion as the one this call would compute (None: computed here).
     """
     check_method(method)
     if not isinstance(problem, GaitProblem):
@@ -292,7 +296,7 @@ def optimize(
     candidates = first_guesses(problem, starts, seed)
     candidates += [("given", np.asarray(z, dtype=float)) for z in given]
     if problem.criterion == "energy" and starts > 0:
-        candidates += _sthenic_start(problem, seed, starts, solvers)
+        candidates += _sthenic_start(problem, seed, starts, solvers, sthenic)
     for k in range(nelder_mead_starts):
         parameters, *_ = nelder_mead(
             problem,
@@ -328,14 +332,34 @@ def optimize(
     return checked(problem, best.variables, report)
 
 
-def _sthenic_start(problem: GaitProblem, seed: int, starts: int, solvers=None) -> list:
-    """The sthenic optimum of the same problem, a start of the energy criterion: its
-    landscape has basins of short fast steps (3-7 times the minimum) that no first guess
-    escapes, and the gait of least torque lies in the basin of least energy."""
-    sthenic = optimize(
-        dataclasses.replace(problem, criterion="sthenic"), seed, starts, solvers=solvers
-    )
+def _sthenic_start(
+    problem: GaitProblem, seed: int, starts: int, solvers=None, sthenic: Optimum | None = None
+) -> list:
+    """The sthenic optimum of the same problem (``sthenic``, or computed), a start of the
+    energy criterion: its landscape has basins of short fast steps (3-7 times the minimum)
+    that no first guess escapes, and the gait of least torque lies in the basin of least
+    energy."""
+    twin = dataclasses.replace(problem, criterion="sthenic")
+    if sthenic is None:
+        sthenic = optimize(twin, seed, starts, solvers=solvers)
+    elif _family(sthenic.problem) != _family(twin):
+        raise BipedError(
+            f"sthenic = the optimum of {sthenic.problem.criterion} at {sthenic.problem.speed} "
+            f"m/s ({sthenic.problem.knee} knee): allowed the sthenic optimum of this problem"
+        )
     return [("sthenic optimum", sthenic.variables)] if sthenic.report.converged else []
+
+
+def _family(problem: GaitProblem) -> tuple:
+    """What makes two problems one (``Biped`` compares by identity)."""
+    return (
+        problem.model.robot,
+        problem.knee,
+        problem.speed,
+        problem.criterion,
+        problem.safety,
+        problem.samples_per_half,
+    )
 
 
 def _at_best(history, value: float) -> int:

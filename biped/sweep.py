@@ -1,16 +1,20 @@
 """Sweeps of certified optimal gaits over walking speed, both knees and both criteria.
 
-Every point (knee, criterion, speed) is solved in two stages, each point of a stage
-independent of the others, so the points run in parallel (``biped.runner``: on all
-cores, or on the workers of a Dask cluster):
+Every point (knee, criterion, speed) is solved twice:
 
 1. independent: IPOPT from the point's own starts (``biped.optimize.optimize``); the result
-   is kept in the hidden folder ``.independent/``;
+   is kept in the hidden folder ``.independent/``. The energy criterion also starts from
+   the sthenic optimum of its problem: the sthenic point's independent optimum, read from
+   there (the same numbers as computed again);
 2. neighbours: IPOPT again from the independent optima of the neighbouring speeds of the
-   same series and of the other knee at the same speed; the best of both stages is the
-   point's gait file.
+   same series and of the other knee at the same speed; the best of both is the point's
+   gait file.
 
-Each result depends only on the files of the stage before, which are written whole
+The solves run in three stages, each task of a stage independent of the others, so they run
+in parallel (``biped.runner``: on all cores, or on the workers of a Dask cluster): the
+sthenic independent optima; the energy independent optima with the sthenic neighbours'
+solves; the energy neighbours' solves. Each result depends only on files of the stages
+before, which are written whole
 (``biped.files``), so a sweep stopped at any moment and run again ends with exactly the files
 of an uninterrupted sweep. The folder's ``sweep.json`` records what shapes the numbers
 (robot, safety, speeds, seed, starts, method, versions); resuming with any of them changed is
@@ -116,9 +120,14 @@ def _save(path: Path, optimum: Optimum, settings: Settings) -> None:
 
 
 def _solve_independent(task) -> str:
-    settings, point, folder = task
+    settings, point, folder, twin = task
     problem = _problem(settings, point)
-    optimum = optimize(problem, seed=settings.seed, starts=settings.starts)
+    sthenic = None
+    if twin is not None:  # the energy criterion starts from the sthenic optimum, solved
+        sthenic = _optimum_of(
+            gait_file.read(Path(folder) / INDEPENDENT / twin.filename()), settings, twin
+        )
+    optimum = optimize(problem, seed=settings.seed, starts=settings.starts, sthenic=sthenic)
     _save(Path(folder) / INDEPENDENT / point.filename(), optimum, settings)
     return _line("independent", point, optimum)
 
@@ -204,12 +213,7 @@ def run_sweep(
         clean_stale_temporaries(place)
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
     final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
-    stage1 = [
-        p
-        for p in points
-        if _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is None
-        and (p in final or any(n in final for n in _neighbours(p, speeds, knees)))
-    ]
+    stages = _stages(folder, settings, points, final, knees)
     print(
         f"sweep: {len(points)} points in {folder}, {len(points) - len(final)} already done, "
         f"{len(final)} to run",
@@ -217,21 +221,15 @@ def run_sweep(
         flush=True,
     )
     began = time.perf_counter()
-    stages = [
-        (_solve_independent, [(settings, p, str(folder)) for p in stage1]),
-        (
-            _solve_with_neighbours,
-            [(settings, p, str(folder), _neighbours(p, speeds, knees)) for p in final],
-        ),
-    ]
-    bar = progress(len(stage1) + len(final)) if progress is not None and final else None
+    total = sum(len(tasks) for tasks in stages)
+    bar = progress(total) if progress is not None and final else None
     if bar is not None:
         bar.advance(0)  # drawn from the start
     try:
-        for function, tasks in stages:
-            for line in run_tasks(
-                function, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar
-            ):
+        for tasks in stages:
+            if not tasks:
+                continue
+            for line in run_tasks(_solve, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar):
                 print(line, file=stream, flush=True)
     finally:
         if bar is not None:
@@ -239,6 +237,49 @@ def run_sweep(
     summary = summarize(folder, points, settings)
     print(f"sweep: done in {time.perf_counter() - began:.1f} s; {summary}", file=stream, flush=True)
     return points
+
+
+def _stages(folder: Path, settings: Settings, points, final, knees) -> list:
+    """The tasks still to run, in stages whose tasks are independent of each other and
+    depend only on the files of the stages before: the sthenic independent optima; the
+    energy ones (each started from the sthenic optimum of its problem, when the sweep has
+    that criterion) with the sthenic finals; the energy finals."""
+    speeds = settings.speeds
+    needed = {n for p in final for n in [p, *_neighbours(p, speeds, knees)]}
+    twins = {p: Point(p.knee, "sthenic", p.speed) for p in points if p.criterion == "energy"}
+    if not any(p.criterion == "sthenic" for p in points):
+        twins = {}
+    needed |= {twins[p] for p in needed if p in twins}
+
+    def missing(p):
+        return _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is None
+
+    independent = [p for p in points if p in needed and missing(p)]
+    first = [p for p in independent if p not in twins]
+    second = [p for p in independent if p in twins]
+
+    def independent_task(p):
+        return (settings, p, str(folder), twins.get(p))
+
+    def final_task(p):
+        return (settings, p, str(folder), _neighbours(p, speeds, knees))
+
+    early = [p for p in final if p not in twins]  # their neighbours are all in ``first``
+    late = [p for p in final if p in twins]
+    if not second:  # no stage waits for the sthenic optima: two stages
+        first, early, late = first + second, [], early + late
+    return [
+        [(_solve_independent, independent_task(p)) for p in first],
+        [(_solve_independent, independent_task(p)) for p in second]
+        + [(_solve_with_neighbours, final_task(p)) for p in early],
+        [(_solve_with_neighbours, final_task(p)) for p in late],
+    ]
+
+
+def _solve(task) -> str:
+    """One task of a stage: (function, its arguments)."""
+    function, arguments = task
+    return function(arguments)
 
 
 def _neighbours(point: Point, speeds, knees) -> list[Point]:

@@ -60,9 +60,13 @@ class Interrupt(Exception):
     pass
 
 
-@pytest.mark.parametrize("after", [1, 3, 6])
-def test_interrupted_sweep_resumes_to_the_same_files(sweep, tmp_path, monkeypatch, after):
-    """A sweep stopped after any number of written points (during either stage), with a
+@pytest.mark.parametrize(
+    "after, criteria",
+    [(1, ("sthenic",)), (3, ("sthenic",)), (6, ("sthenic",)), (6, ("sthenic", "energy"))],
+)
+def test_interrupted_sweep_resumes_to_the_same_files(sweep, tmp_path, monkeypatch, after, criteria):
+    """A sweep stopped after any number of written files (in any stage: with both criteria,
+    after 6 the energy optima started from the sthenic ones are being written), with a
     stale temporary file left behind, and run again ends with the files of an uninterrupted
     sweep and no temporary file."""
     folder, _ = sweep
@@ -78,11 +82,12 @@ def test_interrupted_sweep_resumes_to_the_same_files(sweep, tmp_path, monkeypatc
     robot = biped.Robot.paper()
     monkeypatch.setattr(gait_file, "write_json", stop_after)
     with pytest.raises(Interrupt):
-        run_sweep(tmp_path, robot, SPEEDS, criteria=("sthenic",), stream=io.StringIO(), **FAST)
+        run_sweep(tmp_path, robot, SPEEDS, criteria=criteria, stream=io.StringIO(), **FAST)
+    assert count[0] == after
     monkeypatch.setattr(gait_file, "write_json", write)
     (tmp_path / INDEPENDENT / ".rolling-sthenic-0.300.json.abc123.tmp").write_text('{"cut')
-    run_sweep(tmp_path, robot, SPEEDS, criteria=("sthenic",), stream=io.StringIO(), **FAST)
-    expected = {k: v for k, v in _content(folder).items() if "-sthenic-" in k}
+    run_sweep(tmp_path, robot, SPEEDS, criteria=criteria, stream=io.StringIO(), **FAST)
+    expected = {k: v for k, v in _content(folder).items() if k.split("-")[1] in criteria}
     assert _content(tmp_path) == expected
     assert not list(tmp_path.rglob("*.tmp"))
 
