@@ -359,6 +359,7 @@ class Walker:
         self.model = with_servos(spec, self.biped.knee, KP, KV)
         self.layout = Layout(self.model)
         self.table = phase_table(self.samples, self.layout, self.biped.radii)
+        self._spare_data = []  # MjData of finished walks (pop and append are atomic)
 
     @property
     def period(self) -> float:
@@ -383,8 +384,18 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     if settings.friction is not None:
         collides = (model.geom_contype != 0) | (model.geom_conaffinity != 0)
         model.geom_friction[collides, 0] = settings.friction
+    # The data of a finished walk serves (the copy has the same sizes), reset as new.
+    spare = walker._spare_data
+    data = spare.pop() if spare else mujoco.MjData(model)
+    mujoco.mj_resetData(model, data)
+    try:
+        return _walk_on(walker, steps, settings, model, data)
+    finally:
+        spare.append(data)
+
+
+def _walk_on(walker, steps, settings, model, data) -> Simulation:
     layout = walker.layout.of(model)
-    data = mujoco.MjData(model)
     table, samples = walker.table, walker.samples
     q0, qd0 = samples.start()
     start = mapping(model, "left", walker.biped.radii)
@@ -434,6 +445,7 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     hip_x_at, hip_speed_at = layout.state_index("hip_x"), layout.state_index("hip_speed")
     hip_height_at = layout.state_index("hip_height")
     warmstart = data.qacc_warmstart[None]
+    models, datas = [model], [data]
     k = 0
     with rollout.Rollout(nthread=0) as runner:
         for j in range(steps):
@@ -497,8 +509,8 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
                     pushed_in[0][:, : model.nu] = block
                     pushed_in[0][:, model.nu + 6 * layout.trunk] = force
                 runner.rollout(
-                    [model],
-                    [data],
+                    models,
+                    datas,
                     log_state[k : k + 1],
                     pushed_in if pushing else block[None],
                     control_spec=with_force if pushing else only_controls,
