@@ -26,7 +26,8 @@ At r1 = r2 = 0 the rolling knee is the revolute knee exactly (``biped.kinematics
 Starts, as for gaits (``biped.optimize``): the gait's first guesses at the robot's own radii
 (Table 1's) and starts with radii drawn uniformly in the bounds and the gait's first guess
 there perturbed, from ``numpy.random.default_rng(seed)`` (``DESIGN_STARTS``), and any given
-(gait, radii) pairs; for the energy criterion also the sthenic design. The best converged
+(gait, radii) pairs; for the energy criterion also the sthenic design (under both barriers,
+``biped.optimize.MONOTONE_START``). The best converged
 start wins; its report counts the starts that reached the same value. When no start
 converged the report carries IPOPT's status (and the command line exits 1): never a silent
 fallback.
@@ -49,10 +50,12 @@ from biped.optimize import (
     AGREEMENT,
     DEFAULT_STARTS,
     GUESS_PERIODS,
+    MONOTONE_START,
     PERTURBATION,
     Optimum,
     Report,
     Start,
+    barrier_of,
     checked,
     optimize,
 )
@@ -271,10 +274,14 @@ def optimize_design(
     if problem.criterion == "energy" and starts > 0:  # as biped.optimize: least torque first
         sthenic = optimize_design(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
         if sthenic.report.converged:
-            candidates.append(("sthenic optimum", sthenic.optimum.variables, sthenic.radii))
+            for kind in ("sthenic optimum", MONOTONE_START):
+                candidates.append((kind, sthenic.optimum.variables, sthenic.radii))
     if not candidates:
         raise BipedError("no start: allowed starts >= 1 or given starts")
-    solutions = [(kind, solver.solve(problem, z, radii)) for kind, z, radii in candidates]
+    solutions = [
+        (kind, solver.solve(problem, z, radii, barrier=barrier_of(kind)))
+        for kind, z, radii in candidates
+    ]
     converged = [s for _, s in solutions if s.converged]
     pool = converged or [s for _, s in solutions]
     best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
@@ -322,8 +329,8 @@ class _HeldSolver:
     design: Solver
     radii: tuple
 
-    def solve(self, gait: GaitProblem, start):
-        return self.design.solve(gait, start, self.radii, hold_radii=True)
+    def solve(self, gait: GaitProblem, start, barrier: str = "adaptive"):
+        return self.design.solve(gait, start, self.radii, hold_radii=True, barrier=barrier)
 
 
 def optimize_at(

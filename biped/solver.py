@@ -46,6 +46,10 @@ IPOPT_OPTIONS = {
     "sb": "yes",
     "mu_strategy": "adaptive",
 }
+# The barrier strategies a start can be solved with: IPOPT's adaptive one (the default) and
+# its monotone one from mu = 0.01. From the same start they follow other paths through the
+# energy criterion's basins and may end in other local minima (``biped.optimize``).
+BARRIERS = {"adaptive": {}, "monotone": {"mu_strategy": "monotone", "mu_init": 1e-2}}
 # IPOPT's statuses that are a converged local optimum.
 CONVERGED = ("Solve_Succeeded",)
 # One unit of the knee radii in the solver's scaled space [m].
@@ -156,9 +160,8 @@ class Solver:
             g = ca.vertcat(constraints, slack - power, slack + power)
         substituted = ca.substitute([objective, g], unknowns, scaled)
         nlp = {"x": x, "p": graph.speed, "f": substituted[0], "g": substituted[1]}
-        options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
-        options["print_time"] = False
-        self.nlp = ca.nlpsol("design" if design else "gait", "ipopt", nlp, options)
+        self.nlp = ca.nlpsol("design" if design else "gait", "ipopt", nlp, _options("adaptive"))
+        self._nlps = {"adaptive": self.nlp}  # and the other barriers', built when first used
         self.evaluate = ca.Function(
             "evaluate", graph.inputs, [graph.sthenic, graph.energy, graph.power]
         )
@@ -172,16 +175,28 @@ class Solver:
         self.ubx = np.concatenate([upper, np.full(self.slacks, np.inf)])
         self.n_constraints = g.shape[0]
 
-    def solve(self, problem, start, radii=None, hold_radii: bool = False) -> Solution:
+    def solve(
+        self, problem, start, radii=None, hold_radii: bool = False, barrier: str = "adaptive"
+    ) -> Solution:
         """IPOPT from the variables ``start`` (21,), clipped into the bounds, at
         ``problem.speed``; with radii as variables, from the knee radii ``radii`` (r1, r2) [m]
         clipped into theirs, or held at them (``hold_radii``: the gait alone optimised, IPOPT
-        treating the radii as parameters)."""
+        treating the radii as parameters). ``barrier``: one of ``BARRIERS``."""
+        if barrier not in BARRIERS:
+            raise BipedError(f"barrier = {barrier!r}: allowed {', '.join(map(repr, BARRIERS))}")
         with kept_interrupts():  # CasADi stops at Ctrl-C but swallows it: raised again
-            return self._solve(problem, start, radii, hold_radii)
+            return self._solve(problem, start, radii, hold_radii, barrier)
 
-    def _solve(self, problem, start, radii, hold_radii) -> Solution:
+    def _nlp(self, barrier: str):
+        if barrier not in self._nlps:  # the same problem (IPOPT's oracle), other settings
+            self._nlps[barrier] = ca.nlpsol(
+                f"{self.nlp.name()}_{barrier}", "ipopt", self.nlp.oracle(), _options(barrier)
+            )
+        return self._nlps[barrier]
+
+    def _solve(self, problem, start, radii, hold_radii, barrier) -> Solution:
         began = time.perf_counter()
+        nlp = self._nlp(barrier)
         z0 = np.clip(np.asarray(start, dtype=float), self.lower, self.upper)
         x0 = z0 / SCALES
         inputs = [z0, problem.speed]
@@ -202,8 +217,8 @@ class Solver:
             held = slice(N_VARIABLES, N_VARIABLES + 2)
             lbx, ubx = lbx.copy(), ubx.copy()
             lbx[held] = ubx[held] = r0 / RADIUS_SCALE
-        result = self.nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
-        stats = self.nlp.stats()
+        result = nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
+        stats = nlp.stats()
         x = np.asarray(result["x"]).ravel()
         g = np.asarray(result["g"]).ravel()
         violation = max(
@@ -224,6 +239,14 @@ class Solver:
             dual_infeasibility=float(dual[-1]),
             seconds=time.perf_counter() - began,
         )
+
+
+def _options(barrier: str) -> dict:
+    """nlpsol's options: ``IPOPT_OPTIONS`` with those of ``barrier``."""
+    options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
+    options.update({f"ipopt.{key}": value for key, value in BARRIERS[barrier].items()})
+    options["print_time"] = False
+    return options
 
 
 @functools.lru_cache(maxsize=8)

@@ -14,8 +14,9 @@ import pytest
 import biped
 from biped.criteria import PAPER_SAFETY, Safety, clearance_profile, evaluate_step
 from biped.gait import build_step
-from biped.optimize import AGREEMENT, optimize
+from biped.optimize import AGREEMENT, MONOTONE_START, optimize
 from biped.problem import SCALES, GaitProblem, bounds, max_walking_speed
+from biped.solver import solver_for
 from biped.symbolic import StepGraph
 from tests.conftest import optimal_gait
 
@@ -167,10 +168,25 @@ def test_energy_optimum_spends_no_more_than_the_gait_of_least_torque():
     _, ev = numeric(energy, sthenic.variables)
     optimum = optimize(energy, starts=1)
     assert optimum.report.converged
-    assert [s.kind for s in optimum.report.history] == ["first guess", "sthenic optimum"]
+    kinds = [s.kind for s in optimum.report.history]
+    assert kinds == ["first guess", "sthenic optimum", MONOTONE_START]
     assert optimum.report.value <= ev.energy
     first_guess_only = optimize(energy, starts=0, given=[energy.first_guess()])
     assert first_guess_only.report.value > 2 * optimum.report.value
+
+
+def test_the_energy_criterion_starts_from_the_sthenic_optimum_under_both_barriers():
+    """The energy criterion has close local minima: from the sthenic optimum (revolute knee,
+    0.3 m/s) IPOPT's adaptive barrier ends 0.1 % above where its monotone barrier ends, and
+    the optimum is the lower of the two (without the monotone start it would be the
+    higher)."""
+    problem = GaitProblem(biped.Biped(ROBOT, "revolute"), 0.3, "energy")
+    optimum = optimize(problem, starts=1)
+    values = {s.kind: s.value for s in optimum.report.history}
+    assert values[MONOTONE_START] < (1 - 5e-4) * values["sthenic optimum"]
+    assert optimum.report.value == min(values.values())
+    with pytest.raises(biped.BipedError, match="barrier = 'other': allowed 'adaptive'"):
+        solver_for(problem).solve(problem, problem.first_guess(), barrier="other")
 
 
 def test_papers_method_stops_far_above_the_certified_optimum():
