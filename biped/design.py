@@ -47,21 +47,22 @@ from biped.criteria import PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
 from biped.optimize import (
-    AGREEMENT,
     DEFAULT_STARTS,
     GUESS_PERIODS,
     MONOTONE_START,
     PERTURBATION,
+    STHENIC_START,
     Optimum,
     Report,
     Start,
     barrier_of,
     checked,
     optimize,
+    starts_at_value,
 )
 from biped.problem import SCALES, GaitProblem, bounds, check_criterion, check_speed
 from biped.robot import Robot
-from biped.solver import CONVERGED, Solver
+from biped.solver import Solver
 
 RADII = ("r1", "r2")
 
@@ -274,7 +275,7 @@ def optimize_design(
     if problem.criterion == "energy" and starts > 0:  # as biped.optimize: least torque first
         sthenic = optimize_design(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
         if sthenic.report.converged:
-            for kind in ("sthenic optimum", MONOTONE_START):
+            for kind in (STHENIC_START, MONOTONE_START):
                 candidates.append((kind, sthenic.optimum.variables, sthenic.radii))
     if not candidates:
         raise BipedError("no start: allowed starts >= 1 or given starts")
@@ -286,10 +287,7 @@ def optimize_design(
     pool = converged or [s for _, s in solutions]
     best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
     history = tuple(Start(kind, s.value, s.status, s.iterations) for kind, s in solutions)
-    at_best = sum(
-        s.status in CONVERGED and abs(s.value - best.value) <= AGREEMENT * abs(best.value)
-        for s in history
-    )
+    at_best = starts_at_value(history, best.value)
     report = Report(
         method="ipopt",
         status="converged" if best.converged else best.status,

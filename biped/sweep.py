@@ -124,9 +124,9 @@ def _solve_independent(task) -> str:
     problem = _problem(settings, point)
     sthenic = None
     if twin is not None:  # the energy criterion starts from the sthenic optimum, solved
-        sthenic = _optimum_of(
-            gait_file.read(Path(folder) / INDEPENDENT / twin.filename()), settings, twin
-        )
+        gait = gait_file.read(Path(folder) / INDEPENDENT / twin.filename())
+        if all(gait["optimizer"]["variables"][name] is not None for name in VARIABLES):
+            sthenic = _optimum_of(gait, settings, twin)  # else computed again, as before
     optimum = optimize(problem, seed=settings.seed, starts=settings.starts, sthenic=sthenic)
     _save(Path(folder) / INDEPENDENT / point.filename(), optimum, settings)
     return _line("independent", point, optimum)
@@ -199,7 +199,7 @@ def run_sweep(
     The optimizations run through ``biped.runner.run_tasks``: ``jobs`` local processes
     (default: all cores), or the workers of the Dask scheduler at ``dask`` (``tcp://HOST:PORT``).
     A line per optimization goes to ``stream`` (default: ``sys.stderr``); ``progress(total)``,
-    if given, makes the bar advanced after each of the ``total`` optimizations (both
+    if given, makes the bar advanced after each of the ``total`` optimizations (all
     stages)."""
     stream = sys.stderr if stream is None else stream
     if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
@@ -249,10 +249,11 @@ def _stages(folder: Path, settings: Settings, points, final, knees) -> list:
     twins = {p: Point(p.knee, "sthenic", p.speed) for p in points if p.criterion == "energy"}
     if not any(p.criterion == "sthenic" for p in points):
         twins = {}
-    needed |= {twins[p] for p in needed if p in twins}
 
     def missing(p):
         return _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is None
+
+    needed |= {twins[p] for p in needed if p in twins and missing(p)}
 
     independent = [p for p in points if p in needed and missing(p)]
     first = [p for p in independent if p not in twins]
@@ -283,7 +284,7 @@ def _solve(task) -> str:
 
 
 def _neighbours(point: Point, speeds, knees) -> list[Point]:
-    """The points whose optima start the second stage of ``point``: the neighbouring speeds
+    """The points whose independent optima start ``point``'s second solve: the neighbouring speeds
     of its series, and the same speed with the other knees (the variables mean the same for
     both knees)."""
     i = list(speeds).index(point.speed)

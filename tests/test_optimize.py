@@ -14,7 +14,14 @@ import pytest
 import biped
 from biped.criteria import PAPER_SAFETY, Safety, clearance_profile, evaluate_step
 from biped.gait import build_step
-from biped.optimize import AGREEMENT, MONOTONE_START, optimize
+from biped.optimize import (
+    AGREEMENT,
+    MONOTONE_START,
+    STHENIC_START,
+    Start,
+    optimize,
+    starts_at_value,
+)
 from biped.problem import SCALES, GaitProblem, bounds, max_walking_speed
 from biped.solver import solver_for
 from biped.symbolic import StepGraph
@@ -187,6 +194,21 @@ def test_the_energy_criterion_starts_from_the_sthenic_optimum_under_both_barrier
     assert optimum.report.value == min(values.values())
     with pytest.raises(biped.BipedError, match="barrier = 'other': allowed 'adaptive'"):
         solver_for(problem).solve(problem, problem.first_guess(), barrier="other")
+
+
+def test_one_point_solved_under_both_barriers_is_one_start_at_the_best():
+    """Two solves from the sthenic optimum that end at the same value do not confirm each
+    other; a second start that ends there does."""
+    value = 1.0
+
+    def start(kind, v=value):
+        return Start(kind, v, "Solve_Succeeded", 50)
+
+    pair = [start(STHENIC_START), start(MONOTONE_START, value * (1 + 1e-8))]
+    assert starts_at_value(pair, value) == 1
+    assert starts_at_value([*pair, start("first guess")], value) == 2
+    assert starts_at_value([start("first guess"), start("given")], value) == 2
+    assert starts_at_value([start(MONOTONE_START), start("given", 2.0)], value) == 1
 
 
 def test_papers_method_stops_far_above_the_certified_optimum():

@@ -359,7 +359,7 @@ class Walker:
         self.model = with_servos(spec, self.biped.knee, KP, KV)
         self.layout = Layout(self.model)
         self.table = phase_table(self.samples, self.layout, self.biped.radii)
-        self._spare_data = []  # MjData of finished walks (pop and append are atomic)
+        self._spare_data = []  # MjData of finished walks (list.pop and append are atomic)
 
     @property
     def period(self) -> float:
@@ -386,7 +386,10 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
         model.geom_friction[collides, 0] = settings.friction
     # The data of a finished walk serves (the copy has the same sizes), reset as new.
     spare = walker._spare_data
-    data = spare.pop() if spare else mujoco.MjData(model)
+    try:
+        data = spare.pop()
+    except IndexError:  # none spare (or another thread took it)
+        data = mujoco.MjData(model)
     mujoco.mj_resetData(model, data)
     try:
         return _walk_on(walker, steps, settings, model, data)
