@@ -67,7 +67,7 @@ def main():
                 runs.append(time.perf_counter() - began)
             report = optimum.report
             nlp = solver_for(problem).nlp
-            stats = nlp.stats()  # of the last solve (the last start)
+            stats = nlp.stats()  # of the last start solved under the adaptive barrier
             hessian = nlp.get_function("nlp_hess_l").n_instructions()
             calls = max(stats["n_call_nlp_hess_l"], 1)
             hessians.append(
