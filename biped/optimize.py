@@ -338,10 +338,9 @@ def optimize(
     return checked(problem, best.variables, report)
 
 
-# The energy criterion's start from the sthenic optimum under IPOPT's monotone barrier. The
-# adaptive barrier, from the same point, ends in another of the criterion's local minima at
-# some speeds: over the default sweep's 26 energy points this start alone ended 0.13-0.39 %
-# lower than the sweep's optimum at 4 (and higher at others).
+# The energy criterion's starts from the sthenic optimum, under IPOPT's adaptive and its
+# monotone barrier: from the same point they may end in different local minima (0.1 % apart
+# for the revolute knee at 0.3 m/s, tests/test_optimize.py), and either may be the lower.
 STHENIC_START = "sthenic optimum"
 MONOTONE_START = "sthenic optimum, monotone barrier"
 
@@ -354,6 +353,8 @@ def _sthenic_start(
     that no first guess escapes, and the gait of least torque lies in the basin of least
     energy."""
     twin = dataclasses.replace(problem, criterion="sthenic")
+    if sthenic is not None and not isinstance(sthenic, Optimum):
+        raise BipedError(f"sthenic = {sthenic!r}: allowed a biped.optimize.Optimum or None")
     if sthenic is None:
         sthenic = optimize(twin, seed, starts, solvers=solvers)
     elif _family(sthenic.problem) != _family(twin):

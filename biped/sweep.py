@@ -115,6 +115,13 @@ def _optimum_of(gait: dict, settings: Settings, point: Point) -> Optimum:
     return checked(_problem(settings, point), variables, report)
 
 
+def _variables_of(gait: dict):
+    """The solver's variables (21,) stored in a gait file, or None where it has none (a
+    point whose optimizer ended without them)."""
+    variables = [gait["optimizer"]["variables"][name] for name in VARIABLES]
+    return None if any(v is None for v in variables) else np.array(variables, float)
+
+
 def _save(path: Path, optimum: Optimum, settings: Settings) -> None:
     gait_file.write_json(path, gait_file.to_dict(optimum, settings.robot, settings.seed))
 
@@ -125,8 +132,8 @@ def _solve_independent(task) -> str:
     sthenic = None
     if twin is not None:  # the energy criterion starts from the sthenic optimum, solved
         gait = gait_file.read(Path(folder) / INDEPENDENT / twin.filename())
-        if all(gait["optimizer"]["variables"][name] is not None for name in VARIABLES):
-            sthenic = _optimum_of(gait, settings, twin)  # else computed again, as before
+        if _variables_of(gait) is not None:  # else computed again, as before
+            sthenic = _optimum_of(gait, settings, twin)
     optimum = optimize(problem, seed=settings.seed, starts=settings.starts, sthenic=sthenic)
     _save(Path(folder) / INDEPENDENT / point.filename(), optimum, settings)
     return _line("independent", point, optimum)
@@ -138,10 +145,9 @@ def _solve_with_neighbours(task) -> str:
     own = _optimum_of(gait_file.read(folder / INDEPENDENT / point.filename()), settings, point)
     given = []
     for other in neighbours:
-        gait = gait_file.read(folder / INDEPENDENT / other.filename())
-        variables = [gait["optimizer"]["variables"][name] for name in VARIABLES]
-        if all(v is not None for v in variables):
-            given.append(np.array(variables, float))
+        variables = _variables_of(gait_file.read(folder / INDEPENDENT / other.filename()))
+        if variables is not None:
+            given.append(variables)
     problem = _problem(settings, point)
     optimum = own
     if given:
@@ -268,7 +274,7 @@ def _stages(folder: Path, settings: Settings, points, final, knees) -> list:
     early = [p for p in final if p not in twins]  # their neighbours are all in ``first``
     late = [p for p in final if p in twins]
     if not second:  # no stage waits for the sthenic optima: two stages
-        first, early, late = first + second, [], early + late
+        early, late = [], early + late
     return [
         [(_solve_independent, independent_task(p)) for p in first],
         [(_solve_independent, independent_task(p)) for p in second]

@@ -196,6 +196,17 @@ def test_the_energy_criterion_starts_from_the_sthenic_optimum_under_both_barrier
         solver_for(problem).solve(problem, problem.first_guess(), barrier="other")
 
 
+def test_a_given_sthenic_optimum_must_be_of_the_same_problem():
+    """The sthenic start handed to the energy criterion (a sweep's) is refused, naming it,
+    when it is the optimum of another speed or not an optimum."""
+    sthenic = optimal_gait("rolling")  # 0.3 m/s
+    other = GaitProblem(sthenic.problem.model, 0.325, "energy")
+    with pytest.raises(biped.BipedError, match="sthenic at 0.3 m/s .rolling knee.: allowed"):
+        optimize(other, starts=1, sthenic=sthenic)
+    with pytest.raises(biped.BipedError, match="sthenic = 1.0: allowed a biped.optimize"):
+        optimize(other, starts=1, sthenic=1.0)
+
+
 def test_one_point_solved_under_both_barriers_is_one_start_at_the_best():
     """Two solves from the sthenic optimum that end at the same value do not confirm each
     other; a second start that ends there does."""

@@ -468,7 +468,7 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
                 # on the ground).
                 now = log_state[k]
                 hip_speed = float(now[hip_speed_at])
-                here = float(now[hip_x_at]) - float(log_sensors[k - (k > 0), ankle_at])
+                here = float(now[hip_x_at]) - float(log_sensors[max(k - 1, 0), ankle_at])
                 where = log_where[k : k + chunk]
                 np.multiply(ticks, hip_speed, out=where)
                 where += here
