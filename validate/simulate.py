@@ -439,6 +439,15 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
     interpolants = table.interpolants
     index = np.empty(chunk, dtype=np.intp)
     weight = np.empty(chunk)
+    # The table's columns at the period's points and their increments to the next point
+    # (``PhaseTable.interpolants``), and named views of them: nothing is allocated per period.
+    gathered = np.empty((48, chunk))
+    rows, increments = gathered[:24], gathered[24:]
+    torques, references, rates, rotors = rows[:6], rows[6:12], rows[12:18], rows[18:24]
+    commands = rows[:18].T  # (chunk, 18): the period's controls in ``columns`` order
+    rotor_torques = np.empty((6, chunk))
+    lowest = np.minimum.reduce
+    timeout = STEP_TIMEOUT * period
     push = settings.push
     remaining = 0.0 if push is None else float(push.impulse)  # impulse still to give [N·s]
     # A push goes in as an applied force on the trunk (xfrc_applied) beside the controls.
@@ -462,20 +471,20 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
             touch_at = layout.sensor_index(other(stance), "touch")
             ankle_column = JOINT_ORDER.index(f"{stance}_ankle")
             ankle_gear = float(layout.gears[ankle_column])
-            while log_state[k, 0] - began < STEP_TIMEOUT * period and k < capacity - chunk:
+            ankle_torque = rows[ankle_column]
+            while log_state.item(k, 0) - began < timeout and k < capacity - chunk:
                 # The phase now, and as it goes on at the hip's present speed (the stance
                 # ankle's position is the reading of one physics step before: the foot is
                 # on the ground).
-                now = log_state[k]
-                hip_speed = float(now[hip_speed_at])
-                here = float(now[hip_x_at]) - float(log_sensors[max(k - 1, 0), ankle_at])
+                hip_speed = log_state.item(k, hip_speed_at)
+                here = log_state.item(k, hip_x_at) - log_sensors.item(max(k - 1, 0), ankle_at)
                 where = log_where[k : k + chunk]
                 np.multiply(ticks, hip_speed, out=where)
                 where += here
                 where -= x0
                 where *= per_metre
                 # ``where`` is monotonic over the reading period: its ends bound it
-                first, final = float(where[0]), float(where[-1])
+                first, final = where.item(0), where.item(-1)
                 low, high = (first, final) if first <= final else (final, first)
                 if low < 0.0 or high > last:
                     np.clip(where, 0.0, last, out=where)
@@ -484,29 +493,29 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
                     np.minimum(index, last - 1, out=index)
                 np.subtract(where, index, out=weight)
                 # The table between its points, column by column (24, chunk).
-                gathered = interpolant.take(index, axis=1)
-                rows, step = gathered[:24], gathered[24:]
-                step *= weight
-                rows += step
+                interpolant.take(index, axis=1, out=gathered)
+                increments *= weight
+                rows += increments
                 if last_tick * hip_speed + here > x_end:  # the last of ``advance``, below
                     # Past the end of the step the reference goes on at the end's rates: the
                     # swing foot keeps coming down to the floor.
                     advance = ticks * hip_speed
                     advance += here
                     beyond = np.maximum(advance - x_end, 0.0) / end_speed
-                    rows[6:12] += rows[12:18] * beyond
-                a, b = int(index[0]), float(weight[0])
+                    references += rates * beyond
+                a, b = index.item(0), weight.item(0)
                 planned = speeds[a] + (speeds[a + 1] - speeds[a]) * b
                 rate = min(max(hip_speed / planned, RATE_RANGE[0]), RATE_RANGE[1])
-                rows[12:18] *= rate
-                rows[:6] += rows[18:24] * (rate * rate)
+                rates *= rate
+                np.multiply(rotors, rate * rate, out=rotor_torques)
+                torques += rotor_torques
                 # The ankle strategy: the stance ankle's torque grows with the hip's excess
                 # speed (its centre of pressure moves forward and slows the robot down).
                 speed_torque = SPEED_GAIN * (hip_speed - planned)
-                rows[ankle_column] -= speed_torque / ankle_gear
+                ankle_torque -= speed_torque / ankle_gear
                 block = log_ctrl[k : k + chunk]
-                block[:, columns] = rows[:18].T
-                pushing = remaining != 0.0 and now[0] >= push.time
+                block[:, columns] = commands
+                pushing = remaining != 0.0 and log_state.item(k, 0) >= push.time
                 if pushing:  # the rest of the push's impulse over this reading period
                     force = remaining / (chunk * dt)
                     pushed_in[0][:, : model.nu] = block
@@ -542,7 +551,7 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
                         if len(down):
                             n, landed = int(down[0]) + 1, True
                 heights = log_state[k + 1 : k + 1 + n, hip_height_at]
-                if not heights.min() >= floor:  # below the floor, or not finite
+                if not lowest(heights) >= floor:  # below the floor, or not finite
                     n, fallen, landed = int(np.argmax(~(heights >= floor))) + 1, True, False
                 if pushing:
                     result.pushed += force * n * dt
