@@ -7,7 +7,7 @@ settings in the same process, and the time of each part of a validation.
 The previous settings are the committed models as they were before the model was made
 cheaper: 1 ms step, each sole a box touching the floor at four corners, the floor's default
 contact parameters, knee equality at 2 ms with 1e-3 kg·m² of armature on the knee hinges,
-constraint islands.
+friction 50 times harder than the normal force (impratio), constraint islands.
 """
 
 import os
@@ -43,6 +43,7 @@ def previous_settings(spec: mujoco.MjSpec, robot: biped.Robot) -> mujoco.MjSpec:
     spec = mjcf.with_box_soles(spec, robot, solref=(0.004, 1.0))
     spec.option.timestep = 0.001
     spec.option.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_ISLAND)
+    spec.option.impratio = mjcf.IMPRATIO_HARD
     floor = spec.geom("floor")
     floor.solref, floor.solimp = [0.02, 1.0], [0.9, 0.95, 0.001, 0.5, 2.0]  # MuJoCo's default
     for equality in spec.equalities:

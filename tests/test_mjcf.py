@@ -223,8 +223,9 @@ def test_rolling_knee_discs_are_drawn(knee):
 def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
     """The committed scene of ``gait``'s knee at 1/``factor`` of its time step, each sole a box
     on the floor (four contact points) instead of its heel and toe points, the contacts and
-    the knee equality as stiff as that step allows: the physics the committed model's cheaper
-    settings (2 ms, two points a sole) stand for."""
+    the knee equality as stiff as that step allows, friction harder than the normal force
+    (``IMPRATIO_HARD``): the physics the committed model's cheaper settings (2 ms, two points
+    a sole, friction as soft as the normal force) stand for."""
     from validate import mjcf
     from validate.model import model_spec
     from validate.samples import gait_biped
@@ -232,6 +233,7 @@ def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
     spec = mjcf.with_box_soles(model_spec(gait, gait_biped(gait)), ROBOT)
     step = mjcf.TIMESTEP / factor
     spec.option.timestep = step
+    spec.option.impratio = mjcf.IMPRATIO_HARD
     for geom in spec.geoms:
         if geom.contype or geom.conaffinity:
             geom.solref = [2 * step, 1.0]
@@ -243,8 +245,8 @@ def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
 
 @pytest.mark.parametrize("knee", biped.KNEES)
 def test_cheaper_settings_leave_the_physics(knee):
-    """The committed model's 2 ms step and two contact points a sole against the same robot
-    at 0.5 ms with box soles: the same inverse dynamics (the rigid bodies are one robot, to
+    """The committed model's 2 ms step, two contact points a sole and soft friction against
+    the same robot at 0.5 ms with box soles and hard friction: the same inverse dynamics (the rigid bodies are one robot, to
     1e-9 N·m), and the same 10-step walk of the optimal gait: both walk, the distance within
     1 % of the finer model's, step durations within 2 % of a period, the swing foot's
     clearance within 0.2 mm, the centre of pressure within 0.5 mm RMS of the gait's ZMP,
