@@ -1,6 +1,7 @@
 """MuJoCo beside the analytical model: inverse dynamics per sample, the forward walk's speed
 (simulated seconds per wall second) on the committed models and on the previous model
-settings in the same process, and the time of each part of a validation.
+settings in the same process, with MuJoCo's part of it (its rollout calls, per physics step)
+and the controller's (the rest), and the time of a whole validation.
 
     python benchmarks/bench_mujoco.py
 
@@ -15,7 +16,9 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"  # one core, set before numpy loads its BLAS
 
+import contextlib  # noqa: E402
 import time  # noqa: E402
+import types  # noqa: E402
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
@@ -26,7 +29,7 @@ import biped  # noqa: E402
 from biped import gait_file  # noqa: E402
 from biped.optimize import optimize  # noqa: E402
 from biped.problem import GaitProblem  # noqa: E402
-from validate import mjcf  # noqa: E402
+from validate import mjcf, simulate  # noqa: E402
 from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
 from validate.model import model_spec  # noqa: E402
 from validate.report import validate  # noqa: E402
@@ -54,22 +57,45 @@ def previous_settings(spec: mujoco.MjSpec, robot: biped.Robot) -> mujoco.MjSpec:
     return spec
 
 
+class _TimedRollout(rollout.Rollout):
+    """MuJoCo's rollout, adding up the wall time of its calls."""
+
+    seconds = 0.0
+
+    def rollout(self, *args, **kwargs):
+        began = time.perf_counter()
+        try:
+            return super().rollout(*args, **kwargs)
+        finally:
+            _TimedRollout.seconds += time.perf_counter() - began
+
+
+@contextlib.contextmanager
+def timed_rollouts():
+    """The walk's calls to MuJoCo timed (``_TimedRollout.seconds``)."""
+    saved = simulate.rollout
+    simulate.rollout = types.SimpleNamespace(Rollout=_TimedRollout)
+    try:
+        yield
+    finally:
+        simulate.rollout = saved
+
+
 def walk_times(walker: Walker):
-    """Median wall times [s] of the walk and of MuJoCo stepping its model through the same
-    controls in one call (the floor of any controller), the seconds simulated, the number of
-    physics steps and the steps walked."""
-    walls, floors = [], []
+    """Median wall times [s] of the walk and of MuJoCo's part of it (its rollout calls, in
+    walks timed apart), the seconds simulated, the number of physics steps and the steps
+    walked."""
+    walls, physics = [], []
     for _ in range(REPEATS):
         began = time.perf_counter()
         sim = walker.walk(STEPS)
         walls.append(time.perf_counter() - began)
-        data = mujoco.MjData(sim.model)
-        state = np.concatenate([sim.time[:1], sim.qpos[0], sim.qvel[0]])
-        began = time.perf_counter()
-        rollout.rollout(sim.model, data, state, sim.ctrl)
-        floors.append(time.perf_counter() - began)
+        with timed_rollouts():
+            _TimedRollout.seconds = 0.0
+            walker.walk(STEPS)
+            physics.append(_TimedRollout.seconds)
     simulated = sim.time[-1] - sim.time[0] + sim.model.opt.timestep
-    return np.median(walls), np.median(floors), simulated, len(sim.ctrl), sum(sim.landed)
+    return np.median(walls), np.median(physics), simulated, len(sim.ctrl), sum(sim.landed)
 
 
 def main():
@@ -97,7 +123,7 @@ def main():
     )
     print(
         f"{'knee':10}{'model':>10}{'step':>8}{'walked':>8}{'walk':>10}{'x real':>8}"
-        f"{'physics':>10}{'x real':>8}{'per step':>10}"
+        f"{'MuJoCo':>10}{'per step':>10}{'controller':>12}"
     )
     gaits = {}
     for knee in biped.KNEES:
@@ -108,12 +134,12 @@ def main():
         factors = {}
         for name, settings in (("committed", spec), ("previous", previous_settings(spec, robot))):
             walker = Walker(gait, settings)
-            wall, floor, simulated, n, walked = walk_times(walker)
+            wall, physics, simulated, n, walked = walk_times(walker)
             factors[name] = simulated / wall
             print(
                 f"{knee:10}{name:>10}{walker.model.opt.timestep * 1e3:6.1f}ms{walked:8d}"
-                f"{wall:8.3f} s{simulated / wall:7.0f}x{floor:8.3f} s{simulated / floor:7.0f}x"
-                f"{floor / n * 1e6:8.1f} µs"
+                f"{wall:8.3f} s{simulated / wall:7.0f}x{physics:8.3f} s{physics / n * 1e6:8.1f} µs"
+                f"{1 - physics / wall:11.0%}"
             )
         print(
             f"{knee:10}committed / previous: {factors['committed'] / factors['previous']:.2f}x "
