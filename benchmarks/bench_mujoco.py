@@ -58,9 +58,11 @@ def previous_settings(spec: mujoco.MjSpec, robot: biped.Robot) -> mujoco.MjSpec:
 
 
 class _TimedRollout(rollout.Rollout):
-    """MuJoCo's rollout, adding up the wall time of its calls."""
+    """MuJoCo's rollout, adding up the wall time of its calls and the physics steps they
+    take (a reading period cut short by a landing still takes all its steps)."""
 
     seconds = 0.0
+    steps = 0
 
     def rollout(self, *args, **kwargs):
         began = time.perf_counter()
@@ -68,6 +70,7 @@ class _TimedRollout(rollout.Rollout):
             return super().rollout(*args, **kwargs)
         finally:
             _TimedRollout.seconds += time.perf_counter() - began
+            _TimedRollout.steps += kwargs["nstep"]
 
 
 @contextlib.contextmanager
@@ -83,7 +86,7 @@ def timed_rollouts():
 
 def walk_times(walker: Walker):
     """Median wall times [s] of the walk and of MuJoCo's part of it (its rollout calls, in
-    walks timed apart), the seconds simulated, the number of physics steps and the steps
+    walks timed apart), the seconds simulated, the physics steps MuJoCo took and the steps
     walked."""
     walls, physics = [], []
     for _ in range(REPEATS):
@@ -91,11 +94,11 @@ def walk_times(walker: Walker):
         sim = walker.walk(STEPS)
         walls.append(time.perf_counter() - began)
         with timed_rollouts():
-            _TimedRollout.seconds = 0.0
+            _TimedRollout.seconds, _TimedRollout.steps = 0.0, 0
             walker.walk(STEPS)
             physics.append(_TimedRollout.seconds)
     simulated = sim.time[-1] - sim.time[0] + sim.model.opt.timestep
-    return np.median(walls), np.median(physics), simulated, len(sim.ctrl), sum(sim.landed)
+    return np.median(walls), np.median(physics), simulated, _TimedRollout.steps, sum(sim.landed)
 
 
 def main():

@@ -246,11 +246,11 @@ def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
 @pytest.mark.parametrize("knee", biped.KNEES)
 def test_cheaper_settings_leave_the_physics(knee):
     """The committed model's 2 ms step, two contact points a sole and soft friction against
-    the same robot at 0.5 ms with box soles and hard friction: the same inverse dynamics (the rigid bodies are one robot, to
-    1e-9 N·m), and the same 10-step walk of the optimal gait: both walk, the distance within
-    1 % of the finer model's, step durations within 2 % of a period, the swing foot's
-    clearance within 0.2 mm, the centre of pressure within 0.5 mm RMS of the gait's ZMP,
-    the stance foot's slip under 1 mm."""
+    the same robot at 0.5 ms with box soles and hard friction: the same inverse dynamics
+    (the rigid bodies are one robot, to 1e-9 N·m), and the same 10-step walk of the optimal
+    gait: both walk, the distance within 1 % of the finer model's, step durations within 2 %
+    of a period, the swing foot's clearance within 0.2 mm, the centre of pressure within
+    0.5 mm RMS of the gait's ZMP, the stance foot's slip under 1 mm."""
     from tests.conftest import gait_content, optimal_gait
     from validate.checks import MAX_SLIP, walk_figures, walks
     from validate.contact import ground_reaction

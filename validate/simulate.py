@@ -440,7 +440,7 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
     index = np.empty(chunk, dtype=np.intp)
     weight = np.empty(chunk)
     # The table's columns at the period's points and their increments to the next point
-    # (``PhaseTable.interpolants``), and named views of them: nothing is allocated per period.
+    # (``PhaseTable.interpolants``), gathered into one buffer, and named views of it.
     gathered = np.empty((48, chunk))
     rows, increments = gathered[:24], gathered[24:]
     torques, references, rates, rotors = rows[:6], rows[6:12], rows[12:18], rows[18:24]
@@ -493,7 +493,9 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
                     np.minimum(index, last - 1, out=index)
                 np.subtract(where, index, out=weight)
                 # The table between its points, column by column (24, chunk).
-                interpolant.take(index, axis=1, out=gathered)
+                # (``index`` is within the table: "clip" writes straight into the buffer,
+                # where "raise" would go through a temporary copy)
+                interpolant.take(index, axis=1, out=gathered, mode="clip")
                 increments *= weight
                 rows += increments
                 if last_tick * hip_speed + here > x_end:  # the last of ``advance``, below
