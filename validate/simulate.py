@@ -492,9 +492,8 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
                 if high >= last:
                     np.minimum(index, last - 1, out=index)
                 np.subtract(where, index, out=weight)
-                # The table between its points, column by column (24, chunk).
-                # (``index`` is within the table: "clip" writes straight into the buffer,
-                # where "raise" would go through a temporary copy)
+                # The table between its points, column by column (24, chunk); ``index`` is
+                # within it, and "clip" writes straight into the buffer ("raise" copies).
                 interpolant.take(index, axis=1, out=gathered, mode="clip")
                 increments *= weight
                 rows += increments
