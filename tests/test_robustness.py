@@ -6,6 +6,9 @@ same on one process or two and on a rerun, and bad input is one line."""
 import copy
 import dataclasses
 import json
+import os
+import subprocess
+import sys
 
 import mujoco
 import numpy as np
@@ -22,7 +25,9 @@ from validate.mjcf import FOLDER
 from validate.model import compile_spec
 from validate.robustness import (
     LIMITS,
+    Limit,
     RobustnessSettings,
+    distinguishable,
     map_limit,
     robustness_map,
     trunk_mass_spec,
@@ -133,6 +138,67 @@ def test_a_far_end_that_walks_is_the_limit_unbracketed(gait, monkeypatch):
     limit = map_limit(gait, "kp_scale_high", settings=SETTINGS)
     assert not limit.bracketed and limit.limit == 2.0 and limit.fails_at is None
     assert limit.tolerance is None and limit.walks == 1
+
+
+def test_a_limit_lies_on_any_machine_within_a_step_of_its_bracket(mapped):
+    """Each limit's reproducible range holds its bracket (the limit and the first failing
+    value) widened by one bisection step on either side: arithmetic steps of ``tolerance``,
+    geometric ones of the ratio fails_at / limit."""
+    for limit in mapped.limits.values():
+        low, high = limit.reproducible
+        near, far = sorted((limit.limit, limit.fails_at))
+        if limit.geometric:
+            ratio = far / near
+            assert (low, high) == pytest.approx((near / ratio, far * ratio))
+        else:
+            assert (low, high) == pytest.approx((near - limit.tolerance, far + limit.tolerance))
+
+
+def _shifted(limit: Limit, steps: float) -> dict:
+    """``limit`` moved ``steps`` bisection steps away from its nominal value, as JSON."""
+    move = steps * (limit.fails_at - limit.limit)
+    return dataclasses.replace(
+        limit, limit=limit.limit + move, fails_at=limit.fails_at + move
+    ).to_dict()
+
+
+def test_limits_a_step_apart_are_not_distinguishable_and_far_ones_are(mapped):
+    """Two maps whose limit differs by one or two bisection steps cannot be told apart across
+    machines; by four steps they can; a limit beyond its bracket's end is distinct from one
+    well inside it and not from another beyond it."""
+    push = mapped.limits["push_forward"]
+    same = push.to_dict()
+    assert not distinguishable(same, _shifted(push, 1.0))
+    assert not distinguishable(same, _shifted(push, 2.0))
+    assert distinguishable(same, _shifted(push, 4.0))
+    assert distinguishable(_shifted(push, 4.0), same)  # symmetric
+    beyond = Limit("push_forward", "N·s", (0.0, 2.0), 2.0, None, (), False, 1).to_dict()
+    assert distinguishable(same, beyond) == (push.reproducible[1] < 2.0)
+    assert not distinguishable(beyond, dict(beyond))
+
+
+def test_the_map_keeps_its_limits_without_avx512_kernels(tmp_path):
+    """The revolute knee's optimal gait at 0.3 m/s optimized and mapped without numpy's
+    AVX-512 kernels, as on a machine without them, and with them: every limit of each map
+    lies within the other's reproducible range (there, 3 of 14 limits moved by one step)."""
+    maps = {}
+    for name, env in (("avx", {}), ("baseline", {"NPY_DISABLE_CPU_FEATURES": "AVX512_ICL X86_V4"})):
+        gait, out = tmp_path / f"{name}.json", tmp_path / name
+        run = {**os.environ, **env}
+        for command in (
+            ["optimize", "--knee", "revolute", "--speed", "0.3", "--out", str(gait)],
+            ["robustness", str(gait), "--out", str(out)],
+        ):
+            subprocess.run(
+                [sys.executable, "-m", "biped", *command], env=run, check=True, capture_output=True
+            )
+        maps[name] = json.loads((out / f"{tmp_path.name}-{name}.json").read_text())["limits"]
+    for name in LIMITS:
+        avx, baseline = maps["avx"][name], maps["baseline"][name]
+        low, high = avx["reproducible"]
+        assert low <= baseline["limit"] <= high, (name, avx, baseline)
+        low, high = baseline["reproducible"]
+        assert low <= avx["limit"] <= high, (name, avx, baseline)
 
 
 def test_trunk_mass_models_come_from_the_robot(gait):

@@ -62,6 +62,12 @@ from validate.simulate import KP, KV, Push, Walker, WalkSettings
 MAX_PUSH = 20.0
 MAX_TRUNK_MASS_ERROR = 0.5
 MAX_GAIN_SCALE = 16.0
+# Bisection steps a limit may move by from one machine to another. A bisection's last walks lie
+# on a boundary between walking and failing where the contact simulation turns on the last bits
+# of the gait and of the arithmetic: measured on the optimal gaits at 0.3 m/s, mapped with and
+# without numpy's AVX-512 kernels (NPY_DISABLE_CPU_FEATURES="AVX512_ICL X86_V4"), 3 of the 14
+# limits moved by one step (revolute: push forward, trunk heavier, kp high), none by more.
+MACHINE_STEPS = 1
 # The nominal walk's settings (the validation's walk).
 NOMINAL = WalkSettings()
 # The limits, in the order of the map.
@@ -154,11 +160,29 @@ class Limit:
         """|fails_at - limit|: how far beyond ``limit`` the true limit may lie."""
         return None if self.fails_at is None else abs(self.fails_at - self.limit)
 
+    @property
+    def reproducible(self) -> tuple[float, float] | None:
+        """[low, high] where the limit lies on any machine: from ``MACHINE_STEPS`` bisection
+        steps nearer the nominal value than ``limit`` to as many beyond ``fails_at`` (a step
+        is ``tolerance``, a ratio for the geometric bisections); None if the far end walked."""
+        if self.fails_at is None:
+            return None
+        near, far = self.limit, self.fails_at
+        if self.geometric:
+            ratio = (far / near) ** MACHINE_STEPS
+            ends = (near / ratio, far * ratio)
+        else:
+            step = (far - near) * MACHINE_STEPS
+            ends = (near - step, far + step)
+        return (min(ends), max(ends))
+
     def to_dict(self) -> dict:
+        reproducible = self.reproducible
         return {
             "limit": self.limit,
             "fails_at": self.fails_at,
             "tolerance": self.tolerance,
+            "reproducible": None if reproducible is None else list(reproducible),
             "bracket": list(self.bracket),
             "bracketed": self.bracketed,
             "bisection": "geometric" if self.geometric else "arithmetic",
@@ -258,13 +282,30 @@ def units(content: dict) -> dict:
         "walks": PURE,
     }
     for name in content.get("limits", {}):
-        for key in ("limit", "fails_at", "tolerance", "bracket"):
+        for key in ("limit", "fails_at", "tolerance", "reproducible", "bracket"):
             found[f"limits.{name}.{key}"] = LIMIT_UNITS[name]
         found[f"limits.{name}.walks"] = PURE
     ranges = {"push": "N·s", "friction": PURE, "trunk_mass": PURE, "kp_scale": PURE}
     for name in content.get("ranges", {}):
         found[f"ranges.{name}"] = ranges[name]
     return found
+
+
+def reproducible_range(limit: dict) -> tuple[float, float]:
+    """Where a limit of a map's JSON content (``Limit.to_dict``) lies on any machine: its
+    ``reproducible`` range, or, if the far end of its bracket walked, beyond that end."""
+    if limit["reproducible"] is not None:
+        low, high = limit["reproducible"]
+        return (low, high)
+    nominal, far = limit["bracket"]
+    return (far, math.inf) if far > nominal else (-math.inf, far)
+
+
+def distinguishable(a: dict, b: dict) -> bool:
+    """Whether two maps' values of one limit (``Limit.to_dict``) differ by more than what
+    they keep across machines: their ``reproducible_range``s do not overlap."""
+    (a_low, a_high), (b_low, b_high) = reproducible_range(a), reproducible_range(b)
+    return a_high < b_low or b_high < a_low
 
 
 def model_friction(model: mujoco.MjModel) -> float:
@@ -463,8 +504,10 @@ __all__ = [
     "Limit",
     "RobustnessMap",
     "RobustnessSettings",
+    "distinguishable",
     "map_limit",
     "model_friction",
+    "reproducible_range",
     "robustness_map",
     "trunk_mass_spec",
     "units",
