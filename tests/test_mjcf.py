@@ -90,6 +90,40 @@ def test_scene_steps_without_warnings(knee):
     assert np.all(np.isfinite(data.qpos))
 
 
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_a_robot_left_without_control_folds_at_its_stops_onto_the_floor(knee):
+    """Dropped from standing with no control for 2 s, the robot folds like one: every hinge
+    has a range, knees not inverted (their range stops 0.05 rad past straight), none passes
+    its range by more than 0.02 rad, and no joint (hip, knees, ankles) goes into the floor."""
+    from validate.mjcf import KNEE_RANGE
+
+    model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
+    hinges = [j for j in range(model.njnt) if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]
+    limited = [j for j in hinges if model.jnt_limited[j]]
+    assert limited == [j for j in hinges if j != model.joint("rooty").id]
+    for side in ("left", "right"):
+        knees = (
+            [f"{side}_knee"]
+            if knee == "revolute"
+            else [f"{side}_knee_{p}" for p in ("upper", "lower")]
+        )
+        assert sum(model.joint(name).range[1] for name in knees) == pytest.approx(KNEE_RANGE[1])
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    low, lowest, past = model.jnt_range[limited, 0], np.inf, 0.0
+    high, angles = model.jnt_range[limited, 1], model.jnt_qposadr[limited]
+    points = [
+        model.body(f"{side}_{body}").id for side in ("left", "right") for body in ("shank", "foot")
+    ]
+    for _ in range(round(2.0 / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+        q = data.qpos[angles]
+        past = max(past, float(np.max(np.maximum(low - q, q - high))))
+        lowest = min(lowest, float(data.xpos[[model.body("trunk").id, *points], 2].min()))
+    assert past < 0.02 and lowest > 0.02, (past, lowest)
+    assert all(w.number == 0 for w in data.warning)
+
+
 def test_rolling_knee_equality_and_tendon():
     """The knee hinges turn in the ratio r2 : r1 and the tendon measures the flexion."""
     model = mujoco.MjModel.from_xml_path(str(FOLDER / "scene_rolling.xml"))

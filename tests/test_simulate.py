@@ -201,3 +201,18 @@ def test_simulation_is_deterministic():
     walker = Walker(gait_content(small_optimum("rolling")))
     first, second = (walker.walk(2) for _ in range(2))
     assert np.array_equal(first.qpos, second.qpos) and np.array_equal(first.ctrl, second.ctrl)
+
+
+def test_an_unstable_walk_counts_its_warnings_and_writes_no_log(tmp_path, monkeypatch, capfd):
+    """A walk MuJoCo finds unstable (servos 10⁴ times too stiff for its step) counts its
+    warnings and fails, prints nothing and leaves no MUJOCO_LOG.TXT in the working directory;
+    MuJoCo's warning handler is the caller's again after it."""
+    monkeypatch.chdir(tmp_path)
+    before = mujoco.get_mju_user_warning()
+    walker = Walker(gait_content(small_optimum("revolute")))
+    sim = walker.walk(1, WalkSettings(kp_scale=1e4))
+    assert sim.warnings > 0
+    assert not walks(walk_figures(walker.biped, walker.samples, sim, 1.0), 1)
+    assert list(tmp_path.iterdir()) == []
+    assert capfd.readouterr() == ("", "")
+    assert mujoco.get_mju_user_warning() is before

@@ -153,11 +153,13 @@ def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_pa
     assert code == 1 and not table_1["passed"]
     assert not table_1["feedforward"]["passed"] and not table_1["inverse_dynamics"]["passed"]
     assert table_1["model"]["mass_difference"] == pytest.approx(-0.1 * Robot.paper().trunk_mass)
+    assert not table_1["model"]["passed"] and "trunk_mass" in table_1["model"]["notes"][0]
     stance = [table_1["feedforward"][f"feedback_share_stance_{j}"] for j in ("knee", "hip")]
     assert min(stance) > 0.1
     _, out, _ = _run(args, capsys)
     own = json.loads(out)
     assert own["feedforward"]["passed"] and own["inverse_dynamics"]["passed"]
+    assert own["model"]["passed"] and own["impact"]["passed"]
 
 
 def test_a_rolling_gait_on_the_revolute_model_is_refused(gait_path, tmp_path, capsys):
@@ -229,3 +231,94 @@ def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
         assert isinstance(content[name]["passed"], bool), name
         assert isinstance(content[name]["notes"], list), name
     assert missing(content, content["units"]) == []
+
+
+ROBOT_FIELDS = list(Robot.__dataclass_fields__)  # in their order
+
+
+@pytest.fixture(scope="module")
+def table_1_models():
+    """The committed Table 1 scene of each knee, compiled."""
+    import mujoco
+
+    from validate.mjcf import FOLDER
+
+    return {
+        knee: mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
+        for knee in ("revolute", "rolling")
+    }
+
+
+@pytest.mark.parametrize(
+    "knee, field",
+    [
+        (knee, field)
+        for field in ROBOT_FIELDS
+        for knee in ("revolute", "rolling")
+        if knee == "rolling" or field not in ("r1", "r2")  # a revolute knee has no radii
+    ],
+)
+def test_the_model_check_names_a_field_that_differs(table_1_models, knee, field):
+    """A gait's robot with one field 5 % off Table 1: the Table 1 model fails the model check
+    naming that field first with both values, the model generated from that robot passes."""
+    import dataclasses
+
+    from biped import Biped
+    from validate.checks import check_model
+    from validate.mjcf import scene_model
+
+    paper = Robot.paper()
+    robot = dataclasses.replace(paper, **{field: 1.05 * getattr(paper, field)})
+    biped = Biped(robot, knee)
+    check = check_model(table_1_models[knee], biped)
+    assert not check.passed
+    named = [note for note in check.notes if note.startswith(f"{field}:")]
+    assert named and named[0] == check.notes[-1] and "differing too" not in named[0], check.notes
+    assert f"{getattr(paper, field):.6g}" in named[0] and f"{getattr(robot, field):.6g}" in named[0]
+    assert check.line().startswith("FAIL  model") and named[0] in check.line()
+    assert check_model(scene_model(robot, knee), biped).passed
+
+
+def test_a_revolute_model_does_not_hold_the_knee_radii(table_1_models):
+    """The radii of a revolute-knee robot are not its dynamics: the Table 1 revolute model is
+    the model of a revolute robot whose r1, r2 differ."""
+    import dataclasses
+
+    from biped import Biped
+    from validate.checks import check_model
+
+    robot = dataclasses.replace(Robot.paper(), r1=0.08, r2=0.02)
+    assert check_model(table_1_models["revolute"], Biped(robot, "revolute")).passed
+
+
+@pytest.mark.parametrize("knee", ["revolute", "rolling"])
+def test_a_gait_under_other_gravity_passes_on_its_own_model(knee):
+    """A gait of a robot under g = 9.5 m/s²: its generated model holds that gravity, so inverse
+    dynamics and the model check pass there; the Table 1 model fails the model check naming
+    gravity and inverse dynamics."""
+    import dataclasses
+
+    from biped import Biped
+    from biped.optimize import optimize
+    from biped.problem import GaitProblem
+    from tests.conftest import gait_content
+    from validate import checks
+    from validate.mjcf import FOLDER
+    from validate.model import compile_spec, model_spec
+    from validate.samples import GaitSamples
+
+    robot = dataclasses.replace(Robot.paper(), gravity=9.5)
+    biped = Biped(robot, knee)
+    optimum = optimize(
+        GaitProblem(biped, 0.3), method="nelder-mead", max_restarts=0, evaluations_per_run=100
+    )
+    gait = gait_content(optimum, robot)
+    samples = GaitSamples.from_gait(gait)
+    own = compile_spec(model_spec(gait, biped))
+    assert own.opt.gravity[2] == -9.5
+    assert checks.check_model(own, biped).passed
+    assert checks.check_inverse_dynamics(own, biped, samples).passed
+    table_1 = compile_spec(model_spec(gait, biped, FOLDER / f"scene_{knee}.xml"))
+    model = checks.check_model(table_1, biped)
+    assert not model.passed and model.notes[-1].startswith("gravity: 9.81 m/s² in the model")
+    assert not checks.check_inverse_dynamics(table_1, biped, samples).passed

@@ -1,7 +1,9 @@
 """The checks of a gait file against MuJoCo, each a ``Check``: a verdict, figures and notes.
 
-model             the MJCF is the gait's robot where the harness relies on it (the rolling
-                  knee's equalities and their ratio r2 / r1); its mass beside the gait's
+model             the MJCF is the gait's robot: the rolling knee's equalities and their
+                  ratio r2 / r1, and every field of ``biped.Robot`` the MJCF holds
+                  (``validate.model.parameter_differences``: the first that differs named
+                  with both values); its mass beside the gait's
 inverse_dynamics  the file's Γ, F_e, ZMP against MuJoCo's dynamics of the model along the
                   file's motion (1e-6)
 impact            the file's start velocities and impulse against MuJoCo's impact map
@@ -132,7 +134,7 @@ def _model_failure(name: str, error: Exception) -> Check:
 
 
 def check_model(model: mujoco.MjModel, biped: Biped) -> Check:
-    """The model is the gait's robot where the harness relies on it; masses reported."""
+    """The model is the gait's robot (``validate.model.model_problems``); masses reported."""
     problems = model_problems(model, biped)
     trunk = model.body("trunk").id
     mass = float(model.body_subtreemass[trunk])

@@ -10,7 +10,17 @@ the robot standing straight with its soles on the floor, the ``home`` key, and q
 equals x_H, z_H, q5 (MuJoCo moves a body by qpos - ref). Every hinge turns about "0 -1 0", so a positive angle is
 counter-clockwise in the x-z plane like the paper's angles: a child's absolute angle is its
 parent's plus the joint angle. The legs are ``left`` and ``right``; which one is the stance leg
-changes every step (``validate.mapping``).
+changes every step (``validate.mapping``). Every hinge but ``rooty`` stops at a human's range
+(``HIP_RANGE``, ``KNEE_RANGE``, ``ANKLE_RANGE``: the knee never inverted beyond 0.05 rad, the
+paper's Ψ4, Ψ5 >= 0) and the trunk, thighs and shanks collide with the floor as the soles do,
+so that the robot left without control (``python -m mujoco.viewer``) folds and lies down like
+one; the gaits never come near the stops or touch the floor with a link.
+
+The MJCF holds every field of ``biped.Robot`` (``validate.model.model_parameters`` reads them
+back): segment lengths as the bodies' places, masses, inertias and centres of mass as their
+``inertial``, the sole as the heel and toe sites and contact points, the knee radii as the
+rolling knee's link (r1 + r2) and equality (r2 / r1), the trunk's length as its ``head`` site,
+gravity as the option's.
 
 Rolling knee: thigh, then a near-massless link of length r1 + r2 between two hinges at the
 centres C2 and C1 of the rolling circles, then the shank. Rolling without slip turns the two
@@ -82,9 +92,28 @@ IMPRATIO_HARD = 50.0
 # No constraint islands: the robot is one kinematic tree (its planar base hangs from the
 # world), so every contact and knee equality acts on the same island, and finding it at each
 # step is work for nothing (4 % of a step; the walks are the same to the bit).
+# Ranges of the joints [rad], in MuJoCo's joint angles (a child's absolute angle minus its
+# parent's, the paper's sign: hip q_thigh - q_trunk, knee q_shank - q_thigh, ankle
+# q_foot - q_shank): a human's anatomical stops, so that a robot left without control folds
+# like one instead of through itself. The knee's stop is the paper's constraint that it never
+# inverts (Ψ4 = q2 - q1 >= 0, Ψ5 = q3 - q4 >= 0: its angle here is -Ψ <= 0), a little past
+# straight: the optimal gaits keep the stance knee straight to the solver's 1 mrad margin
+# and their walks to 0.3 mrad. MuJoCo's limit acts only beyond its range (margin 0), and the
+# optimal gaits of 0.15-0.45 m/s stay far inside every range (hip -0.17 to 0.22, knee
+# -0.18 to 0, ankle -0.15 to 0.19 rad), their walks too: they play as without limits. A
+# rolling knee's two hinges share the range as they share the flexion (r1 / l and r2 / l).
+HIP_RANGE = (-0.5, 2.0)  # extension 29°, flexion 115°
+KNEE_RANGE = (-2.4, 0.05)  # flexion 138°, 3° past straight
+ANKLE_RANGE = (-0.8, 0.6)  # plantar flexion 46°, dorsiflexion 34°
+# The stops are as stiff as the contacts (a stop hit by a falling robot gives by a few
+# hundredths of a radian; at MuJoCo's default, 0.02 s, by 0.13 rad).
+LIMIT_SOLREF = "0.004 1"
+LIMIT_SOLIMP = "0.99 0.999 0.001 0.5 2"
+# The links collide with the floor too (capsules as drawn, group 3), so that a robot that
+# falls lies on it; a walk never brings them near it (the knees stay 0.4 m up).
 # Legs side by side, for the eye only: the motion is planar (slides along x, z and hinges
-# about y), so offsets along y change nothing in it. Feet collide with the floor, not each
-# other (contype / conaffinity).
+# about y), so offsets along y change nothing in it. Links collide with the floor, not with
+# each other (contype / conaffinity).
 HIP_OFFSET = 0.09  # [m]
 # Colours (RGBA) of the trunk and of each leg, and of each leg's knee discs.
 TRUNK_RGBA = "0.62 0.62 0.66 1"
@@ -119,8 +148,14 @@ def _inertial(pos_z: float, mass: float, inertia: float) -> str:
     return f'<inertial pos="0 0 {_f(pos_z)}" mass="{_f(mass)}" diaginertia="{i} {i} {i}"/>'
 
 
+def _range(limits: tuple[float, float], share: float = 1.0) -> str:
+    return f'range="{_f(share * limits[0])} {_f(share * limits[1])}"'
+
+
 def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None) -> str:
-    """The robot's MJCF (no floor), for one knee kinematic.
+    """The robot's MJCF (no floor), for one knee kinematic: every field of ``robot`` the
+    dynamics use (lengths, masses, inertias, centres of mass, the sole, the knee radii of a
+    rolling knee, gravity) and the trunk's length as its ``head`` site.
 
     Args:
         servos: (kp [N·m/rad], kv [N·m·s/rad]) adds, after the six motors, a position and a
@@ -140,7 +175,7 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         f'<mujoco model="biped_{knee}">',
         '  <compiler angle="radian" autolimits="true" inertiafromgeom="false"/>',
         f'  <option timestep="{_f(TIMESTEP)}" integrator="implicitfast" cone="elliptic" '
-        f'impratio="{_f(IMPRATIO)}">',
+        f'impratio="{_f(IMPRATIO)}" gravity="0 0 {_f(-r.gravity)}">',
         '    <flag island="disable"/>',
         "  </option>",
         "",
@@ -151,7 +186,8 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         "  </asset>",
         "",
         "  <default>",
-        '    <joint type="hinge" axis="0 -1 0"/>',
+        f'    <joint type="hinge" axis="0 -1 0" solreflimit="{LIMIT_SOLREF}" '
+        f'solimplimit="{LIMIT_SOLIMP}"/>',
         '    <motor ctrlrange="-400 400" gear="-1"/>',
         '    <default class="visual">',
         '      <geom contype="0" conaffinity="0" group="2"/>',
@@ -171,37 +207,41 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         '      <joint name="rooty"/>',
         f"      {_inertial(r.trunk_com, r.trunk_mass, r.trunk_inertia)}",
         f'      <geom class="visual" type="capsule" size="0.08" fromto="0 0 0.1 0 0 {_f(r.trunk_length - 0.1)}" material="trunk"/>',
+        f'      <geom name="trunk_contact" class="collision" type="capsule" size="0.08" fromto="0 0 0.1 0 0 {_f(r.trunk_length - 0.1)}"/>',
         '      <site name="hip"/>',
+        f'      <site name="head" pos="0 0 {_f(r.trunk_length)}"/>',
     ]
     for side in SIDES:
         pad = "      "
         lines += [
             f'{pad}<body name="{side}_thigh" pos="0 {_f(HIP_OFFSET if side == "left" else -HIP_OFFSET)} 0">',
-            f'{pad}  <joint name="{side}_hip"/>',
+            f'{pad}  <joint name="{side}_hip" {_range(HIP_RANGE)}/>',
             f"{pad}  {_inertial(-r.thigh_com, r.thigh_mass, r.thigh_inertia)}",
             f'{pad}  <geom class="visual" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}" material="{side}"/>',
+            f'{pad}  <geom name="{side}_thigh_contact" class="collision" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
         ]
         if rolling:
             lines += [
                 f'{pad}  <geom name="{side}_thigh_disc" class="visual" type="cylinder" size="{_f(r2)} {_f(DISC_HALF_WIDTH)}" pos="0 0 {_f(-thigh)}" zaxis="0 1 0" material="{side}_disc"/>',
                 f'{pad}  <body name="{side}_knee_link" pos="0 0 {_f(-thigh)}">',
-                f'{pad}    <joint name="{side}_knee_upper" armature="{_f(KNEE_ARMATURE)}"/>',
+                f'{pad}    <joint name="{side}_knee_upper" {_range(KNEE_RANGE, r1 / link)} armature="{_f(KNEE_ARMATURE)}"/>',
                 f"{pad}    {_inertial(-link / 2, KNEE_LINK_MASS, KNEE_LINK_INERTIA)}",
                 f'{pad}    <body name="{side}_shank" pos="0 0 {_f(-link)}">',
-                f'{pad}      <joint name="{side}_knee_lower" armature="{_f(KNEE_ARMATURE)}"/>',
+                f'{pad}      <joint name="{side}_knee_lower" {_range(KNEE_RANGE, r2 / link)} armature="{_f(KNEE_ARMATURE)}"/>',
                 f'{pad}      <geom name="{side}_shank_disc" class="visual" type="cylinder" size="{_f(r1)} {_f(DISC_HALF_WIDTH)}" zaxis="0 1 0" material="{side}_disc"/>',
             ]
             pad += "  "  # inside the knee link and the shank
         else:
             lines += [
                 f'{pad}  <body name="{side}_shank" pos="0 0 {_f(-thigh)}">',
-                f'{pad}    <joint name="{side}_knee"/>',
+                f'{pad}    <joint name="{side}_knee" {_range(KNEE_RANGE)}/>',
             ]
         lines += [
             f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia)}",
             f'{pad}    <geom class="visual" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}" material="{side}"/>',
+            f'{pad}    <geom name="{side}_shank_contact" class="collision" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}"/>',
             f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
-            f'{pad}      <joint name="{side}_ankle" armature="{_f(ANKLE_ARMATURE)}"/>',
+            f'{pad}      <joint name="{side}_ankle" {_range(ANKLE_RANGE)} armature="{_f(ANKLE_ARMATURE)}"/>',
             f"{pad}      {_inertial(-r.foot_com, r.foot_mass, r.foot_inertia)}",
             *(
                 f'{pad}      <geom name="{side}_{end}_contact" class="collision" type="sphere" '

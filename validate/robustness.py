@@ -37,12 +37,10 @@ spends about as long again in Python between, holding its lock.)
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import itertools
 import math
 import os
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -55,7 +53,7 @@ from biped.units import PURE
 from validate.checks import walk_verdict
 from validate.model import compile_spec, model_spec
 from validate.samples import gait_biped
-from validate.simulate import KP, KV, Push, Walker, WalkSettings
+from validate.simulate import KP, KV, Push, Walker, WalkSettings, quiet_mujoco
 
 # Far ends of the brackets: impulse [N·s] (a 70 kg robot's speed changes by 0.29 m/s), trunk
 # mass error (fraction), gain scale (each way).
@@ -341,19 +339,6 @@ def trunk_mass_spec(
             f"where {wanted:.6g} kg was set): allowed a trunk with an explicit <inertial> mass"
         )
     return spec
-
-
-@contextlib.contextmanager
-def quiet_mujoco() -> Iterator[None]:
-    """Within the block, MuJoCo's warnings are not printed (a walk that raises one still
-    counts it, ``Simulation.warnings``, and fails): the far ends of the brackets make the
-    simulation unstable on purpose."""
-    previous = mujoco.get_mju_user_warning()
-    mujoco.set_mju_user_warning(lambda message: None)
-    try:
-        yield
-    finally:
-        mujoco.set_mju_user_warning(previous)
 
 
 class _Mapper:

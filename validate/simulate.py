@@ -46,8 +46,11 @@ of its height, the walk ends.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import functools
+import threading
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import mujoco
@@ -379,6 +382,31 @@ def simulate(
     return Walker(gait, model).walk(steps, settings)
 
 
+# MuJoCo's warning handler while walks silence it: (walks under way, the handler before).
+_QUIET = [0, None]
+_QUIET_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def quiet_mujoco() -> Iterator[None]:
+    """Within the block, MuJoCo's warnings are neither printed nor written to its log file
+    (MuJoCo's own handler writes ``MUJOCO_LOG.TXT`` into the working directory): a walk counts
+    them itself (``Simulation.warnings``) and a walk that raises one fails. Nests, and holds
+    across threads: the handler comes back when the last block ends."""
+    with _QUIET_LOCK:
+        if _QUIET[0] == 0:
+            _QUIET[1] = mujoco.get_mju_user_warning()
+            mujoco.set_mju_user_warning(lambda message: None)
+        _QUIET[0] += 1
+    try:
+        yield
+    finally:
+        with _QUIET_LOCK:
+            _QUIET[0] -= 1
+            if _QUIET[0] == 0:
+                mujoco.set_mju_user_warning(_QUIET[1])
+
+
 def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     model = copy.deepcopy(walker.model)  # gains and friction change in it
     if settings.friction is not None:
@@ -392,7 +420,8 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
         data = mujoco.MjData(model)
     mujoco.mj_resetData(model, data)
     try:
-        return _walk_on(walker, steps, settings, model, data)
+        with quiet_mujoco():  # counted in the result
+            return _walk_on(walker, steps, settings, model, data)
     finally:
         spare.append(data)
 
