@@ -8,6 +8,8 @@
 
 The page gives the gait's parameters by name with their units, its criteria, the tightest
 margin of each constraint (which sample of the step, and how far above the solver's margin δ),
+where a constraint dips below δ between the solver's samples (an inset on its panel), the
+jumps of the torques and ground reaction at the mid-step knot (marked on their panels),
 the verdict and figures of its validation in MuJoCo when a report is given, and links to the
 recording and the video. ``write_pages`` writes pages as a set, all or none
 (``biped.files.atomic_set``). The constraints are computed again from the gait's parameters
@@ -16,16 +18,18 @@ on the grid the optimiser checks feasibility on (``CHECK_SAMPLES_PER_HALF``).
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter
 
 from biped import gait_file
 from biped.criteria import CONSTRAINTS, evaluate_step, margin_profile
-from biped.dynamics import Biped
+from biped.dynamics import JOINTS, Biped
 from biped.figures import (
     ANGLE_PANELS,
     DPI,
@@ -34,11 +38,13 @@ from biped.figures import (
     TORQUE_PANELS,
     Panel,
     certified,
+    joint_label,
     time_figure,
 )
 from biped.files import atomic_set
 from biped.gait import PARAMETERS, build_step, half_grid
 from biped.optimize import CHECK_SAMPLES_PER_HALF
+from biped.problem import SOLVER_SAMPLES_PER_HALF
 from biped.units import CONSTRAINT_UNITS, CRITERION_UNITS, parameter_unit
 
 # What each constraint of eq. (28) keeps.
@@ -57,6 +63,15 @@ COST_NAMES = {
     "energy_per_metre": ("energy per metre walked", "J/m"),
 }
 FIGURE_NAMES = ("torques.png", "angles.png", "ground.png", "constraints.png")
+# A constraint dips below δ_i where Ψ_i < δ_i (1 − DIP_TOLERANCE): IPOPT holds its
+# constraints to about 1e-9 (the gait file's optimizer.constraint_violation), a millionth of δ.
+DIP_TOLERANCE = 1e-6
+# Mid-step, where the two spline pieces of eqs. (25)-(26) meet [t/T].
+KNOT = 0.5
+KNOT_WHY = (
+    "the spline is C¹ at mid-step (eqs. 25-26, the paper's choice), so the accelerations "
+    "jump there, and the torques and the ground reaction with them"
+)
 
 
 @dataclass(frozen=True)
@@ -77,15 +92,136 @@ class Tightest:
         return self.value / self.margin
 
 
-def constraint_profile(gait: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """On the optimiser's check grid: the step's normalised times t/T (N,), Ψ1..Ψ7 (N, 7)
-    less the gait's safety margins (NaN where a constraint is not checked: the swing foot at
-    the ends) and the solver's margins δ (N, 7)."""
+def constraint_profile(
+    gait: dict, samples_per_half: int = CHECK_SAMPLES_PER_HALF
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """On the optimiser's check grid (or ``samples_per_half`` samples per spline piece): the
+    step's normalised times t/T (N,), Ψ1..Ψ7 (N, 7) less the gait's safety margins (NaN
+    where a constraint is not checked: the swing foot at the ends) and the solver's margins
+    δ (N, 7)."""
     model = Biped(gait["robot"], gait["knee"])
     step = build_step(model, gait["speed"], gait_file.parameters(gait))
-    evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF, safety=gait["safety"])
-    t_n = np.concatenate(half_grid(CHECK_SAMPLES_PER_HALF))
-    return t_n, evaluation.constraints, margin_profile(CHECK_SAMPLES_PER_HALF)
+    evaluation = evaluate_step(model, step, samples_per_half, safety=gait["safety"])
+    t_n = np.concatenate(half_grid(samples_per_half))
+    return t_n, evaluation.constraints, margin_profile(samples_per_half)
+
+
+@dataclass(frozen=True)
+class Dip:
+    """A constraint below the solver's margin on the check grid: its smallest Ψ_i − δ_i
+    there, Ψ_i [unit] at that sample, at t/T, δ_i there; and ``kept``: whether the solver's
+    own samples (``SOLVER_SAMPLES_PER_HALF`` per piece) all hold Ψ_i >= δ_i, so that the
+    dip lies between them."""
+
+    name: str
+    value: float
+    unit: str
+    at: float
+    margin: float
+    kept: bool
+
+
+def _below(psi: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    """Where Ψ < δ beyond ``DIP_TOLERANCE`` (False where Ψ is not checked)."""
+    with np.errstate(invalid="ignore"):
+        return (delta > 0) & (psi < delta * (1.0 - DIP_TOLERANCE))
+
+
+def margin_dips(gait: dict) -> list[Dip]:
+    """The constraints that dip below the solver's margin δ on the check grid, each at its
+    deepest sample (smallest Ψ_i − δ_i), in ``CONSTRAINTS`` order."""
+    t_n, psi, delta = constraint_profile(gait)
+    _, psi_solver, delta_solver = constraint_profile(gait, SOLVER_SAMPLES_PER_HALF)
+    dips = []
+    for i, name in enumerate(CONSTRAINTS):
+        below = _below(psi[:, i], delta[:, i])
+        if not below.any():
+            continue
+        k = int(np.argmin(np.where(below, psi[:, i] - delta[:, i], np.inf)))
+        kept = not _below(psi_solver[:, i], delta_solver[:, i]).any()
+        unit = CONSTRAINT_UNITS[name]
+        dips.append(Dip(name, float(psi[k, i]), unit, float(t_n[k]), float(delta[k, i]), kept))
+    return dips
+
+
+def _milli(value: float, unit: str) -> str:
+    """'0.883 mrad' for 8.83e-4 rad: the constraints' small lengths and angles in milli-units."""
+    if unit in ("m", "rad"):
+        return f"{value * 1e3:.3g} m{unit}"
+    return f"{value:.3g} {unit}"
+
+
+def dip_sentence(gait: dict, dips: list[Dip]) -> str:
+    """Why Ψ_i reads below δ_i on the page, from the gait's dips ('' if none)."""
+    if not dips:
+        return ""
+    each = ", ".join(
+        f"{CONSTRAINT_MEANING[d.name].split()[0]} to {_milli(d.value, d.unit)} at t/T = "
+        f"{d.at:.3f} (δ = {_milli(d.margin, d.unit)})"
+        for d in dips
+    )
+    if gait["optimizer"].get("method") != "ipopt":
+        why = (
+            "the paper's method keeps the margins through its penalty only, not as bounds "
+            "at samples"
+        )
+    elif all(d.kept for d in dips):
+        why = (
+            f"each between the solver's samples: the solver holds Ψ ≥ δ at its "
+            f"{SOLVER_SAMPLES_PER_HALF + 1} samples per spline piece only (dots in the insets)"
+        )
+    else:
+        kept = [CONSTRAINT_MEANING[d.name].split()[0] for d in dips if not d.kept]
+        why = f"{', '.join(kept)} at the solver's own samples too: the solver did not hold δ"
+    verdict = (
+        "Ψ ≥ 0 holds on every sample of the check grid: the gait is feasible"
+        if gait["feasible"]
+        else "the gait is not feasible on the check grid"
+    )
+    return (
+        f"Below the solver's margin δ on the check grid ({CHECK_SAMPLES_PER_HALF + 1} samples "
+        f"per spline piece): {each}; {why}. {verdict}."
+    )
+
+
+def knot_index(gait: dict) -> int | None:
+    """The sample of the left limit at the mid-step knot (the next one is the right limit:
+    the samples hold t = T/2 twice); None if they do not."""
+    t = gait["samples"]["t"]
+    twice = np.flatnonzero((np.diff(t) == 0.0) & np.isclose(t[1:], KNOT * gait["period"]))
+    return int(twice[0]) if twice.size else None
+
+
+def knot_jumps(gait: dict, field: str) -> np.ndarray | None:
+    """The jump (right limit − left limit) of ``samples[field]`` at the mid-step knot; None
+    if the samples do not hold both limits."""
+    k = knot_index(gait)
+    return None if k is None else gait["samples"][field][k + 1] - gait["samples"][field][k]
+
+
+def figure_captions(gait: dict) -> dict[str, str]:
+    """The sentence above each figure that needs one, by file name: why the torques and the
+    ground reaction jump at the knot (their largest jumps), why Ψ dips below δ."""
+    captions = {}
+    torques, wrench = knot_jumps(gait, "torques"), knot_jumps(gait, "wrench")
+    if torques is not None:
+        i = int(np.argmax(np.abs(torques)))
+        captions["torques.png"] = (
+            f"The torques jump at t/T = {KNOT:g} (dash-dotted line; the largest jump "
+            f"{torques[i]:+.3g} N·m, {joint_label(i, JOINTS[i])}): {KNOT_WHY}."
+        )
+        zmp = knot_jumps(gait, "zmp")
+        captions["ground.png"] = (
+            f"The ground reaction jumps at t/T = {KNOT:g} too (Fx {wrench[0]:+.3g} N, "
+            f"Fz {wrench[1]:+.3g} N, x_ZMP {zmp:+.3g} m), for the same reason."
+        )
+    dips = margin_dips(gait)
+    if dips:
+        names = ", ".join(CONSTRAINT_MEANING[d.name].split()[0] for d in dips)
+        captions["constraints.png"] = (
+            f"The insets zoom on {names} below the solver's margin δ: see the constraints above."
+        )
+    return captions
 
 
 def tightest_margins(gait: dict) -> list[Tightest]:
@@ -100,8 +236,123 @@ def tightest_margins(gait: dict) -> list[Tightest]:
     return sorted(rows, key=lambda row: row.ratio)
 
 
+def _free_side(ax, x: float, width: float) -> tuple[str, str]:
+    """Where a label beside x (``width`` wide in data units) covers the least of the axes'
+    first curve: ('left' or 'right' of x, 'top' or 'bottom')."""
+    t, y = np.asarray(ax.lines[0].get_xdata()), np.asarray(ax.lines[0].get_ydata())
+    low, high = ax.get_ylim()
+    best = None
+    for side, (a, b) in (("right", (x, x + width)), ("left", (x - width, x))):
+        near = y[(t >= a) & (t <= b)]
+        for edge, room in (("top", high - np.max(near)), ("bottom", np.min(near) - low)):
+            if best is None or room > best[0]:
+                best = (room, side, edge)
+    return best[1], best[2]
+
+
+def _with_knot(panel: Panel, jump: float | None, legend: bool = False) -> Panel:
+    """``panel`` with the mid-step knot marked (a dash-dotted line) and, if given, the jump
+    of its values there written beside it in the panel's unit."""
+    unit = panel.ylabel.rsplit("[", 1)[-1].rstrip("]") if "[" in panel.ylabel else "1"
+    unit = "" if unit == "1" else f" {unit}"
+
+    def decorate(ax, gaits):
+        ax.axvline(KNOT, color="0.45", linestyle="-.", linewidth=1.0, label="knot: spline C¹")
+        if panel.decorate is not None:
+            panel.decorate(ax, gaits)
+        elif legend:
+            ax.legend(fontsize=8, loc="best")
+        if jump is not None:
+            side, edge = _free_side(ax, KNOT, 0.2)
+            ax.annotate(
+                f"jump {jump:+.3g}{unit}",
+                xy=(KNOT, 1.0 if edge == "top" else 0.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(4 if side == "right" else -4, -4 if edge == "top" else 4),
+                textcoords="offset points",
+                ha="left" if side == "right" else "right",
+                va=edge,
+                fontsize=8,
+                color="0.3",
+            )
+
+    return dataclasses.replace(panel, decorate=decorate)
+
+
+def _knot_panels(gait: dict, panels: tuple) -> tuple:
+    """Each panel with the knot marked and its jump there (the first with the legend)."""
+    k = knot_index(gait)
+    return tuple(
+        _with_knot(
+            panel,
+            None if k is None else float(np.diff(panel.values(gait)[k : k + 2])[0]),
+            legend=i == 0,
+        )
+        for i, panel in enumerate(panels)
+    )
+
+
+# Candidate places of a dip's inset, (x0, y0) of its lower-left corner in axes fraction,
+# leaving room in the axes for its tick labels and title.
+INSET_SIZE = (0.38, 0.36)
+INSET_PLACES = tuple((x, y) for y in (0.5, 0.12) for x in (0.14, 0.36, 0.58))
+
+
+def _inset_place(ax, avoid: list) -> tuple[float, float]:
+    """The inset place covering the fewest of the first curve's points and of ``avoid``
+    ((x, y) in data units, what must stay in sight: marks and their labels)."""
+    to_axes = ax.transData + ax.transAxes.inverted()
+    curve = to_axes.transform(ax.lines[0].get_xydata())
+    marks = to_axes.transform(np.asarray(avoid, dtype=float).reshape(-1, 2))
+    width, height = INSET_SIZE
+
+    def covered(place, points, room):
+        x0, y0 = place  # room beyond the box: its tick labels left and below, its title above
+        inside = (
+            (points[:, 0] > x0 - room[0])
+            & (points[:, 0] < x0 + width + room[1])
+            & (points[:, 1] > y0 - room[0])
+            & (points[:, 1] < y0 + height + room[1])
+        )
+        return int(np.count_nonzero(inside))
+
+    return min(
+        INSET_PLACES,
+        key=lambda p: covered(p, curve, (0.1, 0.06)) + 100 * covered(p, marks, (0.15, 0.15)),
+    )
+
+
+def _dip_inset(
+    ax, dip: Dip, profile, solver_profile, color: str, solver_samples: bool, avoid: list
+) -> None:
+    """A zoom on the dip of Ψ_i below δ_i, placed clear of the curve and of ``avoid`` (see
+    ``_inset_place``): the curve on the check grid, δ dotted and, with ``solver_samples``,
+    the solver's samples (dots) on either side of it."""
+    (t_n, psi, delta), (t_s, psi_s) = profile, solver_profile
+    spacing = KNOT / SOLVER_SAMPLES_PER_HALF
+    x0, x1 = dip.at - 1.5 * spacing, dip.at + 1.5 * spacing
+    depth = dip.margin - dip.value
+    y0, y1 = dip.value - 0.4 * depth, dip.margin + 1.2 * depth
+    place = _inset_place(ax, [(dip.at, dip.value), *avoid])
+    inset = ax.inset_axes([*place, *INSET_SIZE], xlim=(x0, x1), ylim=(y0, y1))
+    inset.plot(t_n, psi, color=color, linewidth=1.2)
+    inset.plot(t_n, delta, color="0.4", linestyle=":", linewidth=1.2)
+    if solver_samples:
+        inset.plot(t_s, psi_s, linestyle="none", marker="o", markersize=3.5, color="k")
+    inset.plot([dip.at], [dip.value], marker="v", markersize=5, color=color)
+    scale, unit = (1e3, f"m{dip.unit}") if dip.unit in ("m", "rad") else (1.0, dip.unit)
+    inset.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v * scale:.4g}"))
+    inset.tick_params(labelsize=6, length=2, pad=1)
+    inset.set_ylabel(unit, fontsize=6, labelpad=1)
+    inset.set_title(f"{_milli(dip.value, dip.unit)} < δ", fontsize=7, pad=2)
+    ax.indicate_inset_zoom(inset, edgecolor="0.3")
+
+
 def _constraint_panels(gait: dict) -> tuple:
     t_n, psi, delta = constraint_profile(gait)
+    t_s, psi_solver, _ = constraint_profile(gait, SOLVER_SAMPLES_PER_HALF)
+    dips = {dip.name: dip for dip in margin_dips(gait)}
+    solver_samples = gait["optimizer"].get("method") == "ipopt"
 
     def panel(i, name):
         def mark(ax, gaits):
@@ -123,6 +374,16 @@ def _constraint_panels(gait: dict) -> tuple:
                 color=color,
                 bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.8),
             )
+            if name in dips:
+                _dip_inset(
+                    ax,
+                    dips[name],
+                    (t_n, psi[:, i], delta[:, i]),
+                    (t_s, psi_solver[:, i]),
+                    color,
+                    solver_samples,
+                    [(t_n[k], psi[k, i])],
+                )
 
         return Panel(
             CONSTRAINT_MEANING[name],
@@ -134,15 +395,33 @@ def _constraint_panels(gait: dict) -> tuple:
     return tuple(panel(i, name) for i, name in enumerate(CONSTRAINTS))
 
 
+def _constraints_title(gait: dict, dips: list[Dip]) -> str:
+    """The constraints figure's title, saying what its insets show (if it has any)."""
+    title = "constraints Ψ (the solver's margin δ dotted"
+    if not dips:
+        return f"{title})"
+    between = gait["optimizer"].get("method") == "ipopt" and all(dip.kept for dip in dips)
+    where = " between the solver's samples, dots" if between else ""
+    return f"{title}; insets: Ψ below δ{where})"
+
+
 def gait_figures(gait: dict) -> dict[str, Figure]:
     """The page's figures of one gait, by file name."""
     gaits = {gait["knee"]: gait}
     return {
-        "torques.png": time_figure(gaits, "joint torques", TORQUE_PANELS),
+        "torques.png": time_figure(
+            gaits,
+            "joint torques, jumping at the knot t/T = 0.5 where the spline is C¹",
+            _knot_panels(gait, TORQUE_PANELS),
+        ),
         "angles.png": time_figure(gaits, "absolute angles", ANGLE_PANELS),
-        "ground.png": time_figure(gaits, "ground reaction on the stance foot", GROUND_PANELS),
+        "ground.png": time_figure(
+            gaits,
+            "ground reaction on the stance foot, jumping at the knot t/T = 0.5",
+            _knot_panels(gait, GROUND_PANELS),
+        ),
         "constraints.png": time_figure(
-            gaits, "constraints Ψ (the solver's margin δ dotted)", _constraint_panels(gait), 4
+            gaits, _constraints_title(gait, margin_dips(gait)), _constraint_panels(gait), 4
         ),
     }
 
@@ -246,13 +525,19 @@ def markdown(page: Page, folder: Path) -> str:
             f"| {CONSTRAINT_MEANING[row.name]} | {row.value:.4g} | {row.unit} | {row.at:.3f} | "
             f"{row.margin:g} | {row.ratio:.3g} |"
         ]
+    dips = dip_sentence(gait, margin_dips(gait))
+    if dips:
+        lines += ["", dips]
     lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [
         f"| {name} | {gait['parameters'][name]:.6g} | {parameter_unit(name)} |"
         for name in PARAMETERS
     ]
     lines += ["", "## Figures", ""]
+    captions = figure_captions(gait)
     for name in FIGURE_NAMES:
+        if captions.get(name):
+            lines += [captions[name], ""]
         lines += [f"![{name[:-4]}]({page.name}/{name})", ""]
     if page.validation is not None:
         lines += _validation_lines(page, folder)
@@ -283,7 +568,8 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
 
 
 def write_pages(pages: list[Page], out: str | Path) -> list[Path]:
-    """Write each page and its figures into ``out``, all or none; returns the pages' paths."""
+    """Write each page and its figures into ``out``, all or none; returns every file written
+    (each page, then its figures)."""
     out = Path(out)
     rendered = [(page, gait_figures(page.gait), markdown(page, out)) for page in pages]
     with atomic_set(out, "report") as staging:
@@ -292,4 +578,8 @@ def write_pages(pages: list[Page], out: str | Path) -> list[Path]:
             for name, figure in figures.items():
                 figure.savefig(staging / page.name / name, dpi=DPI)
             (staging / f"{page.name}.md").write_text(text, encoding="utf-8")
-    return [out / f"{page.name}.md" for page in pages]
+    return [
+        path
+        for page, figures, _ in rendered
+        for path in [out / f"{page.name}.md", *(out / page.name / name for name in figures)]
+    ]

@@ -59,6 +59,10 @@ MIN_SPEED = 0.01
 SCALES = np.array([0.03, 0.03, 0.03] + [0.3] * 5 + [2.0] * 12 + [0.05])
 # Duration of a step in the first guess [s].
 FIRST_GUESS_PERIOD = 0.6
+# Samples per spline piece where the solver imposes the constraints Ψ_i >= δ_i (each piece
+# closed: 26 samples); feasibility is then checked on a finer grid
+# (``biped.optimize.CHECK_SAMPLES_PER_HALF``), where Ψ_i may dip below δ_i between them.
+SOLVER_SAMPLES_PER_HALF = 25
 
 
 def bounds() -> tuple[np.ndarray, np.ndarray]:
@@ -126,7 +130,7 @@ class GaitProblem:
     speed: float
     criterion: str = "sthenic"
     safety: Safety = PAPER_SAFETY
-    samples_per_half: int = 25
+    samples_per_half: int = SOLVER_SAMPLES_PER_HALF
 
     def __post_init__(self):
         object.__setattr__(self, "speed", check_speed(self.model, self.speed))

@@ -14,7 +14,7 @@ import json
 from pathlib import Path
 
 from biped.errors import BipedError
-from biped_cli.args import check_folder
+from biped_cli.args import FOLDER_CREATED, check_folder
 from biped_cli.commands import DEFAULT_RECORDINGS
 
 DEFAULT_REPORTS = "logs/reports"
@@ -45,7 +45,7 @@ def read_validation(path: Path) -> dict | None:
 def links(gait_path: Path, validation: dict | None) -> list:
     """The recording and videos of a gait that exist and were made from it as it is now."""
     from biped.page import Link
-    from biped_cli.outputs import belongs_to, output_name
+    from biped_cli.outputs import belongs_to, open_command, output_name
 
     found = []
     recording = (validation or {}).get("recording")
@@ -60,7 +60,7 @@ def links(gait_path: Path, validation: dict | None) -> list:
         if owned is None:
             found.append(Link("recording", recording, "no owner record: gait unchecked"))
         elif owned:
-            found.append(Link("recording", recording, f"open with: rerun {recording}"))
+            found.append(Link("recording", recording, f"open with: {open_command(recording)}"))
         owned_videos = owned is not False
     else:
         owned_videos = True  # a video named by the report, the recording gone
@@ -84,7 +84,7 @@ def cmd_report(args) -> int:
     check_folder(args.out, "--out")
     pages = []
     for path in args.gait:  # every input read and checked before any work
-        gait = gait_file.read(path)
+        gait = gait_file.read_consistent(path)  # its figures its parameters'
         validation_file = validation_path(path)
         validation = read_validation(validation_file)
         if validation is not None and not isinstance(validation.get("units"), dict):
@@ -125,6 +125,6 @@ def add_parser(commands) -> None:
         "--out",
         default=DEFAULT_REPORTS,
         metavar="DIR",
-        help=f"pages and their figures (default {DEFAULT_REPORTS})",
+        help=f"folder of the pages and their figures, {FOLDER_CREATED} (default {DEFAULT_REPORTS})",
     )
     parser.set_defaults(run=cmd_report)

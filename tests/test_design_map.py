@@ -84,3 +84,23 @@ def test_map_figures_and_summary(small_map):
     revolute = json.loads((small_map / MapPoint("revolute", SPEED).filename()).read_text())
     assert float(row[7]) == pytest.approx(100 * (design["value"] / revolute["value"] - 1), abs=1e-3)
     assert json.loads((small_map / MANIFEST).read_text())["r1"] == GRID["r1"]
+
+
+def test_map_legend_lies_outside_the_plot(small_map):
+    """The map's legend covers no part of its plot area (the grid's corners, the Table 1
+    radii near r = 0 among them): it lies below the axes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from biped.design_map import map_figure
+
+    settings, results = load(small_map)
+    figure = map_figure(settings, speed_summaries(settings, results)[0], results)
+    renderer = FigureCanvasAgg(figure).get_renderer()
+    figure.draw(renderer)
+    (ax,) = [ax for ax in figure.axes if ax.get_xlabel().startswith("r1")]
+    legends = figure.legends + [ax.get_legend()] * (ax.get_legend() is not None)
+    assert len(legends) == 1
+    box, plot = legends[0].get_window_extent(renderer), ax.get_window_extent(renderer)
+    assert not box.overlaps(plot) and box.y1 <= plot.y0
+    labels = {text.get_text() for text in legends[0].get_texts()}
+    assert {"Table 1 radii", "joint optimum"} <= labels

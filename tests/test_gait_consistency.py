@@ -169,3 +169,50 @@ def test_figures_refuse_an_edited_sweep_file(content, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "feasible = " in err[0] and str(path) in err[0], err
     assert not out.exists() or not list(out.iterdir())
+
+
+# The commands that read gait files: name -> its arguments for a gait file and a scratch folder.
+GAIT_READERS = {
+    "validate": lambda gait, tmp: ["validate", gait, "--rrd", f"{tmp}/walk.rrd", "--steps", "1"],
+    "robustness": lambda gait, tmp: ["robustness", gait, "--out", f"{tmp}/out"],
+    "report": lambda gait, tmp: ["report", gait, "--out", f"{tmp}/out"],
+    "figures": lambda sweep, tmp: ["figures", "--sweep", sweep, "--out", f"{tmp}/out"],
+    "validate.video": lambda gait, tmp: [gait, "--out", f"{tmp}/walk.mp4", "--steps", "1"],
+}
+
+
+def test_every_command_taking_gait_files_is_checked_here():
+    """Each subcommand with a GAIT.json argument is among the readers tested below."""
+    import argparse
+
+    from biped_cli.main import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    takes_gaits = {
+        name
+        for name, sub in commands.choices.items()
+        if any(a.metavar == "GAIT.json" for a in sub._actions if not a.option_strings)
+    }
+    assert takes_gaits and takes_gaits <= set(GAIT_READERS), takes_gaits
+
+
+@pytest.mark.parametrize("command", GAIT_READERS)
+def test_every_reader_refuses_edited_torques(command, content, tmp_path, capsys):
+    """A gait file whose torques were doubled is refused by every command that reads gait
+    files (a sweep's file of any name for figures): exit 2, one line naming the field and
+    the file, nothing written."""
+    from validate import video
+
+    def doubled(gait):
+        gait["samples"]["torques"] = [[2 * x for x in row] for row in gait["samples"]["torques"]]
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    path = _write(content, folder, doubled, "mine.json")
+    argv = GAIT_READERS[command](str(folder if command == "figures" else path), tmp_path)
+    code = video.main(argv) if command == "validate.video" else main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and "samples.torques" in err[0] and str(path) in err[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]

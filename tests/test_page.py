@@ -135,3 +135,75 @@ def test_report_is_all_or_none(written, tmp_path, capsys):
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
     assert main(["report", str(gait_path), str(gait_path), "--out", str(out)]) == 2
     assert "share the page" in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def optimal_page(tmp_path_factory):
+    """The optimal rolling-knee gait at 0.3 m/s (IPOPT) as read from its file, its page's
+    Markdown and its figures."""
+    from biped.page import Page, gait_figures, markdown
+    from tests.conftest import optimal_gait
+
+    path = tmp_path_factory.mktemp("optimal") / f"{NAME}.json"
+    gait_file.write_json(path, gait_file.to_dict(optimal_gait("rolling"), Robot.paper(), 0))
+    gait = gait_file.read(path)
+    return gait, markdown(Page(NAME, path, gait), path.parent), gait_figures(gait)
+
+
+def test_page_says_why_the_torques_jump_at_the_knot(optimal_page):
+    """The page states the largest torque jump at t/T = 0.5 from the samples' two limits
+    there and why (the spline is C¹), and every torque panel marks the knot and its jump."""
+    from matplotlib.lines import Line2D
+
+    gait, text, figures = optimal_page
+    t, torques = gait["samples"]["t"], gait["samples"]["torques"]
+    k = int(np.flatnonzero(np.diff(t) == 0.0)[0])
+    assert t[k] == pytest.approx(gait["period"] / 2)
+    jumps = torques[k + 1] - torques[k]
+    largest = jumps[int(np.argmax(np.abs(jumps)))]
+    assert abs(largest) > 0.1  # the paper's C¹ spline: a jump worth saying
+    assert "jump at t/T = 0.5" in text and f"{largest:+.3g} N·m" in text and "C¹" in text
+    panels = [ax for ax in figures["torques.png"].axes if ax.get_title()]
+    assert len(panels) == 6
+    for ax, jump in zip(panels, jumps, strict=True):
+        knots = [ln for ln in ax.findobj(Line2D) if list(ln.get_xdata()) == [0.5, 0.5]]
+        assert knots, ax.get_title()
+        assert any(t.get_text().startswith(f"jump {jump:+.3g}") for t in ax.texts), ax.get_title()
+
+
+def test_page_says_where_constraints_dip_below_the_solver_margin(optimal_page):
+    """Each constraint below its margin δ on the check grid (only between the solver's
+    samples, which hold δ) is named on the page with its smallest value, and its panel
+    zooms on it in an inset; no other panel has one."""
+    from biped.criteria import evaluate_step, margin_profile
+    from biped.dynamics import Biped
+    from biped.gait import build_step
+    from biped.optimize import CHECK_SAMPLES_PER_HALF
+    from biped.page import CONSTRAINT_MEANING
+    from biped.problem import SOLVER_SAMPLES_PER_HALF
+
+    gait, text, figures = optimal_page
+    model = Biped(gait["robot"], gait["knee"])
+    step = build_step(model, gait["speed"], gait_file.parameters(gait))
+
+    def below(n):
+        psi = evaluate_step(model, step, n, safety=gait["safety"]).constraints
+        delta = margin_profile(n)
+        with np.errstate(invalid="ignore"):
+            return psi, (delta > 0) & (psi < delta * (1 - 1e-6))
+
+    psi, dips = below(CHECK_SAMPLES_PER_HALF)
+    assert not below(SOLVER_SAMPLES_PER_HALF)[1].any()  # the solver holds δ at its samples
+    assert dips[:, CONSTRAINTS.index("swing_knee")].any()  # the dip of the issue, Ψ5
+    assert "between the solver's samples" in text and "the gait is feasible" in text
+    panels = {ax.get_title(): ax for ax in figures["constraints.png"].axes if ax.get_title()}
+    delta = margin_profile(CHECK_SAMPLES_PER_HALF)
+    for i, name in enumerate(CONSTRAINTS):
+        insets = panels[CONSTRAINT_MEANING[name]].child_axes
+        if dips[:, i].any():
+            k = int(np.argmin(np.where(dips[:, i], psi[:, i] - delta[:, i], np.inf)))
+            unit = "mrad" if name.endswith("knee") else "mm"  # δ: 1 mrad, 1 mm
+            assert f"Ψ{i + 1} to {psi[k, i] * 1e3:.3g} {unit}" in text, name
+            assert len(insets) == 1, name
+        else:
+            assert not insets, name

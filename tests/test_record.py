@@ -7,6 +7,7 @@ import pytest
 import rerun.chunk
 
 from biped import Robot, gait_file
+from biped.dynamics import JOINTS
 from tests.conftest import small_optimum
 
 ROBOT = Robot.paper()
@@ -175,3 +176,90 @@ def test_torque_range_follows_the_gait_not_the_landings():
     # A nearly flat torque still gets a readable span.
     low, high = torque_range(np.full(10, 1.0), np.ones(10, bool))
     assert high - low == pytest.approx(2.0)
+
+
+def _views(path) -> dict:
+    """The recording's default blueprint: {view origin: {component: value}}, each view's own
+    and its properties' (``TimeAxis:view_range``, ``PlotLegend:visible``, ...) components."""
+    reader = rerun.chunk.RrdReader(path)
+    chunks = reader.stream(store=reader.blueprints()[0]).to_chunks()
+    by_view: dict = {}
+    for chunk in chunks:
+        parts = chunk.entity_path.strip("/").split("/")
+        if parts[0] != "view":
+            continue
+        batch = chunk.to_record_batch()
+        components = by_view.setdefault(parts[1], {})
+        for name in batch.schema.names:
+            if ":" in name:
+                components[name] = batch.column(name).to_pylist()[-1][0]
+    return {c["ViewBlueprint:space_origin"]: c for c in by_view.values()}
+
+
+def _scalars(chunks, entity: str) -> np.ndarray:
+    """Every value of a series, over all its chunks."""
+    values = []
+    for chunk in chunks:
+        batch = chunk.to_record_batch()
+        if chunk.entity_path == entity and "Scalars:scalars" in batch.schema.names:
+            values += [row[0] for row in batch.column("Scalars:scalars").to_pylist()]
+    return np.array(values, dtype=float)
+
+
+PLOTS = [f"torques/Γ{i + 1}_{joint}" for i, joint in enumerate(JOINTS)] + [
+    "ground/Fx",
+    "ground/Fz",
+    "zmp",
+]
+
+
+def test_every_series_of_a_plot_has_its_own_colour_the_gait_widest(recorded):
+    """In each torque, ground-reaction (Fx, Fz: a plot each) and ZMP plot no two series share
+    a colour, and the gait's line is wider than any drawn over it."""
+    _, chunks, folder = recorded
+    assert {"ground/Fx", "ground/Fz"} <= set(_views(folder / "rolling.rrd"))
+    for plot in PLOTS:
+        styles = {}
+        for chunk in chunks:
+            series = chunk.entity_path.removeprefix(f"/{plot}/")
+            if series == chunk.entity_path or chunk.timeline_names:
+                continue
+            batch = chunk.to_record_batch()
+            if "SeriesLines:colors" in batch.schema.names:
+                width = batch.column("SeriesLines:widths").to_pylist()[0][0]
+                styles[series] = (batch.column("SeriesLines:colors").to_pylist()[0][0], width)
+            else:  # the landings' marks
+                styles[series] = (batch.column("SeriesPoints:colors").to_pylist()[0][0], 0.0)
+        colours = [colour for colour, _ in styles.values()]
+        assert len(styles) >= 2 and len(set(colours)) == len(colours), (plot, styles)
+        others = [width for series, (_, width) in styles.items() if series != "analytic"]
+        assert styles["analytic"][1] > max(others), (plot, styles)
+
+
+def test_time_plots_open_on_the_last_steps_legends_clear_of_the_curves(recorded):
+    """The torque, ground and ZMP plots open on the last SHOWN_STEPS steps of the walk; the
+    torque plots have no legend over their curves (their key is a text beside them) and the
+    others' legend has the top of the plot above the gait's curves and the sole's edges."""
+    from validate.record import SHOWN_STEPS
+
+    result, chunks, folder = recorded
+    views = _views(folder / "rolling.rrd")
+    end = result.simulation.time[-1]
+    start = max(result.simulation.time[0], end - SHOWN_STEPS * result.step.period)
+    for plot in PLOTS:
+        shown = views[plot]["TimeAxis:view_range"]
+        assert shown["start"] * 1e-9 == pytest.approx(start, abs=1e-6), plot
+        assert shown["end"] * 1e-9 == pytest.approx(end, abs=1e-6), plot
+        if plot.startswith("torques/"):
+            assert views[plot]["PlotLegend:visible"] is False, plot
+            continue
+        assert views[plot]["PlotLegend:visible"] is True, plot
+        low, high = views[plot]["ScalarAxis:range"]
+        curves = ["analytic"] + (["heel", "toe"] if plot == "zmp" else [])
+        top = max(np.max(_scalars(chunks, f"/{plot}/{curve}")) for curve in curves)
+        assert (high - top) / (high - low) > 0.4, plot  # the legend's room above the curves
+    key = column(chunks, "/torque_key", "TextDocument:text")[0][0]
+    key = key[0] if isinstance(key, list) else key
+    assert "torque_key" in views
+    for series in ("the gait", "feedforward", "MuJoCo (ff + fb)", "feedback", "landings"):
+        assert series in key, series

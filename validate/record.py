@@ -22,10 +22,16 @@ Entity paths, on the timeline ``time`` (seconds of simulation):
                                           stance ankle [m]
     phase                                 the gait's time the controller follows, over T
     summary                               the gait's parameters, criteria and every check
+    torque_key                            the torque plots' series in words (their legend)
 
 ``blueprint()`` lays them out: the 3D view following the robot, one plot per joint with its
 y range fixed to the bulk of the gait's torques (the landings' spikes run off it rather than
-flatten it), the ground reaction, the ZMP, the phase and the summary.
+flatten it), Fx and Fz in plots of their own (ranged the same way), the ZMP, the phase and
+the summary. The time plots open on the last ``SHOWN_STEPS`` steps (zoom out for the whole
+walk); every series of a plot has a colour of its own, and where two run together the gait's
+(widest) shows around MuJoCo's feedforward and MuJoCo's torque (narrowest) drawn over them.
+A legend in a plot has room of its own above the curves; the torques' legend would be taller
+than their plots and is a key in words beside them (``torque_key``).
 """
 
 from __future__ import annotations
@@ -51,12 +57,24 @@ FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
 APPLICATION = "biped_validation"
 # Longest wait [s] for a viewer (--spawn, --connect) to take the recording.
 VIEWER_TIMEOUT = 10.0
-# Series colours, the same in every plot (RGB).
+# Series colours, the same in every plot (RGB), and line widths [UI points]: the gait's
+# widest, so that it shows around the series drawn over it where they run together.
 ANALYTIC_COLOR = (80, 140, 230)
 MUJOCO_COLOR = (230, 120, 60)
 FEEDFORWARD_COLOR = (70, 170, 90)
 FEEDBACK_COLOR = (200, 60, 160)
 LANDING_COLOR = (150, 150, 150)
+SOLE_COLORS = {"heel": (120, 120, 120), "toe": (215, 215, 215)}  # the ZMP plot's sole edges
+ANALYTIC_WIDTH = 7.0
+FEEDFORWARD_WIDTH = 3.0
+MUJOCO_WIDTH = 1.5
+FEEDBACK_WIDTH = 1.5
+EDGE_WIDTH = 1.0
+# The time plots open on the last SHOWN_STEPS steps of the walk.
+SHOWN_STEPS = 2
+# Room above the curves of a plot with a legend (ground reaction, ZMP), a fraction of their
+# range; the torque plots' key is a text of its own (``TORQUE_KEY``).
+LEGEND_ROOM = 0.9
 # The gait's ghost: pale and translucent (RGBA), this far behind MuJoCo's robot (+y) [m].
 GHOST_COLOR = (235, 235, 245, 110)
 GHOST_OFFSET = 0.35
@@ -71,6 +89,16 @@ LANDING = 0.1
 # of their span on each side, and at least this span [N·m].
 TORQUE_MARGIN = 0.25
 TORQUE_MIN_SPAN = 2.0
+# The torque plots' key, in words: their legend is taller than a plot.
+TORQUE_KEY = f"""\
+Last {SHOWN_STEPS} steps (zoom out: the walk)
+
+- **blue**, widest: the gait
+- **green**: feedforward (the gait)
+- **orange**, thin: MuJoCo (ff + fb)
+- **magenta**: feedback (servos)
+- **grey** squares: landings
+"""
 
 
 def torque_series_path(i: int, joint: str) -> str:
@@ -86,20 +114,46 @@ def torque_range(analytic: np.ndarray, steady: np.ndarray) -> tuple[float, float
     return low - pad, high + pad
 
 
-def blueprint(ranges: dict | None = None) -> rrb.Blueprint:
-    """The 3D walk above the ground reaction, ZMP and phase; one plot per joint's torque
-    (y range from ``ranges``: path -> (low, high)) above the summary."""
+def with_legend_room(low: float, high: float) -> tuple[float, float]:
+    """A plot's y range with ``LEGEND_ROOM`` of it added on top, where its legend goes."""
+    return low, high + LEGEND_ROOM * (high - low)
+
+
+def blueprint(ranges: dict | None = None, window: tuple | None = None) -> rrb.Blueprint:
+    """The 3D walk above the ground reaction (Fx, Fz), ZMP and phase; one plot per joint's
+    torque (no legend: too tall for a plot, it would cover the curves) above their key, in
+    words, and the summary.
+
+    Args:
+        ranges: y range (low, high) of a plot, by its origin (a torque's path, ``ground/Fx``,
+            ``zmp``); a plot with a legend gets ``LEGEND_ROOM`` on top of it.
+        window: the time plots' x range at first, (start, end) [s]; None: the whole walk.
+    """
     ranges = ranges or {}
-    legend = rrb.PlotLegend(corner=rrb.Corner2D.LeftTop)
-    torque_views = [
-        rrb.TimeSeriesView(
-            origin=torque_series_path(i, joint),
-            name=f"Γ{i + 1} {joint.replace('_', ' ')} [N·m]",
-            plot_legend=legend if i == 0 else rrb.PlotLegend(visible=False),
-            axis_y=rrb.ScalarAxis(range=ranges.get(torque_series_path(i, joint)), zoom_lock=False),
+
+    def axis_x(span):
+        if span is None:
+            return None
+        start, end = (rrb.TimeRangeBoundary.absolute(seconds=float(t)) for t in span)
+        return rrb.TimeAxis(view_range=rr.encodings.TimeRange(start, end), zoom_lock=False)
+
+    def plot(origin, name, legend=True):
+        span = ranges.get(origin)
+        if span is not None and legend:
+            span = with_legend_room(*span)
+        return rrb.TimeSeriesView(
+            origin=origin,
+            name=name,
+            plot_legend=rrb.PlotLegend(corner=rrb.Corner2D.LeftTop, visible=legend),
+            axis_x=axis_x(window),
+            axis_y=rrb.ScalarAxis(range=span, zoom_lock=False),
         )
+
+    torque_views = [
+        plot(torque_series_path(i, joint), f"Γ{i + 1} {joint.replace('_', ' ')} [N·m]", False)
         for i, joint in enumerate(JOINTS)
     ]
+    key = rrb.TextDocumentView(origin="torque_key", name="torque plots [N·m]")
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Vertical(
@@ -114,15 +168,20 @@ def blueprint(ranges: dict | None = None) -> rrb.Blueprint:
                     ),
                 ),
                 rrb.Horizontal(
-                    rrb.TimeSeriesView(origin="ground", name="ground reaction [N]"),
-                    rrb.TimeSeriesView(origin="zmp", name="ZMP from the stance ankle [m]"),
+                    plot("ground/Fx", "ground Fx [N]"),
+                    plot("ground/Fz", "ground Fz [N]"),
+                    plot("zmp", "ZMP, CoP [m]"),
                     rrb.TimeSeriesView(origin="phase", name="phase [T]"),
                 ),
-                row_shares=[3, 1],
+                row_shares=[2, 1],
             ),
             rrb.Vertical(
                 rrb.Grid(*torque_views, grid_columns=2),
-                rrb.TextDocumentView(origin="summary", name="gait and checks"),
+                rrb.Horizontal(
+                    key,
+                    rrb.TextDocumentView(origin="summary", name="gait and checks"),
+                    column_shares=[1, 1],
+                ),
                 row_shares=[3, 1],
             ),
             column_shares=[3, 2],
@@ -308,8 +367,15 @@ def record(
         torque_series_path(i, joint): torque_range(torques[:, i], steady)
         for i, joint in enumerate(JOINTS)
     }
+    for i, name in enumerate(("Fx", "Fz")):  # MuJoCo's landing spikes run off the plot too
+        ranges[f"ground/{name}"] = torque_range(wrench[:, i], steady)
+    heel, toe = sorted(biped.robot.sole_edges().values())  # the sole, a little beyond
+    pad = TORQUE_MARGIN * (toe - heel) / 2
+    ranges["zmp"] = (heel - pad, toe + pad)
+    end = float(sim.time[-1])
+    window = (max(float(sim.time[0]), end - SHOWN_STEPS * step.period), end)
     recording_id = f"{biped.knee}-{path.stem}"
-    layout = blueprint(ranges)
+    layout = blueprint(ranges, window)
 
     def log_all(rec) -> None:
         _log_torques(rec, biped, sim, torques, ranges, steady)
@@ -317,6 +383,8 @@ def record(
         _log_world(rec, biped, sim, contact, q_ref, zmp)
         text = summary(biped, step, sim, checks, gait)
         rec.log("summary", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
+        key = rr.TextDocument(TORQUE_KEY, media_type=rr.MediaType.MARKDOWN)
+        rec.log("torque_key", key, static=True)
 
     with atomic_path(path) as tmp:
         rec = rr.RecordingStream(APPLICATION, recording_id=recording_id)
@@ -365,10 +433,10 @@ def _log_torques(rec, biped: Biped, sim: Simulation, torques, ranges: dict, stea
         parts["feedback"][rows] = feedback[np.ix_(rows, order)]
     landing = np.flatnonzero(~steady)[::5]
     styles = {
-        "analytic": ("gait", ANALYTIC_COLOR, 2.0),
-        "mujoco": ("MuJoCo", MUJOCO_COLOR, 1.5),
-        "feedforward": ("feedforward", FEEDFORWARD_COLOR, 1.0),
-        "feedback": ("feedback", FEEDBACK_COLOR, 1.0),
+        "analytic": ("gait", ANALYTIC_COLOR, ANALYTIC_WIDTH),
+        "mujoco": ("MuJoCo", MUJOCO_COLOR, MUJOCO_WIDTH),
+        "feedforward": ("MuJoCo feedforward", FEEDFORWARD_COLOR, FEEDFORWARD_WIDTH),
+        "feedback": ("MuJoCo feedback", FEEDBACK_COLOR, FEEDBACK_WIDTH),
     }
     for i, joint in enumerate(JOINTS):
         base = torque_series_path(i, joint)
@@ -409,18 +477,28 @@ def _log_series(rec, biped: Biped, step, sim: Simulation, contact, wrench, zmp) 
     for name in ("Fx", "Fz"):
         rec.log(
             f"ground/{name}/analytic",
-            rr.SeriesLines(colors=ANALYTIC_COLOR, names=f"{name} gait"),
+            rr.SeriesLines(colors=ANALYTIC_COLOR, names=f"{name} gait", widths=ANALYTIC_WIDTH),
             static=True,
         )
         rec.log(
             f"ground/{name}/mujoco",
-            rr.SeriesLines(colors=MUJOCO_COLOR, names=f"{name} MuJoCo"),
+            rr.SeriesLines(colors=MUJOCO_COLOR, names=f"{name} MuJoCo", widths=MUJOCO_WIDTH),
             static=True,
         )
-    rec.log("zmp/analytic", rr.SeriesLines(colors=ANALYTIC_COLOR, names="ZMP gait"), static=True)
-    rec.log("zmp/mujoco", rr.SeriesLines(colors=MUJOCO_COLOR, names="CoP MuJoCo"), static=True)
+    rec.log(
+        "zmp/analytic",
+        rr.SeriesLines(colors=ANALYTIC_COLOR, names="ZMP gait", widths=ANALYTIC_WIDTH),
+        static=True,
+    )
+    rec.log(
+        "zmp/mujoco",
+        rr.SeriesLines(colors=MUJOCO_COLOR, names="CoP MuJoCo", widths=MUJOCO_WIDTH),
+        static=True,
+    )
     for name in SOLE_EDGES:
-        rec.log(f"zmp/{name}", rr.SeriesLines(colors=LANDING_COLOR, names=name), static=True)
+        color = SOLE_COLORS[name]
+        edge = rr.SeriesLines(colors=color, names=f"{name} edge", widths=EDGE_WIDTH)
+        rec.log(f"zmp/{name}", edge, static=True)
     for i, name in enumerate(("Fx", "Fz")):
         rec.send_columns(
             f"ground/{name}/analytic",

@@ -10,7 +10,9 @@ its own): one every 1 / ``FPS`` s, drawn by MuJoCo's offscreen renderer (set
 ghost is the gait at the phase the controller followed, its stance foot on MuJoCo's stance
 foot, drawn as translucent copies of the model's geoms (``mjv_addGeoms``) a little behind the
 robot. The MP4 is H.264
-(yuv420p) written by imageio-ffmpeg's ffmpeg; the GIF, smaller and slower, by Pillow.
+(yuv420p) written by imageio-ffmpeg's ffmpeg; the GIF, smaller and slower, by Pillow. A path
+whose suffix is not that of the file written there (``walk.avi`` for the MP4) is refused
+before any work (``check_suffix``).
 """
 
 from __future__ import annotations
@@ -51,6 +53,22 @@ OFFSCREEN_SAMPLES = 0
 # right one) exceeds the other two by these margins [0-255]: grey floor, sky and trunk do not.
 LEG_MARGIN = (40, 60)
 PASS_COLOR, FAIL_COLOR, TEXT_COLOR = (90, 210, 110), (240, 80, 70), (235, 235, 235)
+# What each writer produces, by the suffix of its path (any case).
+WRITTEN = {".mp4": "an H.264 MP4 video", ".gif": "an animated GIF", ".png": "a PNG image"}
+
+
+def check_suffix(path: str | Path, option: str, suffix: str, hint: str = "") -> None:
+    """Refuse (BipedError naming ``option`` and ``path``) a path whose suffix is not
+    ``suffix``, that of the file written there; ``hint`` ends the message."""
+    from biped.errors import BipedError
+
+    found = Path(path).suffix
+    if found.lower() != suffix:
+        named = f"named {found}" if found else "without a suffix"
+        raise BipedError(
+            f"{option} {str(path)!r}: would be {WRITTEN[suffix]} {named}; allowed a path "
+            f"ending in {suffix}{hint}"
+        )
 
 
 def leg_pixels(image: np.ndarray) -> dict:
@@ -208,10 +226,12 @@ def verdict_of(checks) -> tuple[str, bool]:
 
 
 def write_mp4(path: str | Path, frames, fps: int = FPS) -> Path:
-    """Write frames (iterable of equal (H, W, 3) uint8 arrays) as an H.264 MP4, atomically."""
+    """Write frames (iterable of equal (H, W, 3) uint8 arrays) as an H.264 MP4, atomically
+    (its missing folders created)."""
     import imageio_ffmpeg
 
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     frames = iter(frames)
     first = next(frames)
     height, width = first.shape[:2]
@@ -237,7 +257,8 @@ def write_mp4(path: str | Path, frames, fps: int = FPS) -> Path:
 
 
 def write_gif(path: str | Path, frames, fps: int = FPS) -> Path:
-    """Write frames as an animated GIF (every GIF_EVERY-th, scaled by GIF_SCALE), atomically."""
+    """Write frames as an animated GIF (every GIF_EVERY-th, scaled by GIF_SCALE), atomically
+    (its missing folders created)."""
     from PIL import Image
 
     images = []
@@ -247,6 +268,7 @@ def write_gif(path: str | Path, frames, fps: int = FPS) -> Path:
             size = (round(image.width * GIF_SCALE), round(image.height * GIF_SCALE))
             images.append(image.resize(size, Image.Resampling.BILINEAR))
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:
         images[0].save(
             tmp,
@@ -269,8 +291,9 @@ def write_video(
     ghost: bool = True,
     fps: int = FPS,
 ) -> list[Path]:
-    """Render the walk of ``sim`` to an MP4 at ``path`` and/or a GIF at ``gif``; returns the
-    files written. ``checks`` (``validate.report.Check``) give the verdict in the caption."""
+    """Render the walk of ``sim`` to an MP4 at ``path`` and/or a GIF at ``gif`` (their missing
+    folders created); returns the files written. ``checks`` (``validate.report.Check``) give
+    the verdict in the caption."""
     verdict, passed = verdict_of(checks) if checks else ("", None)
     renderer = WalkRenderer(biped, step, sim, ghost=ghost)
     try:
@@ -292,7 +315,8 @@ def write_video(
 def write_frame(
     path: str | Path, biped: Biped, step, sim: Simulation, at: float, checks=(), ghost=True
 ) -> Path:
-    """One captioned frame of the walk, at ``at`` seconds of simulation, as a PNG."""
+    """One captioned frame of the walk, at ``at`` seconds of simulation, as a PNG (its missing
+    folders created)."""
     from PIL import Image
 
     verdict, passed = verdict_of(checks) if checks else ("", None)
@@ -303,6 +327,7 @@ def write_frame(
     finally:
         renderer.close()
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:
         Image.fromarray(frame).save(tmp, format="PNG")
     return path
@@ -330,7 +355,14 @@ def main(argv=None) -> int:
     if not (args.out or args.gif or args.frame):
         parser.error("nothing to write: give --out, --gif or --frame")
     try:
-        result = validate(gait_file.read(args.gait), steps=args.steps)
+        for option, path, suffix in (
+            ("--out", args.out, ".mp4"),
+            ("--gif", args.gif, ".gif"),
+            ("--frame", args.frame, ".png"),
+        ):
+            if path is not None:
+                check_suffix(path, option, suffix)
+        result = validate(gait_file.read_consistent(args.gait), steps=args.steps)
         ghost = not args.no_ghost
         written = []
         if args.out or args.gif:
