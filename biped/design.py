@@ -21,7 +21,15 @@ the thigh circle's centre C2. The centres of mass are measured from the knee for
 which are the bounds by default (``radius_limits``: 0.181 m and 0.236 m for Table 1, 43 %
 and 57 % of the segments); narrower upper bounds may be given. Beyond them the robot's
 fixed masses and inertias would describe a segment whose centre of mass lies off it.
-At r1 = r2 = 0 the rolling knee is the revolute knee exactly (``biped.kinematics``).
+At r1 = r2 = 0 the rolling knee is the revolute knee exactly (``biped.kinematics``), and so
+it is at r1 = 0 or r2 = 0 alone: a circle rolling on a point turns about it, the link
+between the centres stays on the other segment. Such a "rolling knee" is no design of one:
+it is the revolute knee, beside which every design is compared, and the MJCF of a rolling
+knee (a link between the two centres, hinges turning in the ratio r2 / r1) cannot hold it.
+The radii are therefore bounded below by ``MIN_RADIUS`` (1 mm; MuJoCo plays a knee of 1 mm
+and 20 cm, its hinges in the ratio 200); a design at that bound says that the knee gains
+nothing by rolling there. The robot's own radii, the reference design, are moved into the
+bounds where they lie beyond them, and ``DesignProblem.moved_reference`` says so.
 
 Starts, as for gaits (``biped.optimize``): the gait's first guesses at the robot's own radii
 (Table 1's) and starts with radii drawn uniformly in the bounds and the gait's first guess
@@ -43,6 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from biped.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
 from biped.criteria import PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
@@ -61,10 +70,13 @@ from biped.optimize import (
     starts_at_value,
 )
 from biped.problem import SCALES, GaitProblem, bounds, check_criterion, check_speed
-from biped.robot import Robot
+from biped.robot import LENGTH_MIN, Robot
 from biped.solver import Solver
 
 RADII = ("r1", "r2")
+# [m] Lower bound of a designed knee radius: the smallest length of a robot
+# (``biped.robot.LENGTH_MIN``); at 0 the rolling knee is the revolute knee (module docstring).
+MIN_RADIUS = LENGTH_MIN
 
 
 def radius_limits(robot: Robot) -> tuple[float, float]:
@@ -107,7 +119,7 @@ class DesignProblem:
         safety: margins of ours beyond the paper's constraints.
         samples_per_half: samples per spline piece of the solver's constraints.
         upper: [m] upper bounds of (r1, r2); default ``radius_limits(robot)``; each within
-            (0, its limit].
+            (``MIN_RADIUS``, its limit].
     """
 
     robot: Robot
@@ -127,21 +139,48 @@ class DesignProblem:
         upper = radius_limits(self.robot) if self.upper is None else self.upper
         upper = check_radii(self.robot, upper, "upper bounds of the radii")
         for name, value in zip(RADII, upper, strict=True):
-            if value <= 0.0:
-                raise BipedError(f"upper bound of {name} = {value!r} m: allowed > 0")
+            if value <= MIN_RADIUS:
+                raise BipedError(
+                    f"upper bound of {name} = {value!r} m: allowed > {MIN_RADIUS:g} m, the "
+                    "lower bound of a designed radius (at 0 the knee is the revolute knee)"
+                )
         object.__setattr__(self, "upper", upper)
         # the sample count is checked by the gait problem
         self.gait_problem(self.reference_radii)
 
     @property
     def lower(self) -> tuple[float, float]:
-        return (0.0, 0.0)
+        return (MIN_RADIUS, MIN_RADIUS)
 
     @property
     def reference_radii(self) -> tuple[float, float]:
-        """The robot's own radii, clipped into the bounds: the first start."""
+        """The robot's own radii, clipped into the bounds (``moved_reference``): the first
+        start and the rolling knee every design is compared with."""
         own = (self.robot.r1, self.robot.r2)
-        return tuple(float(np.clip(r, 0.0, u)) for r, u in zip(own, self.upper, strict=True))
+        return tuple(
+            float(np.clip(r, low, high))
+            for r, low, high in zip(own, self.lower, self.upper, strict=True)
+        )
+
+    def moved_reference(self) -> list[str]:
+        """A sentence per radius of the robot's own that lies beyond its bound, so that the
+        reference design (``reference_radii``) has another: empty when none moved."""
+        moved = []
+        own = (self.robot.r1, self.robot.r2)
+        radii = zip(RADII, own, self.reference_radii, self.upper, strict=True)
+        for name, value, used, high in radii:
+            if value == used:
+                continue
+            why = (
+                f"its upper bound {high:.4g} m"
+                if used == high
+                else f"its lower bound {MIN_RADIUS:g} m (at 0 the knee is the revolute knee)"
+            )
+            moved.append(
+                f"the robot's own {name} = {value:.4g} m lies beyond {why}: the rolling knee "
+                f"of the robot's own radii is compared at {name} = {used:.4g} m"
+            )
+        return moved
 
     def robot_with(self, radii) -> Robot:
         """The robot with knee radii ``radii`` (r1, r2) [m]."""
@@ -208,7 +247,8 @@ class Design:
 @functools.lru_cache(maxsize=8)
 def _solver(robot: Robot, criterion: str, safety: Safety, samples: int, upper) -> Solver:
     model = Biped(robot, "rolling")  # its radii are symbols in the graph
-    return Solver(model, criterion, safety, samples, radius_bounds=((0.0, 0.0), upper))
+    lower = (MIN_RADIUS, MIN_RADIUS)
+    return Solver(model, criterion, safety, samples, radius_bounds=(lower, upper))
 
 
 def solver_for(problem: DesignProblem) -> Solver:
@@ -372,18 +412,20 @@ class Comparison:
         return all(optimum.certified for _, _, optimum in self.rows())
 
     def gains(self) -> dict:
-        """[%] Change of the criterion: the design against the revolute knee and against
-        the Table 1 radii, the Table 1 radii against the revolute knee."""
+        """[%] Change of the criterion (``biped.comparison.relative_change``: negative, the
+        first needs less): the design against the revolute knee and against the Table 1
+        radii, the Table 1 radii against the revolute knee."""
         design, revolute, reference = self.design.value, self.revolute.value, self.reference.value
         return {
-            "design_vs_revolute": 100.0 * (design / revolute - 1.0),
-            "design_vs_table1": 100.0 * (design / reference - 1.0),
-            "table1_vs_revolute": 100.0 * (reference / revolute - 1.0),
+            "design_vs_revolute": relative_change(design, revolute),
+            "design_vs_table1": relative_change(design, reference),
+            "table1_vs_revolute": relative_change(reference, revolute),
         }
 
     def table(self) -> str:
         """The three knees in a text table: radii, both criteria of the gait optimal for
-        the problem's criterion, its change against the revolute knee."""
+        the problem's criterion, its change against the revolute knee (the convention
+        on the last line)."""
         criterion = self.problem.criterion
         head = (
             f"{'knee':24}{'r1 [m]':>9}{'r2 [m]':>9}{'sthenic [N²·m·s]':>18}{'energy [J]':>12}"
@@ -392,13 +434,14 @@ class Comparison:
         lines = [head]
         for label, radii, optimum in self.rows():
             r1, r2 = ("-", "-") if radii is None else (f"{radii[0]:.4f}", f"{radii[1]:.4f}")
-            change = 100.0 * (optimum.value / self.revolute.value - 1.0)
+            change = relative_change(optimum.value, self.revolute.value)
             status = "" if optimum.certified else "  NOT CERTIFIED"
             lines.append(
                 f"{label:24}{r1:>9}{r2:>9}{optimum.evaluation.sthenic:18.4f}"
                 f"{optimum.evaluation.energy:12.4f}"
                 f"{'' if radii is None else f'{change:+.2f} %':>22}{status}"
             )
+        lines.append(f"{criterion} vs revolute: {DIFFERENCE_VS_REVOLUTE}")
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -415,7 +458,12 @@ class Comparison:
                     "certified": optimum.certified,
                 }
             )
-        return {**self.design.to_dict(), "compared": knees, "gains_percent": self.gains()}
+        return {
+            **self.design.to_dict(),
+            "compared": knees,
+            "gains_percent": self.gains(),
+            "reference_moved": self.problem.moved_reference(),
+        }
 
 
 def compare(

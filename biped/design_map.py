@@ -37,10 +37,16 @@ from pathlib import Path
 
 import numpy as np
 
+from biped.comparison import relative_change
 from biped.criteria import PAPER_SAFETY, Safety
 from biped.design import RADII, DesignProblem, check_radii, optimize_at, optimize_design
 from biped.errors import BipedError
-from biped.files import atomic_path, atomic_write_text, clean_stale_temporaries
+from biped.files import (
+    atomic_path,
+    atomic_write_text,
+    clean_stale_temporaries,
+    distinct_values,
+)
 from biped.manifest import Manifest
 from biped.optimize import DEFAULT_STARTS, optimize
 from biped.problem import VARIABLES
@@ -137,11 +143,7 @@ def radius_grid(robot: Robot, values, name: str) -> tuple:
         radii = [0.0, 0.0]
         radii[index] = value
         check_radii(robot, radii)
-    names = [f"{v:.4f}" for v in values]
-    for a, b in zip(names, names[1:], strict=False):
-        if a == b:
-            raise BipedError(f"{name} = {a} m appears twice at 0.1 mm resolution: allowed distinct")
-    return tuple(values)
+    return tuple(distinct_values(values, name, "m", 4, "0.1 mm"))  # MapPoint.filename's
 
 
 def read_point(folder: Path, point: MapPoint) -> dict | None:
@@ -281,7 +283,7 @@ def run_design_map(
     starts: int = DEFAULT_STARTS,
     jobs: int | None = None,
     dask: str | None = None,
-    stream=sys.stderr,
+    stream=None,
     progress: Callable[[int], ProgressBar] | None = None,
 ) -> MapSettings:
     """Every optimization of the map not yet in ``folder``; returns its settings.
@@ -293,10 +295,8 @@ def run_design_map(
         jobs, dask: where the optimizations run (``biped.runner.run_tasks``).
         progress: ``progress(total)`` makes a bar advanced after each optimization.
     """
-    speeds = sorted(float(s) for s in speeds)
-    names = [f"{s:.3f}" for s in speeds]
-    if len(set(names)) != len(names):
-        raise BipedError("speeds appear twice at 1 mm/s resolution: allowed distinct speeds")
+    stream = sys.stderr if stream is None else stream  # the stderr of the call, not of the import
+    speeds = distinct_values(speeds, "speeds", "m/s", 3, "1 mm/s")  # MapPoint.filename's
     problem = DesignProblem(robot, speeds[0], criterion, safety, upper=upper)
     for speed in speeds[1:]:
         problem = dataclasses.replace(problem, speed=speed)  # each speed checked
@@ -315,8 +315,7 @@ def run_design_map(
         int(starts),
     )
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    _RECORD.claim(folder, settings.to_dict())
+    _RECORD.claim(folder, settings.to_dict())  # checked before the folder is made
     clean_stale_temporaries(folder)
     first, second = map_points(settings)
     todo = [[p for p in stage if read_point(folder, p) is None] for stage in (first, second)]
@@ -394,10 +393,11 @@ class SpeedSummary:
     best_grid: float | None
 
     def gain(self, value: float | None) -> float | None:
-        """[%] Change of ``value`` against the revolute knee."""
+        """[%] Change of ``value`` against the revolute knee
+        (``biped.comparison.relative_change``: negative, ``value`` is the smaller)."""
         if value is None or self.revolute is None:
             return None
-        return 100.0 * (value / self.revolute - 1.0)
+        return relative_change(value, self.revolute)
 
 
 def speed_summaries(settings: MapSettings, results: dict) -> list[SpeedSummary]:
@@ -456,6 +456,70 @@ def summary_csv(settings: MapSettings, results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def map_figure(settings: MapSettings, summary: SpeedSummary, results: dict):
+    """The map of one speed (a matplotlib ``Figure``): the optimal criterion over the (r1, r2)
+    grid, the revolute knee's value as a dashed contour, the grid points, the Table 1 radii
+    and the joint optimum; the legend below the plot, off the grid."""
+    from matplotlib.figure import Figure
+
+    unit = "N²·m·s" if settings.criterion == "sthenic" else "J"
+    r1, r2 = np.array(settings.r1), np.array(settings.r2)
+    table1 = settings.problem(settings.speeds[0]).reference_radii
+    values = np.full((len(r2), len(r1)), np.nan)
+    for i, a in enumerate(r1):
+        for j, b in enumerate(r2):
+            content = results.get(MapPoint("grid", summary.speed, (a, b)))
+            if content is not None and content["certified"]:
+                values[j, i] = content["value"]
+    fig = Figure(figsize=(6.4, 5.6), layout="constrained")
+    ax = fig.subplots()
+    if np.isfinite(values).sum() >= 4 and len(r1) > 1 and len(r2) > 1:
+        filled = ax.contourf(100 * r1, 100 * r2, values, levels=16, cmap="viridis")
+        bar = fig.colorbar(filled, ax=ax, label=f"optimal {settings.criterion} criterion [{unit}]")
+        low, high = np.nanmin(values), np.nanmax(values)
+        if summary.revolute is not None and low <= summary.revolute <= high:
+            # where the rolling knee costs what the revolute knee does (on the axes
+            # r1 = 0 and r2 = 0 it is a hinge: there exactly)
+            ax.contour(
+                100 * r1,
+                100 * r2,
+                values,
+                levels=[summary.revolute],
+                colors="k",
+                linestyles="--",
+                linewidths=1.2,
+            )
+            bar.ax.axhline(summary.revolute, color="k", ls="--", lw=1.5)
+            ax.plot([], [], "k--", label="revolute knee's value")
+    ax.scatter(100 * np.repeat(r1, len(r2)), 100 * np.tile(r2, len(r1)), s=4, c="k")
+    ax.plot(100 * table1[0], 100 * table1[1], "s", color="tab:orange", label="Table 1 radii")
+    if summary.radii is not None:
+        ax.plot(
+            100 * summary.radii[0],
+            100 * summary.radii[1],
+            "*",
+            color="tab:red",
+            markersize=14,
+            label="joint optimum",
+        )
+    revolute = "n/a" if summary.revolute is None else f"{summary.revolute:.4g} {unit}"
+    ax.set_title(
+        f"{settings.criterion} at {summary.speed:.3f} m/s (revolute knee {revolute})",
+        fontsize=10,
+    )
+    for axis, grid, bound in (
+        (ax.set_xlim, r1, settings.upper[0]),
+        (ax.set_ylim, r2, settings.upper[1]),
+    ):
+        top = 100 * max(grid.max(), bound)
+        axis(-0.03 * top, 1.04 * top)
+    ax.set_xlabel("r1, shank circle [cm]")
+    ax.set_ylabel("r2, thigh circle [cm]")
+    # below the plot, not over it: the grid's corners (the Table 1 radii) stay in sight
+    fig.legend(loc="outside lower center", ncol=3, fontsize=8)
+    return fig
+
+
 def draw(folder, out=None) -> list[Path]:
     """The map's figures and summary in ``out`` (default: the map's folder)."""
     import matplotlib
@@ -466,68 +530,13 @@ def draw(folder, out=None) -> list[Path]:
     settings, results = load(folder)
     out = Path(folder if out is None else out)
     out.mkdir(parents=True, exist_ok=True)
-    unit = "N²·m·s" if settings.criterion == "sthenic" else "J"
     written = []
     summaries = speed_summaries(settings, results)
-    r1, r2 = np.array(settings.r1), np.array(settings.r2)
-    table1 = settings.problem(settings.speeds[0]).reference_radii
     for summary in summaries:
-        values = np.full((len(r2), len(r1)), np.nan)
-        for i, a in enumerate(r1):
-            for j, b in enumerate(r2):
-                content = results.get(MapPoint("grid", summary.speed, (a, b)))
-                if content is not None and content["certified"]:
-                    values[j, i] = content["value"]
-        fig, ax = plt.subplots(figsize=(6.4, 5.2))
-        if np.isfinite(values).sum() >= 4 and len(r1) > 1 and len(r2) > 1:
-            filled = ax.contourf(100 * r1, 100 * r2, values, levels=16, cmap="viridis")
-            bar = fig.colorbar(
-                filled, ax=ax, label=f"optimal {settings.criterion} criterion [{unit}]"
-            )
-            low, high = np.nanmin(values), np.nanmax(values)
-            if summary.revolute is not None and low <= summary.revolute <= high:
-                # where the rolling knee costs what the revolute knee does (on the axes
-                # r1 = 0 and r2 = 0 it is a hinge: there exactly)
-                ax.contour(
-                    100 * r1,
-                    100 * r2,
-                    values,
-                    levels=[summary.revolute],
-                    colors="k",
-                    linestyles="--",
-                    linewidths=1.2,
-                )
-                bar.ax.axhline(summary.revolute, color="k", ls="--", lw=1.5)
-                ax.plot([], [], "k--", label="revolute knee's value")
-        ax.scatter(100 * np.repeat(r1, len(r2)), 100 * np.tile(r2, len(r1)), s=4, c="k")
-        ax.plot(100 * table1[0], 100 * table1[1], "s", color="tab:orange", label="Table 1 radii")
-        if summary.radii is not None:
-            ax.plot(
-                100 * summary.radii[0],
-                100 * summary.radii[1],
-                "*",
-                color="tab:red",
-                markersize=14,
-                label="joint optimum",
-            )
-        revolute = "n/a" if summary.revolute is None else f"{summary.revolute:.4g} {unit}"
-        ax.set_title(
-            f"{settings.criterion} at {summary.speed:.3f} m/s (revolute knee {revolute})",
-            fontsize=10,
-        )
-        for axis, grid, bound in (
-            (ax.set_xlim, r1, settings.upper[0]),
-            (ax.set_ylim, r2, settings.upper[1]),
-        ):
-            top = 100 * max(grid.max(), bound)
-            axis(-0.03 * top, 1.04 * top)
-        ax.set_xlabel("r1, shank circle [cm]")
-        ax.set_ylabel("r2, thigh circle [cm]")
-        ax.legend(loc="lower left", fontsize=8)
+        fig = map_figure(settings, summary, results)
         path = out / f"map-{summary.speed:.3f}.png"
         with atomic_path(path) as tmp:
             fig.savefig(tmp, dpi=120, format="png")
-        plt.close(fig)
         written.append(path)
     if len(summaries) > 1:
         speeds = [s.speed for s in summaries]

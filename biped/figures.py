@@ -1,9 +1,20 @@
 """Figures and table of the revolute/rolling comparison, from a sweep's gait files.
 
-Fig. 4: optimal sthenic criterion vs speed (left), energy of the same gaits (right).
+Fig. 4: optimal sthenic criterion vs speed (left), energy of the same gaits (middle), the
+rolling knee's difference to the revolute knee in % (right).
 Figs. 5-7: torques, angles and |Fx| / Fz of the sthenic-optimal gaits at 0.3 m/s.
-Fig. 8: optimal energy criterion vs speed (left), sthenic criterion of the same gaits (right).
+Fig. 8: optimal energy criterion vs speed (left), sthenic criterion of the same gaits
+(middle), the difference in % (right).
 comparison.md: our headline numbers beside the paper's.
+
+Every difference between the knees is ``biped.comparison.relative_change``: (rolling −
+revolute) / revolute in %, negative where the rolling knee needs less; every value is the
+criterion on the check grid (the gait files' ``costs``). The sthenic criterion is per metre
+walked, the energy criterion per step.
+
+A sweep lacking a criterion (or a knee's certified optima of it) gives the figures and rows of
+the other criterion only, and says what it leaves out (``compared_criteria``); one with
+nothing to compare is refused.
 
 Each figure is built by a function returning a matplotlib ``Figure`` (``sweep_figures``;
 ``time_figure`` with the panels ``TORQUE_PANELS``, ``ANGLE_PANELS``, ``GROUND_PANELS`` serves
@@ -17,6 +28,8 @@ triangle at the panel's edge with its value written beside it, and the axis span
 
 from __future__ import annotations
 
+import sys
+import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +38,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from biped import gait_file
+from biped.comparison import CERTIFIED, CHECK_GRID, DIFFERENCE, SOLVER_GRID, relative_change
+from biped.criteria import CRITERIA
 from biped.dynamics import JOINTS
 from biped.errors import BipedError
 from biped.files import atomic_set
@@ -34,13 +49,15 @@ from biped.paper_method import spread_lines
 from biped.robot import FOOT_FRICTION
 from biped.sweep import MANIFEST
 
+# The paper's headline numbers; differences [%] rolling vs revolute (``relative_change``): its
+# 17 % less sthenic criterion and 11 % less energy for the rolling knee.
 PAPER = {
-    "sthenic_reduction": 0.17,
+    "sthenic_difference": -17.0,
     "best_speed": {"revolute": 0.27, "rolling": 0.30},
-    "energy_gain": 0.11,
+    "energy_difference": -11.0,
 }
 DETAIL_SPEED = 0.3  # [m/s] of Figs. 5-7
-LABELS = {"revolute": "revolute knee (ck)", "rolling": "rolling knee (rk)"}
+LABELS = {"revolute": "revolute knee", "rolling": "rolling knee"}
 STYLE = {
     "revolute": dict(color="tab:blue", marker="o"),
     "rolling": dict(color="tab:red", marker="s"),
@@ -53,14 +70,36 @@ MIN_BULK = 5
 # Room around the bulk, a fraction of its span on each side.
 PAD = 0.08
 DPI = 120
-CRITERION_AXES = {"sthenic": "sthenic criterion C_Γ [N²·m·s]", "energy": "energy criterion C_E [J]"}
+CRITERION_AXES = {
+    "sthenic": r"sthenic criterion $C_\Gamma$ per metre walked [N²·m·s]",
+    "energy": r"energy criterion $C_E$ per step [J]",
+}
 CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
+DIFFERENCE_AXIS = "(rolling − revolute) / revolute [%]"
+DIFFERENCE_COLOR = "k"
+# Points of a difference panel labelled with their value, at most.
+MAX_LABELLED = 15
+# The figures of each criterion's optima, in order.
+FIGURES = {"sthenic": ("fig4.png", "fig5.png", "fig6.png", "fig7.png"), "energy": ("fig8.png",)}
+# Why the other criterion of a criterion's optima looks as it does (a figure's caption and
+# comparison.md).
+OTHER_NOTES = {
+    "energy": (
+        "The energy criterion counts only the joints' work |Γ θ̇| and is per step: a torque "
+        "where a joint barely turns costs nothing, and short quick steps are cheap. Its optima "
+        "take such steps with large hip torques, so their sthenic criterion (every torque "
+        "squared, per metre) is many times the sthenic optimum's and jumps from speed to "
+        "speed, where the optimum moves between minima of nearly equal energy but unlike "
+        "torques: it is not what they minimise."
+    ),
+}
 TIME_AXIS = "normalised time t/T"
 
 
 def certified(gait: dict) -> bool:
-    """Whether a gait file holds a certified optimum: its solver converged and it is
-    feasible on the fine grid."""
+    """Whether a gait file holds a certified optimum (``biped.comparison.CERTIFIED``; a
+    sweep's files are its final optima): its solver converged and it is feasible on the
+    check grid."""
     return gait["feasible"] and gait["optimizer"].get("status") == "converged"
 
 
@@ -74,7 +113,7 @@ def read_sweep(folder: str | Path) -> tuple[dict, list]:
     series: dict = {}
     flagged = []
     for path in files:
-        gait = gait_file.read(path)
+        gait = gait_file.read_consistent(path)  # its figures its parameters'
         if certified(gait):
             series.setdefault((gait["knee"], gait["criterion"]), []).append(gait)
         else:
@@ -144,13 +183,71 @@ def _mark_off_scale(ax, x, value, limits, color, text) -> None:
     )
 
 
+def difference_curve(series, criterion, cost) -> tuple[np.ndarray, np.ndarray]:
+    """Speeds [m/s] where both knees have a certified ``criterion`` optimum, and the
+    difference of their ``cost`` there [%] (``relative_change``, rolling vs revolute)."""
+    values = {
+        knee: {round(g["speed"], 6): g["costs"][cost] for g in series.get((knee, criterion), [])}
+        for knee in KNEES
+    }
+    speeds = sorted(set(values["revolute"]) & set(values["rolling"]))
+    return np.array(speeds, dtype=float), np.array(
+        [relative_change(values["rolling"][v], values["revolute"][v]) for v in speeds],
+        dtype=float,
+    )
+
+
+def _difference_panel(ax, series, criterion) -> None:
+    """The rolling knee's difference to the revolute knee [%] of the optimal criterion at
+    each speed both knees have, with the zero line; values off the bulk at the edge."""
+    speeds, percent = difference_curve(series, criterion, criterion)
+    limits = bulk_limits(np.append(percent, 0.0))
+    outside = (percent < limits[0]) | (percent > limits[1])
+    ax.axhline(0.0, color="0.4", linewidth=1.0)
+    ax.plot(speeds, np.where(outside, np.nan, percent), color=DIFFERENCE_COLOR, marker="D")
+    for x, value, out in zip(speeds, percent, outside, strict=True):
+        if out:
+            _mark_off_scale(ax, x, value, limits, DIFFERENCE_COLOR, f"{x:.3f} m/s: {value:+.1f} %")
+        elif len(speeds) <= MAX_LABELLED:
+            ax.annotate(
+                f"{value:+.1f} %",
+                xy=(x, value),
+                xytext=(0, 7),
+                textcoords="offset points",
+                ha="center",
+                fontsize=7,
+            )
+    if len(speeds) == 0:
+        ax.text(
+            0.5,
+            0.5,
+            "no speed where both knees\nhave a certified optimum",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+            fontsize=9,
+        )
+    ax.set_ylim(*limits)
+    ax.text(
+        0.02,
+        0.02,
+        "below 0: the rolling knee needs less",
+        transform=ax.transAxes,
+        fontsize=8,
+        color="0.3",
+    )
+
+
 def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
-    """Fig. 4 or 8: the optimal ``criterion`` against the speed (left) and the ``other``
-    criterion of the same gaits (right), both knees; ``flagged``: gaits not certified."""
-    fig = Figure(figsize=(11, 4.4), layout="constrained")
-    axes = fig.subplots(1, 2)
+    """Fig. 4 or 8: the optimal ``criterion`` against the speed (left), the ``other``
+    criterion of the same gaits (middle), both knees, and the rolling knee's difference to
+    the revolute knee in the optimal criterion (right); ``flagged``: gaits not certified.
+    The caption states the difference's sign, and why the ``other`` panel looks as it does
+    where that needs a word (``OTHER_NOTES``)."""
+    fig = Figure(figsize=(16, 5.0), layout="constrained")
+    axes = fig.subplots(1, 3)
     crosses = [g for g in flagged if g["criterion"] == criterion]
-    for ax, cost in zip(axes, (criterion, other), strict=True):
+    for ax, cost in zip(axes, (criterion, other), strict=False):
         unit = CRITERION_UNITS[cost]
         everything = [g["costs"][cost] for k in KNEES for g in series.get((k, criterion), [])]
         limits = bulk_limits(everything or [g["costs"][cost] for g in crosses])
@@ -189,14 +286,29 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
                 text = f"{gait['knee']} {x:.3f} m/s: {value:.4g} {unit},\nnot certified ({why})"
                 _mark_off_scale(ax, x, value, limits, FLAGGED_COLOR, text)
         ax.set_ylim(*limits)
-        ax.set_xlabel("walking speed [m/s]")
         ax.set_ylabel(CRITERION_AXES[cost])
-        ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
+    _difference_panel(axes[2], series, criterion)
+    axes[2].set_ylabel(DIFFERENCE_AXIS)
+    for ax in axes:
+        ax.set_xlabel("walking speed [m/s]")
+        ax.grid(alpha=0.3)
     axes[0].set_title(f"optimal {criterion} criterion")
     axes[1].set_title(f"{other} criterion of the same gaits")
+    axes[2].set_title(f"rolling vs revolute knee, optimal {criterion} criterion")
     fig.suptitle(title)
+    caption = [
+        f"Right: {DIFFERENCE}, at each speed where both knees have a certified optimum.",
+        "Sthenic criterion per metre walked, energy criterion per step.",
+    ]
+    if criterion in OTHER_NOTES:
+        caption.append(f"Middle: {OTHER_NOTES[criterion]}")
+    fig.supxlabel("\n".join(_wrap(line) for line in caption), fontsize=8.5, ha="center")
     return fig
+
+
+def _wrap(text: str, width: int = 170) -> str:
+    return "\n".join(textwrap.wrap(text, width, break_on_hyphens=False))
 
 
 def _detail_gaits(series):
@@ -337,63 +449,137 @@ def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
     return fig
 
 
-def sweep_figures(series: dict, flagged=()) -> dict:
-    """Figs. 4-8 of a sweep ({file name: Figure}); ``flagged``: gaits not certified."""
-    gaits = _detail_gaits(series)
-    return {
-        "fig4.png": criterion_figure(
-            series, "sthenic", "energy", "Fig. 4: sthenic optimisation", flagged
-        ),
-        "fig5.png": time_figure(
-            gaits, "Fig. 5: joint torques of the sthenic-optimal gaits", TORQUE_PANELS
-        ),
-        "fig6.png": time_figure(
-            gaits, "Fig. 6: absolute angles of the sthenic-optimal gaits", ANGLE_PANELS
-        ),
-        "fig7.png": time_figure(
-            gaits, "Fig. 7: ground reaction of the sthenic-optimal gaits", GROUND_PANELS
-        ),
-        "fig8.png": criterion_figure(
+def compared_criteria(series: dict, flagged=()) -> tuple[tuple[str, ...], list[str]]:
+    """The criteria whose figures and rows a sweep can give (certified optima of both knees),
+    and a sentence for each criterion left out, saying what the sweep lacks."""
+    in_sweep = {g["criterion"] for gaits in series.values() for g in gaits}
+    in_sweep |= {g["criterion"] for g in flagged}
+    compared, missing = [], []
+    for criterion in CRITERIA:
+        lacking = [knee for knee in KNEES if not series.get((knee, criterion))]
+        if criterion not in in_sweep:
+            missing.append(
+                f"the sweep has no {criterion} optima (`biped sweep --criteria sthenic energy` "
+                "makes both)"
+            )
+        elif lacking:
+            knees = " and ".join(f"the {knee} knee" for knee in lacking)
+            missing.append(f"the sweep has no certified {criterion} optimum of {knees}")
+        else:
+            compared.append(criterion)
+    return tuple(compared), missing
+
+
+def left_out_figures(criteria) -> list[str]:
+    """The figures of a set that a sweep comparing only ``criteria`` leaves out."""
+    return [name for c in CRITERIA if c not in criteria for name in FIGURES[c]]
+
+
+def left_out_text(criteria) -> str:
+    """'fig8.png and the energy rows': what a sweep comparing only ``criteria``
+    leaves out."""
+    others = [c for c in CRITERIA if c not in criteria]
+    return f"{', '.join(left_out_figures(criteria))} and the {' and '.join(others)} rows"
+
+
+def sweep_figures(series: dict, flagged=(), criteria=CRITERIA) -> dict:
+    """Figs. 4-8 of a sweep ({file name: Figure}), those of ``criteria`` only (``FIGURES``);
+    ``flagged``: gaits not certified."""
+    figures = {}
+    if "sthenic" in criteria:
+        gaits = _detail_gaits(series)
+        figures |= {
+            "fig4.png": criterion_figure(
+                series, "sthenic", "energy", "Fig. 4: sthenic optimisation", flagged
+            ),
+            "fig5.png": time_figure(
+                gaits, "Fig. 5: joint torques of the sthenic-optimal gaits", TORQUE_PANELS
+            ),
+            "fig6.png": time_figure(
+                gaits, "Fig. 6: absolute angles of the sthenic-optimal gaits", ANGLE_PANELS
+            ),
+            "fig7.png": time_figure(
+                gaits, "Fig. 7: ground reaction of the sthenic-optimal gaits", GROUND_PANELS
+            ),
+        }
+    if "energy" in criteria:
+        figures["fig8.png"] = criterion_figure(
             series, "energy", "sthenic", "Fig. 8: energy optimisation", flagged
-        ),
-    }
+        )
+    return figures
 
 
 def _minimum(series, knee, criterion):
+    """(speed [m/s], value) of the knee's least certified ``criterion`` optimum."""
     v, c = _curve(series, knee, criterion, criterion)
-    if len(v) == 0:
-        return float("nan"), float("nan")
     i = int(np.argmin(c))
     return float(v[i]), float(c[i])
 
 
-def _mean_ratio(series, criterion):
-    """Mean of C_rolling / C_revolute over the speeds both knees have."""
-    v0, c0 = _curve(series, "revolute", criterion, criterion)
-    v1, c1 = _curve(series, "rolling", criterion, criterion)
-    common = np.intersect1d(np.round(v0, 6), np.round(v1, 6))
-    if len(common) == 0:
-        return float("nan"), 0
-    r0 = {round(v, 6): c for v, c in zip(v0, c0, strict=True)}
-    r1 = {round(v, 6): c for v, c in zip(v1, c1, strict=True)}
-    return float(np.mean([r1[v] / r0[v] for v in common])), len(common)
+def _percent(value: float) -> str:
+    """'-0.8 %' (the sign always written)."""
+    return f"{value:+.1f} %"
 
 
-def comparison_table(series) -> str:
-    """Markdown table of the headline numbers, ours beside the paper's."""
-    speed_ck, best_ck = _minimum(series, "revolute", "sthenic")
-    speed_rk, best_rk = _minimum(series, "rolling", "sthenic")
-    _, energy_ck = _minimum(series, "revolute", "energy")
-    _, energy_rk = _minimum(series, "rolling", "energy")
+def _criterion_rows(series, criterion) -> list[str]:
+    """The table's rows of one criterion compared (both knees have certified optima)."""
+    unit = CRITERION_UNITS[criterion]
+    per = "per metre walked" if criterion == "sthenic" else "per step"
+    speed = {knee: _minimum(series, knee, criterion)[0] for knee in KNEES}
+    best = {knee: _minimum(series, knee, criterion)[1] for knee in KNEES}
+    speeds, differences = difference_curve(series, criterion, criterion)
+    mean = (
+        _percent(float(np.mean(differences)))
+        if len(speeds)
+        else "none: no speed where both knees are certified"
+    )
+    paper = _percent(PAPER[f"{criterion}_difference"])
+    rows = [
+        f"| {criterion} criterion, rolling vs revolute, at each knee's best speed "
+        f"| {paper} | {_percent(relative_change(best['rolling'], best['revolute']))} |",
+        f"| {criterion} criterion, rolling vs revolute, mean over the {len(speeds)} speeds "
+        f"both knees have | | {mean} |",
+    ]
+    if criterion == "sthenic":
+        rows += [
+            f"| speed of minimum sthenic criterion, {knee} [m/s] "
+            f"| {PAPER['best_speed'][knee]} | {speed[knee]:.3f} |"
+            for knee in KNEES
+        ]
+    rows.append(
+        f"| minimum {criterion} criterion, revolute / rolling [{unit} {per}] | | "
+        f"{best['revolute']:.{1 if criterion == 'sthenic' else 2}f} / "
+        f"{best['rolling']:.{1 if criterion == 'sthenic' else 2}f} |"
+    )
+    return rows
+
+
+def _detail_rows(series) -> tuple[list[str], dict]:
+    """Rows on the sthenic optima near ``DETAIL_SPEED`` and the stance knee's largest
+    flexion of each [rad]."""
     detail = _detail_gaits(series)
     flexion = {
         knee: float(np.max(g["samples"]["q"][:, 3] - g["samples"]["q"][:, 2]))
         for knee, g in detail.items()
     }
-    sthenic_ratio, n_s = _mean_ratio(series, "sthenic")
-    energy_ratio, n_e = _mean_ratio(series, "energy")
+    rows = [
+        f"| largest stance-knee flexion q2 - q1, sthenic optimum near {DETAIL_SPEED} m/s [rad] "
+        f"| | {flexion['revolute']:.3f} / {flexion['rolling']:.3f} |",
+        *(
+            f"| period / step length of that gait, {knee} [s / m] | | "
+            f"{detail[knee]['period']:.3f} / {detail[knee]['step_length']:.3f} |"
+            for knee in KNEES
+        ),
+    ]
+    return rows, flexion
+
+
+def comparison_table(series, flagged=()) -> str:
+    """Markdown table of the headline numbers, ours beside the paper's, for the criteria
+    the sweep can compare (``compared_criteria``), saying what it leaves out."""
+    criteria, missing = compared_criteria(series, flagged)
     safeties = sorted({g["safety"] for gaits in series.values() for g in gaits}, key=str)
-    everything = [g for gaits in series.values() for g in gaits]
+    everything = [g for c in criteria for k in KNEES for g in series[(k, c)]]
     total = len(everything)
     confirmed = sum(g["optimizer"]["starts_at_best"] >= 2 for g in everything)
     safety = "; ".join(
@@ -404,49 +590,54 @@ def comparison_table(series) -> str:
         "",
         "Generated by `biped figures` from the gait files of `biped sweep`; margins beyond",
         f"the paper's constraints: {safety or '-'} (0 is the paper's problem).",
+        "Differences, rolling vs revolute, the paper's numbers too:",
+        f"{DIFFERENCE}.",
         "",
-        "| quantity | paper | ours |",
-        "|---|---|---|",
-        f"| sthenic criterion reduction, rolling vs revolute, at each knee's best speed "
-        f"| ~{PAPER['sthenic_reduction']:.0%} | {1 - best_rk / best_ck:.1%} |",
-        f"| sthenic criterion reduction, mean over {n_s} common speeds | | "
-        f"{1 - sthenic_ratio:.1%} |",
-        f"| speed of minimum sthenic criterion, revolute [m/s] "
-        f"| {PAPER['best_speed']['revolute']} | {speed_ck:.3f} |",
-        f"| speed of minimum sthenic criterion, rolling [m/s] "
-        f"| {PAPER['best_speed']['rolling']} | {speed_rk:.3f} |",
-        f"| minimum sthenic criterion revolute / rolling [N²·m·s] | | "
-        f"{best_ck:.1f} / {best_rk:.1f} |",
-        f"| energy gain, rolling vs revolute, at each knee's minimum "
-        f"| ~{PAPER['energy_gain']:.0%} | {1 - energy_rk / energy_ck:.1%} |",
-        f"| energy gain, mean over {n_e} common speeds | | {1 - energy_ratio:.1%} |",
-        f"| minimum energy criterion revolute / rolling [J per step] | | "
-        f"{energy_ck:.2f} / {energy_rk:.2f} |",
-        f"| largest stance-knee flexion q2 - q1, sthenic optimum near {DETAIL_SPEED} m/s [rad] "
-        f"| | {flexion['revolute']:.3f} / {flexion['rolling']:.3f} |",
-        "| period / step length of that gait, revolute [s / m] | | "
-        f"{detail['revolute']['period']:.3f} / {detail['revolute']['step_length']:.3f} |",
-        "| period / step length of that gait, rolling [s / m] | | "
-        f"{detail['rolling']['period']:.3f} / {detail['rolling']['step_length']:.3f} |",
+    ]
+    if missing:
+        lines += [f"Left out: {left_out_text(criteria)}: {'; '.join(missing)}.", ""]
+    lines += ["| quantity | paper | ours |", "|---|---|---|"]
+    for criterion in criteria:
+        lines += _criterion_rows(series, criterion)
+    flexion = None
+    if "sthenic" in criteria:
+        rows, flexion = _detail_rows(series)
+        lines += rows
+    lines += [
         "",
-        *_explanations(flexion, speed_ck, speed_rk, series),
-        "Conventions behind our numbers (see `biped/gait.py`, `biped/criteria.py`):",
+        *(_explanations(flexion, series, criteria) if flexion is not None else []),
+        "Conventions behind our numbers (see `biped/gait.py`, `biped/criteria.py`,",
+        "`biped/comparison.py`):",
         "",
         "- d of eq. (30) is read as the swing foot's travel in one step, twice the step length,",
         "  so C_Γ is per metre walked; C_E of eq. (31) is per step, as printed.",
+        *textwrap.wrap(
+            f"- Every value is the criterion on {CHECK_GRID} (the gait files' `costs`); "
+            f"the value on {SOLVER_GRID}, `optimizer.value`, only ranks the starts of an "
+            "optimization.",
+            88,
+            subsequent_indent="  ",
+            break_on_hyphens=False,
+        ),
         "- The speed grid is the sweep's; a minimum between grid points is reported at the",
         "  nearest grid speed.",
-        "- Every value is a certified optimum: IPOPT with exact derivatives converged, from",
-        f"  several starts; {confirmed} of {total} optima were reached by at least two starts",
-        "  (the neighbouring speeds' optima among them).",
+        *textwrap.wrap(
+            f"- Every value is certified: {CERTIFIED}.",
+            88,
+            subsequent_indent="  ",
+            break_on_hyphens=False,
+        ),
+        f"  {confirmed} of {total} optima were reached by at least two starts (the neighbouring",
+        "  speeds' optima among them).",
         "",
     ]
     return "\n".join(lines)
 
 
-def _explanations(flexion, speed_ck, speed_rk, series) -> list[str]:
+def _explanations(flexion, series, criteria) -> list[str]:
     """Sentences that explain a difference with the paper, each only where the data
-    shows it."""
+    shows it (the sthenic optima of both knees; the energy optima's sthenic criterion
+    where ``criteria`` has energy too)."""
     lines = ["Where ours differ from the paper's, what the data shows:", ""]
     straight = max(flexion.values())
     if straight < 0.1:
@@ -457,7 +648,8 @@ def _explanations(flexion, speed_ck, speed_rk, series) -> list[str]:
             "  robots walk almost alike.",
         ]
     speeds = sorted({g["speed"] for gaits in series.values() for g in gaits})
-    if speeds and min(speed_ck, speed_rk) <= speeds[0]:
+    best = min(_minimum(series, knee, "sthenic")[0] for knee in KNEES)
+    if best <= speeds[0]:
         lines += [
             "- The sthenic criterion per metre keeps falling as the speed decreases: its",
             "  minimum is at the slowest speed of the sweep.",
@@ -467,36 +659,59 @@ def _explanations(flexion, speed_ck, speed_rk, series) -> list[str]:
         "- Under the other reading of d in eq. (30), C_Γ per step (∫ΓᵀΓ dt, no 2/d), the",
         f"  minimum is at {per_step['revolute']:.3f} m/s (revolute) and "
         f"{per_step['rolling']:.3f} m/s (rolling).",
-        "",
     ]
-    return lines
+    if "energy" in criteria:
+        lines += textwrap.wrap(
+            f"- Fig. 8, middle: {OTHER_NOTES['energy']}",
+            88,
+            subsequent_indent="  ",
+            break_on_hyphens=False,
+        )
+    return [*lines, ""]
 
 
 def _minimum_per_step(series, knee) -> float:
-    gaits = series.get((knee, "sthenic"), [])
-    if not gaits:
-        return float("nan")
-    best = min(gaits, key=lambda g: g["costs"]["sthenic"] * g["step_length"])
+    """[m/s] Speed of the knee's least sthenic criterion per step (certified optima)."""
+    best = min(series[(knee, "sthenic")], key=lambda g: g["costs"]["sthenic"] * g["step_length"])
     return float(best["speed"])
 
 
-def make_figures(sweep_folder: str | Path, out_folder: str | Path) -> list[Path]:
+def make_figures(sweep_folder: str | Path, out_folder: str | Path, stream=None) -> list[Path]:
     """Write fig4.png ... fig8.png and comparison.md, all or none; returns their paths.
 
-    A sweep without a certified sthenic optimum of each knee is refused before anything is
-    written; the files are written into a staging folder and moved into ``out_folder`` only
-    once all are written, so an earlier set there stays whole.
+    A sweep lacking a criterion, or a knee's certified optima of it, gives the figures and
+    rows of the other criterion only; what is left out is said in comparison.md and in a
+    line on ``stream`` (default ``sys.stderr``), and a left-out figure of an earlier set in
+    ``out_folder`` is removed, so the folder never mixes two sweeps' figures. A sweep with
+    nothing to compare (no criterion with certified optima of both knees) is refused before
+    anything is written; the files are written into a staging folder and moved into
+    ``out_folder`` only once all are written, so an earlier set there stays whole.
     """
     series, flagged = read_sweep(sweep_folder)
-    figures = sweep_figures(series, flagged)
+    criteria, missing = compared_criteria(series, flagged)
+    if not criteria:
+        raise BipedError(
+            f"sweep folder {str(sweep_folder)!r} has nothing to compare: {'; '.join(missing)}; "
+            "allowed a sweep with certified optima of both knees for at least one criterion"
+        )
+    figures = sweep_figures(series, flagged, criteria)
     certified_values = {
         key: {round(g["speed"], 6): g["costs"][key[1]] for g in gaits}
         for key, gaits in series.items()
     }
-    table = "\n".join([comparison_table(series), *spread_lines(sweep_folder, certified_values)])
+    table = "\n".join(
+        [comparison_table(series, flagged), *spread_lines(sweep_folder, certified_values)]
+    )
     out = Path(out_folder)
     with atomic_set(out, "figures") as staging:
         for name, figure in figures.items():
             figure.savefig(staging / name, dpi=DPI)
         (staging / "comparison.md").write_text(table, encoding="utf-8")
+    for name in left_out_figures(criteria):  # an earlier set's, of another sweep
+        (out / name).unlink(missing_ok=True)
+    if missing:
+        print(
+            f"figures: left out {left_out_text(criteria)} of comparison.md: {'; '.join(missing)}",
+            file=sys.stderr if stream is None else stream,
+        )
     return [out / name for name in figures] + [out / "comparison.md"]

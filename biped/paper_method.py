@@ -19,12 +19,14 @@ from __future__ import annotations
 import dataclasses
 import json
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from biped import gait_file
+from biped.comparison import DIFFERENCE, relative_change
 from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
@@ -36,7 +38,7 @@ from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
 from biped.problem import GaitProblem, check_speed
 from biped.provenance import version
 from biped.robot import Robot
-from biped.runner import run_tasks
+from biped.runner import ProgressBar, run_tasks
 
 FOLDER = "paper-method"
 SETTINGS = "settings.json"
@@ -95,6 +97,30 @@ def _solve(task) -> str:
     )
 
 
+def _settings(robot: Robot, speed: float, seeds: int, knees, safety: Safety) -> PaperMethod:
+    """The settings of the runs, each checked (BipedError naming a bad one)."""
+    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
+        raise BipedError(f"seeds = {seeds!r}: allowed an integer >= 1")
+    for knee in knees:
+        check_speed(Biped(robot, knee), speed)
+    return PaperMethod(robot, safety, float(speed), seeds)
+
+
+def check_paper_method(
+    sweep_folder: str | Path,
+    robot: Robot,
+    speed: float = SPEED,
+    seeds: int = DEFAULT_SEEDS,
+    knees=KNEES,
+    safety: Safety = PAPER_SAFETY,
+) -> None:
+    """Raise the BipedError ``run_paper_method`` would raise before running, writing nothing
+    (so that a sweep is refused before it starts, not after)."""
+    _RECORD.check(
+        Path(sweep_folder) / FOLDER, _settings(robot, speed, seeds, knees, safety).to_dict()
+    )
+
+
 def run_paper_method(
     sweep_folder: str | Path,
     robot: Robot,
@@ -105,31 +131,36 @@ def run_paper_method(
     safety: Safety = PAPER_SAFETY,
     jobs: int | None = None,
     dask: str | None = None,
-    stream=sys.stderr,
+    stream=None,
+    progress: Callable[[int], ProgressBar] | None = None,
 ) -> list[Path]:
     """The paper's Nelder-Mead from seeds 0 .. ``seeds`` − 1 for every knee and criterion at
     ``speed``, into ``sweep_folder``/paper-method/ (runs already there are kept); returns
-    the gait files."""
-    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
-        raise BipedError(f"seeds = {seeds!r}: allowed an integer >= 1")
-    for knee in knees:
-        check_speed(Biped(robot, knee), speed)
-    settings = PaperMethod(robot, safety, float(speed), seeds)
+    the gait files. ``progress(total)``, if given, makes a bar advanced after each run."""
+    stream = sys.stderr if stream is None else stream  # the stderr of the call, not of the import
+    settings = _settings(robot, speed, seeds, knees, safety)
     folder = Path(sweep_folder) / FOLDER
-    folder.mkdir(parents=True, exist_ok=True)
-    _RECORD.claim(folder, settings.to_dict())
+    _RECORD.claim(folder, settings.to_dict())  # checked before the folder is made
     clean_stale_temporaries(folder)
     runs = [Run(k, c, s) for c in criteria for k in knees for s in range(seeds)]
     todo = [r for r in runs if not (folder / r.filename(settings.speed)).exists()]
     if todo:
         print(
-            f"paper's method: {len(todo)} Nelder-Mead runs at {speed:.3f} m/s into {folder}",
+            f"paper's method: {len(runs)} Nelder-Mead runs at {speed:.3f} m/s in {folder}: "
+            f"{len(runs) - len(todo)} already done, {len(todo)} to run",
             file=stream,
             flush=True,
         )
     tasks = [(settings, r, str(folder)) for r in todo]
-    for line in run_tasks(_solve, tasks, jobs=jobs, dask=dask, stream=stream):
-        print(line, file=stream, flush=True)
+    bar = progress(len(todo)) if progress is not None and todo else None
+    if bar is not None:
+        bar.advance(0)  # drawn from the start
+    try:
+        for line in run_tasks(_solve, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar):
+            print(line, file=stream, flush=True)
+    finally:
+        if bar is not None:
+            bar.clear()
     return [folder / r.filename(settings.speed) for r in runs]
 
 
@@ -181,34 +212,43 @@ def spread_lines(sweep_folder: str | Path, certified: dict) -> list[str]:
         "| worst / certified |",
         "|---|---|---|---|",
     ]
-    ratios = {}
     for (knee, criterion), values in sorted(runs.items()):
-        optimum = certified.get((knee, criterion), {}).get(round(speed, 6), float("nan"))
+        optimum = certified.get((knee, criterion), {}).get(round(speed, 6))
         v = np.asarray(values)
+        found = "none certified" if optimum is None else f"{optimum:.4g}"
+        worst = "n/a" if optimum is None else f"{v.max() / optimum:.2f}"
         lines.append(
-            f"| {knee}, {criterion} | {optimum:.4g} | {v.min():.4g} / {np.median(v):.4g} / "
-            f"{v.max():.4g} | {v.max() / optimum:.2f} |"
+            f"| {knee}, {criterion} | {found} | {v.min():.4g} / {np.median(v):.4g} / "
+            f"{v.max():.4g} | {worst} |"
         )
-    lines.append("")
+    lines += ["", f"Differences, rolling vs revolute: {DIFFERENCE}.", ""]
     for criterion in CRITERIA:
         if ("revolute", criterion) not in runs or ("rolling", criterion) not in runs:
             continue
-        seeds = np.asarray(runs[("rolling", criterion)]) / np.asarray(runs[("revolute", criterion)])
-        ratios[criterion] = seeds - 1.0
+        diff = np.array(
+            [
+                relative_change(rolling, revolute)
+                for rolling, revolute in zip(
+                    runs[("rolling", criterion)], runs[("revolute", criterion)], strict=True
+                )
+            ]
+        )
+        seeds = "the paper's method, seed by seed: " + ", ".join(f"{d:+.1f} %" for d in diff)
         a = certified.get(("revolute", criterion), {}).get(round(speed, 6), float("nan"))
         b = certified.get(("rolling", criterion), {}).get(round(speed, 6), float("nan"))
-        true = b / a - 1.0
-        diff = ratios[criterion]
+        true = relative_change(b, a)
+        if not np.isfinite(true):
+            lines.append(f"- {criterion}: no certified optimum of both knees here; {seeds}.")
+            continue
         lines.append(
-            f"- {criterion}: rolling vs revolute, certified optima {true:+.1%}; the paper's "
-            f"method, seed by seed: " + ", ".join(f"{d:+.1%}" for d in diff) + "."
+            f"- {criterion}: rolling vs revolute, certified optima {true:+.1f} %; {seeds}."
         )
-        if np.isfinite(true) and np.ptp(diff) > abs(true):
+        if np.ptp(diff) > abs(true):
             lines.append(
-                f"  The seeds alone move the paper's method's answer over {np.ptp(diff):.0%}, "
-                f"more than the certified difference ({abs(true):.1%})."
+                f"  The seeds alone move the paper's method's answer over a range of "
+                f"{np.ptp(diff):.0f} %, more than the certified difference ({abs(true):.1f} %)."
             )
-        flips = int(np.sum(np.sign(diff) != np.sign(true))) if np.isfinite(true) else 0
+        flips = int(np.sum(np.sign(diff) != np.sign(true)))
         if flips:
             lines.append(f"  {flips} of {len(diff)} seeds report the wrong knee as the better one.")
     lines.append("")

@@ -34,10 +34,11 @@ from pathlib import Path
 import numpy as np
 
 from biped import gait_file
+from biped.comparison import SINGLE_START
 from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
 from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.files import clean_stale_temporaries
+from biped.files import clean_stale_temporaries, distinct_values
 from biped.kinematics import KNEES
 from biped.manifest import Manifest
 from biped.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, optimize
@@ -45,6 +46,7 @@ from biped.problem import VARIABLES, GaitProblem, check_speed
 from biped.provenance import version
 from biped.robot import Robot
 from biped.runner import ProgressBar, run_tasks
+from biped.units import CRITERION_UNITS
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
 MANIFEST = "sweep.json"
@@ -157,17 +159,30 @@ def _solve_with_neighbours(task) -> str:
     return _line("final", point, optimum)
 
 
+# What each stage's line calls its result: only the final stage's optimum is a point's
+# answer, so only it may be called certified (``biped.comparison.CERTIFIED``).
+STAGES = {"independent": "own starts, stage 1/2", "final": "final, stage 2/2"}
+
+
 def _line(stage: str, point: Point, optimum: Optimum) -> str:
+    """One optimization's line: its stage, the criterion on the check grid with its unit,
+    what the result is (only a final one is "certified") and the starts at its value."""
     report = optimum.report
-    status = (
-        "certified"
-        if optimum.certified
-        else ("NOT CONVERGED: " + report.status if not report.converged else "INFEASIBLE")
-    )
+    if not report.converged:
+        status = "NOT CONVERGED: " + report.status
+    elif not optimum.feasible:
+        status = "INFEASIBLE"
+    elif stage == "final":
+        status = "certified" + (f" ({SINGLE_START})" if report.starts_at_best < 2 else "")
+    else:
+        status = "converged, feasible, not final"
+    if stage == "final" and not status.startswith("certified"):
+        status = "NOT CERTIFIED, " + status
     return (
-        f"[{stage:11} {point.knee:8} {point.criterion:7}] {point.speed:.3f} m/s  "
-        f"C = {optimum.value:12.6f}  {status}  {report.starts_at_best}/{report.starts} starts "
-        f"at best  {report.seconds:5.1f} s"
+        f"[{STAGES[stage]:21}] {point.knee:8} {point.criterion:7} {point.speed:.3f} m/s  "
+        f"C = {optimum.value:12.6f} {CRITERION_UNITS[point.criterion]:6} on the check grid: "
+        f"{status}; {report.starts_at_best}/{report.starts} starts at best  "
+        f"{report.seconds:5.1f} s"
     )
 
 
@@ -178,11 +193,7 @@ def check_speeds(robot: Robot, speeds, knees) -> list[float]:
         model = Biped(robot, knee)
         for speed in speeds:
             check_speed(model, speed)
-    names = [f"{s:.3f}" for s in speeds]
-    for a, b in zip(names, names[1:], strict=False):
-        if a == b:
-            raise BipedError(f"speeds {a} m/s appear twice at 1 mm/s resolution: allowed distinct")
-    return speeds
+    return distinct_values(speeds, "speeds", "m/s", 3, "1 mm/s")  # Point.filename's
 
 
 def run_sweep(
@@ -213,19 +224,14 @@ def run_sweep(
     speeds = check_speeds(robot, speeds, knees)
     settings = Settings(robot, safety, tuple(speeds), int(seed), int(starts))
     folder = Path(folder)
-    (folder / INDEPENDENT).mkdir(parents=True, exist_ok=True)
-    _RECORD.claim(folder, settings.to_dict())
+    _RECORD.claim(folder, settings.to_dict())  # checked before anything is written
+    (folder / INDEPENDENT).mkdir(exist_ok=True)
     for place in (folder, folder / INDEPENDENT):
         clean_stale_temporaries(place)
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
     final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
     stages = _stages(folder, settings, points, final, knees)
-    print(
-        f"sweep: {len(points)} points in {folder}, {len(points) - len(final)} already done, "
-        f"{len(final)} to run",
-        file=stream,
-        flush=True,
-    )
+    print(_plan(folder, settings, points, final, stages), file=stream, flush=True)
     began = time.perf_counter()
     total = sum(len(tasks) for tasks in stages)
     bar = progress(total) if progress is not None and final else None
@@ -243,6 +249,27 @@ def run_sweep(
     summary = summarize(folder, points, settings)
     print(f"sweep: done in {time.perf_counter() - began:.1f} s; {summary}", file=stream, flush=True)
     return points
+
+
+def _plan(folder: Path, settings: Settings, points, final, stages) -> str:
+    """What the sweep will do, counted in optimizations as its progress bar counts them: two
+    per point, in the stages of its lines (``STAGES``: own starts, then final), those of
+    each stage already in the folder, and those to run (the bar's total)."""
+
+    def saved(p):
+        return _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is not None
+
+    done = {"independent": sum(map(saved, points)), "final": len(points) - len(final)}
+    to_run = sum(len(tasks) for tasks in stages)
+    unneeded = 2 * len(points) - sum(done.values()) - to_run  # stage 1 of finished points
+    text = (
+        f"sweep: {2 * len(points)} optimizations for {len(points)} points in {folder}, in 2 "
+        f"stages (own starts, final): {sum(done.values())} already done "
+        f"({done['independent']} of stage 1, {done['final']} of stage 2), {to_run} to run"
+    )
+    if unneeded:
+        text += f", {unneeded} of stage 1 not needed (their points are final)"
+    return text
 
 
 def _stages(folder: Path, settings: Settings, points, final, knees) -> list:
@@ -303,13 +330,20 @@ def _neighbours(point: Point, speeds, knees) -> list[Point]:
 
 def summarize(folder: Path, points, settings: Settings) -> str:
     """How many points are certified, and which are not."""
-    bad = []
+    bad, single = [], []
     for p in points:
         gait = _read_gait(Path(folder) / p.filename(), p, settings)
         if gait is None:
             bad.append(f"{p.filename()} missing")
         elif gait["optimizer"].get("status") != "converged" or not gait["feasible"]:
             bad.append(f"{p.filename()} {gait['optimizer'].get('status')}")
+        elif gait["optimizer"]["starts_at_best"] < 2:
+            single.append(p.filename())
     certified = len(points) - len(bad)
-    text = f"{certified} of {len(points)} points certified (converged and feasible)"
+    text = (
+        f"{certified} of {len(points)} points certified (final optima, solver converged, "
+        "feasible on the check grid)"
+    )
+    if single:
+        text += f"; {len(single)} of them {SINGLE_START}: " + ", ".join(single)
     return text + ("; NOT: " + ", ".join(bad) if bad else "")

@@ -10,7 +10,10 @@ object maps the path of each numeric field to its unit::
 A path goes through objects by key, and ``[]`` stands for every element of a list of objects.
 A unit is a string in the notation the project prints (``N·m``, ``rad/s²``), ``"1"`` for a pure
 number (a count, a ratio) and ``"T"`` for a fraction of the gait's period; a list holds one
-unit per column of an array whose columns differ. Only numbers (and null, a figure that could
+unit per column of an array whose columns differ. A unit may be followed by what the number is,
+in parentheses, where the key alone would mislead: ``optimizer.value`` is the criterion on the
+solver's samples, which ranks the starts, where ``costs`` hold it on the check grid, which the
+comparisons use (``biped.comparison``). Only numbers (and null, a figure that could
 not be measured) have units; texts, booleans and ``provenance`` have none.
 """
 
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 
+from biped.comparison import CHECKED_VALUE, SOLVER_VALUE
 from biped.criteria import CONSTRAINTS, CRITERIA
 from biped.gait import PARAMETERS
 from biped.kinematics import ANGLES, COORDINATES
@@ -128,8 +132,8 @@ def gait_units(criterion: str) -> dict:
         "optimizer.dual_infeasibility": "1 (IPOPT's measure)",
         "optimizer.seconds": "s",
         "optimizer.seed": PURE,
-        "optimizer.value": value,
-        "optimizer.history[].value": value,
+        "optimizer.value": f"{value} ({SOLVER_VALUE}; costs.{criterion} is {CHECKED_VALUE})",
+        "optimizer.history[].value": f"{value} ({SOLVER_VALUE})",
         "optimizer.history[].iterations": PURE,
         **{f"optimizer.variables.{name}": parameter_unit(name) for name in VARIABLES},
         "samples.t": "s",

@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 
-from biped.criteria import CRITERIA
 from biped.errors import BipedError
 from biped_cli import args as types
 
@@ -36,17 +35,21 @@ def radii(text: str) -> np.ndarray:
 def _add_common(parser) -> None:
     from biped.optimize import DEFAULT_STARTS
 
-    parser.add_argument("--criterion", choices=CRITERIA, default="sthenic")
+    types.add_criterion(parser)
     parser.add_argument(
         "--starts",
         type=types.positive,
         default=DEFAULT_STARTS,
         metavar="N",
         help="IPOPT starts of each optimization: the first guess (at the robot's radii) and "
-        f"N-1 random ones (default {DEFAULT_STARTS})",
+        f"N-1 random ones (default {DEFAULT_STARTS}); {types.CERTIFIED_HELP}",
     )
     parser.add_argument(
-        "--seed", type=types.non_negative, default=0, help="seed of the random starts (default 0)"
+        "--seed",
+        type=types.non_negative,
+        default=0,
+        metavar="N",
+        help="seed of the random starts (default 0)",
     )
     parser.add_argument(
         "--clearance",
@@ -85,8 +88,15 @@ def add_parsers(commands) -> None:
         help="optimal rolling-knee radii with the gait at one speed",
         description=cmd_design.__doc__,
     )
-    design.add_argument("--speed", type=types.speed, required=True, metavar="V", help="[m/s]")
-    design.add_argument("--out", required=True, metavar="FILE", help="gait file to write (JSON)")
+    design.add_argument(
+        "--speed", type=types.speed, required=True, metavar="V", help=types.SPEED_HELP
+    )
+    design.add_argument(
+        "--out",
+        required=True,
+        metavar="FILE",
+        help=f"gait file to write (JSON; {types.FOLDERS_CREATED})",
+    )
     _add_common(design)
     design.set_defaults(run=cmd_design)
 
@@ -111,10 +121,13 @@ def add_parsers(commands) -> None:
             help=f"{name} values [m]: START:STOP:COUNT or a list (default 10 from 0 to its "
             "upper bound)",
         )
-    grid.add_argument("--out", default=DEFAULT_MAP, metavar="DIR", help=f"(default {DEFAULT_MAP})")
     grid.add_argument(
-        "--jobs", type=types.jobs, default=None, help="processes (default: all cores)"
+        "--out",
+        default=DEFAULT_MAP,
+        metavar="DIR",
+        help=f"folder of the map, {types.FOLDER_CREATED} (default {DEFAULT_MAP})",
     )
+    grid.add_argument("--jobs", type=types.jobs, default=None, metavar="N", help=types.JOBS_HELP)
     types.add_dask(grid)
     _add_common(grid)
     grid.set_defaults(run=cmd_design_map)
@@ -122,7 +135,7 @@ def add_parsers(commands) -> None:
 
 def _upper(args, robot) -> tuple:
     """The upper bounds of the radii given on the command line (default the limits)."""
-    from biped.design import radius_limits
+    from biped.design import MIN_RADIUS, radius_limits
 
     limits = radius_limits(robot)
     upper = []
@@ -130,9 +143,10 @@ def _upper(args, robot) -> tuple:
         value = getattr(args, f"max_{name}", None)  # the pipeline has none
         if value is None:
             upper.append(limit)
-        elif not 0.0 < value <= limit:
+        elif not MIN_RADIUS < value <= limit:
             raise BipedError(
-                f"--max-{name} {value:g} m: allowed > 0 and <= {limit:.4g} m (beyond, the "
+                f"--max-{name} {value:g} m: allowed > {MIN_RADIUS:g} m (the radii's lower "
+                f"bound) and <= {limit:.4g} m (beyond, the "
                 f"{'shank' if name == 'r1' else 'thigh'}'s centre of mass leaves the segment)"
             )
         else:
@@ -166,6 +180,22 @@ def _radii_line(comparison) -> str:
         f"{gains['design_vs_revolute']:+.2f} % vs revolute, "
         f"{gains['design_vs_table1']:+.2f} % vs Table 1 radii"
     )
+
+
+def _bound_notes(problem, design=None) -> list[str]:
+    """What the design's bounds did: the robot's own radii moved into them (the reference
+    design of the table), and a designed radius at its lower bound (``MIN_RADIUS``)."""
+    from biped.design import MIN_RADIUS
+
+    notes = [f"note: {sentence}" for sentence in problem.moved_reference()]
+    for bound in [] if design is None else design.at_bounds():
+        if bound.endswith("lower bound"):
+            notes.append(
+                f"note: {bound} {MIN_RADIUS:g} m: the radii are bounded away from 0, where "
+                "the rolling knee is the revolute knee (the first row); the design gains "
+                "nothing by rolling on that side"
+            )
+    return notes
 
 
 def _uncertified(comparison) -> list[str]:
@@ -207,6 +237,8 @@ def cmd_design(args) -> int:
     comparison = compare(problem, seed=args.seed, starts=args.starts)
     design = comparison.design
     print(comparison.table())
+    for note in _bound_notes(problem, design):
+        print(note)
     print(_radii_line(comparison))
     print(f"design: {design.report.summary()}")
     if design.report.converged and not design.report.confirmed:
@@ -248,13 +280,16 @@ def cmd_design_map(args) -> int:
     to resume. Runs on all cores, or on a Dask cluster with --dask tcp://HOST:PORT. Exits 1
     when an optimization is not certified (converged and feasible).
     """
-    from biped.design_map import draw, load, run_design_map, speed_summaries
+    from biped.comparison import DIFFERENCE_VS_REVOLUTE
+    from biped.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
     from biped.runner import check_dask
     from biped_cli.progress import Progress
 
     robot = _robot(args.robot)
     problem = _problem(args, robot, float(args.speeds[0]))
     types.check_folder(args.out, "--out")
+    for note in _bound_notes(problem):
+        print(note)
     if args.dask is not None:
         check_dask(args.dask)
     run_design_map(
@@ -275,6 +310,9 @@ def cmd_design_map(args) -> int:
     for path in draw(args.out):
         print(f"wrote {path}")
     settings, results = load(args.out)
+    print(  # the folder's other files, once: a file per optimization is too many to name
+        f"design map results in {args.out}: {MANIFEST}, {len(results)} optimizations, one JSON each"
+    )
     unit = CRITERION_UNITS[settings.criterion]
     print(
         f"{'speed [m/s]':>12}{'r1 [m]':>9}{'r2 [m]':>9}{f'design [{unit}]':>18}"
@@ -289,6 +327,7 @@ def cmd_design_map(args) -> int:
             f"{'n/a' if gain is None else f'{gain:+.2f} %':>13}"
             f"{'n/a' if table1 is None else f'{table1:+.2f} %':>21}"
         )
+    print(f"vs revolute: {DIFFERENCE_VS_REVOLUTE}")
     certified = all(content["certified"] for content in results.values())
     return 0 if certified else 1
 
@@ -301,7 +340,7 @@ def pipeline_design(args, robot, optima: dict, out: Path, recordings: Path) -> b
     from biped import gait_file
     from biped.design import compare
     from biped_cli.commands import _validate_and_record
-    from biped_cli.outputs import check_owner
+    from biped_cli.outputs import check_owner, recording_lines
 
     problem = _problem(args, robot, args.speed)
     name = f"design-{args.criterion}-{args.speed:.3f}"
@@ -313,7 +352,7 @@ def pipeline_design(args, robot, optima: dict, out: Path, recordings: Path) -> b
     }
     comparison = compare(problem, seed=args.seed, starts=args.starts, **given)
     design = comparison.design
-    for line in comparison.table().splitlines():
+    for line in comparison.table().splitlines() + _bound_notes(problem, design):
         print(f"[design] {line}")
     print(f"[design] {_radii_line(comparison)}")
     print(f"[design] {design.report.summary()}")
@@ -331,6 +370,9 @@ def pipeline_design(args, robot, optima: dict, out: Path, recordings: Path) -> b
     report_path = gait_file.write_json(
         out / f"{name}.report.json", {**report, "gait": str(gait_path)}
     )
-    print(f"[design] gait {gait_path}, report {report_path}")
-    print(f"[design] recording {report['recording']}  (open with: rerun {report['recording']})")
+    print(f"[design] gait {gait_path}, report {report_path}")  # every file written, once
+    for line in recording_lines(report["recording"]):
+        print(f"[design] {line}")
+    for written in report.get("video", []):
+        print(f"[design] video {written}")
     return result.passed and not _uncertified(comparison)

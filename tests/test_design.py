@@ -267,7 +267,8 @@ def test_designed_gait_passes_validation_on_its_own_robot_only(designed):
 @pytest.mark.parametrize(
     "argv, needle",
     [
-        (["design", "--speed", "0.3", "--max-r1", "0.3"], "--max-r1 0.3 m: allowed > 0 and <="),
+        (["design", "--speed", "0.3", "--max-r1", "0.3"], "--max-r1 0.3 m: allowed > 0.001 m"),
+        (["design", "--speed", "0.3", "--max-r2", "0.001"], "--max-r2 0.001 m: allowed > 0.001"),
         (["design", "--speed", "0.3", "--max-r2", "-0.1"], "--max-r2 -0.1 m"),
         (["design", "--speed", "9"], "speed = 9.0 m/s"),
         (["design", "--speed", "0.3", "--clearance", "-1"], "clearance = '-1'"),
@@ -336,3 +337,46 @@ def test_pipeline_with_design_compares_three_knees_in_one_table(tmp_path, capsys
     assert report["inverse_dynamics"]["passed"] and report["impact"]["passed"]
     knee_report = json.loads((out / "revolute-sthenic-0.300.report.json").read_text())
     assert code == (0 if report["passed"] and knee_report["passed"] else 1)
+
+
+def test_bounds_that_move_the_robots_own_radii_say_so():
+    """A robot whose shank's centre of mass is 3 cm from the knee: its r1 is bounded to 3 cm,
+    so its own 5 cm are moved there as the reference design, and the problem says so with
+    both values and the bound; own radii of 0 move up to the radii's lower bound, 1 mm, above
+    the revolute knee that r = 0 is; Table 1's radii move nowhere."""
+    from biped.design import MIN_RADIUS
+
+    problem = DesignProblem(dataclasses.replace(ROBOT, shank_com=0.03), SPEED)
+    assert problem.lower == (MIN_RADIUS, MIN_RADIUS) and MIN_RADIUS == 0.001
+    assert problem.reference_radii == (0.03, 0.05)
+    [note] = problem.moved_reference()
+    assert "r1 = 0.05 m lies beyond its upper bound 0.03 m" in note and "r1 = 0.03 m" in note
+    hinge = DesignProblem(dataclasses.replace(ROBOT, r2=0.0), SPEED)
+    assert hinge.reference_radii == (0.05, MIN_RADIUS)
+    [note] = hinge.moved_reference()
+    assert "r2 = 0 m lies beyond its lower bound 0.001 m" in note
+    assert DesignProblem(ROBOT, SPEED).moved_reference() == []
+
+
+def test_a_design_against_a_bound_is_said_and_validated(tmp_path, capsys):
+    """'biped design --robot R.toml' with shank_com = 0.03 m: it says that the Table 1 r1 was
+    moved to its bound, its optimum lies at the radii's lower bound of 1 mm (said, where r = 0
+    would be the revolute knee) and 'biped validate' plays the file it writes."""
+    from biped import gait_file
+    from biped.design import MIN_RADIUS
+    from biped_cli import main
+
+    robot, path = tmp_path / "R.toml", tmp_path / "design.json"
+    robot.write_text("shank_com = 0.03\n")
+    argv = ["design", "--robot", str(robot), "--speed", "0.3", "--starts", "1", "--out", str(path)]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "note: the robot's own r1 = 0.05 m lies beyond its upper bound 0.03 m" in out
+    gait = gait_file.read(path)
+    radii = gait["design"]["radii"]
+    assert min(radii.values()) >= MIN_RADIUS and gait["design"]["reference_moved"]
+    for name, value in radii.items():
+        if value == MIN_RADIUS:
+            assert f"note: {name} at its lower bound 0.001 m" in out
+    rrd = tmp_path / "design.rrd"
+    assert main(["validate", str(path), "--steps", "2", "--rrd", str(rrd)]) == 0

@@ -40,7 +40,9 @@ def test_sweep_saves_every_point_certified(sweep):
         # its own start, its one neighbouring speed's and the other knee's, and for the
         # energy criterion the sthenic optimum of its own problem under both barriers
         assert gait["optimizer"]["starts"] == 3 + 2 * (gait["criterion"] == "energy")
-    assert "8 to run" in log and "8 of 8 points certified" in log
+    assert "16 optimizations for 8 points" in log
+    assert "0 already done (0 of stage 1, 0 of stage 2), 16 to run" in log
+    assert "8 of 8 points certified" in log
     manifest = json.loads((folder / MANIFEST).read_text())
     assert manifest["seed"] == 0 and manifest["starts"] == 1 and manifest["speeds"] == list(SPEEDS)
 
@@ -92,6 +94,49 @@ def test_interrupted_sweep_resumes_to_the_same_files(sweep, tmp_path, monkeypatc
     assert not list(tmp_path.rglob("*.tmp"))
 
 
+class CountingBar:
+    """A progress bar that records its total and the units advanced."""
+
+    def __init__(self, total):
+        self.total, self.done = total, 0
+
+    def advance(self, units=1, note=None):
+        self.done += units
+
+    def clear(self):
+        pass
+
+
+def test_a_resumed_sweep_counts_optimizations_as_its_bar_does(tmp_path, monkeypatch):
+    """A sweep interrupted once its independent optima are saved says, when resumed, how many
+    optimizations it has, how many of each kind are done, and as many to run as its bar
+    counts and runs."""
+    write = gait_file.write_json
+    tiny = dict(knees=("revolute",), criteria=("sthenic",), **FAST)
+
+    def stop_after_independent(path, content):
+        if INDEPENDENT not in str(path):
+            raise Interrupt
+        return write(path, content)
+
+    robot = biped.Robot.paper()
+    monkeypatch.setattr(gait_file, "write_json", stop_after_independent)
+    with pytest.raises(Interrupt):
+        run_sweep(tmp_path, robot, SPEEDS, stream=io.StringIO(), **tiny)
+    monkeypatch.setattr(gait_file, "write_json", write)
+    log, bars = io.StringIO(), []
+
+    def counting_bar(total):
+        bars.append(CountingBar(total))
+        return bars[-1]
+
+    run_sweep(tmp_path, robot, SPEEDS, stream=log, progress=counting_bar, **tiny)
+    plan = log.getvalue().splitlines()[0]
+    assert "4 optimizations for 2 points" in plan and "in 2 stages (own starts, final)" in plan
+    assert plan.endswith("2 already done (2 of stage 1, 0 of stage 2), 2 to run")
+    assert [(bar.total, bar.done) for bar in bars] == [(2, 2)]
+
+
 def test_sweep_refuses_other_settings(sweep):
     """Resuming into a folder made with another robot, seed or start count is refused."""
     folder, _ = sweep
@@ -125,8 +170,10 @@ def test_figures_and_table(sweep, tmp_path):
     for knee in biped.KNEES:
         gaits = [gait_file.read(p) for p in folder.glob(f"{knee}-sthenic-*.json")]
         best[knee] = min(gaits, key=lambda g: g["costs"]["sthenic"])
-    reduction = 1 - best["rolling"]["costs"]["sthenic"] / best["revolute"]["costs"]["sthenic"]
-    assert f"| ~17% | {reduction:.1%} |" in table
+    difference = 100 * (
+        best["rolling"]["costs"]["sthenic"] / best["revolute"]["costs"]["sthenic"] - 1
+    )
+    assert f"| -17.0 % | {difference:+.1f} % |" in table
     assert f"| 0.27 | {best['revolute']['speed']:.3f} |" in table
     gaits = [gait_file.read(p) for p in folder.glob("*-*.json")]
     confirmed = sum(g["optimizer"]["starts_at_best"] >= 2 for g in gaits)
@@ -191,7 +238,10 @@ def test_each_figure_is_drawn_with_its_labels(sweep):
         colours = np.unique(pixels.astype(np.int32) @ np.array([1 << 16, 1 << 8, 1]))
         assert pixels.std() > 20 and len(colours) > 50, name
     for name in ("fig4.png", "fig8.png"):
-        assert {"walking speed [m/s]", "sthenic criterion C_Γ [N²·m·s]"} <= _texts(figures[name])
+        assert {
+            "walking speed [m/s]",
+            r"sthenic criterion $C_\Gamma$ per metre walked [N²·m·s]",
+        } <= _texts(figures[name])
     torques = _texts(figures["fig5.png"])
     assert {f"Γ{i + 1} {j.replace('_', ' ')}" for i, j in enumerate(JOINTS)} <= torques
     assert {"Γ2 stance knee", "Γ5 swing knee", "torque [N·m]"} <= torques
@@ -311,3 +361,120 @@ def test_figures_are_written_all_or_none(sweep, tmp_path, monkeypatch):
         make_figures(folder, out)
     after = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in out.iterdir()}
     assert after == before
+
+
+def _copy(folder, destination, pattern):
+    destination.mkdir()
+    for path in folder.glob(pattern):
+        (destination / path.name).write_bytes(path.read_bytes())
+    return destination
+
+
+def test_a_sweep_lacking_a_criterion_gives_the_other_and_says_what_it_leaves_out(sweep, tmp_path):
+    """A sweep of one criterion gives that criterion's figures and rows only, says in
+    comparison.md and on the console what it leaves out, removes the left-out figure of an
+    earlier set, and writes no 'nan'; one with nothing to compare is refused."""
+    from biped.figures import compared_criteria, read_sweep
+
+    folder, _ = sweep
+    out = tmp_path / "figures"
+    make_figures(folder, out, stream=io.StringIO())  # an earlier, complete set
+    sthenic = _copy(folder, tmp_path / "sthenic", "*-sthenic-*.json")
+    log = io.StringIO()
+    paths = make_figures(sthenic, out, stream=log)
+    assert sorted(p.name for p in paths) == [
+        "comparison.md",
+        "fig4.png",
+        "fig5.png",
+        "fig6.png",
+        "fig7.png",
+    ]
+    assert not (out / "fig8.png").exists()
+    table = (out / "comparison.md").read_text()
+    assert "nan" not in table.lower() and "energy criterion, rolling vs revolute" not in table
+    assert "Left out: fig8.png and the energy rows: the sweep has no energy optima" in table
+    assert "left out fig8.png and the energy rows" in log.getvalue()
+    energy = _copy(folder, tmp_path / "energy", "*-energy-*.json")
+    paths = make_figures(energy, tmp_path / "energy-figures", stream=io.StringIO())
+    assert sorted(p.name for p in paths) == ["comparison.md", "fig8.png"]
+    table = paths[-1].read_text()
+    assert "nan" not in table.lower() and "Left out: fig4.png, fig5.png" in table
+    # a criterion whose optima of one knee are not certified is left out, naming the knee
+    name = "rolling-energy-0.300.json"
+    gait = json.loads((energy / name).read_text())
+    gait["optimizer"]["status"] = "Maximum_Iterations_Exceeded"
+    (energy / name).write_text(json.dumps(gait))
+    (energy / "rolling-energy-0.275.json").unlink()
+    series, flagged = read_sweep(energy)
+    assert compared_criteria(series, flagged) == (
+        (),
+        [
+            "the sweep has no sthenic optima (`biped sweep --criteria sthenic energy` makes both)",
+            "the sweep has no certified energy optimum of the rolling knee",
+        ],
+    )
+    with pytest.raises(biped.BipedError, match="nothing to compare.*rolling knee"):
+        make_figures(energy, tmp_path / "refused")
+    assert not (tmp_path / "refused").exists()
+
+
+def test_every_difference_between_the_knees_has_one_sign(sweep, tmp_path):
+    """(rolling − revolute) / revolute in %, negative where the rolling knee needs less:
+    in comparison.md (the paper's numbers too) and in the figures' difference panels."""
+    from biped.comparison import DIFFERENCE, relative_change
+    from biped.figures import PAPER, read_sweep, sweep_figures
+
+    assert relative_change(0.9, 1.0) == pytest.approx(-10.0)
+    assert PAPER["sthenic_difference"] < 0 and PAPER["energy_difference"] < 0  # less: rolling
+    folder, _ = sweep
+    table = make_figures(folder, tmp_path, stream=io.StringIO())[-1].read_text()
+    assert DIFFERENCE in table
+    series, flagged = read_sweep(folder)
+    figures = sweep_figures(series, flagged)
+    for criterion, name in (("sthenic", "fig4.png"), ("energy", "fig8.png")):
+        best = {
+            knee: min(g["costs"][criterion] for g in series[(knee, criterion)])
+            for knee in biped.KNEES
+        }
+        change = relative_change(best["rolling"], best["revolute"])
+        assert f"| {change:+.1f} % |" in table
+        panel = _panel(figures[name], f"rolling vs revolute knee, optimal {criterion} criterion")
+        curve = next(line for line in panel.get_lines() if line.get_marker() == "D")
+        expected = [
+            relative_change(
+                *(
+                    next(g for g in series[(k, criterion)] if g["speed"] == v)["costs"][criterion]
+                    for k in ("rolling", "revolute")
+                )
+            )
+            for v in SPEEDS
+        ]
+        assert np.allclose(curve.get_ydata(), expected)
+
+
+def test_criterion_figures_say_their_units_and_sign_and_why_fig8_middle_scatters():
+    """Figs. 4 and 8: each axis of a criterion says per metre or per step with its symbol
+    set as mathtext (no literal underscore), the knees are named in words, a third panel
+    holds the difference in %, and Fig. 8 says why the sthenic criterion of the energy
+    optima is not a smooth curve."""
+    from biped.comparison import DIFFERENCE
+    from biped.figures import OTHER_NOTES, criterion_figure
+
+    series = _synthetic_series()
+    for criterion, other in (("sthenic", "energy"), ("energy", "sthenic")):
+        figure = criterion_figure(series, criterion, other, "Fig.")
+        texts = _texts(figure)
+        assert r"energy criterion $C_E$ per step [J]" in texts
+        assert r"sthenic criterion $C_\Gamma$ per metre walked [N²·m·s]" in texts
+        assert not [t for t in texts if "C_" in t and "$" not in t]
+        assert not [t for t in texts if "(ck)" in t or "(rk)" in t]
+        assert {"revolute knee", "rolling knee"} <= texts
+        assert "(rolling − revolute) / revolute [%]" in texts
+        caption = figure.get_supxlabel().replace("\n", " ")
+        assert DIFFERENCE in caption
+        assert (
+            OTHER_NOTES["energy"] in caption if criterion == "energy" else "Middle" not in caption
+        )
+        panel = _panel(figure, f"rolling vs revolute knee, optimal {criterion} criterion")
+        assert any(np.allclose(line.get_ydata(), 0.0) for line in panel.get_lines())
+        _pixels(figure)  # the mathtext renders
