@@ -23,6 +23,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from biped.errors import BipedError
+
 TEMPORARY_SUFFIX = ".tmp"
 
 
@@ -156,3 +158,19 @@ def atomic_set(folder: str | Path, name: str = "set") -> Iterator[Path]:
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     _fsync_folder(folder)
+
+
+def distinct_values(values, name: str, unit: str, decimals: int, resolution: str) -> list[float]:
+    """``values`` sorted, each distinct in the file names that write it with ``decimals``
+    decimals (``resolution`` says that step in words, e.g. "1 mm/s"); otherwise an error that
+    names the value given twice, or the two values that share a name."""
+    values = sorted(float(v) for v in values)
+    for a, b in zip(values, values[1:], strict=False):
+        shown = f"{a:.{decimals}f}"
+        if shown != f"{b:.{decimals}f}":
+            continue
+        what = f"{a:g} {unit} given twice" if a == b else f"{a:g} and {b:g} {unit} are both {shown}"
+        raise BipedError(
+            f"{name}: {what}: allowed values distinct at the files' {resolution} resolution"
+        )
+    return values

@@ -4,7 +4,8 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
 
     knee, criterion, speed [m/s], period [s], step_length [m],
     safety {clearance, zmp_margin} [m] (margins beyond the paper's constraints), feasible,
-    costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]},
+    costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]} (on the check grid of 202
+        samples per step: what the comparisons, tables and figures use),
     robot {field: value}, parameters {name: value} (the 21 of ``biped.gait.PARAMETERS``),
     constraints {name: worst Ψ_i on the samples, less the safety margins: >= 0 when met},
     impact {impulse [N·s, N·s, N·m·s], trailing_foot_lift [m/s] (heel, toe), consistent
@@ -12,7 +13,9 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
             qd_plus},
     optimizer {method, status ("converged" when the best start's solver converged), starts,
                starts_at_best, iterations, constraint_violation, dual_infeasibility,
-               seconds, seed, history (each start), variables (the solver's variables)},
+               seconds, seed, value (the criterion on the solver's 52 samples per step, which
+               ranks the starts; it differs from costs.<criterion> by a fraction of a percent),
+               history (each start), variables (the solver's variables)},
     provenance {package, version, python, platform, numpy, scipy, casadi, mujoco, command}
         (``biped.provenance``: what produced the file),
     units {path: unit} of every number above and below ("costs.sthenic": "N²·m·s",
@@ -24,7 +27,8 @@ left and right limits, because the accelerations (and torques) jump at the knot.
 
 ``read`` checks the format and names the bad field; ``read_consistent`` also recomputes what
 the parameters determine (period, step length, samples, costs, constraints, ``feasible``,
-impact) and refuses a file whose figures are not those of its parameters, naming the field.
+impact) and refuses a file whose figures are not those of its parameters, naming the field:
+every command that reads a gait file a user gives reads it with ``read_consistent``.
 """
 
 from __future__ import annotations
@@ -53,6 +57,20 @@ FORMAT = "biped-gait/2"  # 2: safety margins recorded
 # Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
 MIN_STEP_LENGTH = 1e-3
 SAMPLE_FIELDS = {"t": 1, "q": 9, "qd": 9, "qdd": 9, "torques": 6, "wrench": 3, "zmp": 1}
+# What a gait file is and who writes it, for a message refusing another file.
+GAIT_FILE = f"a gait file (format {FORMAT!r}) that biped optimize, sweep, design or pipeline writes"
+# The project's other JSON files with a "format", by its prefix (the version follows "/"):
+# what each is, and the command that writes it.
+OTHER_FORMATS = {
+    "biped-sweep/": "a sweep's record (which biped sweep writes, as sweep.json)",
+    "biped-design-map/": (
+        "a design map's record (which biped design-map writes, as design-map.json)"
+    ),
+    "biped-paper-method/": (
+        "the record of the paper's method's runs (which biped sweep --paper-seeds writes, as "
+        "paper-method/settings.json)"
+    ),
+}
 
 
 def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None = None) -> dict:
@@ -139,8 +157,40 @@ def parameters(gait: dict) -> np.ndarray:
     return np.array([gait["parameters"][name] for name in PARAMETERS])
 
 
-def read(path: str | Path) -> dict:
-    """Read a gait file; samples become numpy arrays. Raises BipedError if it is not one."""
+def other_kind(content) -> str | None:
+    """What a JSON file of this project other than a gait file is, and which command writes
+    it ("a robustness map (which biped robustness writes)"), or None if it is none of them
+    (a gait file, of any version, or something else)."""
+    if not isinstance(content, dict):
+        return None
+    found = content.get("format")
+    for prefix, kind in OTHER_FORMATS.items():
+        if isinstance(found, str) and found.startswith(prefix):
+            return kind
+    if {"nominal", "limits", "ranges"} <= content.keys():
+        return "a robustness map (which biped robustness writes)"
+    if _validation_report(content):
+        return "a validation report (which biped validate --json and biped pipeline write)"
+    if content and all(_validation_report(value) for value in content.values()):
+        return "the validation reports of several gait files (which biped validate --json writes)"
+    if isinstance(content.get("point"), dict) and "certified" in content:
+        return "one optimization of a design map (which biped design-map writes)"
+    return None
+
+
+def _validation_report(content) -> bool:
+    """Whether ``content`` is a validation report (``validate.report.as_json``)."""
+    return (
+        isinstance(content, dict)
+        and "passed" in content
+        and isinstance(content.get("inverse_dynamics"), dict)
+    )
+
+
+def read(path: str | Path, allowed: str = GAIT_FILE) -> dict:
+    """Read a gait file; samples become numpy arrays. Raises BipedError if it is not one,
+    saying what it is if it is another of this project's files and what is ``allowed``
+    (default a gait file: what the command takes)."""
     path = Path(path)
     try:
         content = json.loads(path.read_text())
@@ -156,6 +206,14 @@ def read(path: str | Path) -> dict:
     def bad(what):
         return BipedError(f"gait file {str(path)!r} is corrupt: {what}")
 
+    kind = other_kind(content)
+    if kind is not None:  # a valid file of another kind is not corrupt
+        raise BipedError(f"{str(path)!r} is {kind}, not a gait file: allowed {allowed}")
+    found = content.get("format") if isinstance(content, dict) else None
+    if isinstance(found, str) and found.startswith("biped-gait/") and found != FORMAT:
+        raise BipedError(
+            f"gait file {str(path)!r} has format {found!r}, another version's: allowed {allowed}"
+        )
     if not isinstance(content, dict) or content.get("format") != FORMAT:
         raise bad(f"format is not {FORMAT!r}")
     for key in ("knee", "criterion", "speed", "period", "step_length", "feasible", "costs"):
@@ -360,9 +418,9 @@ def check_consistency(gait: dict, source: str = "gait") -> None:
             )
 
 
-def read_consistent(path: str | Path) -> dict:
+def read_consistent(path: str | Path, allowed: str = GAIT_FILE) -> dict:
     """``read``, then ``check_consistency``: a gait file whose derived fields (samples, costs,
     constraints, feasible, impact) are those of its parameters."""
-    gait = read(path)
+    gait = read(path, allowed)
     check_consistency(gait, f"gait file {str(path)!r}")
     return gait

@@ -34,6 +34,22 @@ class Manifest:
     def claim(self, folder: str | Path, wanted: dict) -> None:
         """Write the folder's record of ``wanted`` settings, or check those it holds.
 
+        The folder (and its missing parents) is created only once the check has passed: a
+        refused run leaves nothing behind. Call it before anything else is written there.
+
+        Raises:
+            BipedError: as ``check``.
+        """
+        folder = Path(folder)
+        if self.check(folder, wanted):
+            return
+        folder.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(folder / self.name, json.dumps(wanted, indent=1))
+
+    def check(self, folder: str | Path, wanted: dict) -> bool:
+        """Whether the folder's record holds ``wanted`` settings (False: it has none yet, a
+        run may claim it); writes nothing.
+
         Raises:
             BipedError: the record is unreadable or holds other settings, or (with an
                 ``owner``) the folder holds JSON files but no record.
@@ -52,10 +68,10 @@ class Manifest:
                         f"has {value!r}: allowed only the same settings, choose another "
                         "--out folder"
                     )
-            return
+            return True
         if self.owner is not None and any(folder.glob("*.json")):
             raise BipedError(
                 f"{folder} holds {self.contents} but no {self.name}: allowed an empty folder "
                 f"or {self.owner}, choose another --out folder"
             )
-        atomic_write_text(path, json.dumps(wanted, indent=1))
+        return False

@@ -7,11 +7,16 @@ import tempfile
 
 import numpy as np
 
-from biped.criteria import MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
+from biped.comparison import CERTIFIED
+from biped.criteria import CRITERIA, MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
 from biped.errors import BipedError
+from biped.kinematics import KNEES
 from biped.problem import MIN_SPEED
 from validate import DEFAULT_STEPS
 
+# What an option naming an output says of its missing folders (the path written is printed).
+FOLDERS_CREATED = "missing folders are created"
+FOLDER_CREATED = "created if missing"
 ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
 SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower steps are mm long)"
 # Most speeds of a sweep: each is an optimisation per knee and criterion.
@@ -21,6 +26,57 @@ MAX_STEPS = 1000
 STEPS_HELP = f"steps to walk, 1 to {MAX_STEPS} (default {DEFAULT_STEPS})"
 # Most worker processes of a sweep.
 MAX_JOBS = 256
+SPEED_HELP = f"[m/s] walking speed, {MIN_SPEED} m/s or faster"
+JOBS_HELP = f"worker processes, 1 to {MAX_JOBS} (default: all cores)"
+# The terms of the help pages, defined once (a definition printed whole on every page that
+# uses the term; no hyphens, where argparse may break a line).
+KNEE_HELP = (
+    "revolute: a pin joint; rolling: the paper's rolling knee, a circle of radius r1 on the "
+    "shank rolling on a circle of radius r2 on the thigh"
+)
+CRITERION_HELP = (
+    "sthenic (the paper's eq. 30): the squared joint torques integrated over a step and divided "
+    "by the step length S, (1/S) ∫ ΓᵀΓ dt, so per metre walked [N²·m·s]; energy (eq. 31): the "
+    "absolute work of the joints over a step, ∫ Σ |Γ_i θ̇_i| dt [J per step]"
+)
+CERTIFIED_HELP = f"certified: {CERTIFIED}"
+
+
+def add_knee(parser, several: bool = False, **kwargs) -> None:
+    """``--knee`` (one, required unless ``kwargs`` say otherwise) or ``--knees`` (one or both,
+    default both), each knee defined in the help."""
+    if several:
+        parser.add_argument(
+            "--knees",
+            nargs="+",
+            choices=KNEES,
+            default=list(KNEES),
+            action=Distinct,
+            help=f"knees to optimise, one or both; {KNEE_HELP} (default: both)",
+        )
+    else:
+        parser.add_argument("--knee", choices=KNEES, help=f"knee kinematic; {KNEE_HELP}", **kwargs)
+
+
+def add_criterion(parser, several: bool = False) -> None:
+    """``--criterion`` (default sthenic) or ``--criteria`` (one or both, default both), each
+    criterion defined with its unit in the help."""
+    if several:
+        parser.add_argument(
+            "--criteria",
+            nargs="+",
+            choices=CRITERIA,
+            default=list(CRITERIA),
+            action=Distinct,
+            help=f"criteria to minimise, one or both; {CRITERION_HELP} (default: both)",
+        )
+    else:
+        parser.add_argument(
+            "--criterion",
+            choices=CRITERIA,
+            default="sthenic",
+            help=f"criterion to minimise; {CRITERION_HELP} (default %(default)s)",
+        )
 
 
 def speed(text: str) -> float:
@@ -123,7 +179,7 @@ def add_budget(parser, sweep: bool = False):
         "--method",
         choices=("ipopt",) if sweep else METHODS,
         default="ipopt",
-        help="ipopt: exact derivatives, several starts, certified optima (default)"
+        help="ipopt: exact derivatives, several starts, certified optima (default %(default)s)"
         + (
             "; a sweep's points are certified optima, the paper's method runs beside them "
             "(--paper-seeds)"
@@ -137,7 +193,7 @@ def add_budget(parser, sweep: bool = False):
         default=DEFAULT_STARTS,
         metavar="N",
         help=f"IPOPT starts: the first guess and N-1 perturbations of it (default "
-        f"{DEFAULT_STARTS})",
+        f"{DEFAULT_STARTS}); {CERTIFIED_HELP}",
     )
     parser.add_argument(
         "--nelder-mead-starts",
@@ -150,12 +206,14 @@ def add_budget(parser, sweep: bool = False):
         "--seed",
         type=non_negative,
         default=0,
+        metavar="N",
         help="seed of the perturbed starts and of Nelder-Mead (default 0)",
     )
     parser.add_argument(
         "--restarts",
         type=non_negative,
         default=MAX_RESTARTS,
+        metavar="N",
         help=f"Nelder-Mead restarts from the best point at most (default {MAX_RESTARTS})",
     )
     parser.add_argument(
@@ -262,7 +320,8 @@ class Distinct(argparse.Action):
 DASK_SCHEMES = ("tcp", "tls")
 DASK_HELP = (
     "run the optimizations on the workers of this running Dask scheduler (tcp://HOST:PORT) "
-    "instead of local processes; needs pip install '.[cluster]'"
+    "instead of local processes; needs pip install '.[cluster]' (default: local processes, "
+    "--jobs)"
 )
 
 

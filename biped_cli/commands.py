@@ -82,6 +82,37 @@ def cmd_demo(args) -> int:
     return 0
 
 
+def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
+    """An optimum in three lines: its step; both criteria on the check grid (``costs`` in
+    its gait file, what the comparisons use); its criterion on the solver's samples
+    (``optimizer.value``, what ranked the starts; left out for a result without it)."""
+    from biped.comparison import (
+        CHECK_SAMPLES_PER_STEP,
+        NELDER_MEAD_SAMPLES_PER_STEP,
+        SOLVER_SAMPLES_PER_STEP,
+    )
+    from biped.units import CRITERION_UNITS
+
+    ev = optimum.evaluation
+    lines = [
+        f"{knee} knee, {criterion}-optimal gait at {speed} m/s: period "
+        f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m",
+        f"  costs, on the check grid ({CHECK_SAMPLES_PER_STEP} samples per step; the "
+        f"comparisons use them): sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J",
+    ]
+    samples = (
+        f"{SOLVER_SAMPLES_PER_STEP} per step; it ranks the starts"
+        if optimum.report.method == "ipopt"
+        else f"{NELDER_MEAD_SAMPLES_PER_STEP} per step, penalties included"
+    )
+    if np.isfinite(optimum.report.value):
+        lines.append(
+            f"  optimizer.value, on the solver's samples ({samples}): {criterion} "
+            f"{optimum.report.value:.6g} {CRITERION_UNITS[criterion]}"
+        )
+    return "\n".join(lines)
+
+
 def cmd_optimize(args) -> int:
     """Find the optimal gait of one robot at one walking speed and write it as JSON.
 
@@ -101,11 +132,7 @@ def cmd_optimize(args) -> int:
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
     optimum = optimize(problem, **budget(args))
     ev = optimum.evaluation
-    print(
-        f"{args.knee} {args.criterion} {args.speed} m/s: criterion {optimum.value:.6g}, "
-        f"sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J, "
-        f"period {optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m"
-    )
+    print(optimum_line(args.knee, args.criterion, args.speed, optimum))
     report = optimum.report
     print(report.summary())
     if report.converged and report.method == "ipopt" and not report.confirmed:
@@ -141,19 +168,25 @@ def cmd_sweep(args) -> int:
     """Optimal gaits over a range of speeds, both knees and both criteria, on all cores
     (or on a Dask cluster with --dask tcp://HOST:PORT).
 
-    Each point is saved as it completes; run the same command again to resume. A progress
-    bar is drawn on stderr when it is a terminal.
+    Each optimization is saved as it completes; run the same command again to resume.
+    Progress on stderr, with the time elapsed and an estimate of the time left: a bar on a
+    terminal, else a line at most every 10 s.
     """
+    from biped.paper_method import FOLDER, SETTINGS, check_paper_method, run_paper_method
     from biped.paper_method import SPEED as PAPER_METHOD_SPEED
-    from biped.paper_method import run_paper_method
     from biped.runner import check_dask
-    from biped.sweep import run_sweep
+    from biped.sweep import INDEPENDENT, MANIFEST, run_sweep
     from biped_cli.progress import Progress
 
     robot = _robot(args.robot)
+    check_folder(args.out, "--out")
+    # at the sweep's speed nearest the paper's optima
+    paper_speed = float(min(args.speeds, key=lambda v: abs(v - PAPER_METHOD_SPEED)))
+    if args.paper_seeds:  # refused before the sweep runs, not after
+        check_paper_method(args.out, robot, paper_speed, args.paper_seeds, args.knees, safety(args))
     if args.dask is not None:
         check_dask(args.dask)
-    run_sweep(
+    points = run_sweep(
         args.out,
         robot,
         args.speeds,
@@ -166,19 +199,29 @@ def cmd_sweep(args) -> int:
         dask=args.dask,
         progress=lambda total: Progress(total, "sweep"),
     )
-    if args.paper_seeds:  # at the sweep's speed nearest the paper's optima
-        run_paper_method(
+    runs = []
+    if args.paper_seeds:
+        runs = run_paper_method(
             args.out,
             robot,
-            speed=float(min(args.speeds, key=lambda v: abs(v - PAPER_METHOD_SPEED))),
+            speed=paper_speed,
             seeds=args.paper_seeds,
             knees=args.knees,
             criteria=args.criteria,
             safety=safety(args),
             jobs=args.jobs,
             dask=args.dask,
+            progress=lambda total: Progress(total, "paper's method"),
         )
-    print(f"sweep results in {args.out}")
+
+    def files(n: int) -> str:
+        return f"{n} gait file{'' if n == 1 else 's'}"
+
+    paper = f", {FOLDER}/ ({SETTINGS} and {files(len(runs))})" if runs else ""
+    print(  # the folder's files, once: a file per optimization is too many to name
+        f"sweep results in {args.out}: {MANIFEST}, {files(len(points))} "
+        f"<knee>-<criterion>-<speed>.json, {INDEPENDENT}/ (each point's first solve){paper}"
+    )
     return 0
 
 
@@ -190,8 +233,9 @@ def cmd_figures(args) -> int:
     from biped.figures import make_figures
 
     check_folder(args.out, "--out")
+    takes = "--sweep a folder of the gait files that biped sweep writes"
     for gait in sorted(Path(args.sweep).glob("*-*.json")):  # each its parameters' gait
-        gait_file.read_consistent(gait)
+        gait_file.read_consistent(gait, takes)
     for path in make_figures(args.sweep, args.out):
         print(f"wrote {path}")
     return 0
@@ -295,7 +339,7 @@ def cmd_validate(args) -> int:
     import json
     from pathlib import Path
 
-    from biped_cli.outputs import check_owner, output_name
+    from biped_cli.outputs import check_owner, output_name, recording_lines
     from biped_cli.progress import Progress
 
     if args.rrd and len(args.gait) > 1:
@@ -305,6 +349,9 @@ def cmd_validate(args) -> int:
     if args.gif and not args.video:
         raise BipedError("--gif writes beside the --video: allowed with --video FILE.mp4")
     if args.video:
+        from validate.video import check_suffix
+
+        check_suffix(args.video, "--video", ".mp4", " (--gif writes a GIF beside it)")
         check_output(args.video, "--video")
     gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
     gaits = read_gaits(args.gait, args.model)
@@ -346,9 +393,10 @@ def cmd_validate(args) -> int:
                 print(f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
                 for check in result.checks:
                     print("  " + check.line())
-                print(f"recording: {written}  (open with: rerun {written})", flush=True)
+                for line in recording_lines(written):
+                    print(line, flush=True)
                 for video in reports[path].get("video", []):
-                    print(f"video: {video}", flush=True)
+                    print(f"video {video}", flush=True)
             bar.advance()
     if args.json:
         print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
@@ -370,9 +418,10 @@ def cmd_pipeline(args) -> int:
     from pathlib import Path
 
     from biped import gait_file
+    from biped.comparison import DIFFERENCE, relative_change
     from biped.optimize import check_speed, optimize
     from biped.problem import GaitProblem
-    from biped_cli.outputs import check_owner
+    from biped_cli.outputs import check_owner, recording_lines
 
     robot = _robot(args.robot)
     out, recordings = Path(args.out), Path(args.recordings)
@@ -423,13 +472,10 @@ def cmd_pipeline(args) -> int:
         )
         for check in result.checks:
             print(f"[{knee}]   " + check.line())
-        rrd = report["recording"]
-        if video is not None:
-            print(f"[{knee}] video {video}")
         report_path = gait_file.write_json(
             out / f"{name}.report.json", {**report, "gait": str(gait_path)}
         )
-        written.append((knee, gait_path, report_path, rrd))
+        written.append((knee, gait_path, report_path, report))
         passed = passed and result.passed
     if getattr(args, "design", False):  # --design: the knee radii optimised too
         from biped_cli.design import pipeline_design
@@ -438,12 +484,15 @@ def cmd_pipeline(args) -> int:
     if len(costs) == 2:
         revolute, rolling = costs["revolute"], costs["rolling"]
         changes = ", ".join(
-            f"{criterion} {100.0 * (rolling[criterion] / revolute[criterion] - 1.0):+.1f} %"
+            f"{criterion} {relative_change(rolling[criterion], revolute[criterion]):+.1f} %"
             for criterion in CRITERIA
         )
-        print(f"rolling vs revolute knee, {args.criterion}-optimal gaits: {changes}")
-    for knee, gait_path, report_path, rrd in written:
+        print(f"rolling vs revolute knee, {args.criterion}-optimal gaits: {changes} ({DIFFERENCE})")
+    for knee, gait_path, report_path, report in written:  # every file written, once
         print(f"{knee:9} gait {gait_path}, report {report_path}")
-        print(f"{knee:9} recording {rrd}  (open with: rerun {rrd})")
+        for line in recording_lines(report["recording"]):
+            print(f"{knee:9} {line}")
+        for video in report.get("video", []):
+            print(f"{knee:9} video {video}")
     print("all checks passed" if passed else "some checks FAILED")
     return 0 if passed else 1

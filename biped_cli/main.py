@@ -7,9 +7,9 @@ of ``biped_cli.guard``.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 
-from biped.criteria import CRITERIA
 from biped.kinematics import KNEES
 from biped.provenance import command_line, version
 from biped.sweep import DEFAULT_SPEEDS
@@ -35,8 +35,21 @@ ROBOT_HELP = types.ROBOT_HELP
 DEBUG_HELP = "on an error, print its traceback before the one-line message"
 
 
+# An argument argparse must hand to its option as a value, not read as an option: a number
+# with a minus sign, alone or first of a list or range (-1, -.5, -1e-3, -0.1,0.2, -0.1:0.3:3,
+# -inf). argparse's own pattern takes only -1 and -0.1, so `--speeds -0.1,0.2` failed with
+# "expected one argument" before the speeds' check could name the value. No option of the
+# program starts like a number.
+NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2."""
+    """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2, and
+    negative numbers read as values (``NEGATIVE_NUMBER``)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
@@ -59,7 +72,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="torques, ground wrench and ZMP of a one-leg posture",
         description=cmd_demo.__doc__,
     )
-    demo.add_argument("--knee", choices=KNEES, help="one knee kinematic (default: both)")
+    demo.add_argument(
+        "--knee", choices=KNEES, help=f"one knee kinematic; {types.KNEE_HELP} (default: both)"
+    )
     demo.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     demo.add_argument(
         "--hip-ahead",
@@ -80,10 +95,15 @@ def build_parser() -> argparse.ArgumentParser:
     opt = commands.add_parser(
         "optimize", help="optimal gait at one speed", description=cmd_optimize.__doc__
     )
-    opt.add_argument("--knee", choices=KNEES, required=True)
-    opt.add_argument("--criterion", choices=CRITERIA, default="sthenic")
-    opt.add_argument("--speed", type=types.speed, required=True, metavar="V", help="[m/s] > 0")
-    opt.add_argument("--out", required=True, metavar="FILE", help="gait file to write (JSON)")
+    types.add_knee(opt, required=True)
+    types.add_criterion(opt)
+    opt.add_argument("--speed", type=types.speed, required=True, metavar="V", help=types.SPEED_HELP)
+    opt.add_argument(
+        "--out",
+        required=True,
+        metavar="FILE",
+        help=f"gait file to write (JSON; {types.FOLDERS_CREATED})",
+    )
     types.add_budget(opt)
     opt.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     opt.set_defaults(run=cmd_optimize)
@@ -98,18 +118,15 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="S",
         help="START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.15:0.45:13)",
     )
+    types.add_knee(sweep, several=True)
+    types.add_criterion(sweep, several=True)
     sweep.add_argument(
-        "--knees", nargs="+", choices=KNEES, default=list(KNEES), action=types.Distinct
+        "--out",
+        default=DEFAULT_SWEEP,
+        metavar="DIR",
+        help=f"folder of the sweep, {types.FOLDER_CREATED} (default {DEFAULT_SWEEP})",
     )
-    sweep.add_argument(
-        "--criteria", nargs="+", choices=CRITERIA, default=list(CRITERIA), action=types.Distinct
-    )
-    sweep.add_argument(
-        "--out", default=DEFAULT_SWEEP, metavar="DIR", help=f"(default {DEFAULT_SWEEP})"
-    )
-    sweep.add_argument(
-        "--jobs", type=types.jobs, default=None, help="processes (default: all cores)"
-    )
+    sweep.add_argument("--jobs", type=types.jobs, default=None, metavar="N", help=types.JOBS_HELP)
     types.add_budget(sweep, sweep=True)
     sweep.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
     types.add_dask(sweep)
@@ -131,12 +148,15 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument(
         "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
     )
-    val.add_argument("--steps", type=types.steps, default=DEFAULT_STEPS, help=types.STEPS_HELP)
+    val.add_argument(
+        "--steps", type=types.steps, default=DEFAULT_STEPS, metavar="N", help=types.STEPS_HELP
+    )
     val.add_argument(
         "--rrd",
         metavar="PATH",
         help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
-        "named from the gait file's folder and name; another gait's recording is refused)",
+        "named from the gait file's folder and name; another gait's recording is refused; "
+        f"{types.FOLDERS_CREATED})",
     )
     val.add_argument(
         "--json",
@@ -146,8 +166,9 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument(
         "--video",
         metavar="FILE.mp4",
-        help="also render MuJoCo's walk of a single gait to an H.264 video (MUJOCO_GL=egl "
-        "without a display)",
+        help="also render MuJoCo's walk of a single gait to an H.264 MP4 video, a path "
+        f"ending in .mp4 ({types.FOLDERS_CREATED}; MUJOCO_GL=egl without a display; default: "
+        "no video)",
     )
     val.add_argument(
         "--gif", action="store_true", help="with --video, also an animated GIF beside it"
@@ -165,7 +186,8 @@ def build_parser() -> argparse.ArgumentParser:
         const="",
         default=None,
         type=types.viewer_url,
-        help="also stream the recording to a running rerun viewer (default its local address)",
+        help="also stream the recording to the rerun viewer running at URL (URL left out: its "
+        "local address; default: no stream)",
     )
     val.add_argument(
         "--model",
@@ -181,24 +203,30 @@ def build_parser() -> argparse.ArgumentParser:
         description=cmd_pipeline.__doc__,
     )
     pipe.add_argument(
-        "--speed", type=types.speed, default=DEFAULT_SPEED, metavar="V", help="[m/s] (default 0.3)"
+        "--speed",
+        type=types.speed,
+        default=DEFAULT_SPEED,
+        metavar="V",
+        help=f"{types.SPEED_HELP} (default %(default)s)",
     )
+    types.add_knee(pipe, several=True)
+    types.add_criterion(pipe)
     pipe.add_argument(
-        "--knees", nargs="+", choices=KNEES, default=list(KNEES), action=types.Distinct
+        "--steps", type=types.steps, default=DEFAULT_STEPS, metavar="N", help=types.STEPS_HELP
     )
-    pipe.add_argument("--criterion", choices=CRITERIA, default="sthenic")
-    pipe.add_argument("--steps", type=types.steps, default=DEFAULT_STEPS, help=types.STEPS_HELP)
     pipe.add_argument(
         "--out",
         default=DEFAULT_PIPELINE,
         metavar="DIR",
-        help=f"gait files and reports (default {DEFAULT_PIPELINE})",
+        help=f"folder of the gait files and reports, {types.FOLDER_CREATED} "
+        f"(default {DEFAULT_PIPELINE})",
     )
     pipe.add_argument(
         "--recordings",
         default=DEFAULT_RECORDINGS,
         metavar="DIR",
-        help=f"rerun recordings and videos (default {DEFAULT_RECORDINGS})",
+        help=f"folder of the rerun recordings and videos, {types.FOLDER_CREATED} "
+        f"(default {DEFAULT_RECORDINGS})",
     )
     pipe.add_argument(
         "--no-video",
@@ -218,8 +246,19 @@ def build_parser() -> argparse.ArgumentParser:
     fig = commands.add_parser(
         "figures", help="figures and table of the comparison", description=cmd_figures.__doc__
     )
-    fig.add_argument("--sweep", default=DEFAULT_SWEEP, metavar="DIR", help="sweep results")
-    fig.add_argument("--out", default=DEFAULT_FIGURES, metavar="DIR", help="(default logs/figures)")
+    fig.add_argument(
+        "--sweep",
+        default=DEFAULT_SWEEP,
+        metavar="DIR",
+        help="folder of a sweep's results, as biped sweep --out writes it (default %(default)s)",
+    )
+    fig.add_argument(
+        "--out",
+        default=DEFAULT_FIGURES,
+        metavar="DIR",
+        help=f"folder of the figures and comparison.md, {types.FOLDER_CREATED} "
+        f"(default {DEFAULT_FIGURES})",
+    )
     fig.set_defaults(run=cmd_figures)
     design.add_parsers(commands)
     report.add_parser(commands)

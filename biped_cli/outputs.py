@@ -6,12 +6,19 @@ so gait files of the same name in two folders do not share them. Beside each rec
 owner record ``<recording>.source.json`` names the gait file it was made from (absolute path)
 and the SHA-256 of that file's content; a recording owned by another gait file is never
 overwritten (``check_owner``), and a page links a recording only if it is its gait's.
+
+Every file a command writes is printed once, the owner record of a recording on the line
+after it (``recording_lines``); the command that opens a recording is this environment's own
+rerun viewer (``open_command``), which works as printed without activating the environment.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import shlex
+import shutil
+import sys
 from pathlib import Path
 
 from biped.errors import BipedError
@@ -75,3 +82,28 @@ def belongs_to(recording: str | Path, gait_path: str | Path) -> bool | None:
         return None
     gait_path = Path(gait_path)
     return record["gait"] == str(gait_path.resolve()) and record.get("sha256") == digest(gait_path)
+
+
+def rerun_command() -> str:
+    """The rerun viewer of this environment, as a command that works as printed: the
+    ``rerun`` beside this Python (a virtual environment's ``bin/``, on the PATH only once
+    activated), else the one on the PATH, else this Python's ``-m rerun``."""
+    beside = Path(sys.executable).parent / ("rerun.exe" if sys.platform == "win32" else "rerun")
+    if beside.is_file():
+        return shlex.quote(str(beside))
+    found = shutil.which("rerun")
+    return shlex.quote(found) if found else f"{shlex.quote(sys.executable)} -m rerun"
+
+
+def open_command(recording: str | Path) -> str:
+    """The command line that opens ``recording`` in this environment's rerun viewer."""
+    return f"{rerun_command()} {shlex.quote(str(recording))}"
+
+
+def recording_lines(recording: str | Path) -> list[str]:
+    """What a command prints of a recording it wrote: the recording and how to open it, then
+    its owner record (a file written too)."""
+    return [
+        f"recording {recording}  (open with: {open_command(recording)})",
+        f"owner record {owner_path(recording)} (the gait file it was made from)",
+    ]

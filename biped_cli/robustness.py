@@ -47,6 +47,7 @@ def add_parser(commands) -> None:
         "--steps",
         type=types.steps,
         default=default.steps,
+        metavar="N",
         help=f"steps of every walk, 2 to {types.MAX_STEPS} (default {default.steps})",
     )
     parser.add_argument(
@@ -67,6 +68,7 @@ def add_parser(commands) -> None:
         "--jobs",
         type=types.jobs,
         default=default.jobs,
+        metavar="N",
         help=f"processes walking the limits side by side (default {default.jobs})",
     )
     parser.add_argument(
@@ -79,7 +81,8 @@ def add_parser(commands) -> None:
         "--out",
         default=DEFAULT_ROBUSTNESS,
         metavar="DIR",
-        help=f"folder of the maps (default {DEFAULT_ROBUSTNESS}): <folder>-<gait>.json and .png",
+        help=f"folder of the maps, {types.FOLDER_CREATED} (default {DEFAULT_ROBUSTNESS}): "
+        "<folder>-<gait>.json and .png",
     )
     parser.set_defaults(run=cmd_robustness)
 
@@ -134,12 +137,47 @@ def lines(content: dict) -> list[str]:
         near, far = limit["bracket"]
         bracket = f"bracket {_value(name, near)} to {_value(name, far)}"
         if limit["bracketed"]:
-            detail = f"fails at {_value(name, limit['fails_at'])}; {bracket}"
+            low, high = limit["reproducible"]
+            machines = f"on any machine {_value(name, low)} to {_value(name, high)}"
+            detail = f"fails at {_value(name, limit['fails_at'])}; {machines}; {bracket}"
             why = ": " + ", ".join(limit["failures"])
         else:
             detail = f"{bracket}: its end walks too, the limit lies beyond"
             why = ""
         out.append(f"  {label:19} {_value(name, limit['limit']):>11}  ({detail}){why}")
+    return out
+
+
+def _range(name: str, limit: dict) -> str:
+    from validate.robustness import reproducible_range
+
+    low, high = reproducible_range(limit)
+    if high == float("inf"):
+        return f"beyond {_value(name, low)}"
+    if low == float("-inf"):
+        return f"beyond {_value(name, high)}"
+    return f"{_value(name, low)} to {_value(name, high)}"
+
+
+def comparison_lines(maps: dict) -> list[str]:
+    """Each limit of the first map (path -> JSON content) beside every other map's, said
+    distinguishable only where the ranges they keep across machines do not overlap
+    (``validate.robustness.distinguishable``)."""
+    from validate.robustness import MACHINE_STEPS, distinguishable
+
+    (first, reference), *others = maps.items()
+    out = [
+        f"compared (each limit as it lies on any machine: {MACHINE_STEPS} bisection step "
+        "either way of its bracket)"
+    ]
+    for name, limit in reference["limits"].items():
+        for path, content in others:
+            other = content["limits"][name]
+            verdict = "distinct" if distinguishable(limit, other) else "not distinguishable"
+            out.append(
+                f"  {SHOWN[name][0]:19} {first} {_range(name, limit)}, "
+                f"{path} {_range(name, other)}: {verdict}"
+            )
     return out
 
 
@@ -153,8 +191,9 @@ def cmd_robustness(args) -> int:
     MuJoCo warning).
 
     Writes per gait <out>/<folder>-<gait>.json (limits, brackets, tolerances, why the first
-    failing walk failed, a units map, provenance) and .png, together; a progress bar on a
-    terminal. Exits 1 if a gait's nominal walk fails (no map is written for it), 0 otherwise.
+    failing walk failed, a units map, provenance) and .png, together; progress on stderr,
+    with the time elapsed and left (a bar on a terminal, else a line at most every 10 s).
+    Exits 1 if a gait's nominal walk fails (no map is written for it), 0 otherwise.
     """
     from biped.files import atomic_set
     from biped.provenance import provenance
@@ -165,8 +204,8 @@ def cmd_robustness(args) -> int:
     from validate.robustness_figure import DPI, robustness_figure
 
     settings = _settings(args)
+    types.check_folder(args.out, "--out")  # before the gait files' checks, which take time
     gaits = read_gaits(args.gait, args.model)
-    types.check_folder(args.out, "--out")
     names = [output_name(path) for path in args.gait]
     repeated = sorted({name for name in names if names.count(name) > 1})
     if repeated:
@@ -174,7 +213,7 @@ def cmd_robustness(args) -> int:
             f"gait files in folders of the same name would share the map {repeated[0]!r}: "
             "allowed gait files of distinct folder or file names"
         )
-    out, failed = Path(args.out), []
+    out, failed, mapped = Path(args.out), [], {}
     with Progress(len(gaits) * (1 + len(robustness.LIMITS)), "robustness") as bar:
         for path, gait, name in zip(args.gait, gaits, names, strict=True):
             bar.update(note=path)
@@ -210,6 +249,7 @@ def cmd_robustness(args) -> int:
                 text = json.dumps(content, indent=1, allow_nan=False)
                 (staging / f"{name}.json").write_text(text, encoding="utf-8")
                 figure.savefig(staging / f"{name}.png", dpi=DPI)
+            mapped[path] = content
             for line in lines(content):
                 print(line)
             print(
@@ -217,6 +257,8 @@ def cmd_robustness(args) -> int:
                 f"{wall:.1f} s, {settings.jobs} process{'es' if settings.jobs > 1 else ''})",
                 flush=True,
             )
+    if len(mapped) > 1:
+        print("\n".join(comparison_lines(mapped)))
     if failed:
         print(
             f"biped robustness: the nominal walk fails for {', '.join(failed)}: no robustness "

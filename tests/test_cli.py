@@ -355,7 +355,8 @@ class _Terminal:
 
 
 def test_progress_draws_on_a_terminal_only(capsys):
-    """The bar draws one line (carriage returns, no newline) on a terminal, nothing elsewhere."""
+    """The bar draws one line (carriage returns, no newline) on a terminal, nothing elsewhere
+    in a short run."""
     import io
 
     piped = io.StringIO()

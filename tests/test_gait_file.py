@@ -97,3 +97,88 @@ def test_deeply_nested_json_is_one_error(tmp_path):
     path.write_text("[" * 100_000 + "]" * 100_000)
     with pytest.raises(BipedError, match="not valid JSON"):
         gait_file.read(path)
+
+
+def _other_files() -> dict:
+    """The content of each of the project's other JSON files, as its writer makes it, by
+    what the refusal must call it."""
+    from biped import design_map, paper_method, sweep
+    from biped.criteria import PAPER_SAFETY
+    from validate import robustness
+    from validate.checks import Check
+    from validate.report import as_json
+
+    robot = Robot.paper()
+    limits = {
+        name: robustness.Limit(name, "1", (0.0, 1.0), 0.5, 0.6, ("fell",), False, 4)
+        for name in robustness.LIMITS
+    }
+    walked = robustness.RobustnessMap(
+        robustness.RobustnessSettings(), 0.6, 1.5, 1.0, 30.0, (), limits
+    )
+    report = as_json(
+        [Check("model", True, {}), Check("inverse_dynamics", True, {"max_zmp_error": 0.0})]
+    )
+    point = design_map.MapPoint("revolute", 0.3)
+    return {
+        "a sweep's record": sweep.Settings(robot, PAPER_SAFETY, (0.3,), 0, 1).to_dict(),
+        "a design map's record": design_map.MapSettings(
+            robot, "sthenic", PAPER_SAFETY, (0.3,), (0.0,), (0.0,), (0.05, 0.05), 0, 1
+        ).to_dict(),
+        "the record of the paper's method's runs": paper_method.PaperMethod(
+            robot, PAPER_SAFETY, 0.3, 1
+        ).to_dict(),
+        "a robustness map": {"gait": "logs/rk.json", **walked.to_dict()},
+        "a validation report": {**report, "gait": "logs/rk.json"},
+        "the validation reports of several gait files": {"a.json": report, "b.json": report},
+        "one optimization of a design map": {
+            "point": design_map._point_dict(point),
+            "certified": True,
+        },
+    }
+
+
+@pytest.mark.parametrize("kind", list(_other_files()))
+def test_a_file_of_another_kind_is_named_not_called_corrupt(kind, tmp_path):
+    """A valid JSON file of another kind is refused in one line saying what it is and what a
+    gait file is, never that it is corrupt."""
+    path = tmp_path / "other.json"
+    path.write_text(json.dumps(_other_files()[kind]))
+    with pytest.raises(BipedError) as error:
+        gait_file.read(path)
+    message = str(error.value)
+    assert message.startswith(f"{str(path)!r} is {kind} (which biped ")
+    assert f"not a gait file: allowed {gait_file.GAIT_FILE}" in message
+    assert "corrupt" not in message and "\n" not in message
+
+
+def test_a_gait_file_of_another_version_says_so(content, tmp_path):
+    """A gait file of another format version is named as such, with the version read."""
+    message = _corrupt(content, tmp_path, lambda g: g.update(format="biped-gait/1"))
+    assert "has format 'biped-gait/1', another version's" in message
+    assert repr(gait_file.FORMAT) in message and "corrupt" not in message
+
+
+def test_report_and_figures_say_what_the_file_is_and_what_they_take(tmp_path, capsys):
+    """`biped report` given a robustness map and `biped figures --sweep` given a design
+    map's folder exit 2 with one line naming the file, what it is and what they take."""
+    from biped_cli import main
+
+    other = _other_files()
+    robustness_map = tmp_path / "logs-rk.json"
+    robustness_map.write_text(json.dumps(other["a robustness map"]))
+    assert main(["report", str(robustness_map), "--out", str(tmp_path / "reports")]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and f"{str(robustness_map)!r} is a robustness map" in error
+    assert "allowed a gait file" in error and "corrupt" not in error
+    folder = tmp_path / "design-map"
+    folder.mkdir()
+    (folder / "design-map.json").write_text(json.dumps(other["a design map's record"]))
+    (folder / "revolute-0.300.json").write_text(
+        json.dumps(other["one optimization of a design map"])
+    )
+    assert main(["figures", "--sweep", str(folder), "--out", str(tmp_path / "figures")]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "design-map.json' is a design map's record" in error
+    assert "allowed --sweep a folder of the gait files that biped sweep writes" in error
+    assert not (tmp_path / "figures").exists() and not (tmp_path / "reports").exists()

@@ -117,3 +117,225 @@ def test_owner_records_name_the_gait_and_its_content(tmp_path):
     with pytest.raises(Exception, match="another gait file"):
         check_owner(recording, tmp_path / "other.json")
     assert not [p for p in os.listdir(tmp_path) if p.endswith(".tmp")]
+
+
+def _refusal(capsys, code) -> str:
+    """The one line on stderr of a command refused with exit 2."""
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "Traceback" not in captured.err, captured.err
+    return lines[0]
+
+
+def _tree(folder: Path) -> list[str]:
+    """Every file and folder under ``folder``, hidden ones included."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["sweep", "--speeds", "0.3"],
+        ["design-map"],
+        ["figures"],
+        ["pipeline"],
+        ["report", "gait.json"],
+        ["robustness", "gait.json"],
+    ],
+)
+def test_an_output_folder_naming_a_file_is_refused_naming_option_and_path(
+    command, tmp_path, monkeypatch, capsys
+):
+    """--out naming a file, for every command whose --out is a folder, is one line naming
+    --out, the path and that a folder is allowed; nothing is written."""
+    monkeypatch.chdir(tmp_path)
+    Path("rk.json").write_text("{}")
+    line = _refusal(capsys, main([*command, "--out", "rk.json"]))
+    assert "--out 'rk.json'" in line and "allowed a folder" in line, line
+    assert _tree(tmp_path) == ["rk.json"]
+
+
+def test_a_refused_sweep_writes_nothing(tmp_path, monkeypatch, capsys):
+    """A sweep refused for its folder (gait files of no sweep) or for the paper's method's
+    record there (other settings) is refused before any optimization and leaves the folder
+    as it was: no .independent/, no record."""
+    import biped.sweep
+    from biped.criteria import Safety
+    from biped.paper_method import PaperMethod
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("swept before its refusal")
+
+    monkeypatch.chdir(tmp_path)
+    foreign = Path("logs/pipeline")
+    gait_file.write_json(foreign / f"{NAME}.json", {"not": "a sweep's"})
+    before = _tree(tmp_path)
+    line = _refusal(capsys, main(["sweep", "--speeds", "0.3", "--out", str(foreign)]))
+    assert "no sweep.json" in line and "choose another --out folder" in line
+    assert _tree(tmp_path) == before
+    monkeypatch.setattr(biped.sweep, "run_sweep", no_work)
+    record = Path("S/paper-method/settings.json")
+    record.parent.mkdir(parents=True)
+    made = PaperMethod(Robot.paper(), Safety(clearance=0.0, zmp_margin=0.0), 0.3, seeds=5)
+    record.write_text(json.dumps(made.to_dict()))
+    before = _tree(tmp_path)
+    argv = ["sweep", "--speeds", "0.3", "--paper-seeds", "1", "--out", "S"]
+    line = _refusal(capsys, main(argv))
+    assert str(record) in line and "seeds = 5" in line, line
+    assert _tree(tmp_path) == before
+
+
+def test_every_output_option_says_missing_folders_are_created():
+    """The help of every option that names an output (--out, --recordings, --rrd, --video)
+    says that its missing folders are created."""
+    from biped_cli.main import build_parser
+
+    outputs = ("--out", "--recordings", "--rrd", "--video")
+    seen = 0
+    for name, parser in build_parser().command_parsers.items():
+        for action in parser._actions:
+            if set(action.option_strings) & set(outputs):
+                assert "created" in (action.help or ""), (name, action.option_strings)
+                seen += 1
+    assert seen >= 10  # optimize, sweep, figures, pipeline (2), design, design-map, ...
+
+
+def test_the_printed_rerun_command_is_this_environments(tmp_path, monkeypatch):
+    """'open with:' names the rerun beside this Python (a virtual environment's bin/, on the
+    PATH only once activated), else the one on the PATH, else this Python's -m rerun; the
+    recording's path is quoted for the shell."""
+    import shlex
+    import shutil
+    import sys
+
+    from biped_cli.outputs import open_command, recording_lines, rerun_command
+
+    command = shlex.split(rerun_command())
+    assert os.access(command[0], os.X_OK), command
+    bin_ = tmp_path / "env dir" / "bin"
+    bin_.mkdir(parents=True)
+    monkeypatch.setattr(sys, "executable", str(bin_ / "python"))
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    assert shlex.split(rerun_command()) == [str(bin_ / "python"), "-m", "rerun"]
+    (bin_ / "rerun").write_text("#!/bin/sh\n")
+    assert shlex.split(open_command("logs/a b.rrd")) == [str(bin_ / "rerun"), "logs/a b.rrd"]
+    lines = recording_lines("r.rrd")
+    assert lines[0].startswith("recording r.rrd") and "r.rrd.source.json" in lines[1]
+
+
+def test_a_model_of_something_else_is_named(tmp_path, capsys):
+    """--model naming a valid MJCF of another mechanism (a pendulum) is one line naming the
+    file and what is allowed."""
+    gait = gait_file.write_json(
+        tmp_path / "g.json", gait_file.to_dict(small_optimum("revolute"), Robot.paper(), 0)
+    )
+    pendulum = tmp_path / "pendulum.xml"
+    pendulum.write_text(
+        '<mujoco model="pendulum"><worldbody><body name="pole" pos="0 0 1">'
+        '<joint name="hinge" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0 0 -0.5" '
+        'size="0.02"/></body></worldbody></mujoco>'
+    )
+    line = _refusal(capsys, main(["validate", str(gait), "--model", str(pendulum)]))
+    assert f"model {str(pendulum)!r} has neither" in line and "allowed an MJCF" in line, line
+
+
+def test_pipeline_with_design_prints_every_file_it_writes_once(tmp_path, capsys, monkeypatch):
+    """Every file 'biped pipeline --design' writes in --out and --recordings (gait files,
+    reports, recordings, their owner records, the videos) is named on exactly one printed
+    line, and every printed path is a file it wrote (the videos stubbed: nothing renders)."""
+    import validate.video
+    from biped.files import atomic_write_bytes
+
+    def video(path, *args, gif=None, **kwargs):
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return [atomic_write_bytes(path, b"an mp4")]
+
+    monkeypatch.setattr(validate.video, "write_video", video)
+    out, rrd = tmp_path / "pipeline", tmp_path / "recordings"
+    argv = ["pipeline", "--knees", "revolute", "--steps", "1", "--starts", "1", "--design"]
+    assert main([*argv, "--out", str(out), "--recordings", str(rrd)]) in (0, 1)
+    lines = capsys.readouterr().out.splitlines()
+    tokens = [{t.strip(",;()") for t in line.split()} for line in lines]
+    written = {str(p) for p in [*out.rglob("*"), *rrd.rglob("*")] if p.is_file()}
+    assert str(rrd / "design-sthenic-0.300.mp4") in written
+    for path in written:
+        assert sum(path in line for line in tokens) == 1, path
+    printed = {t for line in tokens for t in line if t.startswith(str(tmp_path))}
+    assert printed == written
+
+
+@pytest.mark.parametrize("name", ["walk.avi", "walk.gif", "walk"])
+def test_a_video_path_of_another_container_is_refused_before_any_work(
+    name, tmp_path, capsys, monkeypatch
+):
+    """--video takes a path ending in .mp4, the container written: walk.avi, walk.gif or no
+    suffix is one line naming --video, the path and .mp4, before the gait is read; nothing
+    is written."""
+    import biped_cli.commands
+    from biped_cli import main
+
+    monkeypatch.setattr(
+        biped_cli.commands, "read_gaits", lambda *a, **k: pytest.fail("read before refusing")
+    )
+    monkeypatch.chdir(tmp_path)
+    assert main(["validate", "gait.json", "--video", name]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"--video {name!r}" in err[0] and "ending in .mp4" in err[0], err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_video_module_refuses_suffixes_it_does_not_write(tmp_path, capsys):
+    """python -m validate.video refuses --out, --gif, --frame whose suffix is not .mp4, .gif,
+    .png (exit 2, one line naming the option), before reading the gait file."""
+    from validate.video import main
+
+    for option, path, allowed in (
+        ("--out", "walk.avi", ".mp4"),
+        ("--gif", "walk.mp4", ".gif"),
+        ("--frame", "walk.jpg", ".png"),
+    ):
+        assert main(["missing.json", option, str(tmp_path / path)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and option in err[0] and f"ending in {allowed}" in err[0], err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_video_writers_create_missing_folders(tmp_path):
+    """The MP4 and GIF writers create the missing folders of their path, as the command's
+    --help says (three small frames: nothing is rendered)."""
+    import numpy
+
+    from validate.video import write_gif, write_mp4
+
+    frames = [numpy.full((32, 32, 3), 40 * k, dtype=numpy.uint8) for k in range(3)]
+    mp4 = write_mp4(tmp_path / "new" / "dir" / "walk.mp4", frames)
+    gif = write_gif(tmp_path / "other" / "walk.gif", frames)
+    assert mp4.stat().st_size > 0 and gif.stat().st_size > 0
+
+
+def test_report_prints_every_file_it_writes_once(gaits, capsys):
+    """'biped report' names each page and each of its figures on one 'wrote' line, and
+    nothing else under --out."""
+    assert main(["report", str(gaits["pipeline"]), "--out", "pages"]) == 0
+    printed = [line.removeprefix("wrote ") for line in capsys.readouterr().out.splitlines()]
+    written = sorted(str(p) for p in Path("pages").rglob("*") if p.is_file())
+    assert sorted(printed) == written and len(written) > 1
+
+
+def test_sweep_names_the_files_of_its_folder(tmp_path, capsys):
+    """A sweep's last line names its record, its gait files and intermediate folder and the
+    paper's method's, with counts that are those of the files written."""
+    out = tmp_path / "S"
+    argv = ["sweep", "--speeds", "0.3", "--knees", "revolute", "--criteria", "sthenic"]
+    assert (
+        main([*argv, "--starts", "1", "--paper-seeds", "1", "--jobs", "1", "--out", str(out)]) == 0
+    )
+    line = capsys.readouterr().out.strip().splitlines()[-1]
+    gaits = list(out.glob("*-*.json"))
+    runs = list((out / "paper-method").glob("*-*.json"))
+    assert len(gaits) == len(runs) == 1 and (out / "sweep.json").is_file()
+    assert line == (
+        f"sweep results in {out}: sweep.json, 1 gait file <knee>-<criterion>-<speed>.json, "
+        ".independent/ (each point's first solve), paper-method/ (settings.json and 1 gait file)"
+    )

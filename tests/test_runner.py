@@ -24,7 +24,7 @@ import biped
 from biped import runner
 from biped.files import atomic_write_text
 from biped.sweep import INDEPENDENT, run_sweep
-from biped_cli import main
+from biped_cli import main, progress
 
 SPEEDS = (0.275, 0.3)
 # A small sweep: one knee, one criterion, two speeds, one start (4 optimizations).
@@ -258,10 +258,75 @@ def test_screen_renders_a_bar_left_behind():
     assert screen("\rsweep  1/3 [#]\r\x1b[Kdone\n") == ["done", ""]
 
 
+class Clock:
+    """A clock read by ``biped_cli.progress``, set by the test [s]."""
+
+    def __init__(self):
+        self.now = 1000.0
+
+    def monotonic(self):
+        return self.now
+
+
+@pytest.fixture
+def clock(monkeypatch):
+    from biped_cli import progress
+
+    clock = Clock()
+    monkeypatch.setattr(progress, "time", clock)
+    return clock
+
+
+def test_the_bar_shows_the_time_elapsed_and_left_on_a_terminal(clock):
+    """On a terminal the bar says the time elapsed and, once a unit is done, the estimate of
+    the time left (mean time per unit so far times the units left), each with its unit."""
+    from biped_cli.progress import Progress
+
+    terminal = Terminal()
+    with Progress(4, "sweep", stream=terminal) as bar:
+        assert bar.line().endswith("0 %  elapsed 0 s")
+        clock.now += 75.0
+        bar.advance()
+        assert bar.line().endswith("25 %  elapsed 1 min 15 s  ETA 3 min 45 s")
+        assert screen(terminal.getvalue())[-1] == bar.line()
+        clock.now += 3 * 3600.0
+        bar.advance(2)
+        assert bar.line().endswith("75 %  elapsed 3 h 01 min  ETA 1 h 00 min")
+
+
+def test_not_on_a_terminal_a_line_per_completed_unit_at_most_every_interval(clock):
+    """Piped, the progress is a plain line per completed unit (no carriage return, no
+    escape), at most one every ``interval`` seconds, with the time elapsed and left; the
+    last unit's line closes a log that has one, and a short run, or one of a single unit,
+    writes nothing."""
+    from biped_cli.progress import Progress
+
+    piped = io.StringIO()
+    with Progress(5, "validate", stream=piped, interval=10.0) as bar:
+        for seconds in (4.0, 8.0, 1.0, 30.0, 2.0):  # done at 4, 12, 13, 43, 45 s
+            clock.now += seconds
+            bar.advance()
+    assert piped.getvalue().splitlines() == [
+        "validate: 2/5 done (40 %), elapsed 12 s, ETA 18 s",
+        "validate: 4/5 done (80 %), elapsed 43 s, ETA 11 s",
+        "validate: 5/5 done (100 %), elapsed 45 s",
+    ]
+    short = io.StringIO()
+    with Progress(3, "validate", stream=short, interval=10.0) as bar:
+        for _ in range(3):
+            clock.now += 3.0
+            bar.advance()
+    with Progress(1, "validate", stream=short, interval=10.0) as bar:
+        clock.now += 30.0
+        bar.advance()
+    assert short.getvalue() == ""
+
+
 def test_sweep_progress_bar_on_a_terminal_only(local_sweep, tmp_path, monkeypatch, capsys):
     """On a terminal, `biped sweep` draws a bar from 0 to every optimization done and erases
     it before each line of the log and at the end: the screen keeps the log alone. Piped, it
-    writes no bar (no carriage return, no escape)."""
+    writes no bar (no carriage return, no escape) but lines of the optimizations done, with
+    the time elapsed."""
     for name in ("sweep.json", ".independent/revolute-sthenic-0.300.json"):
         (tmp_path / name).parent.mkdir(exist_ok=True)
         (tmp_path / name).write_bytes((local_sweep / name).read_bytes())
@@ -274,18 +339,24 @@ def test_sweep_progress_bar_on_a_terminal_only(local_sweep, tmp_path, monkeypatc
     monkeypatch.undo()
     shown = terminal.getvalue()
     assert "\rsweep  0/3 [" in shown and "\rsweep  3/3 [" in shown  # 1 + 2 optimizations
+    assert "100 %  elapsed " in shown
     log = screen(shown)
     assert not [line for line in log if "sweep  " in line and "/3 [" in line]
-    assert [line[:13] for line in log if line.startswith("[")] == ["[independent "] + [
-        "[final       "
+    assert [line[:13] for line in log if line.startswith("[")] == ["[own starts, "] + [
+        "[final, stage"
     ] * 2
     assert log[-2].startswith("sweep: done") and log[-1] == ""
     capsys.readouterr()
     for path in tmp_path.glob("*-*.json"):
         path.unlink()
+    monkeypatch.setattr(progress, "LOG_INTERVAL", 0.0)  # a line per optimization
     assert main(argv) == 0
     piped = capsys.readouterr().err
     assert "[final" in piped and "\r" not in piped and "\x1b" not in piped
+    logged = [line for line in piped.splitlines() if line.startswith("sweep: ") and "/2 " in line]
+    assert len(logged) == 2
+    assert re.fullmatch(r"sweep: 1/2 done \(50 %\), elapsed \d+ s, ETA \d+ s", logged[0])
+    assert re.fullmatch(r"sweep: 2/2 done \(100 %\), elapsed \d+ s", logged[1])
 
 
 # `biped` as its console script runs it (`python -m biped` loads the package first).

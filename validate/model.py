@@ -10,13 +10,17 @@
 
 A model the validation cannot read at all (a file that does not compile, a knee of the other
 kind, a joint, site, actuator or sensor missing by name) is refused (``BipedError``: one line,
-exit status 2). A model it can read but that is not the gait's robot in a way the harness
-would trip on (a rolling knee without its rolling equality, or with another ratio r2/r1) is a
-``ModelError``: the checks report it as a FAIL line (``model_problems``).
+exit status 2). A model it can read but that is not the gait's robot (a rolling knee without
+its rolling equality, or with another ratio r2/r1; a field of the gait's ``biped.Robot`` that
+the model holds with another value: ``parameter_differences``) is reported by the model check
+as a FAIL line naming what differs (``model_problems``); a ``ModelError`` when the harness
+trips on it.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from pathlib import Path
 
 import mujoco
@@ -25,6 +29,7 @@ import numpy as np
 from biped.dynamics import Biped
 from biped.errors import BipedError
 from biped.robot import SOLE_EDGES, Robot
+from biped.units import robot_unit
 from validate.mjcf import FOLDER, FOOT_FRICTION, SIDES, robot_xml, scene_xml
 
 # Names of the six actuated joints, in the order of every (N, 6) array of the validation.
@@ -35,22 +40,28 @@ SITES = ("ankle", *SOLE_EDGES)  # per side
 SENSORS = ("touch", "ankle_pos", "heel_pos", "toe_pos")  # per side
 # Largest relative error of a rolling-knee equality's ratio against r2 / r1.
 RATIO_TOLERANCE = 1e-9
+# Largest relative difference of a robot's parameter read back from a model against the
+# gait's robot: the MJCF holds 10 significant digits, and a knee radius is read from two
+# numbers (the knee link's length r1 + r2 and the equality's r2 / r1).
+PARAMETER_TOLERANCE = 1e-8
 
 
 class ModelError(BipedError):
     """The model is readable but is not the gait's robot in a way the harness relies on."""
 
 
-def knee_of(model: mujoco.MjModel) -> str:
-    """'revolute' or 'rolling': the knee kind of a model, from its joint names."""
+def knee_of(model: mujoco.MjModel, source: str = "the model") -> str:
+    """'revolute' or 'rolling': the knee kind of a model, from its joint names; a BipedError
+    naming ``source`` (the model's file) for a model of neither."""
     names = {model.joint(i).name for i in range(model.njnt)}
     if all(f"{side}_knee" in names for side in SIDES):
         return "revolute"
     if all(f"{side}_knee_{part}" in names for side in SIDES for part in ("upper", "lower")):
         return "rolling"
     raise BipedError(
-        "the model has neither the joints left_knee, right_knee (revolute knee) nor "
-        "left_knee_upper, left_knee_lower, right_knee_upper, right_knee_lower (rolling knee)"
+        f"{source} has neither the joints left_knee, right_knee (revolute knee) nor "
+        "left_knee_upper, left_knee_lower, right_knee_upper, right_knee_lower (rolling knee): "
+        "allowed an MJCF of this biped (mjcf/scene_<knee>.xml, validate.mjcf)"
     )
 
 
@@ -85,7 +96,7 @@ def model_spec(gait: dict, biped: Biped, path: str | Path | None = None) -> mujo
     if not any(geom.type == mujoco.mjtGeom.mjGEOM_PLANE for geom in spec.geoms):
         _add_floor(spec)
     model = compile_spec(spec, source)
-    kind = knee_of(model)
+    kind = knee_of(model, source)
     if kind != biped.knee:
         raise BipedError(
             f"{source} has a {kind} knee, the gait a {biped.knee} knee: allowed a model of "
@@ -138,34 +149,138 @@ def _check_names(model: mujoco.MjModel, source: str) -> None:
 
 
 def model_problems(model: mujoco.MjModel, biped: Biped) -> list[str]:
-    """What makes ``model`` another robot than ``biped`` in a way the harness relies on: the
-    rolling knee's equalities (one per side, knee_lower = (r2 / r1) knee_upper). Empty when
-    none."""
-    if biped.knee != "rolling":
-        return []
-    ratio = biped.robot.r2 / biped.robot.r1
+    """What makes ``model`` another robot than ``biped``'s: the rolling knee's equalities
+    (one per side, knee_lower = (r2 / r1) knee_upper), then the first field of the robot that
+    the model holds with another value, with both values (``parameter_differences``; the
+    other differing fields named after it). Empty when none."""
     problems = []
-    for side in SIDES:
-        upper, lower = (model.joint(f"{side}_knee_{part}").id for part in ("upper", "lower"))
-        found = [
-            k
-            for k in range(model.neq)
-            if model.eq_type[k] == mujoco.mjtEq.mjEQ_JOINT
+    if biped.knee == "rolling":
+        ratio = biped.robot.r2 / biped.robot.r1
+        for side in SIDES:
+            seen = _knee_ratio(model, side)
+            if seen is None:
+                problems.append(f"{side} knee: no equality between knee_upper and knee_lower")
+            elif not seen or abs(seen / ratio - 1) > RATIO_TOLERANCE:
+                shown = "not a ratio" if not seen else f"{seen:.6g} knee_upper"
+                problems.append(
+                    f"{side} knee: knee_lower = {shown}, the gait's robot r2 / r1 = {ratio:.6g}"
+                )
+    differences = parameter_differences(model, biped)
+    if differences:
+        first, *others = differences
+        also = f" (differing too: {', '.join(d.split(':')[0] for d in others)})" if others else ""
+        problems.append(first + also)
+    return problems
+
+
+def _knee_ratio(model: mujoco.MjModel, side: str) -> float | None:
+    """The ratio knee_lower / knee_upper of the active joint equality of ``side``'s rolling
+    knee; None without one, 0.0 if it is not a plain ratio (an offset or a polynomial)."""
+    upper, lower = (model.joint(f"{side}_knee_{part}").id for part in ("upper", "lower"))
+    for k in range(model.neq):
+        if (
+            model.eq_type[k] == mujoco.mjtEq.mjEQ_JOINT
             and {model.eq_obj1id[k], model.eq_obj2id[k]} == {upper, lower}
             and model.eq_active0[k]
-        ]
-        if not found:
-            problems.append(f"{side} knee: no equality between knee_upper and knee_lower")
-            continue
-        k = found[0]
-        data = model.eq_data[k]
-        seen = data[1] if model.eq_obj1id[k] == lower else 1.0 / data[1]
-        if data[0] != 0.0 or np.any(data[2:5] != 0.0) or abs(seen / ratio - 1) > RATIO_TOLERANCE:
-            problems.append(
-                f"{side} knee: knee_lower = {seen:.6g} knee_upper, the gait's robot "
-                f"r2 / r1 = {ratio:.6g}"
-            )
-    return problems
+        ):
+            data = model.eq_data[k]
+            if data[0] != 0.0 or np.any(data[2:5] != 0.0) or data[1] == 0.0:
+                return 0.0
+            return float(data[1] if model.eq_obj1id[k] == lower else 1.0 / data[1])
+    return None
+
+
+def model_parameters(model: mujoco.MjModel, knee: str) -> dict[str, list[tuple[str, float]]]:
+    """The fields of ``biped.Robot`` that ``model`` holds, each as the (where, value) pairs of
+    every place that holds it, read back through ``validate.mjcf``'s layout (bodies from the
+    hip down each leg, sites of the ankle, heel, toe and head, the soles' contact spheres, the
+    knee link and equality of a rolling knee, gravity). Fields the model does not hold (the
+    radii of a revolute knee, the trunk's length without a ``head`` site; a rolling knee's
+    radii, and the lengths and shank centre of mass they enter, without the equality whose
+    ratio splits the link into r1 and r2) are left out."""
+    values: dict[str, list[tuple[str, float]]] = {}
+
+    def add(name: str, where: str, value: float):
+        values.setdefault(name, []).append((where, float(value)))
+
+    def masses(part: str, body) -> None:
+        add(f"{part}_mass", body.name, body.mass[0])
+        add(f"{part}_inertia", body.name, _inertia_about_y(model, body.id))
+
+    trunk = model.body("trunk")
+    masses("trunk", trunk)
+    add("trunk_com", "trunk's centre of mass", trunk.ipos[2])
+    head = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "head")
+    if head >= 0:
+        add("trunk_length", "site head", model.site_pos[head][2])
+    add("gravity", "the model's gravity", -model.opt.gravity[2])
+    for side in SIDES:
+        thigh, shank, foot = (model.body(f"{side}_{part}") for part in ("thigh", "shank", "foot"))
+        for part, b in (("thigh", thigh), ("shank", shank), ("foot", foot)):
+            masses(part, b)
+        add("thigh_com", f"{side}_thigh's centre of mass", -thigh.ipos[2])
+        add("foot_com", f"{side}_foot's centre of mass", -foot.ipos[2])
+        sites = {end: model.site(f"{side}_{end}").pos for end in SOLE_EDGES}
+        heel, toe = sites["heel"], sites["toe"]
+        add("foot_heel", f"site {side}_heel", -heel[0])
+        add("foot_length", f"sites {side}_heel, {side}_toe", toe[0] - heel[0])
+        for end in SOLE_EDGES:
+            add("ankle_height", f"site {side}_{end}", -sites[end][2])
+        spheres = {}
+        for end in SOLE_EDGES:
+            g = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{side}_{end}_contact")
+            if g >= 0 and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE:
+                spheres[end] = g
+                where = f"geom {side}_{end}_contact"
+                radius = model.geom_size[g][0]
+                add("ankle_height", where, radius - model.geom_pos[g][2])
+        if len(spheres) == len(SOLE_EDGES):
+            heel, toe = (model.geom_pos[spheres[end]][0] for end in SOLE_EDGES)
+            add("foot_heel", f"geom {side}_heel_contact", -heel)
+            add("foot_length", f"geoms {side}_heel_contact, {side}_toe_contact", toe - heel)
+        r1 = r2 = 0.0
+        below_thigh = shank
+        if knee == "rolling":
+            below_thigh = model.body(f"{side}_knee_link")
+            ratio = _knee_ratio(model, side)  # r2 / r1
+            if not ratio:  # None or not a ratio (model_problems says so)
+                continue
+            link = -shank.pos[2]  # r1 + r2, from C2 to C1
+            r1, r2 = link / (1.0 + ratio), link * ratio / (1.0 + ratio)
+            where = f"length of {side}_knee_link, ratio of {side}_knee_coupling"
+            add("r1", where, r1)
+            add("r2", where, r2)
+        add("shank_com", f"{side}_shank's centre of mass", -shank.ipos[2] + r1)
+        add("thigh_length", f"position of {below_thigh.name}", -below_thigh.pos[2] + r2)
+        add("shank_length", f"position of {side}_foot", -foot.pos[2] + r1)
+    return values
+
+
+def _inertia_about_y(model: mujoco.MjModel, body: int) -> float:
+    """[kg·m²] A body's moment of inertia about the y axis through its centre of mass (the
+    axis of the planar motion), from its principal moments and axes."""
+    axes = np.empty(9)
+    mujoco.mju_quat2Mat(axes, model.body_iquat[body])
+    return float(np.square(axes.reshape(3, 3)[1]) @ model.body_inertia[body])
+
+
+def parameter_differences(model: mujoco.MjModel, biped: Biped) -> list[str]:
+    """The fields of ``biped``'s robot that ``model`` holds with another value
+    (``model_parameters``, relative ``PARAMETER_TOLERANCE``), one line each in the order of
+    ``biped.Robot``'s fields: the field, the model's value and where it is, the robot's."""
+    held = model_parameters(model, biped.knee)
+    lines = []
+    for field in dataclasses.fields(Robot):
+        wanted = getattr(biped.robot, field.name)
+        unit = robot_unit(field.name)
+        for where, value in held.get(field.name, []):
+            if not math.isclose(value, wanted, rel_tol=PARAMETER_TOLERANCE, abs_tol=1e-12):
+                lines.append(
+                    f"{field.name}: {value:.6g} {unit} in the model ({where}), "
+                    f"{wanted:.6g} {unit} in the gait's robot"
+                )
+                break
+    return lines
 
 
 def with_servos(spec: mujoco.MjSpec, knee: str, kp: float, kv: float) -> mujoco.MjModel:
