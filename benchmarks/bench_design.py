@@ -22,10 +22,10 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 import biped  # noqa: E402
-from biped.design import DesignProblem, optimize_design, solver_for  # noqa: E402
-from biped.design_map import run_design_map  # noqa: E402
-from biped.optimize import optimize  # noqa: E402
-from biped.solver import solver_for as gait_solver_for  # noqa: E402
+from biped.optimization.design import DesignProblem, optimize_design, solver_for  # noqa: E402
+from biped.optimization.optimize import optimize  # noqa: E402
+from biped.optimization.solver import solver_for as gait_solver_for  # noqa: E402
+from biped.studies.design_map import run_design_map  # noqa: E402
 
 SPEED = 0.3
 WORKERS = 2

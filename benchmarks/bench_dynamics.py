@@ -17,7 +17,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 import biped  # noqa: E402
-from biped.dynamics import JOINT_MATRIX  # noqa: E402
+from biped.model.dynamics import JOINT_MATRIX  # noqa: E402
 
 BATCH = 1000
 REPEATS = 200

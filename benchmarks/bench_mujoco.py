@@ -27,8 +27,8 @@ from mujoco import rollout  # noqa: E402
 
 import biped  # noqa: E402
 from biped import gait_file  # noqa: E402
-from biped.optimize import optimize  # noqa: E402
-from biped.problem import GaitProblem  # noqa: E402
+from biped.optimization.optimize import optimize  # noqa: E402
+from biped.optimization.problem import GaitProblem  # noqa: E402
 from validate import mjcf, simulate  # noqa: E402
 from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
 from validate.model import model_spec  # noqa: E402

@@ -17,11 +17,11 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 import biped  # noqa: E402
-from biped.optimize import first_guesses, optimize  # noqa: E402
-from biped.penalty import nelder_mead, polish  # noqa: E402
-from biped.problem import GaitProblem  # noqa: E402
-from biped.solver import solver_for  # noqa: E402
-from biped.sweep import run_sweep  # noqa: E402
+from biped.optimization.optimize import first_guesses, optimize  # noqa: E402
+from biped.optimization.penalty import nelder_mead, polish  # noqa: E402
+from biped.optimization.problem import GaitProblem  # noqa: E402
+from biped.optimization.solver import solver_for  # noqa: E402
+from biped.studies.sweep import run_sweep  # noqa: E402
 
 SPEED = 0.3
 
@@ -31,7 +31,7 @@ def previous_method(problem):
     start = problem.first_parameters()
     p, _, count, _ = nelder_mead(problem, start, np.random.default_rng(0))
     polished, more, message = polish(problem, p)
-    from biped.optimize import Report, checked
+    from biped.optimization.optimize import Report, checked
 
     report = Report("nelder-mead+slsqp", message, 1, 1, count + more, np.nan, np.nan, 0.0, 0)
     return checked(problem, None, report, polished)

@@ -1,4 +1,4 @@
-"""One small sweep run three ways through ``biped.runner``: in this process, on a local pool
+"""One small sweep run three ways through ``biped.runtime.runner``: in this process, on a local pool
 of worker processes, and on a local Dask cluster of as many single-thread worker processes;
 seconds of each and the ratio to the in-process run, and whether the gait files are the same.
 
@@ -21,7 +21,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import biped  # noqa: E402
-from biped.sweep import run_sweep  # noqa: E402
+from biped.studies.sweep import run_sweep  # noqa: E402
 
 
 def _gaits(folder: Path) -> dict:

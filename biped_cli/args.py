@@ -7,11 +7,11 @@ import tempfile
 
 import numpy as np
 
-from biped.comparison import CERTIFIED
-from biped.criteria import CRITERIA, MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
 from biped.errors import BipedError
-from biped.kinematics import KNEES
-from biped.problem import MIN_SPEED
+from biped.model.criteria import CRITERIA, MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
+from biped.model.kinematics import KNEES
+from biped.optimization.problem import MIN_SPEED
+from biped.records.comparison import CERTIFIED
 from validate import DEFAULT_STEPS
 
 # What an option naming an output says of its missing folders (the path written is printed).
@@ -155,7 +155,8 @@ def check_folder(path: str, option: str, of: str | None = None) -> None:
 
 
 def budget(args) -> dict:
-    """The keyword arguments of ``biped.optimize.optimize`` given on the command line."""
+    """The keyword arguments of ``biped.optimization.optimize.optimize`` given on the command
+    line."""
     return {
         "seed": args.seed,
         "method": args.method,
@@ -172,8 +173,8 @@ def safety(args) -> Safety:
 
 
 def add_budget(parser, sweep: bool = False):
-    from biped.optimize import DEFAULT_STARTS, METHODS
-    from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
+    from biped.optimization.optimize import DEFAULT_STARTS, METHODS
+    from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
 
     parser.add_argument(
         "--method",

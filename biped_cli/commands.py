@@ -9,12 +9,12 @@ import sys
 
 import numpy as np
 
-from biped.criteria import CRITERIA
-from biped.dynamics import JOINTS, Biped
 from biped.errors import BipedError, UnreachableError
-from biped.kinematics import KNEES
-from biped.provenance import provenance
-from biped.robot import Robot
+from biped.model.criteria import CRITERIA
+from biped.model.dynamics import JOINTS, Biped
+from biped.model.kinematics import KNEES
+from biped.model.robot import Robot
+from biped.records.provenance import provenance
 from biped_cli.args import budget, check_folder, check_output, safety
 
 DEFAULT_SWEEP = "logs/sweep"
@@ -86,12 +86,12 @@ def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
     """An optimum in three lines: its step; both criteria on the check grid (``costs`` in
     its gait file, what the comparisons use); its criterion on the solver's samples
     (``optimizer.value``, what ranked the starts; left out for a result without it)."""
-    from biped.comparison import (
+    from biped.records.comparison import (
         CHECK_SAMPLES_PER_STEP,
         NELDER_MEAD_SAMPLES_PER_STEP,
         SOLVER_SAMPLES_PER_STEP,
     )
-    from biped.units import CRITERION_UNITS
+    from biped.records.units import CRITERION_UNITS
 
     ev = optimum.evaluation
     lines = [
@@ -122,9 +122,9 @@ def cmd_optimize(args) -> int:
     status) or the optimum is infeasible (naming the violated constraints); the file is
     written only when feasible, with the solver's status in it.
     """
-    from biped import gait_file
-    from biped.optimize import optimize
-    from biped.problem import GaitProblem
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
+    from biped.records import gait_file
 
     robot = _robot(args.robot)
     problem = GaitProblem(Biped(robot, args.knee), args.speed, args.criterion, safety(args))
@@ -172,10 +172,10 @@ def cmd_sweep(args) -> int:
     Progress on stderr, with the time elapsed and an estimate of the time left: a bar on a
     terminal, else a line at most every 10 s.
     """
-    from biped.paper_method import FOLDER, SETTINGS, check_paper_method, run_paper_method
-    from biped.paper_method import SPEED as PAPER_METHOD_SPEED
-    from biped.runner import check_dask
-    from biped.sweep import INDEPENDENT, MANIFEST, run_sweep
+    from biped.runtime.runner import check_dask
+    from biped.studies.paper_method import FOLDER, SETTINGS, check_paper_method, run_paper_method
+    from biped.studies.paper_method import SPEED as PAPER_METHOD_SPEED
+    from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep
     from biped_cli.progress import Progress
 
     robot = _robot(args.robot)
@@ -229,8 +229,8 @@ def cmd_figures(args) -> int:
     """PNG figures reproducing the paper's Figs. 4-8 and a comparison table (markdown)."""
     from pathlib import Path
 
-    from biped import gait_file
-    from biped.figures import make_figures
+    from biped.pages.figures import make_figures
+    from biped.records import gait_file
 
     check_folder(args.out, "--out")
     takes = "--sweep a folder of the gait files that biped sweep writes"
@@ -304,7 +304,7 @@ def read_gaits(paths: list, model: str | None = None) -> list[dict]:
 
     Raises BipedError naming the file (and ``--model``).
     """
-    from biped import gait_file
+    from biped.records import gait_file
 
     gaits = [gait_file.read_consistent(path) for path in paths]
     for path, gait in zip(paths, gaits, strict=True):
@@ -417,10 +417,10 @@ def cmd_pipeline(args) -> int:
     """
     from pathlib import Path
 
-    from biped import gait_file
-    from biped.comparison import DIFFERENCE, relative_change
-    from biped.optimize import check_speed, optimize
-    from biped.problem import GaitProblem
+    from biped.optimization.optimize import check_speed, optimize
+    from biped.optimization.problem import GaitProblem
+    from biped.records import gait_file
+    from biped.records.comparison import DIFFERENCE, relative_change
     from biped_cli.outputs import check_owner, recording_lines
 
     robot = _robot(args.robot)

@@ -1,5 +1,6 @@
 """``biped design`` and ``biped design-map``: the rolling knee's radii optimised with the gait
-(``biped.design``) and mapped over a grid of radii (``biped.design_map``); the design stage
+(``biped.optimization.design``) and mapped over a grid of radii (``biped.studies.design_map``); the
+design stage
 of ``biped pipeline --design``."""
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ def radii(text: str) -> np.ndarray:
 
 
 def _add_common(parser) -> None:
-    from biped.optimize import DEFAULT_STARTS
+    from biped.optimization.optimize import DEFAULT_STARTS
 
     types.add_criterion(parser)
     parser.add_argument(
@@ -135,7 +136,7 @@ def add_parsers(commands) -> None:
 
 def _upper(args, robot) -> tuple:
     """The upper bounds of the radii given on the command line (default the limits)."""
-    from biped.design import MIN_RADIUS, radius_limits
+    from biped.optimization.design import MIN_RADIUS, radius_limits
 
     limits = radius_limits(robot)
     upper = []
@@ -155,13 +156,13 @@ def _upper(args, robot) -> tuple:
 
 
 def _robot(path):
-    from biped.robot import Robot
+    from biped.model.robot import Robot
 
     return Robot.paper() if path is None else Robot.from_file(path)
 
 
 def _problem(args, robot, speed):
-    from biped.design import DesignProblem
+    from biped.optimization.design import DesignProblem
 
     return DesignProblem(
         robot, speed, args.criterion, types.safety(args), upper=_upper(args, robot)
@@ -185,7 +186,7 @@ def _radii_line(comparison) -> str:
 def _bound_notes(problem, design=None) -> list[str]:
     """What the design's bounds did: the robot's own radii moved into them (the reference
     design of the table), and a designed radius at its lower bound (``MIN_RADIUS``)."""
-    from biped.design import MIN_RADIUS
+    from biped.optimization.design import MIN_RADIUS
 
     notes = [f"note: {sentence}" for sentence in problem.moved_reference()]
     for bound in [] if design is None else design.at_bounds():
@@ -207,7 +208,7 @@ def _uncertified(comparison) -> list[str]:
 
 
 def _gait(comparison, seed: int) -> dict:
-    from biped import gait_file
+    from biped.records import gait_file
 
     design = comparison.design
     content = gait_file.to_dict(design.optimum, design.robot, seed)
@@ -227,8 +228,8 @@ def cmd_design(args) -> int:
     the design's solver did not converge or its gait is infeasible (no file), or when a
     knee it is compared with is not certified.
     """
-    from biped import gait_file
-    from biped.design import compare
+    from biped.optimization.design import compare
+    from biped.records import gait_file
 
     robot = _robot(args.robot)
     problem = _problem(args, robot, args.speed)
@@ -280,9 +281,9 @@ def cmd_design_map(args) -> int:
     to resume. Runs on all cores, or on a Dask cluster with --dask tcp://HOST:PORT. Exits 1
     when an optimization is not certified (converged and feasible).
     """
-    from biped.comparison import DIFFERENCE_VS_REVOLUTE
-    from biped.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
-    from biped.runner import check_dask
+    from biped.records.comparison import DIFFERENCE_VS_REVOLUTE
+    from biped.runtime.runner import check_dask
+    from biped.studies.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
     from biped_cli.progress import Progress
 
     robot = _robot(args.robot)
@@ -337,8 +338,8 @@ def pipeline_design(args, robot, optima: dict, out: Path, recordings: Path) -> b
     pipeline's speed, the table of the revolute knee, the Table 1 radii and the optimal
     radii (the pipeline's own optima where certified), and the designed gait written and
     validated in MuJoCo as the knees' are. Returns whether every step passed."""
-    from biped import gait_file
-    from biped.design import compare
+    from biped.optimization.design import compare
+    from biped.records import gait_file
     from biped_cli.commands import _validate_and_record
     from biped_cli.outputs import check_owner, recording_lines
 

@@ -10,9 +10,9 @@ import argparse
 import re
 import sys
 
-from biped.kinematics import KNEES
-from biped.provenance import command_line, version
-from biped.sweep import DEFAULT_SPEEDS
+from biped.model.kinematics import KNEES
+from biped.records.provenance import command_line, version
+from biped.studies.sweep import DEFAULT_SPEEDS
 from biped_cli import args as types
 from biped_cli import design, report, robustness
 from biped_cli.commands import (

@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 
 from biped.errors import BipedError
-from biped.files import atomic_write_text
+from biped.runtime.files import atomic_write_text
 
 OWNER_SUFFIX = ".source.json"
 

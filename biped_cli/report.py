@@ -1,6 +1,6 @@
 """``biped report GAIT.json ... [--out DIR]``: one Markdown page per gait file, with figures.
 
-The page (``biped.page``) is named from the gait file's path as its recording is
+The page (``biped.pages.page``) is named from the gait file's path as its recording is
 (``biped_cli.outputs``). Its validation is the report beside the gait file,
 ``<gait>.report.json`` (``biped pipeline`` writes it; ``biped validate GAIT.json --json >
 GAIT.report.json`` too); its links are the recording and videos that report names, or the
@@ -44,7 +44,7 @@ def read_validation(path: Path) -> dict | None:
 
 def links(gait_path: Path, validation: dict | None) -> list:
     """The recording and videos of a gait that exist and were made from it as it is now."""
-    from biped.page import Link
+    from biped.pages.page import Link
     from biped_cli.outputs import belongs_to, open_command, output_name
 
     found = []
@@ -77,8 +77,8 @@ def cmd_report(args) -> int:
     of its validation in MuJoCo when <gait>.report.json lies beside it; links to its recording
     and video. All pages are written, or none.
     """
-    from biped import gait_file
-    from biped.page import Page, write_pages
+    from biped.pages.page import Page, write_pages
+    from biped.records import gait_file
     from biped_cli.outputs import output_name
 
     check_folder(args.out, "--out")

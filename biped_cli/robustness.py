@@ -195,8 +195,8 @@ def cmd_robustness(args) -> int:
     with the time elapsed and left (a bar on a terminal, else a line at most every 10 s).
     Exits 1 if a gait's nominal walk fails (no map is written for it), 0 otherwise.
     """
-    from biped.files import atomic_set
-    from biped.provenance import provenance
+    from biped.records.provenance import provenance
+    from biped.runtime.files import atomic_set
     from biped_cli.commands import read_gaits
     from biped_cli.outputs import output_name
     from biped_cli.progress import Progress

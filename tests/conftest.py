@@ -46,8 +46,8 @@ def small_optimum(knee: str):
     """A feasible gait at 0.3 m/s from the paper's method on a small budget (Nelder-Mead,
     one run of 300 evaluations): far from optimal, its motors work (about 4 N·m RMS).
     Computed once per session."""
-    from biped.optimize import optimize
-    from biped.problem import GaitProblem
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
 
     if knee not in _GAITS:
         problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3)
@@ -63,8 +63,8 @@ _OPTIMA: dict = {}
 def optimal_gait(knee: str):
     """The optimal gait at 0.3 m/s with the optimiser's defaults (seed 0): the gait
     ``biped optimize --knee KNEE --speed 0.3`` writes, computed once per session."""
-    from biped.optimize import optimize
-    from biped.problem import GaitProblem
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
 
     if knee not in _OPTIMA:
         _OPTIMA[knee] = optimize(GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3))
@@ -73,6 +73,6 @@ def optimal_gait(knee: str):
 
 def gait_content(optimum, robot=None) -> dict:
     """The content of the gait file of ``optimum`` (``gait_file.to_dict``, seed 0), in memory."""
-    from biped import gait_file
+    from biped.records import gait_file
 
     return gait_file.to_dict(optimum, robot or biped.Robot.paper(), seed=0)

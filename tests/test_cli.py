@@ -49,7 +49,7 @@ FAST = ["--starts", "1"]
 
 def test_optimize_writes_a_complete_gait_file(tmp_path, capsys):
     """optimize writes every documented field, ≥ 200 samples from t = 0 to T inclusive."""
-    from biped import gait_file
+    from biped.records import gait_file
 
     out = tmp_path / "gait.json"
     assert main(["optimize", "--knee", "rolling", "--speed", "0.3", "--out", str(out), *FAST]) == 0
@@ -152,7 +152,7 @@ def test_pipeline_writes_gait_report_and_recording(tmp_path, capsys, monkeypatch
     validated in memory (its file is never read back)."""
     import json
 
-    from biped import gait_file
+    from biped.records import gait_file
 
     read = gait_file.read
     monkeypatch.setattr(gait_file, "read", lambda *a, **k: pytest.fail("gait file read back"))
@@ -317,7 +317,7 @@ def test_numpy_warnings_stay_off_the_terminal(capsys, monkeypatch):
 
 def test_version_and_python_m_biped(capsys):
     """--version prints the package's version; python -m biped runs the same program."""
-    from biped.provenance import version
+    from biped.records.provenance import version
 
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.strip() == f"biped {version()}"

@@ -57,20 +57,20 @@ def _stand_in(*args, **kwargs):
 def no_work(monkeypatch):
     """The optimiser, the sweep, the design map, the figures, the MuJoCo validation and the
     robustness map stop the command."""
-    import biped.design
-    import biped.design_map
-    import biped.figures
-    import biped.optimize
-    import biped.sweep
+    import biped.optimization.design
+    import biped.optimization.optimize
+    import biped.pages.figures
+    import biped.studies.design_map
+    import biped.studies.sweep
     import validate.report
     import validate.robustness
 
     for module, name in [
-        (biped.optimize, "optimize"),
-        (biped.sweep, "run_sweep"),
-        (biped.design, "compare"),
-        (biped.design_map, "run_design_map"),
-        (biped.figures, "make_figures"),
+        (biped.optimization.optimize, "optimize"),
+        (biped.studies.sweep, "run_sweep"),
+        (biped.optimization.design, "compare"),
+        (biped.studies.design_map, "run_design_map"),
+        (biped.pages.figures, "make_figures"),
         (validate.report, "validate"),
         (validate.robustness, "robustness_map"),
     ]:

@@ -1,4 +1,4 @@
-"""The words and the sign of comparisons (``biped.comparison``): one sign for a difference
+"""The words and the sign of comparisons (``biped.records.comparison``): one sign for a difference
 between knees, the two values of a gait file's criterion named for what they are, and
 "certified" said of a sweep's final optima only."""
 
@@ -7,15 +7,15 @@ from types import SimpleNamespace
 
 import pytest
 
-from biped.comparison import (
+from biped.records.comparison import (
     CHECK_SAMPLES_PER_STEP,
     CHECKED_VALUE,
     SOLVER_SAMPLES_PER_STEP,
     SOLVER_VALUE,
     relative_change,
 )
-from biped.sweep import Point, _line
-from biped.units import gait_units
+from biped.records.units import gait_units
+from biped.studies.sweep import Point, _line
 
 
 def test_a_difference_is_negative_where_the_first_needs_less():

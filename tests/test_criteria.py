@@ -5,9 +5,15 @@ import pytest
 from scipy.integrate import quad
 
 import biped
-from biped.criteria import CONSTRAINTS, PENALTY_WEIGHT, constraints, evaluate_step, penalty_rate
-from biped.gait import build_step, evaluate
-from biped.problem import GaitProblem
+from biped.model.criteria import (
+    CONSTRAINTS,
+    PENALTY_WEIGHT,
+    constraints,
+    evaluate_step,
+    penalty_rate,
+)
+from biped.model.gait import build_step, evaluate
+from biped.optimization.problem import GaitProblem
 
 SPEED = 0.3
 

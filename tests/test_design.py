@@ -9,17 +9,17 @@ import numpy as np
 import pytest
 
 import biped
-from biped.criteria import PAPER_SAFETY, Safety, evaluate_step
-from biped.design import (
+from biped.model.criteria import PAPER_SAFETY, Safety, evaluate_step
+from biped.model.gait import build_step
+from biped.optimization.design import (
     DesignProblem,
     check_radii,
     optimize_at,
     optimize_design,
     radius_limits,
 )
-from biped.gait import build_step
-from biped.problem import SCALES, GaitProblem
-from biped.symbolic import StepGraph
+from biped.optimization.problem import SCALES, GaitProblem
+from biped.optimization.symbolic import StepGraph
 from tests.conftest import optimal_gait
 
 ROBOT = biped.Robot.paper()
@@ -35,7 +35,7 @@ def graph():
 _DESIGNS: dict = {}
 
 
-def optimal_design(safety=PAPER_SAFETY) -> "biped.design.Design":
+def optimal_design(safety=PAPER_SAFETY) -> "biped.optimization.design.Design":
     """The design optimum at 0.3 m/s (sthenic, default starts and seed), once per session."""
     if safety not in _DESIGNS:
         _DESIGNS[safety] = optimize_design(DesignProblem(ROBOT, SPEED, safety=safety))
@@ -143,7 +143,7 @@ def test_design_graph_with_radii_held_finds_the_gait_optimum_of_those_radii():
     """The design graph with the radii held (the map's solver, one graph for every radius)
     reaches the optimum 'biped optimize' finds for the robot built with those radii; held
     at other radii, it does not."""
-    from biped.optimize import optimize
+    from biped.optimization.optimize import optimize
 
     problem = DesignProblem(ROBOT, SPEED)
     radii = (0.12, 0.2)
@@ -198,8 +198,8 @@ def test_bad_design_input_is_refused():
 def test_design_that_does_not_converge_fails_loudly(monkeypatch):
     """With IPOPT cut to 3 iterations no start converges: the design's report carries
     IPOPT's status and the design is not certified."""
-    from biped import design as design_module
-    from biped import solver
+    from biped.optimization import design as design_module
+    from biped.optimization import solver
 
     monkeypatch.setitem(solver.IPOPT_OPTIONS, "max_iter", 3)
     design_module._solver.cache_clear()
@@ -230,7 +230,7 @@ def test_design_command_writes_the_designed_robot_and_compares(designed):
     """'biped design' exits 0, writes a gait file whose robot holds the optimal radii and
     prints the revolute knee, the Table 1 radii and the optimal radii with the changes
     against the revolute knee, each computed from the printed criteria."""
-    from biped import gait_file
+    from biped.records import gait_file
 
     code, out, err, path = designed
     assert code == 0, err
@@ -254,7 +254,7 @@ def test_design_command_writes_the_designed_robot_and_compares(designed):
 def test_designed_gait_passes_validation_on_its_own_robot_only(designed):
     """The designed gait walks 20 steps in MuJoCo on the MJCF of its radii and passes every
     check; played on the Table 1 robot, the inverse-dynamics check fails."""
-    from biped import gait_file
+    from biped.records import gait_file
     from validate.report import check_inverse_dynamics, validate
 
     gait = gait_file.read(designed[3])
@@ -293,8 +293,8 @@ def test_bad_design_options_are_one_line_and_exit_2(tmp_path, capsys, argv, need
 def test_design_command_that_does_not_converge_exits_1(tmp_path, monkeypatch, capsys):
     """With IPOPT cut to 3 iterations 'biped design' exits 1 naming IPOPT's status and
     writes no file."""
-    from biped import design as design_module
-    from biped import solver
+    from biped.optimization import design as design_module
+    from biped.optimization import solver
     from biped_cli import main
 
     monkeypatch.setitem(solver.IPOPT_OPTIONS, "max_iter", 3)
@@ -317,7 +317,7 @@ def test_pipeline_with_design_compares_three_knees_in_one_table(tmp_path, capsys
     side; the exit status is the verdict of every check."""
     import json
 
-    from biped import gait_file
+    from biped.records import gait_file
     from biped_cli import main
 
     out, rrd = tmp_path / "pipeline", tmp_path / "recordings"
@@ -344,7 +344,7 @@ def test_bounds_that_move_the_robots_own_radii_say_so():
     so its own 5 cm are moved there as the reference design, and the problem says so with
     both values and the bound; own radii of 0 move up to the radii's lower bound, 1 mm, above
     the revolute knee that r = 0 is; Table 1's radii move nowhere."""
-    from biped.design import MIN_RADIUS
+    from biped.optimization.design import MIN_RADIUS
 
     problem = DesignProblem(dataclasses.replace(ROBOT, shank_com=0.03), SPEED)
     assert problem.lower == (MIN_RADIUS, MIN_RADIUS) and MIN_RADIUS == 0.001
@@ -362,8 +362,8 @@ def test_a_design_against_a_bound_is_said_and_validated(tmp_path, capsys):
     """'biped design --robot R.toml' with shank_com = 0.03 m: it says that the Table 1 r1 was
     moved to its bound, its optimum lies at the radii's lower bound of 1 mm (said, where r = 0
     would be the revolute knee) and 'biped validate' plays the file it writes."""
-    from biped import gait_file
-    from biped.design import MIN_RADIUS
+    from biped.optimization.design import MIN_RADIUS
+    from biped.records import gait_file
     from biped_cli import main
 
     robot, path = tmp_path / "R.toml", tmp_path / "design.json"

@@ -6,7 +6,7 @@ import json
 import pytest
 
 import biped
-from biped.design_map import (
+from biped.studies.design_map import (
     MANIFEST,
     MapPoint,
     draw,
@@ -91,7 +91,7 @@ def test_map_legend_lies_outside_the_plot(small_map):
     radii near r = 0 among them): it lies below the axes."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from biped.design_map import map_figure
+    from biped.studies.design_map import map_figure
 
     settings, results = load(small_map)
     figure = map_figure(settings, speed_summaries(settings, results)[0], results)

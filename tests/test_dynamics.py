@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import biped
-from biped.dynamics import JOINT_MATRIX
-from biped.kinematics import XH, ZH
+from biped.model.dynamics import JOINT_MATRIX
+from biped.model.kinematics import XH, ZH
 from tests.conftest import complex_step_velocity, random_state, smooth_motion
 
 ROBOT = biped.Robot.paper()

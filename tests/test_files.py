@@ -4,7 +4,8 @@ import stat
 
 import pytest
 
-from biped import files, gait_file
+from biped.records import gait_file
+from biped.runtime import files
 
 
 def _listing(folder):

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import biped
-from biped.gait import PARAMETERS, build_step, evaluate, sample
-from biped.kinematics import QP2, XH, ZH
-from biped.problem import GaitProblem
+from biped.model.gait import PARAMETERS, build_step, evaluate, sample
+from biped.model.kinematics import QP2, XH, ZH
+from biped.optimization.problem import GaitProblem
 
 SPEED = 0.3
 
@@ -97,9 +97,9 @@ def test_out_of_reach_hip_is_a_graded_error(model):
     """A hip out of the legs' reach raises StepBuildError with how far it is."""
     p = GaitProblem(model, SPEED).first_parameters()
     p[1] = 1.2
-    with pytest.raises(biped.gait.StepBuildError) as error:
+    with pytest.raises(biped.model.gait.StepBuildError) as error:
         build_step(model, SPEED, p)
     p[1] = 1.4
-    with pytest.raises(biped.gait.StepBuildError) as further:
+    with pytest.raises(biped.model.gait.StepBuildError) as further:
         build_step(model, SPEED, p)
     assert further.value.excess > error.value.excess > 0.0

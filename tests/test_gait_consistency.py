@@ -9,8 +9,9 @@ import sys
 
 import pytest
 
-from biped import Robot, gait_file
+from biped import Robot
 from biped.errors import BipedError
+from biped.records import gait_file
 from biped_cli import main
 from tests.conftest import small_optimum
 
@@ -56,7 +57,7 @@ def test_a_file_is_consistent_on_other_cpu_features(content, tmp_path):
         "NPY_DISABLE_CPU_FEATURES": "AVX512_ICL X86_V4",
         "OPENBLAS_NUM_THREADS": "1",
     }
-    code = f"from biped import gait_file; gait_file.read_consistent({str(path)!r}); print('ok')"
+    code = f"from biped.records import gait_file; gait_file.read_consistent({str(path)!r}); print('ok')"
     done = subprocess.run(
         [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
     )

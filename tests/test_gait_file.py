@@ -4,9 +4,10 @@ import json
 
 import pytest
 
-from biped import Robot, gait_file
+from biped import Robot
 from biped.errors import BipedError
-from biped.provenance import PACKAGE
+from biped.records import gait_file
+from biped.records.provenance import PACKAGE
 from tests.conftest import small_optimum
 
 
@@ -102,8 +103,8 @@ def test_deeply_nested_json_is_one_error(tmp_path):
 def _other_files() -> dict:
     """The content of each of the project's other JSON files, as its writer makes it, by
     what the refusal must call it."""
-    from biped import design_map, paper_method, sweep
-    from biped.criteria import PAPER_SAFETY
+    from biped.model.criteria import PAPER_SAFETY
+    from biped.studies import design_map, paper_method, sweep
     from validate import robustness
     from validate.checks import Check
     from validate.report import as_json

@@ -3,7 +3,7 @@
 import numpy as np
 
 import biped
-from biped.kinematics import QP2, XH, ZH
+from biped.model.kinematics import QP2, XH, ZH
 from tests.conftest import complex_step_velocity, random_state
 
 
@@ -118,7 +118,7 @@ def test_next_step_starts_on_the_new_stance_foot(model):
 
 def test_trailing_foot_lift_is_the_stance_foot_velocity(model):
     """trailing_foot_lift equals the vertical velocity of the old stance heel and toe."""
-    from biped.impact import trailing_foot_lift
+    from biped.model.impact import trailing_foot_lift
 
     q, qd = touchdown_state(model, seed=37, n=5)
     qd_plus, _ = model.impact(q, qd)

@@ -1,5 +1,5 @@
 """Ctrl-C and SIGTERM during an IPOPT solve stop the program: CasADi stops the solver when a
-signal's handler raises but swallows the exception (``biped.interrupts`` raises it again),
+signal's handler raises but swallows the exception (``biped.runtime.interrupts`` raises it again),
 and its notice of the swallowed exception stays off the terminal."""
 
 import contextlib
@@ -12,9 +12,9 @@ import threading
 import pytest
 
 import biped
-from biped.interrupts import kept_interrupts
-from biped.problem import GaitProblem
-from biped.solver import Solver, solver_for
+from biped.optimization.problem import GaitProblem
+from biped.optimization.solver import Solver, solver_for
+from biped.runtime.interrupts import kept_interrupts
 from biped_cli import main
 
 # CasADi's notice, in the pieces it writes.
@@ -120,7 +120,7 @@ def test_ctrl_c_while_casadi_builds_the_graph_is_not_lost(monkeypatch):
         Solver(model, "sthenic", GaitProblem(model, 0.3).safety, 4)
     assert calls["n"] > calls["at"] + 1000  # the build went on past the interrupt: swallowed
     calls["n"], calls["at"] = 0, 20  # and the same without the guard: lost
-    monkeypatch.setattr("biped.solver.kept_interrupts", _no_guard)
+    monkeypatch.setattr("biped.optimization.solver.kept_interrupts", _no_guard)
     Solver(model, "sthenic", GaitProblem(model, 0.3).safety, 4)  # no KeyboardInterrupt
     assert calls["n"] > calls["at"] + 1000  # the handler ran (at call 20): its exception lost
 

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import biped
-from biped.kinematics import QP2, XH, ZH, swap_legs
+from biped.model.kinematics import QP2, XH, ZH, swap_legs
 from tests.conftest import random_state
 
 ROBOT = biped.Robot.paper()

@@ -66,9 +66,9 @@ def test_mass_properties_match_robot(knee):
 
 @pytest.mark.parametrize("knee", biped.KNEES)
 def test_soles_and_floor_have_the_robot_modules_friction(knee):
-    """The friction coefficient of the soles and the floor is biped.robot.FOOT_FRICTION, the
+    """The friction coefficient of the soles and the floor is biped.model.robot.FOOT_FRICTION, the
     one the figures draw (MuJoCo takes the larger of the two geoms' coefficients)."""
-    from biped.robot import FOOT_FRICTION
+    from biped.model.robot import FOOT_FRICTION
 
     model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
     colliding = [

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import biped
-from biped.criteria import PAPER_SAFETY, Safety, clearance_profile, evaluate_step
-from biped.gait import build_step
-from biped.optimize import (
+from biped.model.criteria import PAPER_SAFETY, Safety, clearance_profile, evaluate_step
+from biped.model.gait import build_step
+from biped.optimization.optimize import (
     AGREEMENT,
     MONOTONE_START,
     STHENIC_START,
@@ -22,9 +22,9 @@ from biped.optimize import (
     optimize,
     starts_at_value,
 )
-from biped.problem import SCALES, GaitProblem, bounds, max_walking_speed
-from biped.solver import solver_for
-from biped.symbolic import StepGraph
+from biped.optimization.problem import SCALES, GaitProblem, bounds, max_walking_speed
+from biped.optimization.solver import solver_for
+from biped.optimization.symbolic import StepGraph
 from tests.conftest import optimal_gait
 
 ROBOT = biped.Robot.paper()
@@ -203,7 +203,9 @@ def test_a_given_sthenic_optimum_must_be_of_the_same_problem():
     other = GaitProblem(sthenic.problem.model, 0.325, "energy")
     with pytest.raises(biped.BipedError, match="sthenic at 0.3 m/s .rolling knee.: allowed"):
         optimize(other, starts=1, sthenic=sthenic)
-    with pytest.raises(biped.BipedError, match="sthenic = 1.0: allowed a biped.optimize"):
+    with pytest.raises(
+        biped.BipedError, match="sthenic = 1.0: allowed a biped.optimization.optimize"
+    ):
         optimize(other, starts=1, sthenic=1.0)
 
 
@@ -240,8 +242,8 @@ def test_optimizer_is_deterministic():
 
 _PROBE = """
 import json, biped
-from biped.optimize import optimize
-from biped.problem import GaitProblem
+from biped.optimization.optimize import optimize
+from biped.optimization.problem import GaitProblem
 o = optimize(GaitProblem(biped.Biped(biped.Robot.paper(), "rolling"), 0.3))
 print(json.dumps([o.report.status, o.value]))
 """
@@ -318,7 +320,7 @@ def test_bad_safety_margins_are_rejected():
 def test_solver_that_does_not_converge_fails_loudly(tmp_path, monkeypatch, capsys):
     """With IPOPT cut to 3 iterations no start converges: the report says so with IPOPT's
     status, and 'biped optimize' exits 1 naming it (not a silent fallback)."""
-    from biped import solver
+    from biped.optimization import solver
     from biped_cli import main
 
     monkeypatch.setitem(solver.IPOPT_OPTIONS, "max_iter", 3)

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from biped import Robot, gait_file
+from biped import Robot
+from biped.records import gait_file
 from biped_cli import main
 from biped_cli.outputs import belongs_to, check_owner, claim, output_name, owner
 from tests.conftest import small_optimum
@@ -55,7 +56,7 @@ def test_validating_a_sweep_gait_keeps_the_pipelines_recording(gaits, capsys):
     assert len(err.strip().splitlines()) == 1
     assert _stamp(pipeline) == before
     # Every figure of the report has its unit; the figures keep their names.
-    from biped.units import missing
+    from biped.records.units import missing
 
     assert missing(report, report["units"]) == []
     assert report["units"]["forward.max_slip"] == "m"
@@ -83,12 +84,12 @@ def test_a_recording_of_another_folder_of_the_same_name_is_refused(gaits, capsys
 def test_pipeline_refuses_recordings_of_another_output_folder(gaits, capsys, monkeypatch):
     """A pipeline whose --recordings hold the recordings of another --out's gaits stops
     before optimizing, naming the recording's gait."""
-    import biped.optimize
+    import biped.optimization.optimize
 
     def no_work(*args, **kwargs):
         raise AssertionError("optimized before checking its outputs")
 
-    monkeypatch.setattr(biped.optimize, "optimize", no_work)
+    monkeypatch.setattr(biped.optimization.optimize, "optimize", no_work)
     recording = Path("logs/recordings") / f"{NAME}.rrd"
     recording.parent.mkdir(parents=True)
     recording.write_bytes(b"the pipeline's")
@@ -159,9 +160,9 @@ def test_a_refused_sweep_writes_nothing(tmp_path, monkeypatch, capsys):
     """A sweep refused for its folder (gait files of no sweep) or for the paper's method's
     record there (other settings) is refused before any optimization and leaves the folder
     as it was: no .independent/, no record."""
-    import biped.sweep
-    from biped.criteria import Safety
-    from biped.paper_method import PaperMethod
+    import biped.studies.sweep
+    from biped.model.criteria import Safety
+    from biped.studies.paper_method import PaperMethod
 
     def no_work(*args, **kwargs):
         raise AssertionError("swept before its refusal")
@@ -173,7 +174,7 @@ def test_a_refused_sweep_writes_nothing(tmp_path, monkeypatch, capsys):
     line = _refusal(capsys, main(["sweep", "--speeds", "0.3", "--out", str(foreign)]))
     assert "no sweep.json" in line and "choose another --out folder" in line
     assert _tree(tmp_path) == before
-    monkeypatch.setattr(biped.sweep, "run_sweep", no_work)
+    monkeypatch.setattr(biped.studies.sweep, "run_sweep", no_work)
     record = Path("S/paper-method/settings.json")
     record.parent.mkdir(parents=True)
     made = PaperMethod(Robot.paper(), Safety(clearance=0.0, zmp_margin=0.0), 0.3, seeds=5)
@@ -244,7 +245,7 @@ def test_pipeline_with_design_prints_every_file_it_writes_once(tmp_path, capsys,
     reports, recordings, their owner records, the videos) is named on exactly one printed
     line, and every printed path is a file it wrote (the videos stubbed: nothing renders)."""
     import validate.video
-    from biped.files import atomic_write_bytes
+    from biped.runtime.files import atomic_write_bytes
 
     def video(path, *args, gif=None, **kwargs):
         path = Path(path)

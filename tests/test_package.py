@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from biped.provenance import DEPENDENCIES, PACKAGE, provenance, version
+from biped.records.provenance import DEPENDENCIES, PACKAGE, provenance, version
 
 ROOT = Path(__file__).resolve().parents[1]
 # Packages ``biped`` must not import: the MuJoCo side and what only it needs.
@@ -67,7 +67,9 @@ def test_provenance_does_not_import_mujoco():
     """Reading MuJoCo's version does not import it (biped stays free of the simulator)."""
     import subprocess
 
-    code = "import sys, biped.provenance as p; p.provenance(); print('mujoco' in sys.modules)"
+    code = (
+        "import sys, biped.records.provenance as p; p.provenance(); print('mujoco' in sys.modules)"
+    )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.stdout.strip() == "False", done.stderr
 

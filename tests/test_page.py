@@ -6,9 +6,10 @@ import json
 import numpy as np
 import pytest
 
-from biped import Robot, gait_file
-from biped.criteria import CONSTRAINTS
-from biped.gait import PARAMETERS
+from biped import Robot
+from biped.model.criteria import CONSTRAINTS
+from biped.model.gait import PARAMETERS
+from biped.records import gait_file
 from biped_cli import main
 from biped_cli.outputs import claim
 from tests.conftest import small_optimum
@@ -52,7 +53,7 @@ def written(tmp_path_factory):
 def test_page_states_the_gait_by_name_with_units(written):
     """Every parameter by name with its unit, the criteria with theirs, and the tightest
     margin of each constraint: the file's worst value, at the sample where Ψ is smallest."""
-    from biped.page import constraint_profile
+    from biped.pages.page import constraint_profile
 
     gait_path, _, text = written
     gait = gait_file.read(gait_path)
@@ -89,7 +90,7 @@ def test_page_figures_are_drawn_and_labelled(written):
     from matplotlib.text import Text
     from PIL import Image
 
-    from biped.page import CONSTRAINT_MEANING, FIGURE_NAMES, gait_figures
+    from biped.pages.page import CONSTRAINT_MEANING, FIGURE_NAMES, gait_figures
 
     gait_path, out, text = written
     for name in FIGURE_NAMES:
@@ -106,7 +107,7 @@ def test_page_figures_are_drawn_and_labelled(written):
 def test_page_links_no_recording_of_another_gait(written, tmp_path):
     """A recording whose owner is another gait file is not linked; without a report beside
     the gait, the page says it is not validated."""
-    from biped.page import Page, markdown
+    from biped.pages.page import Page, markdown
     from biped_cli.report import links
 
     gait_path, _, _ = written
@@ -141,7 +142,7 @@ def test_report_is_all_or_none(written, tmp_path, capsys):
 def optimal_page(tmp_path_factory):
     """The optimal rolling-knee gait at 0.3 m/s (IPOPT) as read from its file, its page's
     Markdown and its figures."""
-    from biped.page import Page, gait_figures, markdown
+    from biped.pages.page import Page, gait_figures, markdown
     from tests.conftest import optimal_gait
 
     path = tmp_path_factory.mktemp("optimal") / f"{NAME}.json"
@@ -175,12 +176,12 @@ def test_page_says_where_constraints_dip_below_the_solver_margin(optimal_page):
     """Each constraint below its margin δ on the check grid (only between the solver's
     samples, which hold δ) is named on the page with its smallest value, and its panel
     zooms on it in an inset; no other panel has one."""
-    from biped.criteria import evaluate_step, margin_profile
-    from biped.dynamics import Biped
-    from biped.gait import build_step
-    from biped.optimize import CHECK_SAMPLES_PER_HALF
-    from biped.page import CONSTRAINT_MEANING
-    from biped.problem import SOLVER_SAMPLES_PER_HALF
+    from biped.model.criteria import evaluate_step, margin_profile
+    from biped.model.dynamics import Biped
+    from biped.model.gait import build_step
+    from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
+    from biped.optimization.problem import SOLVER_SAMPLES_PER_HALF
+    from biped.pages.page import CONSTRAINT_MEANING
 
     gait, text, figures = optimal_page
     model = Biped(gait["robot"], gait["knee"])

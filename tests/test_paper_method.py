@@ -1,4 +1,4 @@
-"""The paper's Nelder-Mead over seeds, beside certified optima (``biped.paper_method``)."""
+"""The paper's Nelder-Mead over seeds, beside certified optima (``biped.studies.paper_method``)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 
 import biped
 from biped.errors import BipedError
-from biped.paper_method import FOLDER, read_runs, run_paper_method, spread_lines
+from biped.studies.paper_method import FOLDER, read_runs, run_paper_method, spread_lines
 from tests.conftest import optimal_gait
 
 SEEDS = 2

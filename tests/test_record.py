@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 import rerun.chunk
 
-from biped import Robot, gait_file
-from biped.dynamics import JOINTS
+from biped import Robot
+from biped.model.dynamics import JOINTS
+from biped.records import gait_file
 from tests.conftest import small_optimum
 
 ROBOT = Robot.paper()

@@ -7,7 +7,7 @@ import copy
 import numpy as np
 import pytest
 
-from biped.dynamics import JOINTS
+from biped.model.dynamics import JOINTS
 from tests.conftest import gait_content, optimal_gait
 from validate.checks import FEEDFORWARD_SHARE, check_feedforward
 from validate.model import model_spec

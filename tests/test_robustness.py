@@ -14,9 +14,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from biped import Robot, gait_file
+from biped import Robot
 from biped.errors import BipedError
-from biped.robot import FOOT_FRICTION
+from biped.model.robot import FOOT_FRICTION
+from biped.records import gait_file
 from biped_cli import main
 from tests.conftest import gait_content, optimal_gait
 from validate import robustness
@@ -97,7 +98,7 @@ def test_a_walk_takes_half_the_push_limit_and_falls_past_it(mapped, walker, name
 
 
 def test_friction_limit_lies_between_the_gait_s_need_and_the_model_s(mapped, gait, walker):
-    """The lowest friction coefficient that walks is below the model's (biped.robot's
+    """The lowest friction coefficient that walks is below the model's (biped.model.robot's
     FOOT_FRICTION) and no lower than the largest |Fx| / Fz of the gait's own ground force;
     on half of it the stance foot slips."""
     limit = mapped.limits["friction"]

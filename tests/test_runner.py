@@ -1,4 +1,4 @@
-"""The runner of many independent optimizations (``biped.runner``): the same results in this
+"""The runner of many independent optimizations (``biped.runtime.runner``): the same results in this
 process, on a pool of processes and on a Dask cluster; a sweep on a two-worker Dask cluster
 writes the files of a local sweep; a progress bar on a terminal only; numpy's warnings off the
 terminal; errors and unreachable schedulers are one line."""
@@ -21,9 +21,9 @@ import numpy as np
 import pytest
 
 import biped
-from biped import runner
-from biped.files import atomic_write_text
-from biped.sweep import INDEPENDENT, run_sweep
+from biped.runtime import runner
+from biped.runtime.files import atomic_write_text
+from biped.studies.sweep import INDEPENDENT, run_sweep
 from biped_cli import main, progress
 
 SPEEDS = (0.275, 0.3)
@@ -444,8 +444,8 @@ def test_the_solver_runs_blas_on_one_thread():
 
     import casadi
 
-    from biped.problem import GaitProblem
-    from biped.solver import solver_for
+    from biped.optimization.problem import GaitProblem
+    from biped.optimization.solver import solver_for
 
     solver_for(GaitProblem(biped.Biped(biped.Robot.paper(), "revolute"), 0.3))
     library = ctypes.CDLL(str(Path(casadi.__file__).parent / "libcasadi-tp-openblas.so.0"))

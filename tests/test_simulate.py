@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from biped.kinematics import ZH
+from biped.model.kinematics import ZH
 from tests.conftest import gait_content, optimal_gait, small_optimum
 from validate import contact
 from validate.checks import MAX_FOOT_TILT, MAX_SLIP, scuff_notes, walk_figures, walks

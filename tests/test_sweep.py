@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import biped
-from biped import gait_file
-from biped import sweep as sweep_module
-from biped.figures import LABELS, make_figures
-from biped.sweep import INDEPENDENT, MANIFEST, run_sweep
+from biped.pages.figures import LABELS, make_figures
+from biped.records import gait_file
+from biped.studies import sweep as sweep_module
+from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep
 
 SPEEDS = (0.275, 0.3)
 FAST = dict(starts=1, jobs=1)
@@ -225,8 +225,8 @@ def test_each_figure_is_drawn_with_its_labels(sweep):
     the model's friction coefficient and the largest |Fx| / Fz of each knee in Fig. 7."""
     from matplotlib.figure import Figure
 
-    from biped.dynamics import JOINTS
-    from biped.figures import FOOT_FRICTION, read_sweep, sweep_figures
+    from biped.model.dynamics import JOINTS
+    from biped.pages.figures import FOOT_FRICTION, read_sweep, sweep_figures
 
     folder, _ = sweep
     series, flagged = read_sweep(folder)
@@ -296,7 +296,7 @@ def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
     """An energy 30 times the others' (one gait) is drawn at the panel's edge with its value
     written, and the axis spans the other gaits, so the knees' curves stay apart; without
     it, every point is on the axis and nothing is marked."""
-    from biped.figures import criterion_figure
+    from biped.pages.figures import criterion_figure
 
     series = _synthetic_series(("rolling", 12, 30.0))
     value = series[("rolling", "sthenic")][12]["costs"]["energy"]
@@ -316,7 +316,7 @@ def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
 
 def test_a_gait_not_certified_is_marked_apart_from_the_curves():
     """A gait whose solver did not converge is a labelled cross, not a point of a curve."""
-    from biped.figures import criterion_figure
+    from biped.pages.figures import criterion_figure
 
     series = _synthetic_series()
     gait = dict(series[("revolute", "sthenic")].pop(4))
@@ -374,7 +374,7 @@ def test_a_sweep_lacking_a_criterion_gives_the_other_and_says_what_it_leaves_out
     """A sweep of one criterion gives that criterion's figures and rows only, says in
     comparison.md and on the console what it leaves out, removes the left-out figure of an
     earlier set, and writes no 'nan'; one with nothing to compare is refused."""
-    from biped.figures import compared_criteria, read_sweep
+    from biped.pages.figures import compared_criteria, read_sweep
 
     folder, _ = sweep
     out = tmp_path / "figures"
@@ -421,8 +421,8 @@ def test_a_sweep_lacking_a_criterion_gives_the_other_and_says_what_it_leaves_out
 def test_every_difference_between_the_knees_has_one_sign(sweep, tmp_path):
     """(rolling − revolute) / revolute in %, negative where the rolling knee needs less:
     in comparison.md (the paper's numbers too) and in the figures' difference panels."""
-    from biped.comparison import DIFFERENCE, relative_change
-    from biped.figures import PAPER, read_sweep, sweep_figures
+    from biped.pages.figures import PAPER, read_sweep, sweep_figures
+    from biped.records.comparison import DIFFERENCE, relative_change
 
     assert relative_change(0.9, 1.0) == pytest.approx(-10.0)
     assert PAPER["sthenic_difference"] < 0 and PAPER["energy_difference"] < 0  # less: rolling
@@ -457,8 +457,8 @@ def test_criterion_figures_say_their_units_and_sign_and_why_fig8_middle_scatters
     set as mathtext (no literal underscore), the knees are named in words, a third panel
     holds the difference in %, and Fig. 8 says why the sthenic criterion of the energy
     optima is not a smooth curve."""
-    from biped.comparison import DIFFERENCE
-    from biped.figures import OTHER_NOTES, criterion_figure
+    from biped.pages.figures import OTHER_NOTES, criterion_figure
+    from biped.records.comparison import DIFFERENCE
 
     series = _synthetic_series()
     for criterion, other in (("sthenic", "energy"), ("energy", "sthenic")):

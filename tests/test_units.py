@@ -9,8 +9,9 @@ import re
 import numpy as np
 import pytest
 
-from biped import Robot, gait_file
-from biped.units import PURE, gait_units, missing, numeric_paths
+from biped import Robot
+from biped.records import gait_file
+from biped.records.units import PURE, gait_units, missing, numeric_paths
 from tests.conftest import small_optimum
 
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import rerun.chunk
 
-from biped import Robot, gait_file
+from biped import Robot
+from biped.records import gait_file
 from biped_cli import main
 from tests.conftest import small_optimum
 
@@ -128,8 +129,8 @@ def heavy_gait(tmp_path_factory):
     import dataclasses
 
     from biped import Biped
-    from biped.optimize import optimize
-    from biped.problem import GaitProblem
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
 
     paper = Robot.paper()
     robot = dataclasses.replace(paper, trunk_mass=1.1 * paper.trunk_mass)
@@ -224,7 +225,7 @@ def test_model_errors_are_fail_lines(gait_path, tmp_path, capsys):
 
 def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
     """Each check is an object with ``passed`` and ``notes``; every number has its unit."""
-    from biped.units import missing
+    from biped.records.units import missing
 
     code, content, _ = report
     for name in ("model", "inverse_dynamics", "impact", "feedforward", "forward", "gains"):
@@ -299,8 +300,8 @@ def test_a_gait_under_other_gravity_passes_on_its_own_model(knee):
     import dataclasses
 
     from biped import Biped
-    from biped.optimize import optimize
-    from biped.problem import GaitProblem
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
     from tests.conftest import gait_content
     from validate import checks
     from validate.mjcf import FOLDER

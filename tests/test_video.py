@@ -4,7 +4,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from biped import Robot, gait_file
+from biped import Robot
+from biped.records import gait_file
 from tests.conftest import small_optimum
 from tests.test_mjcf import needs_gl
 

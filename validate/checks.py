@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from biped.dynamics import JOINTS, Biped
-from biped.kinematics import ZH
-from biped.units import PURE
+from biped.model.dynamics import JOINTS, Biped
+from biped.model.kinematics import ZH
+from biped.records.units import PURE
 from validate import contact
 from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
 from validate.mapping import mapping, other

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from biped.dynamics import Biped
+from biped.model.dynamics import Biped
 from validate.mapping import other
 from validate.samples import GaitSamples
 from validate.simulate import LANDING_WINDOW, LIFT_WINDOW, TOUCH_THRESHOLD, Simulation

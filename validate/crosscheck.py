@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from biped.dynamics import Biped
+from biped.model.dynamics import Biped
 from validate.mapping import Mapping, mapping
 from validate.mjcf import SIDES, robot_xml
 from validate.model import JOINT_ORDER, ModelError

@@ -41,10 +41,10 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from biped.files import atomic_write_text
-from biped.kinematics import check_knee
-from biped.robot import FOOT_FRICTION as SLIDING_FRICTION
-from biped.robot import SOLE_EDGES, Robot
+from biped.model.kinematics import check_knee
+from biped.model.robot import FOOT_FRICTION as SLIDING_FRICTION
+from biped.model.robot import SOLE_EDGES, Robot
+from biped.runtime.files import atomic_write_text
 
 SIDES = ("left", "right")
 # Near-massless knee link of the rolling knee (MuJoCo needs mass on a moving body) [kg, kg·m²].
@@ -67,7 +67,7 @@ KNEE_SOLIMP = "0.9999 0.99999 0.0001 0.5 2"
 # Foot box (drawn): width and sole thickness [m]; friction (sliding, torsional, rolling).
 FOOT_WIDTH = 0.10
 SOLE_THICKNESS = 0.02
-FOOT_FRICTION = f"{SLIDING_FRICTION!r} 0.02 0.0001"  # μ from biped.robot
+FOOT_FRICTION = f"{SLIDING_FRICTION!r} 0.02 0.0001"  # μ from biped.model.robot
 # The sole touches the floor at its heel and its toe: two small spheres on the sole's
 # bottom ends (the motion is planar: the sole is the segment between them). Two contact
 # points per foot instead of a box's four make the physics step cheaper, and any centre of

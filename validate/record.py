@@ -43,10 +43,10 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from biped.dynamics import JOINTS, Biped
 from biped.errors import BipedError
-from biped.files import atomic_path
-from biped.robot import SOLE_EDGES
+from biped.model.dynamics import JOINTS, Biped
+from biped.model.robot import SOLE_EDGES
+from biped.runtime.files import atomic_path
 from validate.contact import SAMPLE_EVERY
 from validate.mapping import mapping
 from validate.mjcf import HIP_OFFSET, SIDES
@@ -355,7 +355,7 @@ def record(
         contact: MuJoCo's stance-foot force (N, 2) and centre of pressure (N,) as
             ``{"force": ..., "cop": ...}`` (NaN where not sampled or in double support).
         checks: the validation's checks (``validate.report.Check``), for the summary.
-        gait: the gait file's content (``biped.gait_file.read``), for the summary.
+        gait: the gait file's content (``biped.records.gait_file.read``), for the summary.
         spawn: also stream to a rerun viewer started for it.
         connect: also stream to a running viewer at this URL ("" for rerun's default).
     """

@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from biped.dynamics import JOINTS, Biped
+from biped.model.dynamics import JOINTS, Biped
 from validate.layout import Layout
 from validate.mapping import mapping
 from validate.model import JOINT_ORDER, with_servos
@@ -50,7 +50,7 @@ WINDOW = (0.05, 0.95)
 
 @dataclass
 class Replay:
-    """One step replayed; arrays in the paper's joint order (``biped.dynamics.JOINTS``:
+    """One step replayed; arrays in the paper's joint order (``biped.model.dynamics.JOINTS``:
     stance ankle, knee, hip, swing hip, knee, ankle) and the paper's torque sign.
 
     Attributes:

@@ -14,7 +14,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from biped.dynamics import Biped
+from biped.model.dynamics import Biped
 from validate import DEFAULT_STEPS
 from validate import checks as c
 from validate.checks import EXACT, Check
@@ -48,7 +48,7 @@ class Validation:
 def validate(
     gait: dict, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
 ):
-    """All checks of a gait file's content (``biped.gait_file.read`` or ``to_dict``) on
+    """All checks of a gait file's content (``biped.records.gait_file.read`` or ``to_dict``) on
     ``model`` (``validate.model.model_spec``: by default the committed model of the gait's
     knee for Table 1, the model generated from the gait's robot otherwise).
 

@@ -1,7 +1,8 @@
 """The gait as a gait file stores it: its samples as functions of time.
 
 What MuJoCo plays is the file, not the parameters it came from: the torques Γ(t), the motion
-q(t) and the start state are read from ``samples`` (``biped.gait_file``), interpolated on each
+q(t) and the start state are read from ``samples`` (``biped.records.gait_file``), interpolated on
+each
 spline piece separately (the accelerations and torques jump at the knot t = T/2, where the
 file holds both limits):
 
@@ -18,16 +19,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.robot import Robot
+from biped.model.dynamics import Biped
+from biped.model.robot import Robot
 
 FIELDS = ("q", "qd", "qdd", "torques", "wrench", "zmp")
 
 
 @dataclass(frozen=True)
 class GaitSamples:
-    """A gait file's samples (``biped.gait_file``) over one step.
+    """A gait file's samples (``biped.records.gait_file``) over one step.
 
     Attributes:
         period: T [s].

@@ -57,9 +57,9 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.kinematics import XH, ZH
+from biped.model.dynamics import Biped
+from biped.model.kinematics import XH, ZH
 from validate import DEFAULT_STEPS
 from validate.layout import Layout
 from validate.mapping import mapping, other
@@ -121,7 +121,7 @@ class WalkSettings:
         kp_scale: the servos' stiffness is ``KP`` times this.
         kv_scale: the servos' damping is ``KV`` times this.
         friction: sliding friction coefficient of the soles and the floor (None: the
-            model's, ``biped.robot.FOOT_FRICTION``).
+            model's, ``biped.model.robot.FOOT_FRICTION``).
         push: a shove on the trunk (None: none).
     """
 
@@ -348,7 +348,7 @@ class Walker:
     """A gait file prepared for walking on one MuJoCo model.
 
     Args:
-        gait: the gait file's content (``biped.gait_file.read`` or ``to_dict``).
+        gait: the gait file's content (``biped.records.gait_file.read`` or ``to_dict``).
         model: the scene to walk on (``validate.model.model_spec``: a file, or by default the
             committed model of the gait's knee for Table 1, the generated one otherwise);
             a spec, or a path.

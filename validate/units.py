@@ -1,6 +1,7 @@
 """Units of the validation report's figures (``validate.report``), for its ``units`` map.
 
-Paths and notation as in ``biped.units``: ``"forward.max_slip": "m"``. "weight" is a fraction
+Paths and notation as in ``biped.records.units``: ``"forward.max_slip": "m"``. "weight" is a
+fraction
 of the robot's weight, "S" of the gait's step length; a figure that is the largest of
 several quantities of different units names them all ("N, N·m": the largest of the errors
 of Fx, Fz [N] and Cy [N·m]).
@@ -8,8 +9,8 @@ of Fx, Fz [N] and Cy [N·m]).
 
 from __future__ import annotations
 
-from biped.dynamics import JOINTS
-from biped.units import PERIOD, PURE
+from biped.model.dynamics import JOINTS
+from biped.records.units import PERIOD, PURE
 
 GAIN_KEYS = ("0_5", "1", "2")  # validate.checks.GAIN_SCALES and the default, as keys
 

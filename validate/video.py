@@ -25,8 +25,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from biped.dynamics import Biped
-from biped.files import atomic_path
+from biped.model.dynamics import Biped
+from biped.runtime.files import atomic_path
 from validate import DEFAULT_STEPS
 from validate.mapping import mapping
 from validate.mjcf import SIDES
@@ -335,8 +335,8 @@ def write_frame(
 
 def main(argv=None) -> int:
     """Validate a gait file and write the video, GIF or one frame of its walk in MuJoCo."""
-    from biped import gait_file
     from biped.errors import BipedError
+    from biped.records import gait_file
     from validate.report import validate
 
     parser = argparse.ArgumentParser(prog="python -m validate.video", description=main.__doc__)

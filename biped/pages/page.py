@@ -12,7 +12,7 @@ where a constraint dips below δ between the solver's samples (an inset on its p
 jumps of the torques and ground reaction at the mid-step knot (marked on their panels),
 the verdict and figures of its validation in MuJoCo when a report is given, and links to the
 recording and the video. ``write_pages`` writes pages as a set, all or none
-(``biped.files.atomic_set``). The constraints are computed again from the gait's parameters
+(``biped.runtime.files.atomic_set``). The constraints are computed again from the gait's parameters
 on the grid the optimiser checks feasibility on (``CHECK_SAMPLES_PER_HALF``).
 """
 
@@ -27,10 +27,12 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
-from biped import gait_file
-from biped.criteria import CONSTRAINTS, evaluate_step, margin_profile
-from biped.dynamics import JOINTS, Biped
-from biped.figures import (
+from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
+from biped.model.dynamics import JOINTS, Biped
+from biped.model.gait import PARAMETERS, build_step, half_grid
+from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
+from biped.optimization.problem import SOLVER_SAMPLES_PER_HALF
+from biped.pages.figures import (
     ANGLE_PANELS,
     DPI,
     GROUND_PANELS,
@@ -41,11 +43,9 @@ from biped.figures import (
     joint_label,
     time_figure,
 )
-from biped.files import atomic_set
-from biped.gait import PARAMETERS, build_step, half_grid
-from biped.optimize import CHECK_SAMPLES_PER_HALF
-from biped.problem import SOLVER_SAMPLES_PER_HALF
-from biped.units import CONSTRAINT_UNITS, CRITERION_UNITS, parameter_unit
+from biped.records import gait_file
+from biped.records.units import CONSTRAINT_UNITS, CRITERION_UNITS, parameter_unit
+from biped.runtime.files import atomic_set
 
 # What each constraint of eq. (28) keeps.
 CONSTRAINT_MEANING = {
@@ -77,7 +77,7 @@ KNOT_WHY = (
 @dataclass(frozen=True)
 class Tightest:
     """The tightest sample of one constraint: the smallest Ψ_i [unit], at t/T, and δ_i
-    there, the margin the solver keeps from it (``biped.criteria.margin_profile``: constant,
+    there, the margin the solver keeps from it (``biped.model.criteria.margin_profile``: constant,
     but ramping from 0 at the ends of the step for the swing foot)."""
 
     name: str

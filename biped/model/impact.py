@@ -26,7 +26,7 @@ def flat_foot_impact(model, q, qd_minus, foot: str = "swing"):
         qd_minus: velocities just before touchdown (..., 9).
         foot: the landing foot, ``"swing"`` (end of a step) or ``"stance"``.
 
-    q̇⁺ is in the same labelling as q̇⁻: apply ``biped.kinematics.swap_legs`` to start the
+    q̇⁺ is in the same labelling as q̇⁻: apply ``biped.model.kinematics.swap_legs`` to start the
     next step.
     """
     q = np.asarray(q, dtype=float)

@@ -37,9 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.kinematics import swap_legs
+from biped.model.dynamics import Biped
+from biped.model.kinematics import swap_legs
 
 # Names of the 21 parameters, in order.
 PARAMETERS = (

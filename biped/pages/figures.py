@@ -7,7 +7,7 @@ Fig. 8: optimal energy criterion vs speed (left), sthenic criterion of the same 
 (middle), the difference in % (right).
 comparison.md: our headline numbers beside the paper's.
 
-Every difference between the knees is ``biped.comparison.relative_change``: (rolling −
+Every difference between the knees is ``biped.records.comparison.relative_change``: (rolling −
 revolute) / revolute in %, negative where the rolling knee needs less; every value is the
 criterion on the check grid (the gait files' ``costs``). The sthenic criterion is per metre
 walked, the energy criterion per step.
@@ -37,17 +37,17 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from biped import gait_file
-from biped.comparison import CERTIFIED, CHECK_GRID, DIFFERENCE, SOLVER_GRID, relative_change
-from biped.criteria import CRITERIA
-from biped.dynamics import JOINTS
 from biped.errors import BipedError
-from biped.files import atomic_set
-from biped.gait import FREE_ANGLES
-from biped.kinematics import ANGLES, BODY_DIRECTIONS, COORDINATES, KNEES
-from biped.paper_method import spread_lines
-from biped.robot import FOOT_FRICTION
-from biped.sweep import MANIFEST
+from biped.model.criteria import CRITERIA
+from biped.model.dynamics import JOINTS
+from biped.model.gait import FREE_ANGLES
+from biped.model.kinematics import ANGLES, BODY_DIRECTIONS, COORDINATES, KNEES
+from biped.model.robot import FOOT_FRICTION
+from biped.records import gait_file
+from biped.records.comparison import CERTIFIED, CHECK_GRID, DIFFERENCE, SOLVER_GRID, relative_change
+from biped.runtime.files import atomic_set
+from biped.studies.paper_method import spread_lines
+from biped.studies.sweep import MANIFEST
 
 # The paper's headline numbers; differences [%] rolling vs revolute (``relative_change``): its
 # 17 % less sthenic criterion and 11 % less energy for the rolling knee.
@@ -97,7 +97,7 @@ TIME_AXIS = "normalised time t/T"
 
 
 def certified(gait: dict) -> bool:
-    """Whether a gait file holds a certified optimum (``biped.comparison.CERTIFIED``; a
+    """Whether a gait file holds a certified optimum (``biped.records.comparison.CERTIFIED``; a
     sweep's files are its final optima): its solver converged and it is feasible on the
     check grid."""
     return gait["feasible"] and gait["optimizer"].get("status") == "converged"
@@ -606,8 +606,8 @@ def comparison_table(series, flagged=()) -> str:
     lines += [
         "",
         *(_explanations(flexion, series, criteria) if flexion is not None else []),
-        "Conventions behind our numbers (see `biped/gait.py`, `biped/criteria.py`,",
-        "`biped/comparison.py`):",
+        "Conventions behind our numbers (see `biped/model/gait.py`, `biped/model/criteria.py`,",
+        "`biped/records/comparison.py`):",
         "",
         "- d of eq. (30) is read as the swing foot's travel in one step, twice the step length,",
         "  so C_Γ is per metre walked; C_E of eq. (31) is per step, as printed.",

@@ -2,13 +2,15 @@
 
 The paper fixes the radii of the rolling knee at r1 = r2 = 5 cm and ends on "integrate the
 radii r1 and r2 in the parameter vector". A ``DesignProblem`` does that: minimise the
-criterion over the gait's variables z (``biped.problem.VARIABLES``) and the radii (r1, r2)
+criterion over the gait's variables z (``biped.optimization.problem.VARIABLES``) and the radii (r1,
+r2)
 together, under the gait's constraints, with IPOPT on the graph of the step whose radii are
-symbols (``biped.symbolic.StepGraph(..., design=True)``, ``biped.solver.Solver`` with
+symbols (``biped.optimization.symbolic.StepGraph(..., design=True)``,
+``biped.optimization.solver.Solver`` with
 ``radius_bounds``). Every other parameter of the robot (masses, inertias, segment lengths,
 centres of mass) stays as given.
 
-Design bounds. The segment lengths l1, l2 include the radii (``biped.robot``: both knees
+Design bounds. The segment lengths l1, l2 include the radii (``biped.model.robot``: both knees
 have the same height), so a radius moves length from the shank or the thigh into the knee:
 l'1 = l1 − r1 from the ankle to the shank circle's centre C1, l'2 = l2 − r2 from the hip to
 the thigh circle's centre C2. The centres of mass are measured from the knee for the shank
@@ -21,7 +23,7 @@ the thigh circle's centre C2. The centres of mass are measured from the knee for
 which are the bounds by default (``radius_limits``: 0.181 m and 0.236 m for Table 1, 43 %
 and 57 % of the segments); narrower upper bounds may be given. Beyond them the robot's
 fixed masses and inertias would describe a segment whose centre of mass lies off it.
-At r1 = r2 = 0 the rolling knee is the revolute knee exactly (``biped.kinematics``), and so
+At r1 = r2 = 0 the rolling knee is the revolute knee exactly (``biped.model.kinematics``), and so
 it is at r1 = 0 or r2 = 0 alone: a circle rolling on a point turns about it, the link
 between the centres stays on the other segment. Such a "rolling knee" is no design of one:
 it is the revolute knee, beside which every design is compared, and the MJCF of a rolling
@@ -31,11 +33,12 @@ and 20 cm, its hinges in the ratio 200); a design at that bound says that the kn
 nothing by rolling there. The robot's own radii, the reference design, are moved into the
 bounds where they lie beyond them, and ``DesignProblem.moved_reference`` says so.
 
-Starts, as for gaits (``biped.optimize``): the gait's first guesses at the robot's own radii
+Starts, as for gaits (``biped.optimization.optimize``): the gait's first guesses at the robot's own
+radii
 (Table 1's) and starts with radii drawn uniformly in the bounds and the gait's first guess
 there perturbed, from ``numpy.random.default_rng(seed)`` (``DESIGN_STARTS``), and any given
 (gait, radii) pairs; for the energy criterion also the sthenic design (under both barriers,
-``biped.optimize.MONOTONE_START``). The best converged
+``biped.optimization.optimize.MONOTONE_START``). The best converged
 start wins; its report counts the starts that reached the same value. When no start
 converged the report carries IPOPT's status (and the command line exits 1): never a silent
 fallback.
@@ -51,11 +54,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from biped.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
-from biped.criteria import PAPER_SAFETY, Safety
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.optimize import (
+from biped.model.criteria import PAPER_SAFETY, Safety
+from biped.model.dynamics import Biped
+from biped.model.robot import LENGTH_MIN, Robot
+from biped.optimization.optimize import (
     DEFAULT_STARTS,
     GUESS_PERIODS,
     MONOTONE_START,
@@ -69,13 +72,13 @@ from biped.optimize import (
     optimize,
     starts_at_value,
 )
-from biped.problem import SCALES, GaitProblem, bounds, check_criterion, check_speed
-from biped.robot import LENGTH_MIN, Robot
-from biped.solver import Solver
+from biped.optimization.problem import SCALES, GaitProblem, bounds, check_criterion, check_speed
+from biped.optimization.solver import Solver
+from biped.records.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
 
 RADII = ("r1", "r2")
 # [m] Lower bound of a designed knee radius: the smallest length of a robot
-# (``biped.robot.LENGTH_MIN``); at 0 the rolling knee is the revolute knee (module docstring).
+# (``biped.model.robot.LENGTH_MIN``); at 0 the rolling knee is the revolute knee (module docstring).
 MIN_RADIUS = LENGTH_MIN
 
 
@@ -131,11 +134,11 @@ class DesignProblem:
 
     def __post_init__(self):
         if not isinstance(self.robot, Robot):
-            raise BipedError(f"robot = {self.robot!r}: allowed a biped.robot.Robot")
+            raise BipedError(f"robot = {self.robot!r}: allowed a biped.model.robot.Robot")
         object.__setattr__(self, "speed", check_speed(Biped(self.robot, "rolling"), self.speed))
         check_criterion(self.criterion)
         if not isinstance(self.safety, Safety):
-            raise BipedError(f"safety = {self.safety!r}: allowed a biped.criteria.Safety")
+            raise BipedError(f"safety = {self.safety!r}: allowed a biped.model.criteria.Safety")
         upper = radius_limits(self.robot) if self.upper is None else self.upper
         upper = check_radii(self.robot, upper, "upper bounds of the radii")
         for name, value in zip(RADII, upper, strict=True):
@@ -208,7 +211,7 @@ class Design:
         problem: what was solved.
         radii: (r1, r2) [m].
         optimum: the gait at these radii, checked on the fine grid as every optimum
-            (``biped.optimize.checked``); its report is the design's (starts, status).
+            (``biped.optimization.optimize.checked``); its report is the design's (starts, status).
     """
 
     problem: DesignProblem
@@ -254,7 +257,9 @@ def _solver(robot: Robot, criterion: str, safety: Safety, samples: int, upper) -
 def solver_for(problem: DesignProblem) -> Solver:
     """The design solver of ``problem``'s family, built once per process (every speed)."""
     if not isinstance(problem, DesignProblem):
-        raise BipedError(f"problem = {problem!r}: allowed a biped.design.DesignProblem")
+        raise BipedError(
+            f"problem = {problem!r}: allowed a biped.optimization.design.DesignProblem"
+        )
     robot = dataclasses.replace(problem.robot, r1=0.0, r2=0.0)  # the radii are variables
     return _solver(
         robot, problem.criterion, problem.safety, problem.samples_per_half, problem.upper
@@ -262,7 +267,8 @@ def solver_for(problem: DesignProblem) -> Solver:
 
 
 # Starts of a design, in order: first guesses of the gait at the robot's radii with these step
-# periods [s] (``biped.optimize.GUESS_PERIODS``), or None for a random start (radii uniform in
+# periods [s] (``biped.optimization.optimize.GUESS_PERIODS``), or None for a random start (radii
+# uniform in
 # the bounds, the gait's first guess there perturbed); random starts after these. The short
 # period comes late: from it IPOPT takes several times the iterations of the others (388
 # against 26-88 at 0.3 m/s) to the same design.
@@ -306,13 +312,17 @@ def optimize_design(
             Table 1 radii.
     """
     if not isinstance(problem, DesignProblem):
-        raise BipedError(f"problem = {problem!r}: allowed a biped.design.DesignProblem")
+        raise BipedError(
+            f"problem = {problem!r}: allowed a biped.optimization.design.DesignProblem"
+        )
     began = time.perf_counter()
     solver = solver_for(problem)
     candidates = design_starts(problem, starts, seed)
     for z, radii in given:
         candidates.append(("given", np.asarray(z, dtype=float), check_radii(problem.robot, radii)))
-    if problem.criterion == "energy" and starts > 0:  # as biped.optimize: least torque first
+    if (
+        problem.criterion == "energy" and starts > 0
+    ):  # as biped.optimization.optimize: least torque first
         sthenic = optimize_design(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
         if sthenic.report.converged:
             for kind in (STHENIC_START, MONOTONE_START):
@@ -352,7 +362,7 @@ def optimize_design(
 
 class _HeldRadii:
     """The design graph with the knee radii held: a gait solver for every radius without a
-    new graph (``biped.optimize.optimize``'s ``solvers``)."""
+    new graph (``biped.optimization.optimize.optimize``'s ``solvers``)."""
 
     def __init__(self, problem: DesignProblem, radii):
         self.problem, self.radii = problem, radii
@@ -375,7 +385,8 @@ def optimize_at(
     problem: DesignProblem, radii, seed: int = 0, starts: int = DEFAULT_STARTS, given=()
 ) -> Optimum:
     """The optimal gait of ``problem``'s robot with the radii held at ``radii`` (r1, r2) [m]:
-    ``biped.optimize.optimize`` (same starts, same report) on the design graph, so that a
+    ``biped.optimization.optimize.optimize`` (same starts, same report) on the design graph, so
+    that a
     map of many radii builds one graph per process."""
     radii = check_radii(problem.robot, radii)
     gait = problem.gait_problem(radii)
@@ -412,7 +423,7 @@ class Comparison:
         return all(optimum.certified for _, _, optimum in self.rows())
 
     def gains(self) -> dict:
-        """[%] Change of the criterion (``biped.comparison.relative_change``: negative, the
+        """[%] Change of the criterion (``biped.records.comparison.relative_change``: negative, the
         first needs less): the design against the revolute knee and against the Table 1
         radii, the Table 1 radii against the revolute knee."""
         design, revolute, reference = self.design.value, self.revolute.value, self.reference.value
@@ -481,7 +492,7 @@ def compare(
     the best of every start. Optima given (``revolute``, ``reference``: e.g. gaits already
     written) are kept as they are.
     """
-    from biped.optimize import best_of
+    from biped.optimization.optimize import best_of
 
     ref = problem.reference_radii
     hinge, rolling = problem.gait_problem(ref, "revolute"), problem.gait_problem(ref)

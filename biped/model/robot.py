@@ -1,6 +1,6 @@
 """Robot parameters: the single source of truth for masses, lengths and knee radii.
 
-Conventions (used throughout the package, see also ``biped.kinematics``):
+Conventions (used throughout the package, see also ``biped.model.kinematics``):
 
 - Planar robot in the x-z plane, x forward, z up, ground at z = 0.
 - Every angle is absolute, measured from the vertical, positive counter-clockwise in the

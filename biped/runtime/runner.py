@@ -1,7 +1,7 @@
 """Many independent computations, on local processes or on a Dask cluster, with one interface.
 
 A sweep's points, a design map's radii: each task is one call ``function(task)`` that writes its
-own output file whole (``biped.files``) and returns a short line of text saying what it did.
+own output file whole (``biped.runtime.files``) and returns a short line of text saying what it did.
 ``run_tasks`` runs them all and yields each line as its task completes (in completion order):
 
 - ``jobs=1``: one task after the other in this process;

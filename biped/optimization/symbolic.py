@@ -1,11 +1,13 @@
 """The gait problem as a CasADi expression graph: exact derivatives for the solvers.
 
-The graph is built from the constants of the numeric model (``biped.dynamics.Biped``): the
-directions Φ, W, g, J, the point coefficients and the spline bases of ``biped.gait``, so the
+The graph is built from the constants of the numeric model (``biped.model.dynamics.Biped``): the
+directions Φ, W, g, J, the point coefficients and the spline bases of ``biped.model.gait``, so the
 symbolic and the numeric criterion are one model written twice with the same numbers (a test
-holds them equal to 1e-12). From the variables z (``biped.problem.VARIABLES``) and the speed:
+holds them equal to 1e-12). From the variables z (``biped.optimization.problem.VARIABLES``) and the
+speed:
 
-1. hip at the start of the step from the knee bends (``biped.problem``, eq. *), the legs'
+1. hip at the start of the step from the knee bends (``biped.optimization.problem``, eq. *), the
+legs'
    angles by the forward geometry of each leg (no inverse model, no square root at a straight
    knee);
 2. the end state (legs swapped), the impact map (23) and the start velocities;
@@ -16,8 +18,8 @@ holds them equal to 1e-12). From the variables z (``biped.problem.VARIABLES``) a
 The speed is a parameter of the graph, so one built graph serves every speed of a sweep.
 With ``design=True`` the knee radii (r1, r2) are symbols too: the constants that depend on
 them (directions, point coefficients, W, g) are built by the numeric model's own point table
-(``biped.kinematics.point_table``) from the symbols, so the knee can be optimised with the
-gait (``biped.design``).
+(``biped.model.kinematics.point_table``) from the symbols, so the knee can be optimised with the
+gait (``biped.optimization.design``).
 """
 
 from __future__ import annotations
@@ -25,16 +27,16 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from biped.criteria import (
+from biped.model.criteria import (
     CONSTRAINTS,
     checked_mask,
     clearance_profile,
     margin_profile,
     simpson_weights,
 )
-from biped.dynamics import JOINT_MATRIX, Biped
-from biped.gait import _SWAP, _basis
-from biped.kinematics import (
+from biped.model.dynamics import JOINT_MATRIX, Biped
+from biped.model.gait import _SWAP, _basis
+from biped.model.kinematics import (
     BODY_DIRECTIONS,
     LINK_DIRECTIONS,
     NQ,
@@ -49,12 +51,12 @@ from biped.kinematics import (
     ZH,
     point_table,
 )
-from biped.problem import MIN_HIP_HEIGHT, N_VARIABLES, index
+from biped.optimization.problem import MIN_HIP_HEIGHT, N_VARIABLES, index
 
 # Constraints are divided by these in the solvers so that all are of order one
 # [N, m, m, rad, rad, m, m].
 CONSTRAINT_SCALES = np.array([1000.0, 0.1, 0.1, 1.0, 1.0, 0.1, 0.1])
-_SWAP_ORDER = [QP2, QP1, Q4, Q3, Q2, Q1, Q5, XH, ZH]  # biped.kinematics.swap_legs
+_SWAP_ORDER = [QP2, QP1, Q4, Q3, Q2, Q1, Q5, XH, ZH]  # biped.model.kinematics.swap_legs
 
 
 class _Constants:
@@ -62,8 +64,8 @@ class _Constants:
 
     With ``radii`` (an SX of two symbols r1, r2) the constants that depend on the knee
     radii are SX expressions of them, built by the same point table as the numeric model
-    (``biped.kinematics.point_table``) and the same sums over the bodies as
-    ``biped.dynamics.Biped``; the rolling knee's two links C1C2 are always present (of
+    (``biped.model.kinematics.point_table``) and the same sums over the bodies as
+    ``biped.model.dynamics.Biped``; the rolling knee's two links C1C2 are always present (of
     length r1 + r2, so at r1 = r2 = 0 they carry nothing: the revolute knee).
     """
 
@@ -116,7 +118,7 @@ class _Constants:
             self._points[name] = tuple(columns)
         w, g = ca.SX(k, k), ca.SX(k, 1)
         inertia = np.zeros(k)
-        for body in model.bodies:  # as biped.dynamics.Biped
+        for body in model.bodies:  # as biped.model.dynamics.Biped
             a = self._points[body.com][0]
             w = w + body.mass * (a @ a.T)
             g = g + body.mass * a
@@ -251,7 +253,7 @@ class StepGraph:
     Args:
         model: robot and knee.
         samples_per_half: samples per spline piece (constraints and Simpson's rule).
-        safety: margins of ours (``biped.criteria.Safety``).
+        safety: margins of ours (``biped.model.criteria.Safety``).
         design: the knee radii (r1, r2) are symbols too (``radii``), the rolling knee's
             links always present: ``model`` gives every other constant (its radii and knee
             are not used). At r1 = r2 = 0 the graph is the revolute knee's.
@@ -306,7 +308,7 @@ class StepGraph:
         start_rates = ca.vertcat(*[qd_plus[_SWAP_ORDER[i]] for i in range(1, 7)])
         self.impulse = impulse
 
-        # 3. spline coefficients, as in biped.gait.build_step
+        # 3. spline coefficients, as in biped.model.gait.build_step
         a0, a1, a2 = start_angles, period * start_rates, 0.5 * period**2 * acc0
         b0, b1, b2 = end_angles, -period * end_rates, 0.5 * period**2 * acc1
         r1 = b0 + b1 / 2 + b2 / 4 - a0 - a1 / 2 - a2 / 4

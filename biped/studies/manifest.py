@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from biped.errors import BipedError
-from biped.files import atomic_write_text
+from biped.runtime.files import atomic_write_text
 
 
 @dataclass(frozen=True)

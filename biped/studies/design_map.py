@@ -1,10 +1,11 @@
 """Design maps: the optimal gait's criterion over a grid of knee radii (r1, r2), at one or
-several speeds, with the joint optimum of radii and gait (``biped.design``).
+several speeds, with the joint optimum of radii and gait (``biped.optimization.design``).
 
 At each speed the map holds, each an independent optimization:
 
 - ``grid``: the optimal gait of the rolling knee at every (r1, r2) of the grid
-  (``biped.design.optimize_at``: ``biped.optimize.optimize``'s starts on the design graph
+  (``biped.optimization.design.optimize_at``: ``biped.optimization.optimize.optimize``'s starts on
+  the design graph
   with the radii held, one graph per process for every radius);
 - ``revolute``: the optimal gait of the revolute knee, the map's reference contour (the
   grid's rows r1 = 0 and r2 = 0 are hinges too: a circle rolling on a point turns about it);
@@ -12,8 +13,8 @@ At each speed the map holds, each an independent optimization:
 - ``design``: the radii and gait optimised together, in a second stage that also starts
   from the best grid point and the Table 1 and revolute gaits at that speed.
 
-The optimizations run through ``biped.runner.run_tasks``: local processes, or the workers of
-a Dask cluster. Each writes its result as one small JSON file (``biped.files``: whole or not
+The optimizations run through ``biped.runtime.runner.run_tasks``: local processes, or the workers of
+a Dask cluster. Each writes its result as one small JSON file (``biped.runtime.files``: whole or not
 at all), so a map stopped at any moment and run again ends with the files of an
 uninterrupted run; the folder's ``design-map.json`` records what shapes the numbers and
 resuming with any of it changed is refused. Points whose solver did not converge, or whose
@@ -37,22 +38,28 @@ from pathlib import Path
 
 import numpy as np
 
-from biped.comparison import relative_change
-from biped.criteria import PAPER_SAFETY, Safety
-from biped.design import RADII, DesignProblem, check_radii, optimize_at, optimize_design
 from biped.errors import BipedError
-from biped.files import (
+from biped.model.criteria import PAPER_SAFETY, Safety
+from biped.model.robot import Robot
+from biped.optimization.design import (
+    RADII,
+    DesignProblem,
+    check_radii,
+    optimize_at,
+    optimize_design,
+)
+from biped.optimization.optimize import DEFAULT_STARTS, optimize
+from biped.optimization.problem import VARIABLES
+from biped.records.comparison import relative_change
+from biped.records.provenance import version
+from biped.runtime.files import (
     atomic_path,
     atomic_write_text,
     clean_stale_temporaries,
     distinct_values,
 )
-from biped.manifest import Manifest
-from biped.optimize import DEFAULT_STARTS, optimize
-from biped.problem import VARIABLES
-from biped.provenance import version
-from biped.robot import Robot
-from biped.runner import ProgressBar, run_tasks
+from biped.runtime.runner import ProgressBar, run_tasks
+from biped.studies.manifest import Manifest
 
 MANIFEST = "design-map.json"
 _RECORD = Manifest(MANIFEST, "design-map record", "this folder's map was", "a design map's")
@@ -216,7 +223,7 @@ def _variables(content: dict) -> np.ndarray | None:
 
 
 def solve_point(task) -> str:
-    """One optimization of a map (a task of ``biped.runner.run_tasks``): writes its file and
+    """One optimization of a map (a task of ``biped.runtime.runner.run_tasks``): writes its file and
     returns a line saying what it found."""
     settings, point, folder = task
     problem = settings.problem(point.speed)
@@ -292,7 +299,7 @@ def run_design_map(
         speeds: walking speeds [m/s].
         r1, r2: the grid's radii [m] (default ``DEFAULT_GRID`` from 0 to the upper bound).
         upper: the design's upper bounds of (r1, r2) [m] (default ``radius_limits``).
-        jobs, dask: where the optimizations run (``biped.runner.run_tasks``).
+        jobs, dask: where the optimizations run (``biped.runtime.runner.run_tasks``).
         progress: ``progress(total)`` makes a bar advanced after each optimization.
     """
     stream = sys.stderr if stream is None else stream  # the stderr of the call, not of the import
@@ -394,7 +401,7 @@ class SpeedSummary:
 
     def gain(self, value: float | None) -> float | None:
         """[%] Change of ``value`` against the revolute knee
-        (``biped.comparison.relative_change``: negative, ``value`` is the smaller)."""
+        (``biped.records.comparison.relative_change``: negative, ``value`` is the smaller)."""
         if value is None or self.revolute is None:
             return None
         return relative_change(value, self.revolute)

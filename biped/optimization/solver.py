@@ -2,7 +2,7 @@
 
     min  C(z)   subject to   (Ψ_i − δ_i) / scale_i >= 0 at the samples,
                              hip height at the start >= ``MIN_HIP_HEIGHT``,
-                             bounds on z (``biped.problem.bounds``)
+                             bounds on z (``biped.optimization.problem.bounds``)
 
 C is the sthenic criterion (30) or the energy criterion (31) without penalty. The energy
 criterion's |Γ_i θ̇_i| is written exactly with slack variables s_ij (no smoothing):
@@ -16,7 +16,7 @@ every speed and every start (``solver_for``).
 With ``radius_bounds`` the knee radii (r1, r2) [m] are variables too (scaled by
 ``RADIUS_SCALE``), the rolling knee's graph built with them as symbols
 (``StepGraph(..., design=True)``): the gait and the knee optimised together
-(``biped.design``).
+(``biped.optimization.design``).
 """
 
 from __future__ import annotations
@@ -28,13 +28,13 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from biped.criteria import Safety
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.interrupts import kept_interrupts
-from biped.problem import N_VARIABLES, SCALES, GaitProblem, bounds
-from biped.robot import Robot
-from biped.symbolic import StepGraph
+from biped.model.criteria import Safety
+from biped.model.dynamics import Biped
+from biped.model.robot import Robot
+from biped.optimization.problem import N_VARIABLES, SCALES, GaitProblem, bounds
+from biped.optimization.symbolic import StepGraph
+from biped.runtime.interrupts import kept_interrupts
 
 # IPOPT's settings. ``tol``: its scaled optimality error; certified optima from different
 # starts then agree to about 1e-8 relative.
@@ -48,7 +48,7 @@ IPOPT_OPTIONS = {
 }
 # The barrier strategies a start can be solved with: IPOPT's adaptive one (the default) and
 # its monotone one from mu = 0.01. From the same start they follow other paths through the
-# energy criterion's basins and may end in other local minima (``biped.optimize``).
+# energy criterion's basins and may end in other local minima (``biped.optimization.optimize``).
 BARRIERS = {"adaptive": {}, "monotone": {"mu_strategy": "monotone", "mu_init": 1e-2}}
 # IPOPT's statuses that are a converged local optimum.
 CONVERGED = ("Solve_Succeeded",)
@@ -257,7 +257,7 @@ def _solver(robot: Robot, knee: str, criterion: str, safety: Safety, samples: in
 def solver_for(problem: GaitProblem) -> Solver:
     """The solver of ``problem``'s family, built once per process and reused."""
     if not isinstance(problem, GaitProblem):
-        raise BipedError(f"problem = {problem!r}: allowed a biped.problem.GaitProblem")
+        raise BipedError(f"problem = {problem!r}: allowed a biped.optimization.problem.GaitProblem")
     return _solver(
         problem.model.robot,
         problem.knee,

@@ -11,7 +11,7 @@
     C_Γ = (2/d) ∫₀ᵀ (ΓᵀΓ + k Σ (e^(|Ψ_i| - Ψ_i) - 1)) dt + Err              (30)
     C_E =       ∫₀ᵀ (Σ |Γ_i θ̇_i| + k Σ (e^(|Ψ_i| - Ψ_i) - 1)) dt + Err      (31)
 
-with k = 10⁶ and d = 2 S (see ``biped.gait``). Integrals use Simpson's rule on each spline
+with k = 10⁶ and d = 2 S (see ``biped.model.gait``). Integrals use Simpson's rule on each spline
 piece separately: the accelerations, hence the torques, jump at the knot t = T/2.
 Ψ6 and Ψ7 vanish by construction at t = 0 and t = T (both feet on the ground); they are
 checked at the interior samples only.
@@ -26,10 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import simpson
 
-from biped.dynamics import Biped, zmp_from
 from biped.errors import BipedError
-from biped.gait import Step, half_grid, sample
-from biped.kinematics import Q1, Q2, Q3, Q4
+from biped.model.dynamics import Biped, zmp_from
+from biped.model.gait import Step, half_grid, sample
+from biped.model.kinematics import Q1, Q2, Q3, Q4
 
 CONSTRAINTS = (
     "normal_force",
@@ -59,7 +59,7 @@ FOOT_MARGIN_RAMP = 0.1  # fraction of the step
 
 @functools.cache
 def margin_profile(samples_per_half: int) -> np.ndarray:
-    """δ (N, 7) on the time grid of ``biped.gait.sample``."""
+    """δ (N, 7) on the time grid of ``biped.model.gait.sample``."""
     t_n = np.concatenate(half_grid(samples_per_half))
     ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / FOOT_MARGIN_RAMP, 0.0, 1.0)
     profile = np.tile(MARGINS, (len(t_n), 1))

@@ -1,6 +1,7 @@
 """Units of the numbers in the project's JSON files: a ``units`` map beside them.
 
-Gait files (``biped.gait_file``) and validation reports keep their key names; their ``units``
+Gait files (``biped.records.gait_file``) and validation reports keep their key names; their
+``units``
 object maps the path of each numeric field to its unit::
 
     "costs.sthenic": "N²·m·s",
@@ -13,7 +14,7 @@ number (a count, a ratio) and ``"T"`` for a fraction of the gait's period; a lis
 unit per column of an array whose columns differ. A unit may be followed by what the number is,
 in parentheses, where the key alone would mislead: ``optimizer.value`` is the criterion on the
 solver's samples, which ranks the starts, where ``costs`` hold it on the check grid, which the
-comparisons use (``biped.comparison``). Only numbers (and null, a figure that could
+comparisons use (``biped.records.comparison``). Only numbers (and null, a figure that could
 not be measured) have units; texts, booleans and ``provenance`` have none.
 """
 
@@ -21,12 +22,12 @@ from __future__ import annotations
 
 import dataclasses
 
-from biped.comparison import CHECKED_VALUE, SOLVER_VALUE
-from biped.criteria import CONSTRAINTS, CRITERIA
-from biped.gait import PARAMETERS
-from biped.kinematics import ANGLES, COORDINATES
-from biped.problem import VARIABLES
-from biped.robot import Robot
+from biped.model.criteria import CONSTRAINTS, CRITERIA
+from biped.model.gait import PARAMETERS
+from biped.model.kinematics import ANGLES, COORDINATES
+from biped.model.robot import Robot
+from biped.optimization.problem import VARIABLES
+from biped.records.comparison import CHECKED_VALUE, SOLVER_VALUE
 
 PURE = "1"  # a count or a ratio
 PERIOD = "T"  # a fraction of the gait's period
@@ -85,8 +86,8 @@ def robot_unit(field: str) -> str:
 
 
 def parameter_unit(name: str) -> str:
-    """Unit of a gait parameter (``biped.gait.PARAMETERS``) or solver variable
-    (``biped.problem.VARIABLES``)."""
+    """Unit of a gait parameter (``biped.model.gait.PARAMETERS``) or solver variable
+    (``biped.optimization.problem.VARIABLES``)."""
     if name in ("x_hip", "z_hip"):
         return "m"
     if name == "period":
@@ -98,7 +99,7 @@ def parameter_unit(name: str) -> str:
     return "rad"  # the trunk angle, the knee bends
 
 
-# Units of Ψ1..Ψ7 (``biped.criteria.CONSTRAINTS``), as their margins δ.
+# Units of Ψ1..Ψ7 (``biped.model.criteria.CONSTRAINTS``), as their margins δ.
 CONSTRAINT_UNITS = dict(zip(CONSTRAINTS, ("N", "m", "m", "rad", "rad", "m", "m"), strict=True))
 
 

@@ -2,7 +2,8 @@
 
 Every point (knee, criterion, speed) is solved twice:
 
-1. independent: IPOPT from the point's own starts (``biped.optimize.optimize``); the result
+1. independent: IPOPT from the point's own starts (``biped.optimization.optimize.optimize``); the
+result
    is kept in the hidden folder ``.independent/``. The energy criterion also starts from
    the sthenic optimum of its problem: the sthenic point's independent optimum, read from
    there (the same numbers as computed again);
@@ -11,11 +12,12 @@ Every point (knee, criterion, speed) is solved twice:
    gait file.
 
 The solves run in three stages, each task of a stage independent of the others, so they run
-in parallel (``biped.runner``: on all cores, or on the workers of a Dask cluster): the
+in parallel (``biped.runtime.runner``: on all cores, or on the workers of a Dask cluster): the
 sthenic independent optima; the energy independent optima with the sthenic neighbours'
 solves; the energy neighbours' solves. Each result depends only on files of the stages
 before, which are written whole
-(``biped.files``), so a sweep stopped at any moment and run again ends with exactly the files
+(``biped.runtime.files``), so a sweep stopped at any moment and run again ends with exactly the
+files
 of an uninterrupted sweep. The folder's ``sweep.json`` records what shapes the numbers
 (robot, safety, speeds, seed, starts, method, versions); resuming with any of them changed is
 refused. Points whose solver did not converge, or whose optimum is infeasible, are saved
@@ -33,20 +35,20 @@ from pathlib import Path
 
 import numpy as np
 
-from biped import gait_file
-from biped.comparison import SINGLE_START
-from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.files import clean_stale_temporaries, distinct_values
-from biped.kinematics import KNEES
-from biped.manifest import Manifest
-from biped.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, optimize
-from biped.problem import VARIABLES, GaitProblem, check_speed
-from biped.provenance import version
-from biped.robot import Robot
-from biped.runner import ProgressBar, run_tasks
-from biped.units import CRITERION_UNITS
+from biped.model.criteria import CRITERIA, PAPER_SAFETY, Safety
+from biped.model.dynamics import Biped
+from biped.model.kinematics import KNEES
+from biped.model.robot import Robot
+from biped.optimization.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, optimize
+from biped.optimization.problem import VARIABLES, GaitProblem, check_speed
+from biped.records import gait_file
+from biped.records.comparison import SINGLE_START
+from biped.records.provenance import version
+from biped.records.units import CRITERION_UNITS
+from biped.runtime.files import clean_stale_temporaries, distinct_values
+from biped.runtime.runner import ProgressBar, run_tasks
+from biped.studies.manifest import Manifest
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
 MANIFEST = "sweep.json"
@@ -160,7 +162,7 @@ def _solve_with_neighbours(task) -> str:
 
 
 # What each stage's line calls its result: only the final stage's optimum is a point's
-# answer, so only it may be called certified (``biped.comparison.CERTIFIED``).
+# answer, so only it may be called certified (``biped.records.comparison.CERTIFIED``).
 STAGES = {"independent": "own starts, stage 1/2", "final": "final, stage 2/2"}
 
 
@@ -211,9 +213,9 @@ def run_sweep(
     progress: Callable[[int], ProgressBar] | None = None,
 ) -> list[Point]:
     """Certified optima of every (knee, criterion, speed) not yet in ``folder``; returns all
-    points. ``seed`` and ``starts`` go to ``biped.optimize.optimize``.
+    points. ``seed`` and ``starts`` go to ``biped.optimization.optimize.optimize``.
 
-    The optimizations run through ``biped.runner.run_tasks``: ``jobs`` local processes
+    The optimizations run through ``biped.runtime.runner.run_tasks``: ``jobs`` local processes
     (default: all cores), or the workers of the Dask scheduler at ``dask`` (``tcp://HOST:PORT``).
     A line per optimization goes to ``stream`` (default: ``sys.stderr``); ``progress(total)``,
     if given, makes the bar advanced after each of the ``total`` optimizations (all

@@ -2,7 +2,7 @@
 
 The paper minimises the criterion plus an exponential penalty of the constraints with
 Nelder-Mead (§4), a method that stops where its evaluation budget ends. To show what that does
-to a comparison of two knees, ``run_paper_method`` runs it (``biped.optimize`` with
+to a comparison of two knees, ``run_paper_method`` runs it (``biped.optimization.optimize`` with
 ``method="nelder-mead"``: the paper's kind of budget, a first run then restarts) at one speed,
 for each knee and criterion, from several seeds (seed 0 starts from the first guess, seed k
 from a perturbation of it, the way a designer tries a few first guesses). The gait files go to
@@ -25,20 +25,20 @@ from pathlib import Path
 
 import numpy as np
 
-from biped import gait_file
-from biped.comparison import DIFFERENCE, relative_change
-from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.files import clean_stale_temporaries
-from biped.kinematics import KNEES
-from biped.manifest import Manifest
-from biped.optimize import optimize
-from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
-from biped.problem import GaitProblem, check_speed
-from biped.provenance import version
-from biped.robot import Robot
-from biped.runner import ProgressBar, run_tasks
+from biped.model.criteria import CRITERIA, PAPER_SAFETY, Safety
+from biped.model.dynamics import Biped
+from biped.model.kinematics import KNEES
+from biped.model.robot import Robot
+from biped.optimization.optimize import optimize
+from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
+from biped.optimization.problem import GaitProblem, check_speed
+from biped.records import gait_file
+from biped.records.comparison import DIFFERENCE, relative_change
+from biped.records.provenance import version
+from biped.runtime.files import clean_stale_temporaries
+from biped.runtime.runner import ProgressBar, run_tasks
+from biped.studies.manifest import Manifest
 
 FOLDER = "paper-method"
 SETTINGS = "settings.json"

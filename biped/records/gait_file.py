@@ -6,7 +6,7 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
     safety {clearance, zmp_margin} [m] (margins beyond the paper's constraints), feasible,
     costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]} (on the check grid of 202
         samples per step: what the comparisons, tables and figures use),
-    robot {field: value}, parameters {name: value} (the 21 of ``biped.gait.PARAMETERS``),
+    robot {field: value}, parameters {name: value} (the 21 of ``biped.model.gait.PARAMETERS``),
     constraints {name: worst Ψ_i on the samples, less the safety margins: >= 0 when met},
     impact {impulse [N·s, N·s, N·m·s], trailing_foot_lift [m/s] (heel, toe), consistent
             (Iz > 0 and the trailing foot lifts: the flat-foot impact model holds), qd_minus,
@@ -17,9 +17,9 @@ Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at
                ranks the starts; it differs from costs.<criterion> by a fraction of a percent),
                history (each start), variables (the solver's variables)},
     provenance {package, version, python, platform, numpy, scipy, casadi, mujoco, command}
-        (``biped.provenance``: what produced the file),
+        (``biped.records.provenance``: what produced the file),
     units {path: unit} of every number above and below ("costs.sthenic": "N²·m·s",
-        ``biped.units``),
+        ``biped.records.units``),
     samples {t, q, qd, qdd, torques, wrench, zmp}
 
 The samples run from t = 0 to t = T inclusive on both spline pieces; t = T/2 appears twice,
@@ -40,18 +40,18 @@ from pathlib import Path
 
 import numpy as np
 
-from biped.criteria import CONSTRAINTS, CRITERIA, Safety
-from biped.dynamics import JOINTS, Biped
 from biped.errors import BipedError
-from biped.files import atomic_write_text
-from biped.gait import PARAMETERS
-from biped.impact import trailing_foot_lift
-from biped.kinematics import COORDINATES, KNEES
-from biped.optimize import Optimum, check_speed
-from biped.problem import VARIABLES
-from biped.provenance import provenance as make_provenance
-from biped.robot import Robot
-from biped.units import gait_units
+from biped.model.criteria import CONSTRAINTS, CRITERIA, Safety
+from biped.model.dynamics import JOINTS, Biped
+from biped.model.gait import PARAMETERS
+from biped.model.impact import trailing_foot_lift
+from biped.model.kinematics import COORDINATES, KNEES
+from biped.model.robot import Robot
+from biped.optimization.optimize import Optimum, check_speed
+from biped.optimization.problem import VARIABLES
+from biped.records.provenance import provenance as make_provenance
+from biped.records.units import gait_units
+from biped.runtime.files import atomic_write_text
 
 FORMAT = "biped-gait/2"  # 2: safety margins recorded
 # Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
@@ -77,7 +77,7 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None =
     """The JSON-ready content of a gait file.
 
     Args:
-        provenance: what produced it (default: ``biped.provenance.provenance()`` now).
+        provenance: what produced it (default: ``biped.records.provenance.provenance()`` now).
     """
     ev = optimum.evaluation
     step = optimum.step
@@ -128,7 +128,8 @@ def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None =
 
 
 def write_json(path: str | Path, content: dict) -> Path:
-    """Write JSON whole or not at all (``biped.files``), creating the folder; returns the path."""
+    """Write JSON whole or not at all (``biped.runtime.files``), creating the folder; returns the
+    path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     return atomic_write_text(path, json.dumps(content, indent=1, allow_nan=False))
@@ -330,9 +331,9 @@ def check_consistency(gait: dict, source: str = "gait") -> None:
     does not belong to its parameters, recomputed as ``to_dict`` computes them (no MuJoCo):
     period and step length, the samples on the check grid, the costs, the constraints,
     ``feasible`` and the impact. ``source`` names the file in the message."""
-    from biped.criteria import evaluate_step
-    from biped.gait import build_step
-    from biped.optimize import CHECK_SAMPLES_PER_HALF
+    from biped.model.criteria import evaluate_step
+    from biped.model.gait import build_step
+    from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
 
     def bad(what):
         return BipedError(f"{source} is inconsistent: {what}")

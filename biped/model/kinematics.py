@@ -16,7 +16,7 @@ the centres of the two rolling circles (l = r1 + r2)::
     p(q) = p_H + Σ_k a_k u(φ_k) + b_k u'(φ_k),   u(φ) = (sin φ, -cos φ),  u'(φ) = (cos φ, sin φ)
 
 u(φ) points down a segment hanging with angle φ; u'(φ) along a foot sole. This one form
-gives positions, Jacobians and the Lagrangian dynamics in closed form (``biped.dynamics``).
+gives positions, Jacobians and the Lagrangian dynamics in closed form (``biped.model.dynamics``).
 All functions take leading batch dimensions.
 """
 
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError, UnreachableError
-from biped.robot import Robot
+from biped.model.robot import Robot
 
 KNEES = ("revolute", "rolling")
 
@@ -64,7 +64,7 @@ def point_table(robot: Robot, r1, r2, links: bool) -> dict[str, tuple[dict, dict
     p = p_H + Σ_k a[k] u(φ_k) + b[k] u'(φ_k) over the direction names k of ``a`` and ``b``.
 
     The one statement of the robot's geometry: ``Chain`` fills its tables from it with the
-    radii as numbers, the symbolic graph (``biped.symbolic``) with the radii as CasADi
+    radii as numbers, the symbolic graph (``biped.optimization.symbolic``) with the radii as CasADi
     symbols. Only sums and products of ``r1``, ``r2`` and ``robot``'s lengths appear.
 
     Args:

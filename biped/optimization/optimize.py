@@ -1,6 +1,7 @@
 """Certified optimal gaits: IPOPT with exact derivatives from several starts.
 
-``optimize(problem)`` solves a ``GaitProblem`` with IPOPT (``biped.solver``) from several
+``optimize(problem)`` solves a ``GaitProblem`` with IPOPT (``biped.optimization.solver``) from
+several
 first guesses and keeps the best converged one:
 
 - the default first guess (``GaitProblem.first_guess``);
@@ -19,7 +20,7 @@ Every optimum is then checked on a fine grid (``CHECK_SAMPLES_PER_HALF`` samples
 piece, where the solver imposed the constraints with margins at ``samples_per_half``): it is
 feasible only if every constraint holds there with zero penalty.
 
-``method="nelder-mead"`` runs the paper's method alone (``biped.penalty``) so that its
+``method="nelder-mead"`` runs the paper's method alone (``biped.optimization.penalty``) so that its
 results can be set beside certified optima.
 """
 
@@ -31,11 +32,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from biped.criteria import StepEvaluation, evaluate_step
 from biped.errors import BipedError
-from biped.gait import Step, build_step
-from biped.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
-from biped.problem import (  # noqa: F401 (re-exported)
+from biped.model.criteria import StepEvaluation, evaluate_step
+from biped.model.gait import Step, build_step
+from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
+from biped.optimization.problem import (  # noqa: F401 (re-exported)
     FIRST_GUESS_PERIOD,
     SCALES,
     GaitProblem,
@@ -44,7 +45,7 @@ from biped.problem import (  # noqa: F401 (re-exported)
     check_speed,
     max_walking_speed,
 )
-from biped.solver import CONVERGED, solver_for
+from biped.optimization.solver import CONVERGED, solver_for
 
 METHODS = ("ipopt", "nelder-mead")
 # Starts of IPOPT by default (``first_guesses``).
@@ -181,8 +182,8 @@ class Optimum:
 
     Attributes:
         problem: what was solved.
-        variables: the solvers' variables (``biped.problem.VARIABLES``).
-        parameters: the paper's 21 parameters (``biped.gait.PARAMETERS``).
+        variables: the solvers' variables (``biped.optimization.problem.VARIABLES``).
+        parameters: the paper's 21 parameters (``biped.model.gait.PARAMETERS``).
         step: the step they build.
         evaluation: on the fine check grid.
         value: the criterion there (penalty included: equal to the criterion when feasible).
@@ -283,8 +284,8 @@ def optimize(
             ``max_restarts`` and ``evaluations_per_run``, from the first guess with seed 0
             and from the seed's perturbation of it otherwise).
         solvers: ``solvers(problem)`` gives what solves a problem from a start,
-            ``.solve(problem, z, barrier=...)`` (default ``biped.solver.solver_for``;
-            ``barrier`` one of ``biped.solver.BARRIERS``; ``biped.design``
+            ``.solve(problem, z, barrier=...)`` (default ``biped.optimization.solver.solver_for``;
+            ``barrier`` one of ``biped.optimization.solver.BARRIERS``; ``biped.optimization.design``
             gives its graph with the knee radii held, which serves every radius).
         sthenic: for the energy criterion, the sthenic optimum of the same problem with
             the same ``seed`` and ``starts``, if already known (a sweep's): it starts the
@@ -292,7 +293,7 @@ def optimize(
     """
     check_method(method)
     if not isinstance(problem, GaitProblem):
-        raise BipedError(f"problem = {problem!r}: allowed a biped.problem.GaitProblem")
+        raise BipedError(f"problem = {problem!r}: allowed a biped.optimization.problem.GaitProblem")
     began = time.perf_counter()
     if method == "nelder-mead":
         return _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began)
@@ -354,7 +355,9 @@ def _sthenic_start(
     energy."""
     twin = dataclasses.replace(problem, criterion="sthenic")
     if sthenic is not None and not isinstance(sthenic, Optimum):
-        raise BipedError(f"sthenic = {sthenic!r}: allowed a biped.optimize.Optimum or None")
+        raise BipedError(
+            f"sthenic = {sthenic!r}: allowed a biped.optimization.optimize.Optimum or None"
+        )
     if sthenic is None:
         sthenic = optimize(twin, seed, starts, solvers=solvers)
     elif _family(sthenic.problem) != _family(twin):
@@ -368,7 +371,8 @@ def _sthenic_start(
 
 
 def barrier_of(kind: str) -> str:
-    """The barrier strategy (``biped.solver.BARRIERS``) a start of this kind is solved with."""
+    """The barrier strategy (``biped.optimization.solver.BARRIERS``) a start of this kind is solved
+    with."""
     return "monotone" if kind == MONOTONE_START else "adaptive"
 
 

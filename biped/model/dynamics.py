@@ -2,7 +2,7 @@
 
     D(q) q̈ + H(q, q̇) + Q(q) = B Γ + A_cᵀ(q) F_e                                  (19)
 
-Derivation. With the directions φ = Φ θ_angles of ``biped.kinematics`` (a constant matrix Φ),
+Derivation. With the directions φ = Φ θ_angles of ``biped.model.kinematics`` (a constant matrix Φ),
 the centre of mass of body i is p_H + Σ_k a_ik u(φ_k). Writing W = Σ_i m_i a_i a_iᵀ (a
 constant K x K matrix), g = Σ_i m_i a_i, M the total mass and J_k the body inertias carried by
 direction k, the kinetic and potential energies are
@@ -30,9 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from biped import impact
-from biped.kinematics import NQ, Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH, Chain
-from biped.robot import Robot
+from biped.model import impact
+from biped.model.kinematics import NQ, Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH, Chain
+from biped.model.robot import Robot
 
 # Relative joint angles θ = S q of eq. (32) (θ4 = q5 - q3; the print repeats q5 - q2):
 # ankle, knee, hip of the stance leg, then hip, knee, ankle of the swing leg.
@@ -227,5 +227,5 @@ class Biped(Chain):
 
     # ------------------------------------------------------------------ impact
     def impact(self, q, qd_minus, foot: str = "swing"):
-        """Flat-foot impact of ``foot``, eqs. (21)-(24); see ``biped.impact``."""
+        """Flat-foot impact of ``foot``, eqs. (21)-(24); see ``biped.model.impact``."""
         return impact.flat_foot_impact(self, q, qd_minus, foot)

@@ -31,10 +31,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from biped.criteria import CRITERIA, PAPER_SAFETY, Safety
-from biped.dynamics import Biped
 from biped.errors import BipedError
-from biped.gait import N_PARAMETERS, PARAMETERS
+from biped.model.criteria import CRITERIA, PAPER_SAFETY, Safety
+from biped.model.dynamics import Biped
+from biped.model.gait import N_PARAMETERS, PARAMETERS
 
 # Decision variables of the solvers: the paper's parameters with the hip replaced by the
 # two knee bends at the start of the step.
@@ -61,7 +61,8 @@ SCALES = np.array([0.03, 0.03, 0.03] + [0.3] * 5 + [2.0] * 12 + [0.05])
 FIRST_GUESS_PERIOD = 0.6
 # Samples per spline piece where the solver imposes the constraints Ψ_i >= δ_i (each piece
 # closed: 26 samples); feasibility is then checked on a finer grid
-# (``biped.optimize.CHECK_SAMPLES_PER_HALF``), where Ψ_i may dip below δ_i between them.
+# (``biped.optimization.optimize.CHECK_SAMPLES_PER_HALF``), where Ψ_i may dip below δ_i between
+# them.
 SOLVER_SAMPLES_PER_HALF = 25
 
 
@@ -136,7 +137,7 @@ class GaitProblem:
         object.__setattr__(self, "speed", check_speed(self.model, self.speed))
         check_criterion(self.criterion)
         if not isinstance(self.safety, Safety):
-            raise BipedError(f"safety = {self.safety!r}: allowed a biped.criteria.Safety")
+            raise BipedError(f"safety = {self.safety!r}: allowed a biped.model.criteria.Safety")
         n = self.samples_per_half
         if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 1000:
             raise BipedError(f"samples_per_half = {n!r}: allowed an integer from 2 to 1000")
@@ -175,7 +176,7 @@ class GaitProblem:
         return x, chain.robot.ankle_height + math.sqrt(height2)
 
     def to_parameters(self, variables) -> np.ndarray:
-        """The paper's 21 parameters (``biped.gait.PARAMETERS``) of the solvers' variables."""
+        """The paper's 21 parameters (``biped.model.gait.PARAMETERS``) of the solvers' variables."""
         z = np.asarray(variables, dtype=float)
         if z.shape != (N_VARIABLES,):
             raise BipedError(f"variables have shape {z.shape}: allowed ({N_VARIABLES},)")

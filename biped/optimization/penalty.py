@@ -6,7 +6,8 @@ on the paper's 21 parameters, restarted from the best point with a fresh simplex
 paper suggests. The simplex works on scaled parameters so that one unit is a comparable
 change of every parameter (``SCALES``). Nelder-Mead in 21 dimensions stops far from the
 minimum (its result changes by factors of several with the budget and the seed); it is kept
-so that its results can be set beside certified optima (``biped.optimize``), and as one kind
+so that its results can be set beside certified optima (``biped.optimization.optimize``), and as
+one kind
 of first guess for IPOPT.
 
 ``polish`` is the SLSQP refinement with finite-difference derivatives used before IPOPT, kept
@@ -18,17 +19,17 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
-from biped.criteria import (
+from biped.errors import UnreachableError
+from biped.model.criteria import (
     BUILD_ERROR_COST,
     BUILD_ERROR_SLOPE,
     checked_mask,
     evaluate_step,
     margin_profile,
 )
-from biped.errors import UnreachableError
-from biped.gait import N_PARAMETERS, StepBuildError, build_step
-from biped.problem import GaitProblem
-from biped.symbolic import CONSTRAINT_SCALES
+from biped.model.gait import N_PARAMETERS, StepBuildError, build_step
+from biped.optimization.problem import GaitProblem
+from biped.optimization.symbolic import CONSTRAINT_SCALES
 
 # Samples per spline piece of the penalised criterion.
 OPTIMIZE_SAMPLES_PER_HALF = 40

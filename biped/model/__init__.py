@@ -1,0 +1,7 @@
+"""The analytical model of the bipeds (the paper's section 2 and appendices A, B): the robot's
+parameters and conventions (``robot``), geometry (``kinematics``), Lagrangian dynamics, ground
+wrench and ZMP (``dynamics``), the flat-foot impact (``impact``), the spline gait of one step
+(``gait``, section 3) and its criteria and constraints (``criteria``, section 4).
+
+May import: ``biped.errors``, numpy, scipy. Nothing here knows of solvers, files or MuJoCo.
+"""
