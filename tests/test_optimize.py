@@ -18,6 +18,7 @@ from biped.optimization.optimize import (
     AGREEMENT,
     MONOTONE_START,
     STHENIC_START,
+    Report,
     Start,
     optimize,
     starts_at_value,
@@ -30,6 +31,7 @@ from tests.conftest import optimal_gait
 ROBOT = biped.Robot.paper()
 UNEQUAL = dataclasses.replace(ROBOT, r1=0.03, r2=0.08)
 SAMPLES = 25
+NAN = float("nan")
 
 
 def random_variables(problem, rng):
@@ -222,6 +224,20 @@ def test_one_point_solved_under_both_barriers_is_one_start_at_the_best():
     assert starts_at_value([*pair, start("first guess")], value) == 2
     assert starts_at_value([start("first guess"), start("given")], value) == 2
     assert starts_at_value([start(MONOTONE_START), start("given", 2.0)], value) == 1
+
+
+def test_report_read_back_from_its_json_is_the_report():
+    """A report written as JSON and read back is the same report: a value that is not
+    finite written as null and read as NaN, a file without the best value read as NaN."""
+    history = (Start("first guess", 1.5, "Solve_Succeeded", 40), Start("given", NAN, "x", 3))
+    report = Report("ipopt", "converged", 2, 1, 40, 1e-9, NAN, 2.5, 7, 1.5, history)
+    content = json.loads(json.dumps(report.to_dict()))
+    assert list(content) == [f.name for f in dataclasses.fields(Report)]
+    assert content["dual_infeasibility"] is None and content["history"][1]["value"] is None
+    back = Report.from_dict(content)
+    assert repr(back) == repr(report)
+    del content["value"]
+    assert np.isnan(Report.from_dict(content).value)
 
 
 def test_papers_method_stops_far_above_the_certified_optimum():

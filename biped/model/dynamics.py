@@ -68,29 +68,37 @@ class Biped(Chain):
         knee: ``"revolute"`` or ``"rolling"``.
 
     Every method takes leading batch dimensions: q, q̇, q̈ are (..., 9).
+
+    Attributes (the constants of the module docstring, over the K directions; the symbolic
+    graph, ``biped.optimization.symbolic``, is built from them):
+        mass: M [kg], the total mass.
+        gravity: g₀ [m/s²].
+        second_moments: W = Σ_i m_i a_i a_iᵀ (K, K) [kg·m²].
+        first_moments: g = Σ_i m_i a_i (K,) [kg·m].
+        direction_inertias: J (K,) [kg·m²], the body inertias carried by each direction.
+        coordinate_map: P (K + 2, 9) [-], y = (φ, x_H, z_H) = P q.
     """
 
     def __init__(self, robot: Robot, knee: str = "rolling"):
         super().__init__(robot, knee)
         k = len(self.direction_names)
         index = {name: i for i, name in enumerate(self.direction_names)}
-        self.mass = robot.total_mass  # [kg]
-        self.gravity = robot.gravity  # [m/s²]
-        self._w = np.zeros((k, k))  # W
-        self._g = np.zeros(k)  # g
-        self._inertia = np.zeros(k)  # J
+        self.mass = robot.total_mass
+        self.gravity = robot.gravity
+        self.second_moments = np.zeros((k, k))
+        self.first_moments = np.zeros(k)
+        self.direction_inertias = np.zeros(k)
         for body in self.bodies:
             j = self.point_index(body.com)
             if np.any(self.point_b[:, j]):
                 raise AssertionError(f"centre of mass {body.com} must lie on segment axes")
             a = self.point_a[:, j]
-            self._w += body.mass * np.outer(a, a)
-            self._g += body.mass * a
-            self._inertia[index[body.direction]] += body.inertia
-        # y = P q with y = (φ, xH, zH)
-        self._p = np.zeros((k + 2, NQ))
-        self._p[:k, :7] = self.directions
-        self._p[k, XH] = self._p[k + 1, ZH] = 1.0
+            self.second_moments += body.mass * np.outer(a, a)
+            self.first_moments += body.mass * a
+            self.direction_inertias[index[body.direction]] += body.inertia
+        self.coordinate_map = np.zeros((k + 2, NQ))
+        self.coordinate_map[:k, :7] = self.directions
+        self.coordinate_map[k, XH] = self.coordinate_map[k + 1, ZH] = 1.0
         self._stance_leg = self.directions[:, [Q1, Q2]]
 
     # ------------------------------------------------------------------ matrices of eq. (19)
@@ -110,25 +118,26 @@ class Biped(Chain):
         k = phi.shape[-1]
         dy = np.zeros(phi.shape[:-1] + (k + 2, k + 2))
         cos_diff = c[..., :, None] * c[..., None, :] + s[..., :, None] * s[..., None, :]
-        dy[..., :k, :k] = self._w * cos_diff + np.diag(self._inertia)
-        dy[..., k, :k] = dy[..., :k, k] = self._g * c
-        dy[..., k + 1, :k] = dy[..., :k, k + 1] = self._g * s
+        dy[..., :k, :k] = self.second_moments * cos_diff + np.diag(self.direction_inertias)
+        dy[..., k, :k] = dy[..., :k, k] = self.first_moments * c
+        dy[..., k + 1, :k] = dy[..., :k, k + 1] = self.first_moments * s
         dy[..., k, k] = dy[..., k + 1, k + 1] = self.mass
-        return self._p.T @ dy @ self._p
+        return self.coordinate_map.T @ dy @ self.coordinate_map
 
     def bias_forces(self, q, qd):
         """H(q, q̇) (..., 9): Coriolis and centrifugal terms."""
         phi = self.direction_angles(q)
         rate2 = self.direction_angles(qd) ** 2
         s, c = np.sin(phi), np.cos(phi)
-        h_phi = s * ((c * rate2) @ self._w) - c * ((s * rate2) @ self._w)
-        h_hip = np.stack([-(self._g * s * rate2).sum(-1), (self._g * c * rate2).sum(-1)], -1)
+        w, g = self.second_moments, self.first_moments
+        h_phi = s * ((c * rate2) @ w) - c * ((s * rate2) @ w)
+        h_hip = np.stack([-(g * s * rate2).sum(-1), (g * c * rate2).sum(-1)], -1)
         return self._from_y(h_phi, h_hip)
 
     def gravity_forces(self, q):
         """Q(q) (..., 9): gradient of the potential energy."""
         phi = self.direction_angles(q)
-        q_phi = self.gravity * self._g * np.sin(phi)
+        q_phi = self.gravity * self.first_moments * np.sin(phi)
         q_hip = np.zeros(phi.shape[:-1] + (2,))
         q_hip[..., 1] = self.gravity * self.mass
         return self._from_y(q_phi, q_hip)
@@ -149,14 +158,12 @@ class Biped(Chain):
         qdd = np.asarray(qdd)
         hip_x = qdd[..., XH, None]
         hip_z = qdd[..., ZH, None] + self.gravity
+        w, g = self.second_moments, self.first_moments
         tau_phi = (
-            c * (ax @ self._w + self._g * hip_x)
-            + s * (az @ self._w + self._g * hip_z)
-            + self._inertia * phidd
+            c * (ax @ w + g * hip_x) + s * (az @ w + g * hip_z) + self.direction_inertias * phidd
         )
         tau_hip = np.concatenate(
-            [self.mass * hip_x + ax @ self._g[:, None], self.mass * hip_z + az @ self._g[:, None]],
-            axis=-1,
+            [self.mass * hip_x + ax @ g[:, None], self.mass * hip_z + az @ g[:, None]], axis=-1
         )
         return self._from_y(tau_phi, tau_hip)
 
@@ -219,7 +226,7 @@ class Biped(Chain):
         """V [J], zero at z = 0."""
         q = np.asarray(q)
         phi = self.direction_angles(q)
-        return self.gravity * (self.mass * q[..., ZH] - (self._g * np.cos(phi)).sum(-1))
+        return self.gravity * (self.mass * q[..., ZH] - (self.first_moments * np.cos(phi)).sum(-1))
 
     def motor_power(self, qd, torques):
         """Σ Γ_i θ̇_i [W]."""

@@ -39,7 +39,7 @@ import numpy as np
 
 from biped.errors import BipedError
 from biped.model.dynamics import Biped
-from biped.model.kinematics import swap_legs
+from biped.model.kinematics import LEG_SWAP, Q1, Q5, swap_legs
 
 # Names of the 21 parameters, in order.
 PARAMETERS = (
@@ -52,8 +52,10 @@ PARAMETERS = (
 N_PARAMETERS = len(PARAMETERS)  # 21
 FREE_ANGLES = ("qp2", "q1", "q2", "q3", "q4", "q5")
 
-# Index of each free angle in the six-vector, and its image under the leg swap.
-_SWAP = [0, 4, 3, 2, 1, 5]  # qp2 -> qp2, q1 <-> q4, q2 <-> q3, q5 -> q5
+# The leg swap (``biped.model.kinematics.LEG_SWAP``) of the free angles: the end posture is
+# start[FREE_SWAP] (qp2 -> qp2, q1 <-> q4, q2 <-> q3, q5 -> q5), the swing foot flat at both
+# ends; free angle i is q[i + 1].
+FREE_SWAP = [0] + [LEG_SWAP[i] - 1 for i in range(Q1, Q5 + 1)]
 
 
 @dataclass(frozen=True)
@@ -109,7 +111,7 @@ def build_step(model: Biped, speed: float, p) -> Step:
         raise StepBuildError("hip out of the legs' reach", excess=excess + max(hp - z_hip, 0.0))
     (q1, q2), (q4, q3) = model.leg_angles(hips)
     start_angles = np.array([0.0, q1, q2, q3, q4, trunk])
-    end_angles = start_angles[_SWAP]
+    end_angles = start_angles[FREE_SWAP]
     q_end, qd_end, _ = model.stance_state(end_angles, end_rates)
     qd_plus, impulse = model.impact(q_end, qd_end)
     q_start, qd_start = swap_legs(model, q_end, qd_plus)
@@ -170,9 +172,10 @@ def evaluate(step: Step, t_n, piece: str):
 
 
 @functools.cache
-def _basis(samples_per_half: int):
-    """Matrices mapping the stacked coefficients [a0..a3, b0..b3] (8, 6) to the values and the
-    first and second derivatives in normalised time on both pieces of ``half_grid``.
+def spline_basis(samples_per_half: int):
+    """The normalised times of both pieces of ``half_grid`` (2 (n + 1),) and the matrices [-]
+    mapping the stacked coefficients [a0..a3, b0..b3] (8, 6) to the values and the first and
+    second derivatives in normalised time there: (t_n, (values, rates, accels)).
 
     Piece (26) is a polynomial in u = 1 - t_n, so d/dt_n = -d/du there.
     """
@@ -200,7 +203,7 @@ def sample(model: Biped, step: Step, samples_per_half: int, points=()):
         t [s] (N,), q, q̇, q̈ (N, 9), torques (N, 6), wrench (N, 3), positions of ``points``
         (N, P, 2), N = 2 (n + 1).
     """
-    t_n, (values, rates, accels) = _basis(samples_per_half)
+    t_n, (values, rates, accels) = spline_basis(samples_per_half)
     coefficients = np.concatenate([step.a, step.b], axis=1).T  # (8, 6)
     period = step.period
     return (t_n * period,) + model.single_support(

@@ -37,6 +37,9 @@ NQ = len(COORDINATES)
 
 # Index of each coordinate in q.
 QP1, QP2, Q1, Q2, Q3, Q4, Q5, XH, ZH = range(NQ)
+# The leg swap at the end of a step (``swap_legs``): the same posture with the swing leg as
+# the new stance leg is q[LEG_SWAP] (feet, shanks and thighs exchanged; trunk and hip kept).
+LEG_SWAP = (QP2, QP1, Q4, Q3, Q2, Q1, Q5, XH, ZH)
 
 # Direction names in the order of the rows of ``Chain.directions``; the rolling knee adds
 # the two knee links.
@@ -164,13 +167,13 @@ class Chain:
         self._point_index = {name: j for j, name in enumerate(points)}
         self._stance_ankle = self.point_a[:, self._point_index["stance_ankle"]].copy()
         self._reach = (
-            float(np.sqrt(self._reach_squared(np.pi))),
-            float(np.sqrt(self._reach_squared(0.0))),
+            float(np.sqrt(self.reach_squared(np.pi))),
+            float(np.sqrt(self.reach_squared(0.0))),
         )
         # Table of the monotone reach |hip - ankle|² over the knee flexion [0, π], to start
         # the Newton iterations of the inverse geometric model next to the root.
         self._flexion_table = np.linspace(0.0, np.pi, 1025)
-        self._reach_table = self._reach_squared(self._flexion_table)
+        self._reach_table = self.reach_squared(self._flexion_table)
 
         self.bodies = tuple(
             Body(f"{side}_{segment}", mass, inertia, f"{side}_{segment}", f"{side}_{segment}_com")
@@ -305,8 +308,8 @@ class Chain:
         """[m] Shortest and longest ankle-to-hip distance (knee flexion π and 0)."""
         return self._reach
 
-    def _reach_squared(self, flexion):
-        """|hip - ankle|² as a function of the knee flexion θ = q_thigh - q_shank ≥ 0."""
+    def reach_squared(self, flexion):
+        """|hip - ankle|² [m²] of a leg at knee flexion θ = q_thigh - q_shank ≥ 0 [rad]."""
         r1, r2 = self.radii
         link = r1 + r2
         shank, thigh = self.robot.shank_length - r1, self.robot.thigh_length - r2
@@ -362,7 +365,7 @@ class Chain:
         else:  # Newton on the monotone f(θ) from the tabulated inverse
             flexion = np.interp(dist2, self._reach_table[::-1], self._flexion_table[::-1])
             for _ in range(20):
-                residual = self._reach_squared(flexion) - dist2
+                residual = self.reach_squared(flexion) - dist2
                 if np.all(np.abs(residual) < 1e-13):
                     break
                 slope = self._reach_squared_derivative(flexion)
@@ -386,10 +389,9 @@ def swap_legs(chain: Chain, q, qd=None):
     Returns q (and q̇) of the same posture in the new labelling, translated along x so that
     the new stance ankle is at x = 0. Angles and velocities are only permuted.
     """
-    order = [QP2, QP1, Q4, Q3, Q2, Q1, Q5, XH, ZH]
     q = np.asarray(q, dtype=float)
-    new_q = q[..., order].copy()
+    new_q = q[..., LEG_SWAP].copy()
     new_q[..., XH] -= chain.point(q, "swing_ankle")[..., 0]
     if qd is None:
         return new_q
-    return new_q, np.asarray(qd, dtype=float)[..., order]
+    return new_q, np.asarray(qd, dtype=float)[..., LEG_SWAP]

@@ -2,13 +2,11 @@
 
 The paper fixes the radii of the rolling knee at r1 = r2 = 5 cm and ends on "integrate the
 radii r1 and r2 in the parameter vector". A ``DesignProblem`` does that: minimise the
-criterion over the gait's variables z (``biped.optimization.problem.VARIABLES``) and the radii (r1,
-r2)
-together, under the gait's constraints, with IPOPT on the graph of the step whose radii are
-symbols (``biped.optimization.symbolic.StepGraph(..., design=True)``,
-``biped.optimization.solver.Solver`` with
-``radius_bounds``). Every other parameter of the robot (masses, inertias, segment lengths,
-centres of mass) stays as given.
+criterion over the gait's variables z (``biped.optimization.problem.VARIABLES``) and the
+radii (r1, r2) together, under the gait's constraints, with IPOPT on the graph of the step
+whose radii are symbols (``biped.optimization.symbolic.StepGraph(..., design=True)``,
+``biped.optimization.solver.Solver`` with ``radius_bounds``). Every other parameter of the
+robot (masses, inertias, segment lengths, centres of mass) stays as given.
 
 Design bounds. The segment lengths l1, l2 include the radii (``biped.model.robot``: both knees
 have the same height), so a radius moves length from the shank or the thigh into the knee:
@@ -33,15 +31,14 @@ and 20 cm, its hinges in the ratio 200); a design at that bound says that the kn
 nothing by rolling there. The robot's own radii, the reference design, are moved into the
 bounds where they lie beyond them, and ``DesignProblem.moved_reference`` says so.
 
-Starts, as for gaits (``biped.optimization.optimize``): the gait's first guesses at the robot's own
-radii
-(Table 1's) and starts with radii drawn uniformly in the bounds and the gait's first guess
-there perturbed, from ``numpy.random.default_rng(seed)`` (``DESIGN_STARTS``), and any given
-(gait, radii) pairs; for the energy criterion also the sthenic design (under both barriers,
-``biped.optimization.optimize.MONOTONE_START``). The best converged
-start wins; its report counts the starts that reached the same value. When no start
-converged the report carries IPOPT's status (and the command line exits 1): never a silent
-fallback.
+Starts, solved by the gaits' multistart (``biped.optimization.optimize.multistart``): the
+gait's first guesses at the robot's own radii (Table 1's) and starts with radii drawn
+uniformly in the bounds and the gait's first guess there perturbed, from
+``numpy.random.default_rng(seed)`` (``DESIGN_STARTS``), and any given (gait, radii) pairs; for
+the energy criterion also the sthenic design (under both barriers,
+``biped.optimization.optimize.sthenic_starts``). The best converged start wins; its report
+counts the starts that reached the same value. When no start converged the report carries
+IPOPT's status (and the command line exits 1): never a silent fallback.
 """
 
 from __future__ import annotations
@@ -61,18 +58,16 @@ from biped.model.robot import LENGTH_MIN, Robot
 from biped.optimization.optimize import (
     DEFAULT_STARTS,
     GUESS_PERIODS,
-    MONOTONE_START,
-    PERTURBATION,
-    STHENIC_START,
     Optimum,
-    Report,
-    Start,
-    barrier_of,
+    best_of,
     checked,
+    multistart,
     optimize,
-    starts_at_value,
+    perturbed,
+    start_schedule,
+    sthenic_starts,
 )
-from biped.optimization.problem import SCALES, GaitProblem, bounds, check_criterion, check_speed
+from biped.optimization.problem import GaitProblem, check_criterion, check_speed
 from biped.optimization.solver import Solver
 from biped.records.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
 
@@ -276,34 +271,25 @@ DESIGN_STARTS = (GUESS_PERIODS[0], GUESS_PERIODS[1], None, GUESS_PERIODS[2])
 
 
 def design_starts(problem: DesignProblem, starts: int, seed: int) -> list[tuple]:
-    """(kind, z, radii) of ``starts`` starts in the order of ``DESIGN_STARTS``."""
-    if isinstance(starts, bool) or not isinstance(starts, int) or starts < 0:
-        raise BipedError(f"starts = {starts!r}: allowed an integer >= 0")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise BipedError(f"seed = {seed!r}: allowed an integer >= 0")
+    """(kind, (z, radii)) of ``starts`` starts in the order of ``DESIGN_STARTS``."""
+    schedule = start_schedule(starts, seed, DESIGN_STARTS)
     rng = np.random.default_rng(seed)
-    lower, upper = bounds()
     reference = problem.reference_radii
     result = []
-    for k in range(starts):
-        period = DESIGN_STARTS[k] if k < len(DESIGN_STARTS) else None
+    for kind, period in schedule:
         if period is not None:
-            kind = "first guess" if k == 0 else f"first guess T = {period:g} s"
             z = problem.gait_problem(reference).first_guess(period)
-            result.append((kind, z, reference))
+            result.append((kind, (z, reference)))
             continue
         radii = tuple(float(r) for r in rng.uniform(problem.lower, problem.upper))
-        z = problem.gait_problem(radii).first_guess()
-        z = z + PERTURBATION * SCALES * rng.standard_normal(z.shape)
-        z[:2] = np.abs(z[:2])  # the knee bends stay bends
-        result.append(("perturbed", np.clip(z, lower, upper), radii))
+        result.append((kind, (perturbed(problem.gait_problem(radii).first_guess(), rng), radii)))
     return result
 
 
 def optimize_design(
     problem: DesignProblem, seed: int = 0, starts: int = DEFAULT_STARTS, given=()
 ) -> Design:
-    """The best radii and gait of ``problem``.
+    """The best radii and gait of ``problem`` (``biped.optimization.optimize.multistart``).
 
     Args:
         seed: seed of the random starts; the same seed gives the same result.
@@ -311,46 +297,20 @@ def optimize_design(
         given: further starts, each (z (21,), (r1, r2)), e.g. the optimal gait at the
             Table 1 radii.
     """
-    if not isinstance(problem, DesignProblem):
-        raise BipedError(
-            f"problem = {problem!r}: allowed a biped.optimization.design.DesignProblem"
-        )
     began = time.perf_counter()
-    solver = solver_for(problem)
+    solver = solver_for(problem)  # which checks ``problem``
     candidates = design_starts(problem, starts, seed)
     for z, radii in given:
-        candidates.append(("given", np.asarray(z, dtype=float), check_radii(problem.robot, radii)))
-    if (
-        problem.criterion == "energy" and starts > 0
-    ):  # as biped.optimization.optimize: least torque first
+        start = (np.asarray(z, dtype=float), check_radii(problem.robot, radii))
+        candidates.append(("given", start))
+    if problem.criterion == "energy" and starts > 0:  # as for gaits: least torque first
         sthenic = optimize_design(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
-        if sthenic.report.converged:
-            for kind in (STHENIC_START, MONOTONE_START):
-                candidates.append((kind, sthenic.optimum.variables, sthenic.radii))
-    if not candidates:
-        raise BipedError("no start: allowed starts >= 1 or given starts")
-    solutions = [
-        (kind, solver.solve(problem, z, radii, barrier=barrier_of(kind)))
-        for kind, z, radii in candidates
-    ]
-    converged = [s for _, s in solutions if s.converged]
-    pool = converged or [s for _, s in solutions]
-    best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
-    history = tuple(Start(kind, s.value, s.status, s.iterations) for kind, s in solutions)
-    at_best = starts_at_value(history, best.value)
-    report = Report(
-        method="ipopt",
-        status="converged" if best.converged else best.status,
-        starts=len(solutions),
-        starts_at_best=int(at_best),
-        iterations=best.iterations,
-        constraint_violation=best.constraint_violation,
-        dual_infeasibility=best.dual_infeasibility,
-        seconds=time.perf_counter() - began,
-        seed=int(seed),
-        history=history,
-        value=best.value,
-    )
+        candidates += sthenic_starts(sthenic.report, (sthenic.optimum.variables, sthenic.radii))
+
+    def solve(start, barrier):
+        return solver.solve(problem, *start, barrier=barrier)
+
+    best, report = multistart(candidates, solve, seed, began)
     # IPOPT may end a hair outside a bound (its bound_relax_factor): back inside
     radii = tuple(
         float(np.clip(r, low, high))
@@ -360,25 +320,21 @@ def optimize_design(
     return Design(problem, radii, optimum)
 
 
+@dataclass(frozen=True)
 class _HeldRadii:
     """The design graph with the knee radii held: a gait solver for every radius without a
-    new graph (``biped.optimization.optimize.optimize``'s ``solvers``)."""
+    new graph (``biped.optimization.optimize.optimize``'s ``solvers``, which it is for each
+    gait problem)."""
 
-    def __init__(self, problem: DesignProblem, radii):
-        self.problem, self.radii = problem, radii
-
-    def __call__(self, gait: GaitProblem):
-        design = solver_for(dataclasses.replace(self.problem, criterion=gait.criterion))
-        return _HeldSolver(design, self.radii)
-
-
-@dataclass(frozen=True)
-class _HeldSolver:
-    design: Solver
+    problem: DesignProblem
     radii: tuple
 
+    def __call__(self, gait: GaitProblem):
+        return self  # one held solver serves the gait problems of every criterion
+
     def solve(self, gait: GaitProblem, start, barrier: str = "adaptive"):
-        return self.design.solve(gait, start, self.radii, hold_radii=True, barrier=barrier)
+        design = solver_for(dataclasses.replace(self.problem, criterion=gait.criterion))
+        return design.solve(gait, start, self.radii, hold_radii=True, barrier=barrier)
 
 
 def optimize_at(
@@ -492,8 +448,6 @@ def compare(
     the best of every start. Optima given (``revolute``, ``reference``: e.g. gaits already
     written) are kept as they are.
     """
-    from biped.optimization.optimize import best_of
-
     ref = problem.reference_radii
     hinge, rolling = problem.gait_problem(ref, "revolute"), problem.gait_problem(ref)
     fixed = {"revolute": revolute is not None, "reference": reference is not None}

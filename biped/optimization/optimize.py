@@ -1,8 +1,8 @@
 """Certified optimal gaits: IPOPT with exact derivatives from several starts.
 
 ``optimize(problem)`` solves a ``GaitProblem`` with IPOPT (``biped.optimization.solver``) from
-several
-first guesses and keeps the best converged one:
+several first guesses and keeps the best converged one (``multistart``, which the knee's
+design, ``biped.optimization.design``, shares):
 
 - the default first guess (``GaitProblem.first_guess``);
 - perturbed first guesses, drawn from ``numpy.random.default_rng(seed)``;
@@ -99,8 +99,8 @@ class Report:
     dual_infeasibility: float
     seconds: float
     seed: int
-    history: tuple = field(default_factory=tuple)
     value: float = float("nan")  # the best start's criterion on the solver's samples
+    history: tuple = field(default_factory=tuple)
 
     @property
     def converged(self) -> bool:
@@ -112,51 +112,13 @@ class Report:
         return self.starts_at_best >= 2
 
     def to_dict(self) -> dict:
-        return {
-            "method": self.method,
-            "status": self.status,
-            "starts": self.starts,
-            "starts_at_best": self.starts_at_best,
-            "iterations": self.iterations,
-            "constraint_violation": _finite_or_none(self.constraint_violation),
-            "dual_infeasibility": _finite_or_none(self.dual_infeasibility),
-            "seconds": self.seconds,
-            "seed": self.seed,
-            "value": _finite_or_none(self.value),
-            "history": [
-                {
-                    "kind": s.kind,
-                    "value": _finite_or_none(s.value),
-                    "status": s.status,
-                    "iterations": s.iterations,
-                }
-                for s in self.history
-            ],
-        }
+        """The report as JSON: its fields in order, a value that is not finite as null."""
+        return _to_json(self)
 
     @classmethod
     def from_dict(cls, content: dict) -> Report:
-        """The report written by ``to_dict``."""
-
-        def number(value):
-            return float("nan") if value is None else float(value)
-
-        return cls(
-            method=content["method"],
-            status=content["status"],
-            starts=int(content["starts"]),
-            starts_at_best=int(content["starts_at_best"]),
-            iterations=int(content["iterations"]),
-            constraint_violation=number(content["constraint_violation"]),
-            dual_infeasibility=number(content["dual_infeasibility"]),
-            seconds=float(content["seconds"]),
-            seed=int(content["seed"]),
-            value=number(content.get("value")),
-            history=tuple(
-                Start(s["kind"], number(s["value"]), s["status"], int(s["iterations"]))
-                for s in content["history"]
-            ),
-        )
+        """The report written by ``to_dict`` (a missing ``value``: NaN)."""
+        return _from_json(cls, content)
 
     def summary(self) -> str:
         """One line for the command line."""
@@ -174,6 +136,32 @@ class Report:
 
 def _finite_or_none(value):
     return float(value) if np.isfinite(value) else None
+
+
+def _to_json(record) -> dict:
+    """The fields of a ``Report`` or a ``Start`` in order: floats finite or None, the
+    history a list."""
+
+    def value(v):
+        if isinstance(v, tuple):
+            return [_to_json(start) for start in v]
+        return _finite_or_none(v) if isinstance(v, float) else v
+
+    return {f.name: value(getattr(record, f.name)) for f in dataclasses.fields(record)}
+
+
+def _from_json(cls, content: dict):
+    """The ``Report`` or ``Start`` of ``_to_json``: None as NaN; a field with a default
+    value may be missing."""
+    convert = {
+        "str": str,
+        "int": int,
+        "float": lambda v: float("nan") if v is None else float(v),
+        "tuple": lambda v: tuple(_from_json(Start, start) for start in v),
+    }
+    fields = dataclasses.fields(cls)
+    given = [f for f in fields if f.name in content or f.default is dataclasses.MISSING]
+    return cls(**{f.name: convert[f.type](content[f.name]) for f in given})
 
 
 @dataclass
@@ -228,26 +216,30 @@ def check_method(method: str) -> str:
     return method
 
 
-def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[str, np.ndarray]]:
-    """``starts`` first guesses in the bounds: the default first guess, then first guesses of
-    other step periods (``GUESS_PERIODS``: the step length a gait settles on is its largest
-    choice, and the basins of the optima follow it), then perturbations of the default."""
+def start_schedule(starts: int, seed: int, periods) -> list[tuple[str, float | None]]:
+    """(kind, period) of ``starts`` starts: the first guesses of the step periods [s]
+    ``periods`` in order (None: a random start), random starts after them."""
     if isinstance(starts, bool) or not isinstance(starts, int) or starts < 0:
         raise BipedError(f"starts = {starts!r}: allowed an integer >= 0")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise BipedError(f"seed = {seed!r}: allowed an integer >= 0")
-    guess = problem.first_guess()
-    rng = np.random.default_rng(seed)
-    result = []
-    for k in range(starts):
-        if k == 0:
-            result.append(("first guess", guess))
-        elif k < len(GUESS_PERIODS):
-            period = GUESS_PERIODS[k]
-            result.append((f"first guess T = {period:g} s", problem.first_guess(period)))
-        else:
-            result.append(("perturbed", perturbed(guess, rng)))
-    return result
+    periods = list(periods[:starts]) + [None] * (starts - len(periods))
+    return [
+        ("perturbed" if p is None else f"first guess T = {p:g} s" if k else "first guess", p)
+        for k, p in enumerate(periods)
+    ]
+
+
+def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[str, np.ndarray]]:
+    """``starts`` first guesses in the bounds: the default first guess, then first guesses of
+    other step periods (``GUESS_PERIODS``: the step length a gait settles on is its largest
+    choice, and the basins of the optima follow it), then perturbations of the default."""
+    schedule = start_schedule(starts, seed, GUESS_PERIODS)
+    guess, rng = problem.first_guess(), np.random.default_rng(seed)
+    return [
+        (kind, perturbed(guess, rng) if period is None else problem.first_guess(period))
+        for kind, period in schedule
+    ]
 
 
 def perturbed(guess, rng: np.random.Generator) -> np.ndarray:
@@ -256,6 +248,44 @@ def perturbed(guess, rng: np.random.Generator) -> np.ndarray:
     z = guess + PERTURBATION * SCALES * rng.standard_normal(np.shape(guess))
     z[:2] = np.abs(z[:2])  # the knee bends stay bends
     return np.clip(z, lower, upper)
+
+
+def multistart(candidates, solve, seed: int, began: float):
+    """The best solution from the starts ``candidates`` and its ``Report``: the multistart of
+    gaits (``optimize``) and designs (``biped.optimization.design``), each giving its starts
+    and what solves one.
+
+    Args:
+        candidates: (kind, start) pairs; a kind names its barrier (``barrier_of``).
+        solve: ``solve(start, barrier)`` -> ``biped.optimization.solver.Solution``.
+        seed: recorded in the report.
+        began: ``time.perf_counter()`` when the search began, for the report's seconds.
+
+    Returns:
+        (best, report): the converged solution of least value (of every solution when none
+        converged; a NaN value ranks last).
+    """
+    if not candidates:
+        raise BipedError("no start: allowed starts >= 1 or given starts")
+    solutions = [(kind, solve(start, barrier_of(kind))) for kind, start in candidates]
+    converged = [s for _, s in solutions if s.converged]
+    pool = converged or [s for _, s in solutions]
+    best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
+    history = tuple(Start(kind, s.value, s.status, s.iterations) for kind, s in solutions)
+    report = Report(
+        method="ipopt",
+        status="converged" if best.converged else best.status,
+        starts=len(solutions),
+        starts_at_best=starts_at_value(history, best.value),
+        iterations=best.iterations,
+        constraint_violation=best.constraint_violation,
+        dual_infeasibility=best.dual_infeasibility,
+        seconds=time.perf_counter() - began,
+        seed=int(seed),
+        history=history,
+        value=best.value,
+    )
+    return best, report
 
 
 def optimize(
@@ -314,27 +344,8 @@ def optimize(
             candidates.append(("nelder-mead", problem.from_parameters(parameters)))
         except BipedError:
             continue  # a Nelder-Mead point out of reach starts nothing
-    if not candidates:
-        raise BipedError("no start: allowed starts >= 1 or given guesses")
-    solutions = [
-        (kind, solver.solve(problem, z, barrier=barrier_of(kind))) for kind, z in candidates
-    ]
-    converged = [s for _, s in solutions if s.converged]
-    pool = converged or [s for _, s in solutions]
-    best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
-    history = tuple(Start(kind, s.value, s.status, s.iterations) for kind, s in solutions)
-    report = Report(
-        method="ipopt",
-        status="converged" if best.converged else best.status,
-        starts=len(solutions),
-        starts_at_best=starts_at_value(history, best.value),
-        iterations=best.iterations,
-        constraint_violation=best.constraint_violation,
-        dual_infeasibility=best.dual_infeasibility,
-        seconds=time.perf_counter() - began,
-        seed=int(seed),
-        history=history,
-        value=best.value,
+    best, report = multistart(
+        candidates, lambda z, barrier: solver.solve(problem, z, barrier=barrier), seed, began
     )
     return checked(problem, best.variables, report)
 
@@ -365,9 +376,14 @@ def _sthenic_start(
             f"sthenic = the optimum of {sthenic.problem.criterion} at {sthenic.problem.speed} "
             f"m/s ({sthenic.problem.knee} knee): allowed the sthenic optimum of this problem"
         )
-    if not sthenic.report.converged:
-        return []
-    return [(STHENIC_START, sthenic.variables), (MONOTONE_START, sthenic.variables)]
+    return sthenic_starts(sthenic.report, sthenic.variables)
+
+
+def sthenic_starts(report: Report, start) -> list:
+    """The energy criterion's starts ``start`` from a sthenic optimum found as ``report``
+    says, under both barriers (``STHENIC_START``, ``MONOTONE_START``): none unless it
+    converged."""
+    return [(STHENIC_START, start), (MONOTONE_START, start)] if report.converged else []
 
 
 def barrier_of(kind: str) -> str:

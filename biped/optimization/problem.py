@@ -162,8 +162,8 @@ class GaitProblem:
     def hip_start(self, stance_bend, swing_bend, period):
         """Hip (x_H, z_H) [m] at the start of the step from the knee bends, eq. (*)."""
         chain = self.model
-        d_s2 = chain._reach_squared(stance_bend)
-        d_w2 = chain._reach_squared(swing_bend)
+        d_s2 = chain.reach_squared(stance_bend)
+        d_w2 = chain.reach_squared(swing_bend)
         length = self.speed * period
         x = (d_w2 - d_s2 - length**2) / (2 * length)
         height2 = d_s2 - x**2

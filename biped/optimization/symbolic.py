@@ -1,15 +1,14 @@
 """The gait problem as a CasADi expression graph: exact derivatives for the solvers.
 
-The graph is built from the constants of the numeric model (``biped.model.dynamics.Biped``): the
-directions Φ, W, g, J, the point coefficients and the spline bases of ``biped.model.gait``, so the
-symbolic and the numeric criterion are one model written twice with the same numbers (a test
-holds them equal to 1e-12). From the variables z (``biped.optimization.problem.VARIABLES``) and the
-speed:
+The graph is built from the public constants of the numeric model (``biped.model.dynamics.Biped``:
+the directions Φ, W, g, J, P and the point coefficients; ``biped.model.gait``: the spline bases
+and the leg swap), so the symbolic and the numeric criterion are one model written twice with
+the same numbers (a test holds them equal to 1e-12). From the variables z
+(``biped.optimization.problem.VARIABLES``) and the speed, in the stages of ``StepGraph``:
 
 1. hip at the start of the step from the knee bends (``biped.optimization.problem``, eq. *), the
-legs'
-   angles by the forward geometry of each leg (no inverse model, no square root at a straight
-   knee);
+   legs' angles by the forward geometry of each leg (no inverse model, no square root at a
+   straight knee);
 2. the end state (legs swapped), the impact map (23) and the start velocities;
 3. the spline coefficients (25)-(26), then at each sample the stance state, the one-pass
    inverse dynamics and the swing foot's heel and toe;
@@ -35,9 +34,10 @@ from biped.model.criteria import (
     simpson_weights,
 )
 from biped.model.dynamics import JOINT_MATRIX, Biped
-from biped.model.gait import _SWAP, _basis
+from biped.model.gait import FREE_SWAP, spline_basis
 from biped.model.kinematics import (
     BODY_DIRECTIONS,
+    LEG_SWAP,
     LINK_DIRECTIONS,
     NQ,
     Q1,
@@ -56,7 +56,6 @@ from biped.optimization.problem import MIN_HIP_HEIGHT, N_VARIABLES, index
 # Constraints are divided by these in the solvers so that all are of order one
 # [N, m, m, rad, rad, m, m].
 CONSTRAINT_SCALES = np.array([1000.0, 0.1, 0.1, 1.0, 1.0, 0.1, 0.1])
-_SWAP_ORDER = [QP2, QP1, Q4, Q3, Q2, Q1, Q5, XH, ZH]  # biped.model.kinematics.swap_legs
 
 
 class _Constants:
@@ -77,16 +76,16 @@ class _Constants:
         self.design = radii is not None
         if self.design:
             self._symbolic(model, radii)
-            return
-        self.radii = model.radii
-        self.phi = _sparse(model.directions)  # (K, 7)
-        self.w = _sparse(model._w)
-        self.g = _sparse(model._g)
-        self.inertia = _sparse(model._inertia)
-        self.p = _sparse(model._p)  # y = P q
-        self.ankle = _sparse(model._stance_ankle)
-        self.stance_leg = _sparse(model._stance_leg)  # (K, 2)
-        self.k = model.directions.shape[0]
+        else:
+            self.radii = model.radii
+            self.phi = _sparse(model.directions)  # (K, 7)
+            self.w = _sparse(model.second_moments)
+            self.g = _sparse(model.first_moments)
+            self.inertia = _sparse(model.direction_inertias)
+            self.p = _sparse(model.coordinate_map)  # y = P q
+            self.k = model.directions.shape[0]
+        self.ankle = self.point("stance_ankle")[0]
+        self.stance_leg = self.phi[:, [Q1, Q2]]  # (K, 2)
 
     def _symbolic(self, model: Biped, radii):
         r1, r2 = radii[0], radii[1]
@@ -124,12 +123,10 @@ class _Constants:
             g = g + body.mass * a
             inertia[index[body.direction]] += body.inertia
         self.w, self.g, self.inertia = w, g, _sparse(inertia)
-        p = ca.SX(k + 2, NQ)  # y = P q, as Biped._p
+        p = ca.SX(k + 2, NQ)  # y = P q, as Biped.coordinate_map
         p[:k, :7] = phi
         p[k, XH] = p[k + 1, ZH] = 1.0
         self.p = p
-        self.ankle = self._points["stance_ankle"][0]
-        self.stance_leg = ca.horzcat(phi[:, Q1], phi[:, Q2])
 
     def point(self, name):
         if self.design:
@@ -145,7 +142,7 @@ def _sparse(array):
 
 def _stance_state(c: _Constants, angles, rates, accels):
     """q, q̇, q̈ (9,) and φ̇, φ̈, sin φ, cos φ of a stance-foot-fixed motion
-    (``Chain._stance_state``)."""
+    (``Chain.stance_state``)."""
     zero = ca.SX.zeros(1)
     q7, qd7, qdd7 = (ca.vertcat(zero, v) for v in (angles, rates, accels))
     phi, phid, phidd = c.phi @ q7, c.phi @ qd7, c.phi @ qdd7
@@ -159,7 +156,7 @@ def _stance_state(c: _Constants, angles, rates, accels):
 
 
 def _torques_and_wrench(c: _Constants, qdd, phid, phidd, s, co):
-    """Γ (6,) and F_e (3,): ``Biped._forces`` then ``Biped._torques_and_wrench``."""
+    """Γ (6,) and F_e (3,) in one pass, as ``Biped.inverse_dynamics``."""
     rate2 = phid * phid
     ax = co * phidd - s * rate2
     az = s * phidd + co * rate2
@@ -231,7 +228,7 @@ def _leg_angles(c: _Constants, bend, hip_from_ankle):
 
 
 def _reach_squared(c: _Constants, bend):
-    """|hip − ankle|² at knee flexion ``bend`` (``Chain._reach_squared``)."""
+    """|hip − ankle|² at knee flexion ``bend`` (``Chain.reach_squared``)."""
     r1, r2 = c.radii
     link = r1 + r2
     shank = c.model.robot.shank_length - r1
@@ -263,28 +260,34 @@ class StepGraph:
         parameters (21): the paper's parameters; torques (6, N); wrench (3, N); q (9, N);
         qd (9, N); power (6, N) Γ_i θ̇_i; sthenic, energy: eqs. (30)-(31) without penalty;
         constraints (M): (Ψ_i − δ_i − safety) / scale at the checked samples, >= 0 when met;
-        hip_height: hip above the ankles at the start less ``MIN_HIP_HEIGHT`` (>= 0).
+        hip_height: hip above the ankles at the start less ``MIN_HIP_HEIGHT`` (>= 0);
+        period T [s], length S = V T [m], impulse (3,) of the landing, psi (7, N): Ψ_i with
+        the margins, weights (1, N): Simpson's. Built in the module docstring's stages, one
+        method each.
     """
 
     def __init__(self, model: Biped, samples_per_half: int, safety, design: bool = False):
-        self.model = model
-        self.samples_per_half = samples_per_half
-        self.safety = safety
-        self.design = design
+        self.model, self.samples_per_half = model, samples_per_half
+        self.safety, self.design = safety, design
         self.radii = ca.SX.sym("radii", 2) if design else None
         c = _Constants(model, self.radii)
-        z = ca.SX.sym("z", N_VARIABLES)
-        speed = ca.SX.sym("speed")
-        self.z, self.speed = z, speed
-        bend_s, bend_w = z[index("stance_knee_bend")], z[index("swing_knee_bend")]
-        trunk = z[index("trunk")]
-        period = z[index("period")]
-        end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
-        acc0 = z[index("start_accel_qp2") : index("start_accel_q5") + 1]
-        acc1 = z[index("end_accel_qp2") : index("end_accel_q5") + 1]
+        self.z, self.speed = ca.SX.sym("z", N_VARIABLES), ca.SX.sym("speed")
+        self.period = self.z[index("period")]  # T [s]
+        self.length = self.speed * self.period  # S [m]
+        start_angles = self._start_posture(c)
+        end_angles, end_rates, start_rates = self._impact(c, start_angles)
+        motion = self._splines(start_angles, start_rates, end_angles, end_rates)
+        feet = self._samples(c, *motion)
+        self._criteria()
+        self._constraints(feet)
 
-        # 1. hip and legs at the start of the step
-        length = speed * period
+    def _start_posture(self, c: _Constants):
+        """1. The hip at the start of the step from the knee bends (``biped.optimization.problem``,
+        eq. *), the legs' angles by the forward geometry of each leg (no inverse model, no
+        square root at a straight knee): the six free angles at the start. Sets
+        ``hip_height`` and ``parameters``."""
+        z, length = self.z, self.length
+        bend_s, bend_w = z[index("stance_knee_bend")], z[index("swing_knee_bend")]
         d_s2, d_w2 = _reach_squared(c, bend_s), _reach_squared(c, bend_w)
         x_hip = (d_w2 - d_s2 - length**2) / (2 * length)
         height2 = d_s2 - x_hip**2
@@ -293,22 +296,31 @@ class StepGraph:
         q1, q2 = _leg_angles(c, bend_s, ca.vertcat(x_hip, lift))
         q4, q3 = _leg_angles(c, bend_w, ca.vertcat(x_hip + length, lift))
         self.parameters = ca.vertcat(x_hip, c.hp + lift, z[index("trunk") :])
+        return ca.vertcat(0.0, q1, q2, q3, q4, z[index("trunk")])
 
-        # 2. end state, impact, start velocities
-        start_angles = ca.vertcat(0.0, q1, q2, q3, q4, trunk)
-        end_angles = ca.vertcat(*[start_angles[i] for i in _SWAP])
-        zeros = ca.SX.zeros(6)
-        q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, zeros)
+    def _impact(self, c: _Constants, start_angles):
+        """2. The end state (the start posture with the legs swapped, ``FREE_SWAP``), the
+        impact map (23) and the start velocities, the legs swapped again (``LEG_SWAP``):
+        (end angles, end rates, start rates), each (6,). Sets ``impulse``."""
+        z = self.z
+        end_angles = ca.vertcat(*[start_angles[i] for i in FREE_SWAP])
+        end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
+        q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
         mass = _mass_matrix(c, q_end)
         jac = _swing_contact_jacobian(c, q_end)
         d_inv_jt = ca.solve(mass, jac.T)
         gram = jac @ d_inv_jt
-        impulse = -ca.solve(gram, jac @ qd_end)
-        qd_plus = qd_end + d_inv_jt @ impulse
-        start_rates = ca.vertcat(*[qd_plus[_SWAP_ORDER[i]] for i in range(1, 7)])
-        self.impulse = impulse
+        self.impulse = -ca.solve(gram, jac @ qd_end)
+        qd_plus = qd_end + d_inv_jt @ self.impulse
+        start_rates = ca.vertcat(*[qd_plus[LEG_SWAP[i]] for i in range(1, 7)])
+        return end_angles, end_rates, start_rates
 
-        # 3. spline coefficients, as in biped.model.gait.build_step
+    def _splines(self, start_angles, start_rates, end_angles, end_rates):
+        """3. The spline coefficients (25)-(26), as in ``biped.model.gait.build_step``: the
+        angles, rates and accelerations (6, N) of the free angles at the samples."""
+        z, period = self.z, self.period
+        acc0 = z[index("start_accel_qp2") : index("start_accel_q5") + 1]
+        acc1 = z[index("end_accel_qp2") : index("end_accel_q5") + 1]
         a0, a1, a2 = start_angles, period * start_rates, 0.5 * period**2 * acc0
         b0, b1, b2 = end_angles, -period * end_rates, 0.5 * period**2 * acc1
         r1 = b0 + b1 / 2 + b2 / 4 - a0 - a1 / 2 - a2 / 4
@@ -316,16 +328,20 @@ class StepGraph:
         a3 = 4 * r1 + 2 * r2 / 3
         b3 = 2 * r2 / 3 - 4 * r1
         coefficients = ca.horzcat(a0, a1, a2, a3, b0, b1, b2, b3).T  # (8, 6)
-        _, (values, rates, accels) = _basis(samples_per_half)
+        _, (values, rates, accels) = spline_basis(self.samples_per_half)
         angles = (ca.DM(values) @ coefficients).T  # (6, N)
         rates = (ca.DM(rates) @ coefficients).T / period
         accels = (ca.DM(accels) @ coefficients).T / period**2
+        return angles, rates, accels
 
+    def _samples(self, c: _Constants, angles, rates, accels):
+        """3. At each sample the stance state, the one-pass inverse dynamics and the heights
+        of the swing foot's heel and toe (2, N), returned. Sets ``q``, ``qd``, ``torques``,
+        ``wrench`` and ``power``."""
         heel_a, heel_b = c.point("swing_heel")
         toe_a, toe_b = c.point("swing_toe")
-        n = angles.shape[1]
         columns = {name: [] for name in ("q", "qd", "torques", "wrench", "feet")}
-        for j in range(n):
+        for j in range(angles.shape[1]):
             q, qd, qdd, phid, phidd, s, co = _stance_state(
                 c, angles[:, j], rates[:, j], accels[:, j]
             )
@@ -341,34 +357,36 @@ class StepGraph:
         )
         joint_rates = ca.DM(JOINT_MATRIX) @ self.qd
         self.power = self.torques * joint_rates
+        return feet
 
-        # 4. criteria and constraints
-        weights = ca.DM(simpson_weights(samples_per_half)).T  # (1, N)
+    def _criteria(self):
+        """4. The criteria (Simpson's rule per piece), eqs. (30)-(31) without penalty."""
+        period = self.period
+        self.weights = ca.DM(simpson_weights(self.samples_per_half)).T  # (1, N)
         squared = ca.sum1(self.torques**2)
-        self.sthenic = period * (weights @ squared.T) / length
-        self.energy = period * (weights @ ca.sum1(ca.fabs(self.power)).T)
-        self.weights = weights
-        self.period = period
+        self.sthenic = period * (self.weights @ squared.T) / self.length
+        self.energy = period * (self.weights @ ca.sum1(ca.fabs(self.power)).T)
 
-        robot = model.robot
+    def _constraints(self, feet):
+        """4. The constraints Ψ_i − δ_i (``psi``: Ψ_i with the safety margins, without δ_i),
+        scaled by ``CONSTRAINT_SCALES``, at the checked samples in constraint-major order."""
+        robot, safety, samples = self.model.robot, self.safety, self.samples_per_half
         zmp = (self.torques[0, :] - robot.ankle_height * self.wrench[0, :]) / self.wrench[1, :]
-        feet_z = feet
         if safety.clearance:
-            required = ca.DM(clearance_profile(samples_per_half, safety.clearance)).T
-            feet_z = feet_z - ca.repmat(required, 2, 1)
-        psi = ca.vertcat(
+            required = ca.DM(clearance_profile(samples, safety.clearance)).T
+            feet = feet - ca.repmat(required, 2, 1)
+        self.psi = ca.vertcat(
             self.wrench[1, :],
             zmp + robot.foot_heel - safety.zmp_margin,
             robot.foot_length - robot.foot_heel - zmp - safety.zmp_margin,
             self.q[Q2, :] - self.q[Q1, :],
             self.q[Q3, :] - self.q[Q4, :],
-            feet_z,
+            feet,
         )  # (7, N)
-        self.psi = psi  # with the safety margins, without δ
-        mask = checked_mask(samples_per_half)
-        margins = margin_profile(samples_per_half)
-        scaled = (psi - ca.DM(margins).T) / ca.repmat(ca.DM(CONSTRAINT_SCALES), 1, n)
-        rows, cols = np.nonzero(mask.T)  # constraint-major order
+        n = self.psi.shape[1]
+        margins = ca.DM(margin_profile(samples)).T
+        scaled = (self.psi - margins) / ca.repmat(ca.DM(CONSTRAINT_SCALES), 1, n)
+        rows, cols = np.nonzero(checked_mask(samples).T)  # constraint-major order
         self.constraints = ca.vertcat(*[scaled[i, j] for i, j in zip(rows, cols, strict=True)])
         self.constraint_names = [CONSTRAINTS[i] for i in rows]
 
@@ -379,19 +397,8 @@ class StepGraph:
 
     def function(self) -> ca.Function:
         """A CasADi function (z, speed[, radii]) -> every quantity of the step, for checks."""
-        names = (
-            "parameters",
-            "torques",
-            "wrench",
-            "q",
-            "qd",
-            "psi",
-            "sthenic",
-            "energy",
-            "constraints",
-            "hip_height",
-            "impulse",
-        )
+        names = "parameters torques wrench q qd psi sthenic energy constraints hip_height impulse"
+        names = tuple(names.split())
         return ca.Function(
             "step",
             self.inputs,
