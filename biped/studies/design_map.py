@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -39,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import PAPER_SAFETY, Safety
+from biped.model.criteria import CRITERION_UNITS, PAPER_SAFETY, Safety
 from biped.model.robot import Robot
 from biped.optimization.design import (
     RADII,
@@ -51,19 +50,15 @@ from biped.optimization.design import (
 from biped.optimization.optimize import DEFAULT_STARTS, optimize
 from biped.optimization.problem import VARIABLES
 from biped.records.comparison import relative_change
-from biped.records.provenance import version
-from biped.runtime.files import (
-    atomic_path,
-    atomic_write_text,
-    clean_stale_temporaries,
-    distinct_values,
-)
-from biped.runtime.runner import ProgressBar, run_tasks
-from biped.studies.manifest import Manifest
+from biped.runtime.files import atomic_path, atomic_write_text, distinct_values
+from biped.runtime.runner import ProgressBar
+from biped.studies import campaign
+from biped.studies.campaign import Task
 
 MANIFEST = "design-map.json"
-_RECORD = Manifest(MANIFEST, "design-map record", "this folder's map was", "a design map's")
-MAP_FORMAT = "biped-design-map/1"
+MAP = campaign.Campaign(
+    "design map", MANIFEST, "design-map record", "this folder's map was", "a design map's"
+)
 KINDS = ("grid", "revolute", "table1", "design")
 # Grid points per radius by default, from 0 to the radius's upper bound.
 DEFAULT_GRID = 10
@@ -91,9 +86,10 @@ class MapPoint:
 
 
 @dataclass(frozen=True)
-class MapSettings:
+class MapSettings(campaign.Settings):
     """What shapes a map's numbers, recorded in its folder."""
 
+    FORMAT = "biped-design-map/1"
     robot: Robot
     criterion: str
     safety: Safety
@@ -106,37 +102,6 @@ class MapSettings:
 
     def problem(self, speed: float) -> DesignProblem:
         return DesignProblem(self.robot, speed, self.criterion, self.safety, upper=self.upper)
-
-    def to_dict(self) -> dict:
-        return {
-            "format": MAP_FORMAT,
-            "robot": self.robot.to_dict(),
-            "criterion": self.criterion,
-            "safety": dataclasses.asdict(self.safety),
-            "speeds": list(self.speeds),
-            "r1": list(self.r1),
-            "r2": list(self.r2),
-            "upper": list(self.upper),
-            "seed": self.seed,
-            "starts": self.starts,
-            "method": "ipopt",
-            "version": version(),
-            "casadi": version("casadi"),
-        }
-
-    @classmethod
-    def from_dict(cls, content: dict) -> MapSettings:
-        return cls(
-            robot=Robot.from_mapping(content["robot"], source="robot"),
-            criterion=content["criterion"],
-            safety=Safety(**content["safety"]),
-            speeds=tuple(content["speeds"]),
-            r1=tuple(content["r1"]),
-            r2=tuple(content["r2"]),
-            upper=tuple(content["upper"]),
-            seed=int(content["seed"]),
-            starts=int(content["starts"]),
-        )
 
 
 def radius_grid(robot: Robot, values, name: str) -> tuple:
@@ -197,15 +162,7 @@ def _save(folder: Path, point: MapPoint, optimum, radii, report_seconds: float) 
 
 
 def _line(point: MapPoint, content: dict) -> str:
-    status = (
-        "certified"
-        if content["certified"]
-        else (
-            "NOT CONVERGED: " + content["status"]
-            if content["status"] != "converged"
-            else "INFEASIBLE"
-        )
-    )
+    status = campaign.failure(content["status"], content["feasible"]) or "certified"
     value = content["value"]
     radii = content["radii"]
     where = "" if radii is None else f" at r1 {radii[0]:.4f} m, r2 {radii[1]:.4f} m"
@@ -217,21 +174,16 @@ def _line(point: MapPoint, content: dict) -> str:
     )
 
 
-def _variables(content: dict) -> np.ndarray | None:
-    values = [content["variables"][name] for name in VARIABLES]
-    return None if any(v is None for v in values) else np.array(values, float)
-
-
-def solve_point(task) -> str:
-    """One optimization of a map (a task of ``biped.runtime.runner.run_tasks``): writes its file and
-    returns a line saying what it found."""
-    settings, point, folder = task
+def solve_point(task: Task) -> str:
+    """One optimization of a map (a ``campaign.Task``): writes its file and returns a line
+    saying what it found."""
+    settings, point, folder = task.settings, task.point, Path(task.folder)
     problem = settings.problem(point.speed)
     began = time.perf_counter()
     if point.kind == "design":
         given = []
-        for content in _stage_one(Path(folder), settings, point.speed):
-            variables = _variables(content)
+        for content in _stage_one(folder, settings, point.speed):
+            variables = campaign.variables(content["variables"])
             if variables is not None:
                 given.append((variables, content["radii"] or problem.reference_radii))
         design = optimize_design(problem, seed=settings.seed, starts=settings.starts, given=given)
@@ -299,58 +251,28 @@ def run_design_map(
         speeds: walking speeds [m/s].
         r1, r2: the grid's radii [m] (default ``DEFAULT_GRID`` from 0 to the upper bound).
         upper: the design's upper bounds of (r1, r2) [m] (default ``radius_limits``).
-        jobs, dask: where the optimizations run (``biped.runtime.runner.run_tasks``).
-        progress: ``progress(total)`` makes a bar advanced after each optimization.
+        jobs, dask, stream, progress: as ``campaign.Campaign.run``.
     """
-    stream = sys.stderr if stream is None else stream  # the stderr of the call, not of the import
-    speeds = distinct_values(speeds, "speeds", "m/s", 3, "1 mm/s")  # MapPoint.filename's
+    speeds = campaign.distinct_speeds(speeds)
     problem = DesignProblem(robot, speeds[0], criterion, safety, upper=upper)
     for speed in speeds[1:]:
         problem = dataclasses.replace(problem, speed=speed)  # each speed checked
     upper = problem.upper
-    r1 = np.linspace(0.0, upper[0], DEFAULT_GRID) if r1 is None else r1
-    r2 = np.linspace(0.0, upper[1], DEFAULT_GRID) if r2 is None else r2
-    settings = MapSettings(
-        robot,
-        criterion,
-        safety,
-        tuple(speeds),
-        radius_grid(robot, r1, "r1"),
-        radius_grid(robot, r2, "r2"),
-        tuple(upper),
-        int(seed),
-        int(starts),
-    )
-    folder = Path(folder)
-    _RECORD.claim(folder, settings.to_dict())  # checked before the folder is made
-    clean_stale_temporaries(folder)
-    first, second = map_points(settings)
-    todo = [[p for p in stage if read_point(folder, p) is None] for stage in (first, second)]
-    total = len(first) + len(second)
-    remaining = sum(map(len, todo))
-    print(
+    r1 = radius_grid(robot, np.linspace(0.0, upper[0], DEFAULT_GRID) if r1 is None else r1, "r1")
+    r2 = radius_grid(robot, np.linspace(0.0, upper[1], DEFAULT_GRID) if r2 is None else r2, "r2")
+    upper, seed, starts = tuple(upper), int(seed), int(starts)
+    settings = MapSettings(robot, criterion, safety, tuple(speeds), r1, r2, upper, seed, starts)
+    folder = MAP.claim(folder, settings)  # checked before the folder is made
+    points = map_points(settings)
+    todo = [[p for p in stage if read_point(folder, p) is None] for stage in points]
+    stages = [[Task(solve_point, settings, p, str(folder)) for p in stage] for stage in todo]
+    total, remaining = sum(map(len, points)), sum(map(len, stages))
+    plan = (
         f"design map: {total} optimizations in {folder}, {total - remaining} already done, "
-        f"{remaining} to run",
-        file=stream,
-        flush=True,
+        f"{remaining} to run"
     )
-    bar = progress(remaining) if progress is not None and remaining else None
-    began = time.perf_counter()
-    try:
-        for stage in todo:
-            tasks = [(settings, point, str(folder)) for point in stage]
-            for line in run_tasks(
-                solve_point, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar
-            ):
-                print(line, file=stream, flush=True)
-    finally:
-        if bar is not None:
-            bar.clear()
-    print(
-        f"design map: done in {time.perf_counter() - began:.1f} s; {summarize(folder, settings)}",
-        file=stream,
-        flush=True,
-    )
+    where = dict(jobs=jobs, dask=dask, stream=stream, progress=progress)
+    MAP.run(plan, stages, lambda: summarize(folder, settings), **where)
     return settings
 
 
@@ -364,27 +286,22 @@ def load(folder) -> tuple[MapSettings, dict]:
             f"{folder / MANIFEST}: no design map there ({error}): run 'biped design-map'"
         ) from None
     first, second = map_points(settings)
-    results = {}
-    for point in first + second:
-        content = read_point(folder, point)
-        if content is not None:
-            results[point] = content
-    return settings, results
+    contents = {point: read_point(folder, point) for point in first + second}
+    return settings, {point: c for point, c in contents.items() if c is not None}
 
 
 def summarize(folder, settings: MapSettings) -> str:
     """How many optimizations are certified, and which are not."""
     first, second = map_points(settings)
-    bad = []
-    for point in first + second:
+
+    def why_not(point):
         content = read_point(Path(folder), point)
         if content is None:
-            bad.append(f"{point.filename()} missing")
-        elif not content["certified"]:
-            bad.append(f"{point.filename()} {content['status']}")
-    total = len(first) + len(second)
-    text = f"{total - len(bad)} of {total} optimizations certified (converged and feasible)"
-    return text + ("; NOT: " + ", ".join(bad[:5]) + (" ..." if len(bad) > 5 else "") if bad else "")
+            return "missing"
+        return None if content["certified"] else content["status"]
+
+    counted = "optimizations certified (converged and feasible)"
+    return campaign.tally(first + second, why_not, counted, most=5)
 
 
 @dataclass(frozen=True)
@@ -415,21 +332,11 @@ def speed_summaries(settings: MapSettings, results: dict) -> list[SpeedSummary]:
     summaries = []
     for speed in settings.speeds:
         design = results.get(MapPoint("design", speed))
-        certified = design is not None and design["certified"]
-        grid = [
-            value(MapPoint("grid", speed, (r1, r2))) for r1 in settings.r1 for r2 in settings.r2
-        ]
-        grid = [v for v in grid if v is not None]
-        summaries.append(
-            SpeedSummary(
-                speed,
-                tuple(design["radii"]) if certified else None,
-                design["value"] if certified else None,
-                value(MapPoint("table1", speed)),
-                value(MapPoint("revolute", speed)),
-                min(grid) if grid else None,
-            )
-        )
+        radii = tuple(design["radii"]) if design is not None and design["certified"] else None
+        grid = [value(MapPoint("grid", speed, (a, b))) for a in settings.r1 for b in settings.r2]
+        best = min((v for v in grid if v is not None), default=None)
+        values = {kind: value(MapPoint(kind, speed)) for kind in ("design", "table1", "revolute")}
+        summaries.append(SpeedSummary(speed, radii, **values, best_grid=best))
     return summaries
 
 
@@ -445,21 +352,10 @@ def summary_csv(settings: MapSettings, results: dict) -> str:
 
     for s in speed_summaries(settings, results):
         r1, r2 = s.radii if s.radii is not None else (None, None)
-        lines.append(
-            ",".join(
-                [
-                    f"{s.speed:.3f}",
-                    text(r1, 4),
-                    text(r2, 4),
-                    text(s.design),
-                    text(s.table1),
-                    text(s.revolute),
-                    text(s.best_grid),
-                    text(s.gain(s.design), 3),
-                    text(s.gain(s.table1), 3),
-                ]
-            )
-        )
+        cells = [s.speed, r1, r2, s.design, s.table1, s.revolute, s.best_grid]
+        cells += [s.gain(s.design), s.gain(s.table1)]
+        digits = (3, 4, 4, 6, 6, 6, 6, 3, 3)
+        lines.append(",".join(text(v, d) for v, d in zip(cells, digits, strict=True)))
     return "\n".join(lines) + "\n"
 
 
@@ -469,7 +365,7 @@ def map_figure(settings: MapSettings, summary: SpeedSummary, results: dict):
     and the joint optimum; the legend below the plot, off the grid."""
     from matplotlib.figure import Figure
 
-    unit = "N²·m·s" if settings.criterion == "sthenic" else "J"
+    unit = CRITERION_UNITS[settings.criterion]
     r1, r2 = np.array(settings.r1), np.array(settings.r2)
     table1 = settings.problem(settings.speeds[0]).reference_radii
     values = np.full((len(r2), len(r1)), np.nan)

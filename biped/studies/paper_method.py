@@ -16,9 +16,6 @@ would have reported.
 
 from __future__ import annotations
 
-import dataclasses
-import json
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,37 +33,36 @@ from biped.optimization.problem import GaitProblem, check_speed
 from biped.records import gait_file
 from biped.records.comparison import DIFFERENCE, relative_change
 from biped.records.provenance import version
-from biped.runtime.files import clean_stale_temporaries
-from biped.runtime.runner import ProgressBar, run_tasks
-from biped.studies.manifest import Manifest
+from biped.runtime.runner import ProgressBar
+from biped.studies import campaign
+from biped.studies.campaign import Task
 
 FOLDER = "paper-method"
 SETTINGS = "settings.json"
-_RECORD = Manifest(
-    SETTINGS, "record of the paper's method", "these runs of the paper's method were"
+PAPER = campaign.Campaign(
+    "paper's method",
+    SETTINGS,
+    "record of the paper's method",
+    "these runs of the paper's method were",
 )
-FORMAT = "biped-paper-method/1"
 # The speed of the comparison: the paper's optimal speeds are 0.27 and 0.30 m/s.
 SPEED = 0.3
 DEFAULT_SEEDS = 5
 
 
 @dataclass(frozen=True)
-class PaperMethod:
+class PaperMethod(campaign.Settings):
     """What shapes the paper-method runs of a sweep folder."""
 
+    FORMAT = "biped-paper-method/1"
     robot: Robot
     safety: Safety
     speed: float
     seeds: int
 
-    def to_dict(self) -> dict:
+    def stamp(self) -> dict:
+        """The method's budget and the version (not an IPOPT campaign's)."""
         return {
-            "format": FORMAT,
-            "robot": self.robot.to_dict(),
-            "safety": dataclasses.asdict(self.safety),
-            "speed": self.speed,
-            "seeds": self.seeds,
             "evaluations_per_run": EVALUATIONS_PER_RUN,
             "max_restarts": MAX_RESTARTS,
             "version": version(),
@@ -77,22 +73,22 @@ class PaperMethod:
 class Run:
     knee: str
     criterion: str
+    speed: float
     seed: int
 
-    def filename(self, speed: float) -> str:
-        return f"{self.knee}-{self.criterion}-{speed:.3f}-seed{self.seed}.json"
+    def filename(self) -> str:
+        return f"{self.knee}-{self.criterion}-{self.speed:.3f}-seed{self.seed}.json"
 
 
-def _solve(task) -> str:
-    settings, run, folder = task
+def _solve(task: Task) -> str:
+    settings, run = task.settings, task.point
     problem = GaitProblem(
-        Biped(settings.robot, run.knee), settings.speed, run.criterion, settings.safety
+        Biped(settings.robot, run.knee), run.speed, run.criterion, settings.safety
     )
     optimum = optimize(problem, seed=run.seed, method="nelder-mead")
-    content = gait_file.to_dict(optimum, settings.robot, run.seed)
-    gait_file.write_json(Path(folder) / run.filename(settings.speed), content)
+    gait_file.write_json(task.path, gait_file.to_dict(optimum, settings.robot, run.seed))
     return (
-        f"[paper method {run.knee:8} {run.criterion:7}] {settings.speed:.3f} m/s seed "
+        f"[paper method {run.knee:8} {run.criterion:7}] {run.speed:.3f} m/s seed "
         f"{run.seed}: C = {optimum.value:12.6f}  {optimum.report.status}"
     )
 
@@ -116,7 +112,7 @@ def check_paper_method(
 ) -> None:
     """Raise the BipedError ``run_paper_method`` would raise before running, writing nothing
     (so that a sweep is refused before it starts, not after)."""
-    _RECORD.check(
+    PAPER.check(
         Path(sweep_folder) / FOLDER, _settings(robot, speed, seeds, knees, safety).to_dict()
     )
 
@@ -137,51 +133,37 @@ def run_paper_method(
     """The paper's Nelder-Mead from seeds 0 .. ``seeds`` − 1 for every knee and criterion at
     ``speed``, into ``sweep_folder``/paper-method/ (runs already there are kept); returns
     the gait files. ``progress(total)``, if given, makes a bar advanced after each run."""
-    stream = sys.stderr if stream is None else stream  # the stderr of the call, not of the import
     settings = _settings(robot, speed, seeds, knees, safety)
-    folder = Path(sweep_folder) / FOLDER
-    _RECORD.claim(folder, settings.to_dict())  # checked before the folder is made
-    clean_stale_temporaries(folder)
-    runs = [Run(k, c, s) for c in criteria for k in knees for s in range(seeds)]
-    todo = [r for r in runs if not (folder / r.filename(settings.speed)).exists()]
-    if todo:
-        print(
-            f"paper's method: {len(runs)} Nelder-Mead runs at {speed:.3f} m/s in {folder}: "
-            f"{len(runs) - len(todo)} already done, {len(todo)} to run",
-            file=stream,
-            flush=True,
-        )
-    tasks = [(settings, r, str(folder)) for r in todo]
-    bar = progress(len(todo)) if progress is not None and todo else None
-    if bar is not None:
-        bar.advance(0)  # drawn from the start
-    try:
-        for line in run_tasks(_solve, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar):
-            print(line, file=stream, flush=True)
-    finally:
-        if bar is not None:
-            bar.clear()
-    return [folder / r.filename(settings.speed) for r in runs]
+    folder = PAPER.claim(Path(sweep_folder) / FOLDER, settings)  # checked before it is made
+    runs = [Run(k, c, settings.speed, s) for c in criteria for k in knees for s in range(seeds)]
+    todo = [Task(_solve, settings, r, str(folder)) for r in runs]
+    todo = [task for task in todo if not task.path.exists()]
+    plan = (
+        f"paper's method: {len(runs)} Nelder-Mead runs at {speed:.3f} m/s in {folder}: "
+        f"{len(runs) - len(todo)} already done, {len(todo)} to run"
+    )
+    where = dict(jobs=jobs, dask=dask, stream=stream, progress=progress)
+    PAPER.run(plan if todo else None, [todo], **where)
+    return [folder / r.filename() for r in runs]
 
 
 def read_runs(sweep_folder: str | Path) -> dict:
     """{(knee, criterion): [value of each seed, in seed order]} and the speed, from the
     paper-method folder of a sweep ({} and None if it has none)."""
     folder = Path(sweep_folder) / FOLDER
-    path = folder / SETTINGS
-    if not path.exists():
+    settings = PAPER.read(folder)
+    if settings is None:
         return {}, None
     try:
-        settings = json.loads(path.read_text())
         speed, seeds = float(settings["speed"]), int(settings["seeds"])
-    except (OSError, ValueError, KeyError, TypeError, UnicodeDecodeError) as error:
-        raise BipedError(f"{path}: unreadable record of the paper's method ({error})") from None
+    except (ValueError, KeyError, TypeError) as error:
+        raise BipedError(f"{folder / SETTINGS}: unreadable {PAPER.what} ({error})") from None
     runs = {}
     for knee in KNEES:
         for criterion in CRITERIA:
             values = []
             for seed in range(seeds):
-                file = folder / Run(knee, criterion, seed).filename(speed)
+                file = folder / Run(knee, criterion, speed, seed).filename()
                 if not file.exists():
                     break
                 gait = gait_file.read(file)

@@ -26,9 +26,6 @@ with their status and counted in the summary; they are not optimised again.
 
 from __future__ import annotations
 
-import dataclasses
-import sys
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CRITERIA, PAPER_SAFETY, Safety
+from biped.model.criteria import CRITERIA, CRITERION_UNITS, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
@@ -44,17 +41,16 @@ from biped.optimization.optimize import DEFAULT_STARTS, Optimum, Report, best_of
 from biped.optimization.problem import VARIABLES, GaitProblem, check_speed
 from biped.records import gait_file
 from biped.records.comparison import SINGLE_START
-from biped.records.provenance import version
-from biped.records.units import CRITERION_UNITS
-from biped.runtime.files import clean_stale_temporaries, distinct_values
-from biped.runtime.runner import ProgressBar, run_tasks
-from biped.studies.manifest import Manifest
+from biped.runtime.runner import ProgressBar
+from biped.studies import campaign
+from biped.studies.campaign import Task
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
 MANIFEST = "sweep.json"
-_RECORD = Manifest(MANIFEST, "sweep record", "this folder's sweep was", "a sweep's", "gait files")
+SWEEP = campaign.Campaign(
+    "sweep", MANIFEST, "sweep record", "this folder's sweep was", "a sweep's", "gait files"
+)
 INDEPENDENT = ".independent"
-SWEEP_FORMAT = "biped-sweep/2"
 
 
 @dataclass(frozen=True)
@@ -68,27 +64,15 @@ class Point:
 
 
 @dataclass(frozen=True)
-class Settings:
+class Settings(campaign.Settings):
     """What shapes a sweep's numbers, recorded in its folder."""
 
+    FORMAT = "biped-sweep/2"
     robot: Robot
     safety: Safety
     speeds: tuple
     seed: int
     starts: int
-
-    def to_dict(self) -> dict:
-        return {
-            "format": SWEEP_FORMAT,
-            "robot": self.robot.to_dict(),
-            "safety": dataclasses.asdict(self.safety),
-            "speeds": list(self.speeds),
-            "seed": self.seed,
-            "starts": self.starts,
-            "method": "ipopt",
-            "version": version(),
-            "casadi": version("casadi"),
-        }
 
 
 def _problem(settings: Settings, point: Point) -> GaitProblem:
@@ -119,45 +103,41 @@ def _optimum_of(gait: dict, settings: Settings, point: Point) -> Optimum:
     return checked(_problem(settings, point), variables, report)
 
 
-def _variables_of(gait: dict):
-    """The solver's variables (21,) stored in a gait file, or None where it has none (a
-    point whose optimizer ended without them)."""
-    variables = [gait["optimizer"]["variables"][name] for name in VARIABLES]
-    return None if any(v is None for v in variables) else np.array(variables, float)
+def _save(task: Task, optimum: Optimum) -> None:
+    content = gait_file.to_dict(optimum, task.settings.robot, task.settings.seed)
+    gait_file.write_json(task.path, content)
 
 
-def _save(path: Path, optimum: Optimum, settings: Settings) -> None:
-    gait_file.write_json(path, gait_file.to_dict(optimum, settings.robot, settings.seed))
-
-
-def _solve_independent(task) -> str:
-    settings, point, folder, twin = task
-    problem = _problem(settings, point)
+def _solve_independent(task: Task) -> str:
+    """A point's own starts, in ``INDEPENDENT`` (``task.folder``); the energy criterion's also
+    from the sthenic optimum of its problem (``task.given``), solved."""
+    settings, point = task.settings, task.point
     sthenic = None
-    if twin is not None:  # the energy criterion starts from the sthenic optimum, solved
-        gait = gait_file.read(Path(folder) / INDEPENDENT / twin.filename())
-        if _variables_of(gait) is not None:  # else computed again, as before
+    for twin in task.given:
+        gait = gait_file.read(Path(task.folder) / twin.filename())
+        if campaign.variables(gait["optimizer"]["variables"]) is not None:  # else computed again
             sthenic = _optimum_of(gait, settings, twin)
+    problem = _problem(settings, point)
     optimum = optimize(problem, seed=settings.seed, starts=settings.starts, sthenic=sthenic)
-    _save(Path(folder) / INDEPENDENT / point.filename(), optimum, settings)
+    _save(task, optimum)
     return _line("independent", point, optimum)
 
 
-def _solve_with_neighbours(task) -> str:
-    settings, point, folder, neighbours = task
-    folder = Path(folder)
-    own = _optimum_of(gait_file.read(folder / INDEPENDENT / point.filename()), settings, point)
-    given = []
-    for other in neighbours:
-        variables = _variables_of(gait_file.read(folder / INDEPENDENT / other.filename()))
-        if variables is not None:
-            given.append(variables)
+def _solve_with_neighbours(task: Task) -> str:
+    """A point's final optimum: its own, or better from its neighbours' (``task.given``)."""
+    settings, point, stage = task.settings, task.point, Path(task.folder) / INDEPENDENT
+    own = _optimum_of(gait_file.read(stage / point.filename()), settings, point)
+    given = [
+        campaign.variables(gait_file.read(stage / p.filename())["optimizer"]["variables"])
+        for p in task.given
+    ]
+    given = [variables for variables in given if variables is not None]
     problem = _problem(settings, point)
     optimum = own
     if given:
         again = optimize(problem, seed=settings.seed, starts=0, given=given)
         optimum = best_of(problem, [own, again])
-    _save(folder / point.filename(), optimum, settings)
+    _save(task, optimum)
     return _line("final", point, optimum)
 
 
@@ -170,16 +150,12 @@ def _line(stage: str, point: Point, optimum: Optimum) -> str:
     """One optimization's line: its stage, the criterion on the check grid with its unit,
     what the result is (only a final one is "certified") and the starts at its value."""
     report = optimum.report
-    if not report.converged:
-        status = "NOT CONVERGED: " + report.status
-    elif not optimum.feasible:
-        status = "INFEASIBLE"
-    elif stage == "final":
-        status = "certified" + (f" ({SINGLE_START})" if report.starts_at_best < 2 else "")
-    else:
+    status = campaign.failure(report.status, optimum.feasible)
+    if stage == "final":
+        single = f" ({SINGLE_START})" if report.starts_at_best < 2 else ""
+        status = "certified" + single if status is None else "NOT CERTIFIED, " + status
+    elif status is None:
         status = "converged, feasible, not final"
-    if stage == "final" and not status.startswith("certified"):
-        status = "NOT CERTIFIED, " + status
     return (
         f"[{STAGES[stage]:21}] {point.knee:8} {point.criterion:7} {point.speed:.3f} m/s  "
         f"C = {optimum.value:12.6f} {CRITERION_UNITS[point.criterion]:6} on the check grid: "
@@ -195,7 +171,7 @@ def check_speeds(robot: Robot, speeds, knees) -> list[float]:
         model = Biped(robot, knee)
         for speed in speeds:
             check_speed(model, speed)
-    return distinct_values(speeds, "speeds", "m/s", 3, "1 mm/s")  # Point.filename's
+    return campaign.distinct_speeds(speeds)
 
 
 def run_sweep(
@@ -213,43 +189,20 @@ def run_sweep(
     progress: Callable[[int], ProgressBar] | None = None,
 ) -> list[Point]:
     """Certified optima of every (knee, criterion, speed) not yet in ``folder``; returns all
-    points. ``seed`` and ``starts`` go to ``biped.optimization.optimize.optimize``.
-
-    The optimizations run through ``biped.runtime.runner.run_tasks``: ``jobs`` local processes
-    (default: all cores), or the workers of the Dask scheduler at ``dask`` (``tcp://HOST:PORT``).
-    A line per optimization goes to ``stream`` (default: ``sys.stderr``); ``progress(total)``,
-    if given, makes the bar advanced after each of the ``total`` optimizations (all
-    stages)."""
-    stream = sys.stderr if stream is None else stream
+    points. ``seed`` and ``starts`` go to ``biped.optimization.optimize.optimize``; ``jobs``
+    (default: all cores), ``dask`` (``tcp://HOST:PORT``), ``stream`` (a line per optimization)
+    and ``progress`` (a bar over the optimizations of all stages) to ``campaign.Campaign.run``."""
     if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
         raise BipedError(f"knees {list(knees)}, criteria {list(criteria)}: allowed each once")
     speeds = check_speeds(robot, speeds, knees)
     settings = Settings(robot, safety, tuple(speeds), int(seed), int(starts))
-    folder = Path(folder)
-    _RECORD.claim(folder, settings.to_dict())  # checked before anything is written
-    (folder / INDEPENDENT).mkdir(exist_ok=True)
-    for place in (folder, folder / INDEPENDENT):
-        clean_stale_temporaries(place)
+    folder = SWEEP.claim(folder, settings, INDEPENDENT)  # checked before anything is written
     points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
     final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
     stages = _stages(folder, settings, points, final, knees)
-    print(_plan(folder, settings, points, final, stages), file=stream, flush=True)
-    began = time.perf_counter()
-    total = sum(len(tasks) for tasks in stages)
-    bar = progress(total) if progress is not None and final else None
-    if bar is not None:
-        bar.advance(0)  # drawn from the start
-    try:
-        for tasks in stages:
-            if not tasks:
-                continue
-            for line in run_tasks(_solve, tasks, jobs=jobs, dask=dask, stream=stream, progress=bar):
-                print(line, file=stream, flush=True)
-    finally:
-        if bar is not None:
-            bar.clear()
-    summary = summarize(folder, points, settings)
-    print(f"sweep: done in {time.perf_counter() - began:.1f} s; {summary}", file=stream, flush=True)
+    plan = _plan(folder, settings, points, final, stages)
+    where = dict(jobs=jobs, dask=dask, stream=stream, progress=progress)
+    SWEEP.run(plan, stages, lambda: summarize(folder, points, settings), **where)
     return points
 
 
@@ -295,27 +248,22 @@ def _stages(folder: Path, settings: Settings, points, final, knees) -> list:
     second = [p for p in independent if p in twins]
 
     def independent_task(p):
-        return (settings, p, str(folder), twins.get(p))
+        given = (twins[p],) if p in twins else ()
+        return Task(_solve_independent, settings, p, str(folder / INDEPENDENT), given)
 
     def final_task(p):
-        return (settings, p, str(folder), _neighbours(p, speeds, knees))
+        neighbours = tuple(_neighbours(p, speeds, knees))
+        return Task(_solve_with_neighbours, settings, p, str(folder), neighbours)
 
     early = [p for p in final if p not in twins]  # their neighbours are all in ``first``
     late = [p for p in final if p in twins]
     if not second:  # no stage waits for the sthenic optima: two stages
         early, late = [], early + late
     return [
-        [(_solve_independent, independent_task(p)) for p in first],
-        [(_solve_independent, independent_task(p)) for p in second]
-        + [(_solve_with_neighbours, final_task(p)) for p in early],
-        [(_solve_with_neighbours, final_task(p)) for p in late],
+        [independent_task(p) for p in first],
+        [independent_task(p) for p in second] + [final_task(p) for p in early],
+        [final_task(p) for p in late],
     ]
-
-
-def _solve(task) -> str:
-    """One task of a stage: (function, its arguments)."""
-    function, arguments = task
-    return function(arguments)
 
 
 def _neighbours(point: Point, speeds, knees) -> list[Point]:
@@ -332,20 +280,20 @@ def _neighbours(point: Point, speeds, knees) -> list[Point]:
 
 def summarize(folder: Path, points, settings: Settings) -> str:
     """How many points are certified, and which are not."""
-    bad, single = [], []
-    for p in points:
-        gait = _read_gait(Path(folder) / p.filename(), p, settings)
+    gaits = {p: _read_gait(Path(folder) / p.filename(), p, settings) for p in points}
+
+    def why_not(p):
+        gait = gaits[p]
         if gait is None:
-            bad.append(f"{p.filename()} missing")
-        elif gait["optimizer"].get("status") != "converged" or not gait["feasible"]:
-            bad.append(f"{p.filename()} {gait['optimizer'].get('status')}")
-        elif gait["optimizer"]["starts_at_best"] < 2:
-            single.append(p.filename())
-    certified = len(points) - len(bad)
-    text = (
-        f"{certified} of {len(points)} points certified (final optima, solver converged, "
-        "feasible on the check grid)"
-    )
-    if single:
-        text += f"; {len(single)} of them {SINGLE_START}: " + ", ".join(single)
-    return text + ("; NOT: " + ", ".join(bad) if bad else "")
+            return "missing"
+        status = gait["optimizer"].get("status")
+        return None if status == "converged" and gait["feasible"] else str(status)
+
+    single = [
+        p.filename()
+        for p in points
+        if why_not(p) is None and gaits[p]["optimizer"]["starts_at_best"] < 2
+    ]
+    note = f"; {len(single)} of them {SINGLE_START}: " + ", ".join(single) if single else ""
+    counted = "points certified (final optima, solver converged, feasible on the check grid)"
+    return campaign.tally(points, why_not, counted, note)
