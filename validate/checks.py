@@ -43,7 +43,7 @@ from validate.model import ModelError, model_problems
 from validate.replay import replay_model, replay_step
 from validate.samples import GaitSamples
 from validate.simulate import KP, Simulation, Walker, WalkSettings, reference_along
-from validate.units import FIGURE_UNITS
+from validate.units import FIGURE_UNITS, WalkFigures
 
 # Agreement of two exact rigid-body models of one robot.
 EXACT = 1e-6
@@ -173,7 +173,7 @@ def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait
         "normal_impulse": float(mj_impulse[1]),
         "landing_speed": float(np.linalg.norm(biped.point_jacobian(q, "swing_ankle") @ qd_minus)),
     }
-    impulse = (gait.get("impact") or {}).get("impulse")
+    impulse = (gait.impact or {}).get("impulse")
     notes = []
     if impulse is not None:
         figures["max_impulse_error"] = float(np.abs(mj_impulse - np.asarray(impulse)).max())
@@ -240,28 +240,18 @@ def walk_figures(
 ) -> dict:
     """Figures of a forward simulation (see the module docstring); those of the ground
     reaction (``validate.contact.ground_reaction``) only when it is given."""
-    model, robot, period = sim.model, biped.robot, samples.period
-    steps_run = sim.step_slices()
-    settle = int(contact.SETTLE * period / model.opt.timestep)
-    slips = sim.stance_foot_slip(settle)
-    slides = []
-    for rows, stance in zip(steps_run, sim.stances, strict=True):
-        middle = 0.5 * (sim.heel(stance)[rows, 0] + sim.toe(stance)[rows, 0])
-        slides.append(float(np.ptp(middle[:settle])) if len(middle) else 0.0)
-    tilt = contact.foot_tilt(sim, period)
-    scuffs = contact.scuffs(sim, period)
-    clearance = contact.clearance(biped, samples, sim)
+    period, dt = samples.period, sim.model.opt.timestep
+    settle = int(contact.SETTLE * period / dt)
+    slips, tilt = sim.stance_foot_slip(settle), contact.foot_tilt(sim, period)
     advance = contact.advances(sim) / samples.step_length
-    q_ref, torques_ref, wrench_ref, zmp_ref = reference_along(samples, sim)
-    planned_hip = q_ref[:, ZH].min()
+    reference = reference_along(samples, sim)
+    lowest = HIP_DROP * reference[0][:, ZH].min()  # the lowest hip allowed [m]
     hip, trunk = sim.hip_height(), sim.trunk_angle()
     # Steps walked: leading steps that land, advance the hip, with the stance foot still and
     # flat, hip and trunk held.
     walked = 0
-    for j, rows in enumerate(steps_run):
-        upright = hip[rows].min() >= HIP_DROP * planned_hip and np.abs(trunk[rows]).max() <= (
-            TRUNK_LIMIT
-        )
+    for j, rows in enumerate(sim.step_slices()):
+        upright = hip[rows].min() >= lowest and np.abs(trunk[rows]).max() <= TRUNK_LIMIT
         if not (
             sim.landed[j]
             and upright
@@ -272,41 +262,34 @@ def walk_figures(
             break
         walked += 1
     shuffled = bool(np.any(np.array(sim.landed) & (advance < STEP_ADVANCE)))
-    starts = sim.step_starts + [len(sim.time)]
-    durations = np.diff(sim.time[starts[:-1]].tolist() + [sim.time[-1] + model.opt.timestep])
-    if reaction is None:  # not computed: its figures are not measured
-        nan = np.full(len(sim.time), np.nan)
-        reaction = {"force": np.stack([nan, nan], axis=1), "cop": nan}
-    # Comparisons with the gait over the steps walked (at least the first): after a fall
-    # they would only measure the fall. The landing transient of the soft contact is left
-    # out of them (its impact is not the rigid one of the gait).
-    end = starts[max(walked, 1)]
-    force, cop = reaction["force"][:end], reaction["cop"][:end]
-    steady = sim.phase[:end] >= LANDING * period
-    wrench_ref, zmp_ref = wrench_ref[:end], zmp_ref[:end]
-    single = ~np.isnan(cop)
-    compared = single & steady
-    weight = robot.total_mass * robot.gravity
-    feedforward, feedback = sim.feedforward()[:end], sim.feedback()[:end]
-    rates = -sim.layout.joint_angles(sim.qvel[:end])  # θ̇ of eq. (32), JOINT_ORDER
-    power = np.abs((feedforward + feedback) * rates).sum(axis=1)
-    ff_square, fb_square = np.sum(feedforward[steady] ** 2), np.sum(feedback[steady] ** 2)
     counted = slice(0, max(walked, 1))
+    durations = np.diff(sim.time[sim.step_starts].tolist() + [sim.time[-1] + dt])[counted]
+    fell = hip.min() < lowest or np.abs(trunk).max() > TRUNK_LIMIT or shuffled
     figures = {
         "steps": walked,
-        "fell": bool(
-            not all(sim.landed)
-            or hip.min() < HIP_DROP * planned_hip
-            or np.abs(trunk).max() > TRUNK_LIMIT
-            or shuffled
-        ),
+        "fell": bool(not all(sim.landed) or fell),
         "max_slip": float(slips.max()),
-        "step_duration_range": [
-            float(durations[counted].min() / period),
-            float(durations[counted].max() / period),
-        ],
+        "step_duration_range": [float(durations.min() / period), float(durations.max() / period)],
         "step_advance_range": [float(advance[counted].min()), float(advance[counted].max())],
-        "max_landing_slide": float(max(slides)),
+        "max_landing_slide": float(sim.stance_foot_slip(settle, landing=True).max()),
+        **_foot_figures(biped, samples, sim, tilt, counted),
+        **_tracking_figures(biped, samples, sim, reaction, walked, reference),
+        "analytic_energy_per_step": float(energy),
+        "warnings": int(sim.warnings),
+        "distance": float(sim.hip_x()[-1] - sim.hip_x()[0]),
+        "seconds_simulated": float(sim.time[-1] - sim.time[0]),
+    }
+    if biped.knee == "rolling":
+        figures["max_knee_equality_violation"] = _knee_equality_violation(sim)
+    return WalkFigures(**figures).to_dict()  # the names, their order and units declared there
+
+
+def _foot_figures(biped, samples, sim: Simulation, tilt, counted: slice) -> dict:
+    """``walk_figures`` of the feet: the stance foot's tilt, the swing foot's scuffs and its
+    clearance over the steps ``counted``."""
+    scuffs = contact.scuffs(sim, samples.period)
+    clearance = contact.clearance(biped, samples, sim)
+    return {
         "max_foot_tilt": float(tilt.tilt.max()),
         "max_heel_lift": float(tilt.heel_lift.max()),
         "max_toe_lift": float(tilt.toe_lift.max()),
@@ -315,8 +298,32 @@ def walk_figures(
         "scuff_depth": float(scuffs.depth.max()),
         "swing_clearance": float(np.nanmin(clearance.walk[counted])),
         "gait_swing_clearance": clearance.gait,
-        "zmp_rms_error": _rms(cop[compared] - zmp_ref[compared]),
-        "zmp_relative_error": _rms(cop[compared] - zmp_ref[compared])
+    }
+
+
+def _tracking_figures(biped, samples, sim: Simulation, reaction, walked: int, reference):
+    """``walk_figures`` of the walk against the gait (``reference_along``) over the steps
+    walked (at least the first: after a fall they would only measure the fall), the landing
+    transient of the soft contact (``LANDING``) left out: its impact is not the rigid one of
+    the gait."""
+    _, torques_ref, wrench_ref, zmp_ref = reference
+    end = (sim.step_starts + [len(sim.time)])[max(walked, 1)]
+    if reaction is None:  # not computed: its figures are not measured
+        nan = np.full(len(sim.time), np.nan)
+        reaction = {"force": np.stack([nan, nan], axis=1), "cop": nan}
+    force, cop = reaction["force"][:end], reaction["cop"][:end]
+    steady = sim.phase[:end] >= LANDING * samples.period
+    wrench_ref, zmp_ref = wrench_ref[:end], zmp_ref[:end]
+    compared = ~np.isnan(cop) & steady  # single support, steady
+    weight = biped.robot.total_mass * biped.robot.gravity
+    feedforward, feedback = sim.feedforward()[:end], sim.feedback()[:end]
+    rates = -sim.layout.joint_angles(sim.qvel[:end])  # θ̇ of eq. (32), JOINT_ORDER
+    power = np.abs((feedforward + feedback) * rates).sum(axis=1)
+    ff_square, fb_square = np.sum(feedforward[steady] ** 2), np.sum(feedback[steady] ** 2)
+    zmp_error = _rms(cop[compared] - zmp_ref[compared])
+    return {
+        "zmp_rms_error": zmp_error,
+        "zmp_relative_error": zmp_error
         / _rms(torques_ref[:end][compared, 0] / wrench_ref[compared, 1]),
         "touchdown_jump_error": _median(touchdown_jumps(biped, sim, max(walked, 1))),
         "ground_force_rms_error": _rms((force[compared] - wrench_ref[compared, :2]) / weight),
@@ -325,21 +332,17 @@ def walk_figures(
         "feedback_share": float(np.sqrt(fb_square / max(ff_square + fb_square, 1e-12))),
         "landing_feedback_rms": _rms(feedback[~steady]),
         "energy_per_step": float(np.trapezoid(power, sim.time[:end]) / max(walked, 1)),
-        "analytic_energy_per_step": float(energy),
-        "warnings": int(sim.warnings),
-        "distance": float(sim.hip_x()[-1] - sim.hip_x()[0]),
-        "seconds_simulated": float(sim.time[-1] - sim.time[0]),
     }
-    if biped.knee == "rolling":
-        worst = 0.0
-        for k in range(model.neq):
-            j1, j2 = model.eq_obj1id[k], model.eq_obj2id[k]
-            a, b = model.jnt_qposadr[j1], model.jnt_qposadr[j2]
-            worst = max(
-                worst, float(np.abs(sim.qpos[:, a] - model.eq_data[k, 1] * sim.qpos[:, b]).max())
-            )
-        figures["max_knee_equality_violation"] = worst
-    return figures
+
+
+def _knee_equality_violation(sim: Simulation) -> float:
+    """Largest violation [rad] of the rolling knees' equalities over the walk."""
+    model, worst = sim.model, 0.0
+    for k in range(model.neq):
+        a, b = model.jnt_qposadr[model.eq_obj1id[k]], model.jnt_qposadr[model.eq_obj2id[k]]
+        violation = np.abs(sim.qpos[:, a] - model.eq_data[k, 1] * sim.qpos[:, b]).max()
+        worst = max(worst, float(violation))
+    return worst
 
 
 def scuff_notes(sim: Simulation, period: float, figures: dict, steps: int) -> list:

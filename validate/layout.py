@@ -129,14 +129,9 @@ class Layout:
     def state_index(self, name: str) -> int:
         """Index in MuJoCo's full physics state vector (time first) of ``hip_x``,
         ``hip_height`` or ``hip_speed``."""
-        return (
-            1
-            + {
-                "hip_x": self._rootx,
-                "hip_height": self._rootz,
-                "hip_speed": self.nq + self._rootx_dof,
-            }[name]
-        )
+        offsets = {"hip_x": self._rootx, "hip_height": self._rootz}
+        offsets["hip_speed"] = self.nq + self._rootx_dof
+        return 1 + offsets[name]
 
     def sensor_index(self, side: str, kind: str) -> int:
         """Index in the sensor readings of a side's ``touch`` or of the x of its

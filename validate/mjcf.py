@@ -164,18 +164,37 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
     """
     check_knee(knee)
     rolling = knee == "rolling"
-    r = robot
-    r1, r2 = (r.r1, r.r2) if rolling else (0.0, 0.0)
+    r1, r2 = (robot.r1, robot.r2) if rolling else (0.0, 0.0)
     if rolling and (r1 <= 0.0 or r2 <= 0.0):
         raise ValueError(f"a rolling-knee MJCF needs r1, r2 > 0 (got r1 = {r1}, r2 = {r2})")
-    shank, thigh, link = r.shank_length - r1, r.thigh_length - r2, r1 + r2
-    sole_x = r.foot_length / 2 - r.foot_heel
-    stand = r.ankle_height + r.shank_length + r.thigh_length
-    lines = [
+    stand = robot.ankle_height + robot.shank_length + robot.thigh_length
+    lines = _header(robot, knee) + _trunk(robot, stand)
+    for side in SIDES:
+        lines += _leg(robot, side, r1, r2)
+    lines += ["    </body>", "  </worldbody>", ""]
+    lines += (_knee_coupling(r1, r2) if rolling else []) + _actuators(rolling, servos)
+    lines += ["  <sensor>"]
+    for side in SIDES:
+        lines += [
+            f'    <touch name="{side}_touch" site="{side}_sole_touch"/>',
+            *(
+                f'    <framepos name="{side}_{site}_pos" objtype="site" objname="{side}_{site}"/>'
+                for site in ("ankle", "heel", "toe")
+            ),
+        ]
+    nq = 3 + 2 * (4 if rolling else 3)
+    home = ["0", _f(stand)] + ["0"] * (nq - 2)  # qpos0: standing straight on the floor
+    lines += ["  </sensor>", "", "  <keyframe>", f'    <key name="home" qpos="{" ".join(home)}"/>']
+    return "\n".join(lines + ["  </keyframe>", "</mujoco>", ""])
+
+
+def _header(robot: Robot, knee: str) -> list[str]:
+    """``robot_xml``'s compiler, option, assets and defaults."""
+    return [
         f'<mujoco model="biped_{knee}">',
         '  <compiler angle="radian" autolimits="true" inertiafromgeom="false"/>',
         f'  <option timestep="{_f(TIMESTEP)}" integrator="implicitfast" cone="elliptic" '
-        f'impratio="{_f(IMPRATIO)}" gravity="0 0 {_f(-r.gravity)}">',
+        f'impratio="{_f(IMPRATIO)}" gravity="0 0 {_f(-robot.gravity)}">',
         '    <flag island="disable"/>',
         "  </option>",
         "",
@@ -199,6 +218,12 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         '    <site size="0.01" group="4" rgba="1 0.2 0.2 1"/>',
         "  </default>",
         "",
+    ]
+
+
+def _trunk(r: Robot, stand: float) -> list[str]:
+    """The trunk's body, opened: camera, planar base, inertia, capsule and sites."""
+    return [
         "  <worldbody>",
         f'    <body name="trunk" pos="0 0 {_f(stand)}">',
         f'      <camera name="track" mode="trackcom" pos="0 {_f(-CAMERA_DISTANCE)} {_f(CAMERA_HEIGHT)}" xyaxes="1 0 0 0 0.1 1"/>',
@@ -211,112 +236,105 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
         '      <site name="hip"/>',
         f'      <site name="head" pos="0 0 {_f(r.trunk_length)}"/>',
     ]
+
+
+def _leg(r: Robot, side: str, r1: float, r2: float) -> list[str]:
+    """One leg's bodies, from the thigh down to the foot; a rolling knee (r1, r2 > 0) is a
+    link between two hinges."""
+    shank, thigh, link = r.shank_length - r1, r.thigh_length - r2, r1 + r2
+    pad = "      "
+    y = HIP_OFFSET if side == "left" else -HIP_OFFSET
+    lines = [
+        f'{pad}<body name="{side}_thigh" pos="0 {_f(y)} 0">',
+        f'{pad}  <joint name="{side}_hip" {_range(HIP_RANGE)}/>',
+        f"{pad}  {_inertial(-r.thigh_com, r.thigh_mass, r.thigh_inertia)}",
+        f'{pad}  <geom class="visual" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}" material="{side}"/>',
+        f'{pad}  <geom name="{side}_thigh_contact" class="collision" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
+    ]
+    if link > 0.0:
+        disc = f'class="visual" type="cylinder" size="{{}} {_f(DISC_HALF_WIDTH)}"'
+        hinge = f'armature="{_f(KNEE_ARMATURE)}"'
+        lines += [
+            f'{pad}  <geom name="{side}_thigh_disc" {disc.format(_f(r2))} pos="0 0 {_f(-thigh)}" zaxis="0 1 0" material="{side}_disc"/>',
+            f'{pad}  <body name="{side}_knee_link" pos="0 0 {_f(-thigh)}">',
+            f'{pad}    <joint name="{side}_knee_upper" {_range(KNEE_RANGE, r1 / link)} {hinge}/>',
+            f"{pad}    {_inertial(-link / 2, KNEE_LINK_MASS, KNEE_LINK_INERTIA)}",
+            f'{pad}    <body name="{side}_shank" pos="0 0 {_f(-link)}">',
+            f'{pad}      <joint name="{side}_knee_lower" {_range(KNEE_RANGE, r2 / link)} {hinge}/>',
+            f'{pad}      <geom name="{side}_shank_disc" {disc.format(_f(r1))} zaxis="0 1 0" material="{side}_disc"/>',
+        ]
+        pad += "  "  # inside the knee link and the shank
+    else:
+        lines += [
+            f'{pad}  <body name="{side}_shank" pos="0 0 {_f(-thigh)}">',
+            f'{pad}    <joint name="{side}_knee" {_range(KNEE_RANGE)}/>',
+        ]
+    lines += [
+        f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia)}",
+        f'{pad}    <geom class="visual" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}" material="{side}"/>',
+        f'{pad}    <geom name="{side}_shank_contact" class="collision" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}"/>',
+        f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
+        *_foot(r, side, f"{pad}      "),
+        f"{pad}    </body>",
+        f"{pad}  </body>",
+    ]
+    return lines + (["        </body>"] if link > 0.0 else []) + ["      </body>"]
+
+
+def _foot(r: Robot, side: str, pad: str) -> list[str]:
+    """Inside a foot's body: its ankle, inertia, contact points, drawn sole and sites."""
+    sole_x, sole_z = r.foot_length / 2 - r.foot_heel, -r.ankle_height + SOLE_THICKNESS / 2
+    half = (r.foot_length / 2, FOOT_WIDTH / 2, SOLE_THICKNESS / 2)
+    return [
+        f'{pad}<joint name="{side}_ankle" {_range(ANKLE_RANGE)} armature="{_f(ANKLE_ARMATURE)}"/>',
+        f"{pad}{_inertial(-r.foot_com, r.foot_mass, r.foot_inertia)}",
+        *(
+            f'{pad}<geom name="{side}_{end}_contact" class="collision" type="sphere" size="{_f(SOLE_CONTACT_RADIUS)}" pos="{_f(x)} 0 {_f(-r.ankle_height + SOLE_CONTACT_RADIUS)}"/>'
+            for end, x in r.sole_edges().items()
+        ),
+        f'{pad}<geom class="visual" type="box" size="{" ".join(_f(h) for h in half)}" pos="{_f(sole_x)} 0 {_f(sole_z)}" material="{side}"/>',
+        f'{pad}<site name="{side}_ankle"/>',
+        f'{pad}<site name="{side}_sole_touch" type="box" size="{" ".join(_f(h + 0.005) for h in half)}" pos="{_f(sole_x)} 0 {_f(sole_z)}" rgba="0 0 0 0"/>',
+        f'{pad}<site name="{side}_heel" pos="{_f(-r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
+        f'{pad}<site name="{side}_toe" pos="{_f(r.foot_length - r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
+    ]
+
+
+def _knee_coupling(r1: float, r2: float) -> list[str]:
+    """The rolling knees' equalities (knee_lower = r2 / r1 knee_upper) and their tendons (the
+    flexion, which the knee motor drives)."""
+    lines = ["  <equality>"]
+    lines += [
+        f'    <joint name="{side}_knee_coupling" joint1="{side}_knee_lower" joint2="{side}_knee_upper" polycoef="0 {_f(r2 / r1)} 0 0 0" solref="{KNEE_SOLREF}" solimp="{KNEE_SOLIMP}"/>'
+        for side in SIDES
+    ]
+    lines += ["  </equality>", "", "  <tendon>"]
     for side in SIDES:
-        pad = "      "
         lines += [
-            f'{pad}<body name="{side}_thigh" pos="0 {_f(HIP_OFFSET if side == "left" else -HIP_OFFSET)} 0">',
-            f'{pad}  <joint name="{side}_hip" {_range(HIP_RANGE)}/>',
-            f"{pad}  {_inertial(-r.thigh_com, r.thigh_mass, r.thigh_inertia)}",
-            f'{pad}  <geom class="visual" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}" material="{side}"/>',
-            f'{pad}  <geom name="{side}_thigh_contact" class="collision" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
+            f'    <fixed name="{side}_knee">',
+            *(f'      <joint joint="{side}_knee_{part}" coef="1"/>' for part in ("upper", "lower")),
+            "    </fixed>",
         ]
-        if rolling:
-            lines += [
-                f'{pad}  <geom name="{side}_thigh_disc" class="visual" type="cylinder" size="{_f(r2)} {_f(DISC_HALF_WIDTH)}" pos="0 0 {_f(-thigh)}" zaxis="0 1 0" material="{side}_disc"/>',
-                f'{pad}  <body name="{side}_knee_link" pos="0 0 {_f(-thigh)}">',
-                f'{pad}    <joint name="{side}_knee_upper" {_range(KNEE_RANGE, r1 / link)} armature="{_f(KNEE_ARMATURE)}"/>',
-                f"{pad}    {_inertial(-link / 2, KNEE_LINK_MASS, KNEE_LINK_INERTIA)}",
-                f'{pad}    <body name="{side}_shank" pos="0 0 {_f(-link)}">',
-                f'{pad}      <joint name="{side}_knee_lower" {_range(KNEE_RANGE, r2 / link)} armature="{_f(KNEE_ARMATURE)}"/>',
-                f'{pad}      <geom name="{side}_shank_disc" class="visual" type="cylinder" size="{_f(r1)} {_f(DISC_HALF_WIDTH)}" zaxis="0 1 0" material="{side}_disc"/>',
-            ]
-            pad += "  "  # inside the knee link and the shank
-        else:
-            lines += [
-                f'{pad}  <body name="{side}_shank" pos="0 0 {_f(-thigh)}">',
-                f'{pad}    <joint name="{side}_knee" {_range(KNEE_RANGE)}/>',
-            ]
-        lines += [
-            f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia)}",
-            f'{pad}    <geom class="visual" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}" material="{side}"/>',
-            f'{pad}    <geom name="{side}_shank_contact" class="collision" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}"/>',
-            f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
-            f'{pad}      <joint name="{side}_ankle" {_range(ANKLE_RANGE)} armature="{_f(ANKLE_ARMATURE)}"/>',
-            f"{pad}      {_inertial(-r.foot_com, r.foot_mass, r.foot_inertia)}",
-            *(
-                f'{pad}      <geom name="{side}_{end}_contact" class="collision" type="sphere" '
-                f'size="{_f(SOLE_CONTACT_RADIUS)}" '
-                f'pos="{_f(x)} 0 {_f(-r.ankle_height + SOLE_CONTACT_RADIUS)}"/>'
-                for end, x in r.sole_edges().items()
-            ),
-            f'{pad}      <geom class="visual" type="box" '
-            f'size="{_f(r.foot_length / 2)} {_f(FOOT_WIDTH / 2)} {_f(SOLE_THICKNESS / 2)}" '
-            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}" material="{side}"/>',
-            f'{pad}      <site name="{side}_ankle"/>',
-            f'{pad}      <site name="{side}_sole_touch" type="box" '
-            f'size="{_f(r.foot_length / 2 + 0.005)} {_f(FOOT_WIDTH / 2 + 0.005)} {_f(SOLE_THICKNESS / 2 + 0.005)}" '
-            f'pos="{_f(sole_x)} 0 {_f(-r.ankle_height + SOLE_THICKNESS / 2)}" rgba="0 0 0 0"/>',
-            f'{pad}      <site name="{side}_heel" pos="{_f(-r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
-            f'{pad}      <site name="{side}_toe" pos="{_f(r.foot_length - r.foot_heel)} 0 {_f(-r.ankle_height)}"/>',
-            f"{pad}    </body>",
-            f"{pad}  </body>",
-        ]
-        if rolling:
-            lines += ["        </body>"]
-        lines += ["      </body>"]
-    lines += ["    </body>", "  </worldbody>", ""]
-    if rolling:
-        lines += ["  <equality>"]
-        for side in SIDES:
-            lines += [
-                f'    <joint name="{side}_knee_coupling" joint1="{side}_knee_lower" '
-                f'joint2="{side}_knee_upper" polycoef="0 {_f(r2 / r1)} 0 0 0" '
-                f'solref="{KNEE_SOLREF}" solimp="{KNEE_SOLIMP}"/>'
-            ]
-        lines += ["  </equality>", "", "  <tendon>"]
-        for side in SIDES:
-            lines += [
-                f'    <fixed name="{side}_knee">',
-                f'      <joint joint="{side}_knee_upper" coef="1"/>',
-                f'      <joint joint="{side}_knee_lower" coef="1"/>',
-                "    </fixed>",
-            ]
-        lines += ["  </tendon>", ""]
-    lines += ["  <actuator>"]
-    for side in SIDES:
-        knee_target = f'tendon="{side}_knee"' if rolling else f'joint="{side}_knee"'
-        lines += [
-            f'    <motor name="{side}_hip" joint="{side}_hip"/>',
-            f'    <motor name="{side}_knee" {knee_target}/>',
-            f'    <motor name="{side}_ankle" joint="{side}_ankle"/>',
-        ]
+    return lines + ["  </tendon>", ""]
+
+
+def _actuators(rolling: bool, servos: tuple[float, float] | None) -> list[str]:
+    """The six motors, and the servos (``robot_xml``) when given."""
+
+    def target(side: str, joint: str) -> str:
+        knee = rolling and joint == "knee"
+        return f'tendon="{side}_knee"' if knee else f'joint="{side}_{joint}"'
+
+    joints = [(side, joint) for side in SIDES for joint in ("hip", "knee", "ankle")]
+    lines = ["  <actuator>", *(f'    <motor name="{s}_{j}" {target(s, j)}/>' for s, j in joints)]
     if servos is not None:
         kp, kv = servos
         for kind, gain in (("position", f'kp="{_f(kp)}"'), ("velocity", f'kv="{_f(kv)}"')):
-            for side in SIDES:
-                for joint in ("hip", "knee", "ankle"):
-                    target = (
-                        f'tendon="{side}_knee"'
-                        if rolling and joint == "knee"
-                        else f'joint="{side}_{joint}"'
-                    )
-                    lines += [
-                        f'    <{kind} name="{side}_{joint}_{kind}" {target} {gain} gear="1" '
-                        'ctrllimited="false"/>'
-                    ]
-    lines += ["  </actuator>", "", "  <sensor>"]
-    for side in SIDES:
-        lines += [
-            f'    <touch name="{side}_touch" site="{side}_sole_touch"/>',
-            f'    <framepos name="{side}_ankle_pos" objtype="site" objname="{side}_ankle"/>',
-            f'    <framepos name="{side}_heel_pos" objtype="site" objname="{side}_heel"/>',
-            f'    <framepos name="{side}_toe_pos" objtype="site" objname="{side}_toe"/>',
-        ]
-    lines += ["  </sensor>", "", "  <keyframe>"]
-    nq = 3 + 2 * (4 if rolling else 3)
-    home = ["0", _f(stand)] + ["0"] * (nq - 2)  # qpos0: standing straight on the floor
-    lines += [f'    <key name="home" qpos="{" ".join(home)}"/>', "  </keyframe>", "</mujoco>", ""]
-    return "\n".join(lines)
+            lines += [
+                f'    <{kind} name="{s}_{j}_{kind}" {target(s, j)} {gain} gear="1" ctrllimited="false"/>'
+                for s, j in joints
+            ]
+    return lines + ["  </actuator>", ""]
 
 
 def with_box_soles(spec, robot: Robot, solref=None):

@@ -60,12 +60,13 @@ from mujoco import rollout
 from biped.errors import BipedError
 from biped.model.dynamics import Biped
 from biped.model.kinematics import XH, ZH
+from biped.records.gait_file import Gait
 from validate import DEFAULT_STEPS
 from validate.layout import Layout
 from validate.mapping import mapping, other
 from validate.mjcf import SIDES
 from validate.model import JOINT_ORDER, model_spec, with_servos
-from validate.samples import GaitSamples, gait_biped
+from validate.samples import GaitSamples
 
 __all__ = ["JOINT_ORDER", "Push", "Simulation", "WalkSettings", "Walker", "simulate"]
 
@@ -95,6 +96,11 @@ RESYNC = 0.02
 # Height of the hip, as a fraction of its height at the ends of the step, below which the
 # robot has fallen and the simulation stops (a walk keeps it within a few per cent).
 FALLEN = 0.75
+# Columns of a phase table's controls (``PhaseTable.controls``), six each in ``JOINT_ORDER``:
+# the motors' torques, the servos' references and reference rates (the actuators' commands),
+# and the rotors' torques per unit ṡ².
+TORQUES, REFERENCES, RATES, ROTORS = (slice(6 * i, 6 * i + 6) for i in range(4))
+CONTROLS, COMMANDS = 24, slice(0, 18)
 
 
 @dataclass(frozen=True)
@@ -164,9 +170,9 @@ class PhaseTable:
         advance: (N,) x [m], from the start of the step to its end.
         tau: (N,) the gait's time at each x [s].
         speed: (N,) planned ẋ_H at each x [m/s].
-        controls: stance side -> (N, 24) in ``JOINT_ORDER``: the file's torques of the six
-            motors (as their controls), joint references, reference rates, and what each
-            motor adds per unit ṡ² to turn its rotor (``Layout.rotor_inertia`` θ̈_ref).
+        controls: stance side -> (N, ``CONTROLS``): the file's torques of the six motors (as
+            their controls), joint references, reference rates, and what each motor adds per
+            unit ṡ² to turn its rotor (``Layout.rotor_inertia`` θ̈_ref): ``TORQUES``, ...
     """
 
     advance: np.ndarray
@@ -176,9 +182,9 @@ class PhaseTable:
 
     @functools.cached_property
     def interpolants(self) -> dict:
-        """Stance side -> (48, N - 1): ``controls`` as columns (the first 24 rows, less the
-        last point) over each column's increments to the next point (the other 24): what
-        the walk interpolates, laid out for one gather."""
+        """Stance side -> (2 ``CONTROLS``, N - 1): ``controls`` as columns (the first
+        ``CONTROLS`` rows, less the last point) over each column's increments to the next
+        point: what the walk interpolates, laid out for one gather."""
         return {
             side: np.ascontiguousarray(np.hstack([rows[:-1], np.diff(rows, axis=0)]).T)
             for side, rows in self.controls.items()
@@ -204,15 +210,14 @@ def phase_table(
     controls = {}
     for side in SIDES:
         mapped = mapping(layout.model, side, radii)
-        table = np.zeros((points, 24))
+        table = controls[side] = np.zeros((points, CONTROLS))
         # Motor controls: MuJoCo's joint torque -Γ, per unit of gear (validate.mjcf: gear -1).
-        table[:, mapped.columns] = -torques
-        table[:, :6] /= layout.gears
-        table[:, 6:12] = layout.joint_angles(mapped.qpos(q))
-        table[:, 12:18] = layout.joint_angles(mapped.qpos(qd))
-        table[:, 18:24] = layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
-        table[:, 18:24] /= layout.gears
-        controls[side] = table
+        table[:, TORQUES][:, mapped.columns] = -torques
+        table[:, TORQUES] /= layout.gears
+        table[:, REFERENCES] = layout.joint_angles(mapped.qpos(q))
+        table[:, RATES] = layout.joint_angles(mapped.qpos(qd))
+        table[:, ROTORS] = layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
+        table[:, ROTORS] /= layout.gears
     return PhaseTable(advance, tau, speed=qd[:, XH], controls=controls)
 
 
@@ -237,14 +242,6 @@ class Simulation:
     warnings: int = 0  # MuJoCo warnings raised during the simulation
     settings: WalkSettings = WalkSettings()
     pushed: float = 0.0  # impulse given by the push [N·s]
-
-    @property
-    def kp(self) -> float:
-        return self.settings.kp
-
-    @property
-    def kv(self) -> float:
-        return self.settings.kv
 
     def sensor(self, name: str) -> np.ndarray:
         """Readings (N, dim) of a named sensor."""
@@ -288,14 +285,15 @@ class Simulation:
         """Normal force [N] on a sole."""
         return self.layout.touch(self.sensors, side)
 
-    def stance_foot_slip(self, settle: int = 0) -> np.ndarray:
+    def stance_foot_slip(self, settle: int = 0, landing: bool = False) -> np.ndarray:
         """Travel [m] of each step's stance sole on the ground (the spread of its middle's
-        x) after its first ``settle`` states: a foot rolling on its sole barely moves its
-        middle, a foot sliding moves it by the slide."""
+        x) after its first ``settle`` states (during them if ``landing``): a foot rolling on
+        its sole barely moves its middle, a foot sliding moves it by the slide."""
         slips = []
         for rows, stance in zip(self.step_slices(), self.stances, strict=True):
             middle = 0.5 * (self.heel(stance)[rows, 0] + self.toe(stance)[rows, 0])
-            slips.append(float(np.ptp(middle[settle:])) if len(middle) > settle else 0.0)
+            part = middle[:settle] if landing else middle[settle:]
+            slips.append(float(np.ptp(part)) if len(part) else 0.0)
         return np.array(slips)
 
     # -------------------------------------------------------------- torques (N, 6)
@@ -328,8 +326,8 @@ class Simulation:
         start would add h kv θ̈, an apparent inertia of 0.08 kg·m² at 2 ms and
         kv = 40 N·m·s/rad."""
         layout = self.layout
-        stiffness = np.full((len(self.time), 6), self.kp)
-        damping = np.full((len(self.time), 6), self.kv)
+        stiffness = np.full((len(self.time), 6), self.settings.kp)
+        damping = np.full((len(self.time), 6), self.settings.kv)
         for side in SIDES:
             free = self.stance_of() == side
             column = JOINT_ORDER.index(f"{side}_ankle")
@@ -348,17 +346,17 @@ class Walker:
     """A gait file prepared for walking on one MuJoCo model.
 
     Args:
-        gait: the gait file's content (``biped.records.gait_file.read`` or ``to_dict``).
+        gait: the gait (``Gait``, or a file's content: ``Gait.of``).
         model: the scene to walk on (``validate.model.model_spec``: a file, or by default the
             committed model of the gait's knee for Table 1, the generated one otherwise);
             a spec, or a path.
     """
 
-    def __init__(self, gait: dict, model: mujoco.MjSpec | str | None = None):
-        self.gait = gait
-        self.biped: Biped = gait_biped(gait)
-        self.samples = GaitSamples.from_gait(gait)
-        spec = model if isinstance(model, mujoco.MjSpec) else model_spec(gait, self.biped, model)
+    def __init__(self, gait: Gait | dict, model: mujoco.MjSpec | str | None = None):
+        self.gait = Gait.of(gait)
+        self.biped: Biped = self.gait.biped
+        self.samples = GaitSamples.from_gait(self.gait)
+        spec = model if isinstance(model, mujoco.MjSpec) else model_spec(self.biped, model)
         self.model = with_servos(spec, self.biped.knee, KP, KV)
         self.layout = Layout(self.model)
         self.table = phase_table(self.samples, self.layout, self.biped.radii)
@@ -376,7 +374,10 @@ class Walker:
 
 
 def simulate(
-    gait: dict, steps: int = DEFAULT_STEPS, settings: WalkSettings = WalkSettings(), model=None
+    gait: Gait | dict,
+    steps: int = DEFAULT_STEPS,
+    settings: WalkSettings = WalkSettings(),
+    model=None,
 ) -> Simulation:
     """``Walker(gait, model).walk(steps, settings)``."""
     return Walker(gait, model).walk(steps, settings)
@@ -426,182 +427,247 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
         spare.append(data)
 
 
+class WalkLog:
+    """The walk's preallocated record, which MuJoCo's rollouts write into and read their
+    controls from: row k holds the state at the k-th physics step, the sensors computed at it,
+    the controls of the step that follows it, the controller's place in the phase table
+    (``where``) and the stance ankle's torque on the speed. ``rows`` are written; per step,
+    its first row, stance side and whether it landed; ``warnings``: MuJoCo's, counted."""
+
+    SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, capacity: int):
+        self.state = np.empty((capacity, mujoco.mj_stateSize(model, self.SPEC)))
+        self.ctrl = np.zeros((capacity, model.nu))
+        self.sensors = np.empty((capacity, model.nsensordata))
+        self.where, self.speed_torque = np.empty(capacity), np.empty(capacity)
+        self.rows, self.step_starts, self.stances, self.landed = 0, [], [], []
+        mujoco.mj_getState(model, data, self.state[0], self.SPEC)
+        self.sensors[0] = data.sensordata
+        self.models, self.datas, self.warmstart = [model], [data], data.qacc_warmstart[None]
+        self.counts = data.warning.number  # a view: every rollout resets it, then counts
+        self.counts[:] = 0
+        self.no_warnings, self.warnings = self.counts.tobytes(), 0
+
+    def rollout(self, runner, k: int, nstep: int, controls: np.ndarray, spec: int) -> None:
+        """MuJoCo's ``nstep`` physics steps from row k under ``controls`` (of ``spec``):
+        state[k + 1 + r] is the state after step r, sensors[k + r] those computed before it."""
+        runner.rollout(
+            self.models,
+            self.datas,
+            self.state[k : k + 1],
+            controls,
+            control_spec=spec,
+            nstep=nstep,
+            initial_warmstart=self.warmstart,
+            state=self.state[None, k + 1 : k + 1 + nstep],
+            sensordata=self.sensors[None, k : k + nstep],
+            skip_checks=True,
+        )
+        if self.counts.tobytes() != self.no_warnings:
+            self.warnings += int(self.counts.sum())
+
+    def simulation(self, layout: Layout, table: PhaseTable, **results) -> Simulation:
+        """The rows written, a ``Simulation`` with ``results`` (settings, pushed)."""
+        k, states = self.rows, self.state[: self.rows]
+        return Simulation(
+            layout.model,
+            layout,
+            time=states[:, 0],
+            qpos=layout.state_qpos(states),
+            qvel=layout.state_qvel(states),
+            ctrl=self.ctrl[:k],
+            sensors=self.sensors[:k],
+            phase=np.interp(self.where[:k], np.arange(len(table.tau)), table.tau),
+            speed_torque=self.speed_torque[:k],
+            step_starts=self.step_starts,
+            stances=self.stances,
+            landed=self.landed,
+            warnings=self.warnings,
+            **results,
+        )
+
+
+class PhaseController:
+    """The controls of each reading period (the module docstring's u and u_ankle): the phase
+    read from the state and carried on at the hip's speed, the phase table's rows there
+    (``PhaseTable.interpolants``) gathered into one buffer, scaled through its named views
+    and written into the log in the actuators' order."""
+
+    def __init__(self, table: PhaseTable, layout: Layout, chunk: int, dt: float):
+        self.interpolants, self.layout = table.interpolants, layout
+        self.x0, self.x_end, self.last = table.advance[0], table.advance[-1], len(table.tau) - 1
+        self.per_metre = self.last / (self.x_end - self.x0)  # table rows per metre of advance
+        self.speeds = table.speed.tolist()
+        self.ticks = np.arange(chunk) * dt  # [s] from the reading
+        self.last_tick = float(self.ticks[-1])
+        self.index, self.weight = np.empty(chunk, dtype=np.intp), np.empty(chunk)
+        # The table's rows at the period's points, over their increments to the next point.
+        self.gathered = np.empty((2 * CONTROLS, chunk))
+        self.rows, self.increments = self.gathered[:CONTROLS], self.gathered[CONTROLS:]
+        named = (self.rows[columns] for columns in (TORQUES, REFERENCES, RATES, ROTORS))
+        self.torques, self.references, self.rates, self.rotors = named
+        self.commands = self.rows[COMMANDS].T  # (chunk, 18): in ``columns`` order
+        columns = np.concatenate([layout.motors, layout.positions, layout.velocities])
+        ordered = np.array_equal(columns, np.arange(len(columns)))  # as validate.model does
+        self.columns = slice(0, len(columns)) if ordered else columns
+        self.hip_x_at, self.hip_speed_at = map(layout.state_index, ("hip_x", "hip_speed"))
+
+    def start_step(self, stance: str) -> None:
+        self.interpolant = self.interpolants[stance]
+        self.ankle_at = self.layout.sensor_index(stance, "ankle_pos")
+        ankle = JOINT_ORDER.index(f"{stance}_ankle")
+        self.ankle_gear, self.ankle_torque = float(self.layout.gears[ankle]), self.rows[ankle]
+
+    def before_step(self, log: WalkLog, k: int) -> np.ndarray:
+        """The controls of the reading period from row k, written into the log (returned)."""
+        # The phase now, and as it goes on at the hip's present speed (the stance ankle's
+        # position is the reading of one physics step before: the foot is on the ground).
+        hip_speed = log.state.item(k, self.hip_speed_at)
+        here = log.state.item(k, self.hip_x_at) - log.sensors.item(max(k - 1, 0), self.ankle_at)
+        period = slice(k, k + len(self.ticks))
+        where = log.where[period]
+        where[:] = (self.ticks * hip_speed + here - self.x0) * self.per_metre
+        a, b = self._gather(where)
+        if self.last_tick * hip_speed + here > self.x_end:  # the last of ``advance``, below
+            # Past the end of the step the reference goes on at the end's rates: the swing
+            # foot keeps coming down to the floor.
+            beyond = np.maximum(self.ticks * hip_speed + here - self.x_end, 0.0)
+            self.references += self.rates * (beyond / self.speeds[-1])
+        planned = self.speeds[a] + (self.speeds[a + 1] - self.speeds[a]) * b
+        rate = min(max(hip_speed / planned, RATE_RANGE[0]), RATE_RANGE[1])
+        self.rates *= rate
+        self.torques += self.rotors * (rate * rate)
+        # The ankle strategy: the stance ankle's torque grows with the hip's excess speed
+        # (its centre of pressure moves forward and slows the robot down).
+        speed_torque = log.speed_torque[period] = SPEED_GAIN * (hip_speed - planned)
+        self.ankle_torque -= speed_torque / self.ankle_gear
+        block = log.ctrl[period]
+        block[:, self.columns] = self.commands
+        return block
+
+    def _gather(self, where: np.ndarray) -> tuple[int, float]:
+        """The table between its points at ``where`` (table rows, clipped to the table) into
+        ``rows``; returns the first point's row and weight."""
+        last, index, weight = self.last, self.index, self.weight
+        # ``where`` is monotonic over the reading period: its ends bound it
+        first, final = where.item(0), where.item(-1)
+        low, high = (first, final) if first <= final else (final, first)
+        if low < 0.0 or high > last:
+            np.clip(where, 0.0, last, out=where)
+        index[:] = where  # truncated: where >= 0
+        if high >= last:
+            np.minimum(index, last - 1, out=index)
+        np.subtract(where, index, out=weight)
+        # ``index`` is within the table: "clip" writes straight into the buffer ("raise" copies)
+        self.interpolant.take(index, axis=1, out=self.gathered, mode="clip")
+        self.increments *= weight
+        self.rows += self.increments
+        return index.item(0), weight.item(0)
+
+
+class StepEvents:
+    """How a step ends (the module docstring): the swing foot, off the ground since some time
+    in the step, touches it in the landing window (``landed``), the hip drops below ``floor``
+    [m] (``fallen``), ``timeout`` [s] passes, or the log is full (``rows``)."""
+
+    def __init__(self, layout: Layout, last_row: int, floor: float, timeout: float, rows: int):
+        self.layout, self.floor, self.timeout, self.rows = layout, floor, timeout, rows
+        self.landing_row = LANDING_WINDOW * last_row
+        self.hip_height_at = layout.state_index("hip_height")
+
+    def start_step(self, stance: str, log: WalkLog) -> None:
+        self.touch_at = self.layout.sensor_index(other(stance), "touch")
+        self.began = log.state[log.rows, 0]
+        self.lifted = self.landed = self.fallen = False
+
+    def running(self, log: WalkLog, chunk: int) -> bool:
+        k = log.rows
+        ended = self.landed or self.fallen or k >= self.rows - chunk
+        return not ended and log.state.item(k, 0) - self.began < self.timeout
+
+    def after_step(self, log: WalkLog, k: int, chunk: int) -> int:
+        """The physics steps of the period from row k that belong to the step: up to its
+        landing or its fall, if either came in it."""
+        n, aloft, where = chunk, True, log.where[k : k + chunk]  # clipped: in the window alike
+        if not self.lifted or where.item(-1) >= self.landing_row:
+            contact = log.sensors[k : k + chunk, self.touch_at] > TOUCH_THRESHOLD
+            if not self.lifted:  # a foot that never lifts makes no steps
+                aloft = np.logical_or.accumulate(~contact)
+                self.lifted = bool(aloft[-1])
+            if where.item(-1) >= self.landing_row and contact.any():
+                down = np.flatnonzero((where >= self.landing_row) & contact & aloft)
+                if len(down):
+                    n, self.landed = int(down[0]) + 1, True
+        heights = log.state[k + 1 : k + 1 + n, self.hip_height_at]
+        if not np.minimum.reduce(heights) >= self.floor:  # below the floor, or not finite
+            n, self.fallen, self.landed = int(np.argmax(~(heights >= self.floor))) + 1, True, False
+        return n
+
+
+class Shove:
+    """The push of ``WalkSettings.push``: the rest of its impulse as a constant force on the
+    trunk (MuJoCo's applied force, beside the controls) over each reading period from its
+    time until it is given; ``pushed`` [N·s]: what was given."""
+
+    ONLY_CONTROLS = int(mujoco.mjtState.mjSTATE_CTRL)
+    WITH_FORCE = int(mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_XFRC_APPLIED)
+
+    def __init__(self, push: Push | None, model: mujoco.MjModel, layout: Layout, chunk, dt):
+        self.push, self.chunk, self.dt, self.nu = push, chunk, dt, model.nu
+        self.remaining = 0.0 if push is None else float(push.impulse)  # still to give [N·s]
+        self.pushed, self.force = 0.0, None
+        self.trunk_force_x = model.nu + 6 * layout.trunk
+        self.controls = np.zeros((1, chunk, model.nu + 6 * model.nbody))
+
+    def before_step(self, log: WalkLog, k: int, block: np.ndarray) -> tuple[np.ndarray, int]:
+        """The rollout's controls of the period from row k, and their ``mjtState`` spec."""
+        self.force = None
+        if not (self.remaining != 0.0 and log.state.item(k, 0) >= self.push.time):
+            return block[None], self.ONLY_CONTROLS
+        self.force = self.remaining / (self.chunk * self.dt)
+        self.controls[0][:, : self.nu] = block
+        self.controls[0][:, self.trunk_force_x] = self.force
+        return self.controls, self.WITH_FORCE
+
+    def after_step(self, n: int) -> None:
+        """The first ``n`` physics steps of the period were walked."""
+        if self.force is not None:
+            self.pushed += self.force * n * self.dt
+            self.remaining = 0.0 if n == self.chunk else self.remaining - self.force * n * self.dt
+
+
 def _walk_on(walker, steps, settings, model, data) -> Simulation:
-    layout = walker.layout.of(model)
-    table, samples = walker.table, walker.samples
+    layout, samples, period = walker.layout.of(model), walker.samples, walker.period
     q0, qd0 = samples.start()
     start = mapping(model, "left", walker.biped.radii)
-    data.qpos[:] = start.qpos(q0)
-    data.qvel[:] = start.qpos(qd0)
+    data.qpos[:], data.qvel[:] = start.qpos(q0), start.qpos(qd0)
     mujoco.mj_forward(model, data)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     dt = model.opt.timestep
-    chunk = max(1, round(RESYNC / dt))
-    period = samples.period
-    capacity = int(np.ceil(steps * STEP_TIMEOUT * period / dt)) + chunk
-    # MuJoCo reads each reading period's controls from these logs and writes its states and
-    # sensors straight into them: row k holds the state at the k-th physics step, the
-    # sensors computed at it and the controls of the step that follows it.
-    log_state = np.empty((capacity, mujoco.mj_stateSize(model, spec)))
-    log_ctrl = np.zeros((capacity, model.nu))
-    log_sensors = np.empty((capacity, model.nsensordata))
-    log_where = np.empty(capacity)  # position in the phase table
-    log_speed = np.empty(capacity)
-    mujoco.mj_getState(model, data, log_state[0], spec)
-    log_sensors[0] = data.sensordata
-    data.warning.number[:] = 0
-    result = Simulation(model, layout, *(None,) * 6, settings=settings)
-    x0, x_end = table.advance[0], table.advance[-1]
-    last = len(table.advance) - 1
-    per_metre = last / (x_end - x0)  # table rows per metre of hip advance
-    speeds = table.speed.tolist()
-    end_speed = speeds[-1]
-    landing_row = LANDING_WINDOW * last
+    chunk = max(1, round(RESYNC / dt))  # physics steps per reading period
+    log = WalkLog(model, data, int(np.ceil(steps * STEP_TIMEOUT * period / dt)) + chunk)
+    controller = PhaseController(walker.table, layout, chunk, dt)
     floor = FALLEN * min(q0[ZH], samples.end()[0][ZH])
-    ticks = np.arange(chunk) * dt
-    last_tick = float(ticks[-1])
-    columns = np.concatenate([layout.motors, layout.positions, layout.velocities])
-    if np.array_equal(columns, np.arange(len(columns))):  # as validate.model orders them
-        columns = slice(0, len(columns))
-    warning_counts = data.warning.number  # a view: every rollout resets it, then counts
-    no_warnings = warning_counts.tobytes()
-    interpolants = table.interpolants
-    index = np.empty(chunk, dtype=np.intp)
-    weight = np.empty(chunk)
-    # The table's columns at the period's points and their increments to the next point
-    # (``PhaseTable.interpolants``), gathered into one buffer, and named views of it.
-    gathered = np.empty((48, chunk))
-    rows, increments = gathered[:24], gathered[24:]
-    torques, references, rates, rotors = rows[:6], rows[6:12], rows[12:18], rows[18:24]
-    commands = rows[:18].T  # (chunk, 18): the period's controls in ``columns`` order
-    rotor_torques = np.empty((6, chunk))
-    lowest = np.minimum.reduce
-    timeout = STEP_TIMEOUT * period
-    push = settings.push
-    remaining = 0.0 if push is None else float(push.impulse)  # impulse still to give [N·s]
-    # A push goes in as an applied force on the trunk (xfrc_applied) beside the controls.
-    only_controls = int(mujoco.mjtState.mjSTATE_CTRL)
-    with_force = int(mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_XFRC_APPLIED)
-    pushed_in = np.zeros((1, chunk, model.nu + 6 * model.nbody))
-    hip_x_at, hip_speed_at = layout.state_index("hip_x"), layout.state_index("hip_speed")
-    hip_height_at = layout.state_index("hip_height")
-    warmstart = data.qacc_warmstart[None]
-    models, datas = [model], [data]
-    k = 0
+    events = StepEvents(layout, controller.last, floor, STEP_TIMEOUT * period, len(log.where))
+    shove = Shove(settings.push, model, layout, chunk, dt)
     with rollout.Rollout(nthread=0) as runner:
-        for j in range(steps):
-            stance = SIDES[j % 2]
-            interpolant = interpolants[stance]
+        for stance in (SIDES * steps)[:steps]:
             set_gains(model, layout, stance, settings.kp, settings.kv)
-            result.step_starts.append(k)
-            result.stances.append(stance)
-            began, landed, fallen, lifted = log_state[k, 0], False, False, False
-            ankle_at = layout.sensor_index(stance, "ankle_pos")
-            touch_at = layout.sensor_index(other(stance), "touch")
-            ankle_column = JOINT_ORDER.index(f"{stance}_ankle")
-            ankle_gear = float(layout.gears[ankle_column])
-            ankle_torque = rows[ankle_column]
-            while log_state.item(k, 0) - began < timeout and k < capacity - chunk:
-                # The phase now, and as it goes on at the hip's present speed (the stance
-                # ankle's position is the reading of one physics step before: the foot is
-                # on the ground).
-                hip_speed = log_state.item(k, hip_speed_at)
-                here = log_state.item(k, hip_x_at) - log_sensors.item(max(k - 1, 0), ankle_at)
-                where = log_where[k : k + chunk]
-                np.multiply(ticks, hip_speed, out=where)
-                where += here
-                where -= x0
-                where *= per_metre
-                # ``where`` is monotonic over the reading period: its ends bound it
-                first, final = where.item(0), where.item(-1)
-                low, high = (first, final) if first <= final else (final, first)
-                if low < 0.0 or high > last:
-                    np.clip(where, 0.0, last, out=where)
-                index[:] = where  # truncated: where >= 0
-                if high >= last:
-                    np.minimum(index, last - 1, out=index)
-                np.subtract(where, index, out=weight)
-                # The table between its points, column by column (24, chunk); ``index`` is
-                # within it, and "clip" writes straight into the buffer ("raise" copies).
-                interpolant.take(index, axis=1, out=gathered, mode="clip")
-                increments *= weight
-                rows += increments
-                if last_tick * hip_speed + here > x_end:  # the last of ``advance``, below
-                    # Past the end of the step the reference goes on at the end's rates: the
-                    # swing foot keeps coming down to the floor.
-                    advance = ticks * hip_speed
-                    advance += here
-                    beyond = np.maximum(advance - x_end, 0.0) / end_speed
-                    references += rates * beyond
-                a, b = index.item(0), weight.item(0)
-                planned = speeds[a] + (speeds[a + 1] - speeds[a]) * b
-                rate = min(max(hip_speed / planned, RATE_RANGE[0]), RATE_RANGE[1])
-                rates *= rate
-                np.multiply(rotors, rate * rate, out=rotor_torques)
-                torques += rotor_torques
-                # The ankle strategy: the stance ankle's torque grows with the hip's excess
-                # speed (its centre of pressure moves forward and slows the robot down).
-                speed_torque = SPEED_GAIN * (hip_speed - planned)
-                ankle_torque -= speed_torque / ankle_gear
-                block = log_ctrl[k : k + chunk]
-                block[:, columns] = commands
-                pushing = remaining != 0.0 and log_state.item(k, 0) >= push.time
-                if pushing:  # the rest of the push's impulse over this reading period
-                    force = remaining / (chunk * dt)
-                    pushed_in[0][:, : model.nu] = block
-                    pushed_in[0][:, model.nu + 6 * layout.trunk] = force
-                runner.rollout(
-                    models,
-                    datas,
-                    log_state[k : k + 1],
-                    pushed_in if pushing else block[None],
-                    control_spec=with_force if pushing else only_controls,
-                    nstep=chunk,
-                    initial_warmstart=warmstart,
-                    state=log_state[None, k + 1 : k + 1 + chunk],
-                    sensordata=log_sensors[None, k : k + chunk],
-                    skip_checks=True,
-                )
-                if warning_counts.tobytes() != no_warnings:  # reset by every rollout
-                    result.warnings += int(warning_counts.sum())
-                # log_state[k + 1 + r]: the state after physics step r of this period;
-                # log_sensors[k + r]: the sensors computed before it, at the state it
-                # started from.
-                n = chunk
-                # A landing: the swing foot, off the ground since some time in this step,
-                # touches it in the landing window (a foot that never lifts makes no steps).
-                aloft = True
-                if not lifted or final >= landing_row:
-                    contact = log_sensors[k : k + chunk, touch_at] > TOUCH_THRESHOLD
-                    if not lifted:
-                        aloft = np.logical_or.accumulate(~contact)
-                        lifted = bool(aloft[-1])
-                    if final >= landing_row and contact.any():
-                        down = np.flatnonzero((where >= landing_row) & contact & aloft)
-                        if len(down):
-                            n, landed = int(down[0]) + 1, True
-                heights = log_state[k + 1 : k + 1 + n, hip_height_at]
-                if not lowest(heights) >= floor:  # below the floor, or not finite
-                    n, fallen, landed = int(np.argmax(~(heights >= floor))) + 1, True, False
-                if pushing:
-                    result.pushed += force * n * dt
-                    remaining = 0.0 if n == chunk else remaining - force * n * dt
-                log_speed[k : k + n] = speed_torque
-                k += n
-                if landed or fallen:
-                    break
-            result.landed.append(landed)
-            if not landed:
+            log.step_starts.append(log.rows)
+            log.stances.append(stance)
+            controller.start_step(stance)
+            events.start_step(stance, log)
+            while events.running(log, chunk):
+                k = log.rows
+                block = controller.before_step(log, k)
+                log.rollout(runner, k, chunk, *shove.before_step(log, k, block))
+                n = events.after_step(log, k, chunk)
+                shove.after_step(n)
+                log.rows += n
+            log.landed.append(events.landed)
+            if not events.landed:
                 break
-    states = log_state[:k]
-    result.time = states[:, 0]
-    result.qpos = layout.state_qpos(states)
-    result.qvel = layout.state_qvel(states)
-    result.ctrl = log_ctrl[:k]
-    result.sensors = log_sensors[:k]
-    result.phase = np.interp(log_where[:k], np.arange(last + 1), table.tau)
-    result.speed_torque = log_speed[:k]
-    return result
+    return log.simulation(layout, walker.table, settings=settings, pushed=shove.pushed)
 
 
 def reference_along(samples: GaitSamples, sim: Simulation):
