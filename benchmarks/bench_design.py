@@ -20,6 +20,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+from timing import median_time  # noqa: E402
 
 import biped  # noqa: E402
 from biped.optimization.design import DesignProblem, optimize_design, solver_for  # noqa: E402
@@ -29,15 +30,6 @@ from biped.studies.design_map import run_design_map  # noqa: E402
 
 SPEED = 0.3
 WORKERS = 2
-
-
-def timed(function, repeats):
-    runs, result = [], None
-    for _ in range(repeats):
-        began = time.perf_counter()
-        result = function()
-        runs.append(time.perf_counter() - began)
-    return float(np.median(runs)), result
 
 
 def one_design(repeats: int) -> None:
@@ -50,8 +42,8 @@ def one_design(repeats: int) -> None:
     began = time.perf_counter()
     gait_solver_for(gait)
     gait_build = time.perf_counter() - began
-    design_seconds, design = timed(lambda: optimize_design(problem), repeats)
-    gait_seconds, optimum = timed(lambda: optimize(gait), repeats)
+    design_seconds, design = median_time(optimize_design, problem, repeats=repeats)
+    gait_seconds, optimum = median_time(optimize, gait, repeats=repeats)
     print(f"one optimization at {SPEED} m/s, sthenic, default starts, median of {repeats}")
     print(f"{'':32}{'build [s]':>10}{'solve [s]':>11}{'iterations':>12}{'value':>12}{'starts':>8}")
     for label, build, seconds, result in (

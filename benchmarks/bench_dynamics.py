@@ -12,25 +12,14 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"  # one core, set before numpy loads its BLAS
 
-import time  # noqa: E402
-
 import numpy as np  # noqa: E402
+from timing import median_time  # noqa: E402
 
 import biped  # noqa: E402
 from biped.model.dynamics import JOINT_MATRIX  # noqa: E402
 
 BATCH = 1000
 REPEATS = 200
-
-
-def median_time(function, *args, repeats=REPEATS):
-    function(*args)  # warm up
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function(*args)
-        times.append(time.perf_counter() - start)
-    return float(np.median(times))
 
 
 def reference(model, q, qd, qdd):
@@ -58,8 +47,9 @@ def main():
         q, qd, qdd = random_states(model, rng, BATCH)
         torques, wrench = model.inverse_dynamics(q, qd, qdd)
         assert np.allclose(np.concatenate([torques, wrench], -1), reference(model, q, qd, qdd))
-        fast = median_time(model.inverse_dynamics, q, qd, qdd) / BATCH
-        slow = median_time(reference, model, q, qd, qdd, repeats=20) / BATCH
+        fast = median_time(model.inverse_dynamics, q, qd, qdd, repeats=REPEATS, warm_up=True)
+        slow = median_time(reference, model, q, qd, qdd, repeats=20, warm_up=True)
+        fast, slow = fast[0] / BATCH, slow[0] / BATCH
         print(f"{knee:10}{fast * 1e6:13.3f} µs{slow * 1e6:13.3f} µs{slow / fast:9.1f}x")
     print("target: under 5 µs per sample")
 

@@ -26,15 +26,15 @@ from bench_dynamics import random_states  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
 import biped  # noqa: E402
-from biped import gait_file  # noqa: E402
 from biped.optimization.optimize import optimize  # noqa: E402
 from biped.optimization.problem import GaitProblem  # noqa: E402
+from biped.records import gait_file  # noqa: E402
+from biped.records.gait_file import Gait  # noqa: E402
 from validate import mjcf, simulate  # noqa: E402
 from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
 from validate.model import model_spec  # noqa: E402
-from validate.report import validate  # noqa: E402
-from validate.samples import gait_biped  # noqa: E402
 from validate.simulate import Walker  # noqa: E402
+from validate.validation import validate  # noqa: E402
 
 SAMPLES = 1000
 STEPS = 20
@@ -133,7 +133,7 @@ def main():
         robot = biped.Robot.paper()
         optimum = optimize(GaitProblem(biped.Biped(robot, knee), 0.3))
         gait = gaits[knee] = gait_file.to_dict(optimum, robot, seed=0)
-        spec = model_spec(gait, gait_biped(gait))
+        spec = model_spec(Gait.of(gait).biped)
         factors = {}
         for name, settings in (("committed", spec), ("previous", previous_settings(spec, robot))):
             walker = Walker(gait, settings)

@@ -15,6 +15,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
+from timing import median_time  # noqa: E402
 
 import biped  # noqa: E402
 from biped.optimization.optimize import first_guesses, optimize  # noqa: E402
@@ -60,11 +61,7 @@ def main():
             began = time.perf_counter()
             solver_for(problem)
             build = time.perf_counter() - began
-            runs = []
-            for _ in range(args.repeats):
-                began = time.perf_counter()
-                optimum = optimize(problem)
-                runs.append(time.perf_counter() - began)
+            seconds, optimum = median_time(optimize, problem, repeats=args.repeats)
             report = optimum.report
             nlp = solver_for(problem).nlp
             hessian = nlp.get_function("nlp_hess_l").n_instructions()
@@ -87,7 +84,7 @@ def main():
             old = previous_method(problem)
             old_seconds = time.perf_counter() - began
             print(
-                f"{knee:10}{criterion:10}{build:10.2f}{np.median(runs):11.2f}"
+                f"{knee:10}{criterion:10}{build:10.2f}{seconds:11.2f}"
                 f"{optimum.value:12.5f}{f'{report.starts_at_best}/{report.starts}':>16}"
                 f"{old_seconds:14.2f}{old.value:12.5f}{old.value / optimum.value:8.3f}"
             )

@@ -4,7 +4,8 @@ Kept apart from the ``biped`` package, which holds the analytical models and nev
 the MuJoCo validation (``validate``); this package may import both.
 
 The command line's modules (numpy, scipy, CasADi) take a second or two to load: a Ctrl-C or
-SIGTERM meanwhile ends the program as it would later (``biped_cli.guard``), with one line on
+SIGTERM meanwhile ends the program as it would later (the policy of
+``biped.runtime.interrupts``, not imported here: ``biped`` loads numpy), with one line on
 stderr and exit status 130 / 143, no traceback. Nothing is written yet then, so the program
 ends at once (an exception raised in the middle of an extension module's loading would turn
 into an ImportError).
@@ -15,7 +16,7 @@ import signal
 import sys
 import threading
 
-# Exit status and name of an interrupt while the command line loads (as in biped_cli.guard).
+# Exit status and name of an interrupt while the command line loads (as later: interrupts).
 _INTERRUPTS = {
     signal.SIGINT: (128 + signal.SIGINT, "Ctrl-C"),
     signal.SIGTERM: (128 + signal.SIGTERM, "SIGTERM"),

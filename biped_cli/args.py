@@ -188,57 +188,88 @@ def add_budget(parser, sweep: bool = False):
             else "; nelder-mead: the paper's penalty method alone, to see where it stops"
         ),
     )
+    add_options(
+        parser,
+        ("--starts", positive, DEFAULT_STARTS, "N", f"IPOPT starts: the first guess and N-1 "
+         f"perturbations of it (default {DEFAULT_STARTS}); {CERTIFIED_HELP}"),
+        ("--nelder-mead-starts", non_negative, 0, "K",
+         "IPOPT also starts from the paper's Nelder-Mead with K seeds (default 0)"),
+        ("--seed", non_negative, 0, "N",
+         "seed of the perturbed starts and of Nelder-Mead (default 0)"),
+        ("--restarts", non_negative, MAX_RESTARTS, "N",
+         f"Nelder-Mead restarts from the best point at most (default {MAX_RESTARTS})"),
+        ("--evaluations", positive, EVALUATIONS_PER_RUN, "N",
+         f"criterion evaluations per Nelder-Mead run (default {EVALUATIONS_PER_RUN})"),
+    )  # fmt: skip
+    add_safety(parser)
+
+
+def add_options(parser, *options) -> None:
+    """Options given as rows (option, type, default, metavar, help)."""
+    for option, kind, default, metavar, help in options:
+        parser.add_argument(option, type=kind, default=default, metavar=metavar, help=help)
+
+
+def add_safety(parser) -> None:
+    """``--clearance`` and ``--zmp-margin``: the safety margins of the optimal gait
+    (``safety(args)``)."""
+    add_options(
+        parser,
+        ("--clearance", clearance, 0.0, "M", "[m] height the swing foot must keep off the "
+         "ground away from the ends of the step (default 0, the paper's z >= 0)"),
+        ("--zmp-margin", zmp_margin, 0.0, "M",
+         "[m] distance the ZMP must keep inside the sole's heel and toe (default 0)"),
+    )  # fmt: skip
+
+
+def add_robot(parser) -> None:
+    """``--robot FILE``: the robot's parameters (``robot_of(args)``)."""
+    parser.add_argument("--robot", metavar="FILE", help=ROBOT_HELP)
+
+
+def robot_of(args):
+    """The robot of ``--robot`` (Table 1 without it)."""
+    from biped.model.robot import Robot
+
+    return Robot.paper() if args.robot is None else Robot.from_file(args.robot)
+
+
+def add_steps(parser) -> None:
+    """``--steps N``: the steps of a forward walk in MuJoCo."""
+    parser.add_argument("--steps", type=steps, default=DEFAULT_STEPS, metavar="N", help=STEPS_HELP)
+
+
+def add_folder(parser, option: str, default: str, what: str) -> None:
+    """An output folder, ``--out DIR`` or ``--recordings DIR``: ``what`` it holds."""
+    help = f"{what}, {FOLDER_CREATED} (default {default})"
+    parser.add_argument(option, default=default, metavar="DIR", help=help)
+
+
+def add_gait_out(parser) -> None:
+    """``--out FILE``: the gait file a command writes."""
+    help = f"gait file to write (JSON; {FOLDERS_CREATED})"
+    parser.add_argument("--out", required=True, metavar="FILE", help=help)
+
+
+def add_gaits(parser) -> None:
+    """``GAIT.json ...``: the gait files a command reads."""
+    help = "gait files from optimize, sweep, pipeline"
+    parser.add_argument("gait", metavar="GAIT.json", nargs="+", help=help)
+
+
+def add_model(parser) -> None:
+    """``--model PATH``: the MJCF to play the gaits on."""
     parser.add_argument(
-        "--starts",
-        type=positive,
-        default=DEFAULT_STARTS,
-        metavar="N",
-        help=f"IPOPT starts: the first guess and N-1 perturbations of it (default "
-        f"{DEFAULT_STARTS}); {CERTIFIED_HELP}",
+        "--model",
+        metavar="PATH",
+        help="MJCF to play the gaits on (default: mjcf/scene_<knee>.xml when the gait's robot is "
+        "Table 1, the model generated from the gait's robot otherwise)",
     )
-    parser.add_argument(
-        "--nelder-mead-starts",
-        type=non_negative,
-        default=0,
-        metavar="K",
-        help="IPOPT also starts from the paper's Nelder-Mead with K seeds (default 0)",
-    )
-    parser.add_argument(
-        "--seed",
-        type=non_negative,
-        default=0,
-        metavar="N",
-        help="seed of the perturbed starts and of Nelder-Mead (default 0)",
-    )
-    parser.add_argument(
-        "--restarts",
-        type=non_negative,
-        default=MAX_RESTARTS,
-        metavar="N",
-        help=f"Nelder-Mead restarts from the best point at most (default {MAX_RESTARTS})",
-    )
-    parser.add_argument(
-        "--evaluations",
-        type=positive,
-        default=EVALUATIONS_PER_RUN,
-        metavar="N",
-        help=f"criterion evaluations per Nelder-Mead run (default {EVALUATIONS_PER_RUN})",
-    )
-    parser.add_argument(
-        "--clearance",
-        type=clearance,
-        default=0.0,
-        metavar="M",
-        help="[m] height the swing foot must keep off the ground away from the ends of the "
-        "step (default 0, the paper's z >= 0)",
-    )
-    parser.add_argument(
-        "--zmp-margin",
-        type=zmp_margin,
-        default=0.0,
-        metavar="M",
-        help="[m] distance the ZMP must keep inside the sole's heel and toe (default 0)",
-    )
+
+
+def add_jobs(parser) -> None:
+    """``--jobs N``: the worker processes of a campaign."""
+    parser.add_argument("--jobs", type=jobs, default=None, metavar="N", help=JOBS_HELP)
 
 
 def margin(name: str, high: float):
@@ -258,41 +289,24 @@ clearance = margin("clearance", MAX_CLEARANCE)
 zmp_margin = margin("zmp margin", MAX_ZMP_MARGIN)
 
 
-def non_negative(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer >= 0")
-    return value
-
-
-def positive(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer >= 1")
-    return value
-
-
-def bounded(low: int, high: int):
-    """An integer type from ``low`` to ``high`` inclusive."""
+def bounded(low: int, high: int | None = None):
+    """An integer type from ``low`` to ``high`` inclusive (no upper bound: None)."""
+    allowed = f"an integer >= {low}" if high is None else f"an integer from {low} to {high}"
 
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
             value = low - 1
-        if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"{text!r}: allowed an integer from {low} to {high}")
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed {allowed}")
         return value
 
     return parse
 
 
+non_negative = bounded(0)
+positive = bounded(1)
 steps = bounded(1, MAX_STEPS)
 jobs = bounded(1, MAX_JOBS)
 

@@ -1,4 +1,6 @@
-"""The subcommands of ``biped``: one function per job, each returning the exit status.
+"""The subcommands of ``biped``: one function per job, each returning the exit status, and
+beside each the function that registers its parser (``add_<command>``). The commands check
+their input and print; what they run end to end lives in ``validate.workflows``.
 
 Errors in the input raise ``BipedError`` (one line on stderr, exit status 2).
 """
@@ -10,22 +12,17 @@ import sys
 import numpy as np
 
 from biped.errors import BipedError, UnreachableError
-from biped.model.criteria import CRITERIA
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
-from biped.records.provenance import provenance
-from biped_cli.args import budget, check_folder, check_output, safety
+from biped_cli import args as types
+from biped_cli.args import budget, check_folder, check_output, robot_of, safety
 
 DEFAULT_SWEEP = "logs/sweep"
 DEFAULT_FIGURES = "logs/figures"
 DEFAULT_RECORDINGS = "logs/recordings"
 DEFAULT_PIPELINE = "logs/pipeline"
 DEFAULT_SPEED = 0.3  # [m/s] the walking speed of the pipeline
-
-
-def _robot(path: str | None) -> Robot:
-    return Robot.paper() if path is None else Robot.from_file(path)
 
 
 def check_simulable(robot: Robot, knee: str, source: str) -> None:
@@ -54,7 +51,7 @@ def demo_posture(model: Biped, hip_ahead: float = 0.05, hip_height: float = 0.86
 
 def cmd_demo(args) -> int:
     """Print the torques, ground wrench and ZMP that hold a one-leg posture still."""
-    robot = _robot(args.robot)
+    robot = robot_of(args)
     knees = KNEES if args.knee is None else (args.knee,)
     names = [f"Γ {j} [N·m]" for j in JOINTS] + ["Fx [N]", "Fz [N]", "Cy [N·m]", "x_ZMP [m]"]
     columns = []
@@ -82,16 +79,41 @@ def cmd_demo(args) -> int:
     return 0
 
 
+def add_demo(commands) -> None:
+    """Register ``demo`` on the ``biped`` subcommands."""
+    demo = commands.add_parser(
+        "demo",
+        help="torques, ground wrench and ZMP of a one-leg posture",
+        description=cmd_demo.__doc__,
+    )
+    demo.add_argument(
+        "--knee", choices=KNEES, help=f"one knee kinematic; {types.KNEE_HELP} (default: both)"
+    )
+    types.add_robot(demo)
+    types.add_options(
+        demo,
+        (
+            "--hip-ahead",
+            types.metres,
+            0.05,
+            "M",
+            "[m] hip ahead of the stance ankle (default 0.05)",
+        ),
+        ("--hip-height", types.metres, 0.86, "M", "[m] hip above the ground (default 0.86)"),
+    )
+    demo.set_defaults(run=cmd_demo)
+
+
 def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
     """An optimum in three lines: its step; both criteria on the check grid (``costs`` in
     its gait file, what the comparisons use); its criterion on the solver's samples
     (``optimizer.value``, what ranked the starts; left out for a result without it)."""
+    from biped.model.criteria import CRITERION_UNITS
     from biped.records.comparison import (
         CHECK_SAMPLES_PER_STEP,
         NELDER_MEAD_SAMPLES_PER_STEP,
         SOLVER_SAMPLES_PER_STEP,
     )
-    from biped.records.units import CRITERION_UNITS
 
     ev = optimum.evaluation
     lines = [
@@ -126,7 +148,7 @@ def cmd_optimize(args) -> int:
     from biped.optimization.problem import GaitProblem
     from biped.records import gait_file
 
-    robot = _robot(args.robot)
+    robot = robot_of(args)
     problem = GaitProblem(Biped(robot, args.knee), args.speed, args.criterion, safety(args))
     check_output(args.out)
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
@@ -147,14 +169,14 @@ def cmd_optimize(args) -> int:
             path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
             message += f"; {path} is written but is not a certified optimum"
         else:
-            worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
+            worst = ev.violations_line()
             message += f"; the result is infeasible (Ψ < 0: {worst}), no file written"
         print(message, file=sys.stderr)
         return 1
     if not optimum.feasible:
-        worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
         print(
-            f"biped optimize: infeasible optimum, violated constraints (Ψ < 0): {worst}; "
+            f"biped optimize: infeasible optimum, violated constraints (Ψ < 0): "
+            f"{ev.violations_line()}; "
             f"no file written",
             file=sys.stderr,
         )
@@ -162,6 +184,20 @@ def cmd_optimize(args) -> int:
     path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
     print(f"wrote {path}")
     return 0
+
+
+def add_optimize(commands) -> None:
+    """Register ``optimize`` on the ``biped`` subcommands."""
+    opt = commands.add_parser(
+        "optimize", help="optimal gait at one speed", description=cmd_optimize.__doc__
+    )
+    types.add_knee(opt, required=True)
+    types.add_criterion(opt)
+    opt.add_argument("--speed", type=types.speed, required=True, metavar="V", help=types.SPEED_HELP)
+    types.add_gait_out(opt)
+    types.add_budget(opt)
+    types.add_robot(opt)
+    opt.set_defaults(run=cmd_optimize)
 
 
 def cmd_sweep(args) -> int:
@@ -178,7 +214,7 @@ def cmd_sweep(args) -> int:
     from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep
     from biped_cli.progress import Progress
 
-    robot = _robot(args.robot)
+    robot = robot_of(args)
     check_folder(args.out, "--out")
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - PAPER_METHOD_SPEED)))
@@ -225,6 +261,31 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def add_sweep(commands) -> None:
+    """Register ``sweep`` on the ``biped`` subcommands."""
+    from biped.studies.sweep import DEFAULT_SPEEDS
+
+    sweep = commands.add_parser(
+        "sweep", help="optimal gaits over speeds, knees, criteria", description=cmd_sweep.__doc__
+    )
+    speeds = "START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.15:0.45:13)"
+    types.add_options(sweep, ("--speeds", types.speeds, DEFAULT_SPEEDS, "S", speeds))
+    types.add_knee(sweep, several=True)
+    types.add_criterion(sweep, several=True)
+    types.add_folder(sweep, "--out", DEFAULT_SWEEP, "folder of the sweep")
+    types.add_jobs(sweep)
+    types.add_budget(sweep, sweep=True)
+    types.add_robot(sweep)
+    types.add_dask(sweep)
+    types.add_options(
+        sweep,
+        ("--paper-seeds", types.bounded(0, 100), 5, "N", "also run the paper's Nelder-Mead "
+         "from N seeds at the speed nearest 0.3 m/s, for every knee and criterion, for "
+         "comparison.md (default 5; 0: none)"),
+    )  # fmt: skip
+    sweep.set_defaults(run=cmd_sweep)
+
+
 def cmd_figures(args) -> int:
     """PNG figures reproducing the paper's Figs. 4-8 and a comparison table (markdown)."""
     from pathlib import Path
@@ -241,81 +302,39 @@ def cmd_figures(args) -> int:
     return 0
 
 
-def _validate_and_record(
-    gait: dict,
-    steps: int,
-    rrd,
-    video=None,
-    gif=None,
-    spawn=False,
-    connect=None,
-    source=None,
-    model=None,
-):
-    """Every check of a gait (``gait_file.read`` or ``gait_file.to_dict``: in memory) on
-    ``model`` (an MJCF path; None: ``validate.model.model_spec``'s default), its recording at
-    ``rrd`` (also streamed to a viewer with ``spawn`` or ``connect``) and, if asked, the video
-    of its walk at ``video`` (MP4) and ``gif``. ``source``: the gait file, named as the
-    recording's owner (``biped_cli.outputs``).
-
-    Returns the validation and its report (the checks as JSON with their ``units``, the
-    recording's and video's paths).
-    """
-    from biped_cli.outputs import claim
-    from validate.record import record
-    from validate.report import as_json, validate
-    from validate.units import report_units
-
-    result = validate(gait, steps=steps, model=model)
-    written = record(
-        rrd,
-        result.biped,
-        result.step,
-        result.simulation,
-        result.contact,
-        result.checks,
-        gait,
-        spawn=spawn,
-        connect=connect,
+def add_figures(commands) -> None:
+    """Register ``figures`` on the ``biped`` subcommands."""
+    fig = commands.add_parser(
+        "figures", help="figures and table of the comparison", description=cmd_figures.__doc__
     )
-    if source is not None:
-        claim(written, source)
-    checks = as_json(result.checks)
-    report = {
-        **checks,
-        "units": report_units(checks),
-        "recording": str(written),
-        "provenance": provenance(),
-    }
-    if video is not None or gif is not None:
-        from validate.video import write_video
-
-        files = write_video(
-            video, result.biped, result.step, result.simulation, result.checks, gif=gif
-        )
-        report["video"] = [str(path) for path in files]
-    return result, report
+    fig.add_argument(
+        "--sweep",
+        default=DEFAULT_SWEEP,
+        metavar="DIR",
+        help="folder of a sweep's results, as biped sweep --out writes it (default %(default)s)",
+    )
+    types.add_folder(fig, "--out", DEFAULT_FIGURES, "folder of the figures and comparison.md")
+    fig.set_defaults(run=cmd_figures)
 
 
-def read_gaits(paths: list, model: str | None = None) -> list[dict]:
+def read_gaits(paths: list, model: str | None = None) -> list:
     """The gait files at ``paths`` (``biped validate``, ``biped robustness``), checked before
     any work: each readable, its samples, costs and constraints its parameters', its knee
     one MuJoCo can model, and ``model`` (an MJCF path, if given) one it can be played on.
 
-    Raises BipedError naming the file (and ``--model``).
+    Raises BipedError naming the file (and ``--model``). Returns the ``Gait`` records.
     """
-    from biped.records import gait_file
+    from biped.records.gait_file import Gait
 
-    gaits = [gait_file.read_consistent(path) for path in paths]
+    gaits = [Gait.read(path, consistent=True) for path in paths]
     for path, gait in zip(paths, gaits, strict=True):
-        check_simulable(gait["robot"], gait["knee"], f"gait file {path!r}")
+        check_simulable(gait.robot, gait.knee, f"gait file {path!r}")
     if model is not None:
         from validate.model import model_spec
-        from validate.samples import gait_biped
 
         for path, gait in zip(paths, gaits, strict=True):
             try:
-                model_spec(gait, gait_biped(gait), model)
+                model_spec(gait.biped, model)
             except BipedError as error:
                 raise BipedError(f"--model, gait file {path!r}: {error}") from None
     return gaits
@@ -337,10 +356,47 @@ def cmd_validate(args) -> int:
     of its parameters is refused before any work (exit 2, naming the field).
     """
     import json
-    from pathlib import Path
 
-    from biped_cli.outputs import check_owner, output_name, recording_lines
     from biped_cli.progress import Progress
+    from validate.workflows import validate_and_record
+
+    gif = _check_video(args)
+    gaits = read_gaits(args.gait, args.model)
+    recordings = _recordings(args)
+    reports, passed = {}, 0
+    with Progress(len(args.gait), "validate") as bar:
+        for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
+            bar.update(note=path)
+            try:
+                result, reports[path] = validate_and_record(
+                    gait,
+                    rrd,
+                    steps=args.steps,
+                    video=args.video,
+                    gif=gif,
+                    spawn=args.spawn,
+                    connect=args.connect,
+                    source=path,
+                    model=args.model,
+                )
+            except BipedError as error:
+                raise BipedError(f"gait file {path!r}: {error}") from None
+            passed += result.passed
+            bar.clear()
+            if not args.json:
+                _print_validation(path, gait, result, reports[path])
+            bar.advance()
+    if args.json:
+        print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
+    elif len(args.gait) > 1:
+        print(f"{passed} of {len(args.gait)} gaits pass every check")
+    return 0 if passed == len(args.gait) else 1
+
+
+def _check_video(args) -> str | None:
+    """Refuse --rrd, --video and --gif where they cannot be (before any work); the GIF's
+    path beside the video, if asked."""
+    from pathlib import Path
 
     if args.rrd and len(args.gait) > 1:
         raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
@@ -353,8 +409,16 @@ def cmd_validate(args) -> int:
 
         check_suffix(args.video, "--video", ".mp4", " (--gif writes a GIF beside it)")
         check_output(args.video, "--video")
-    gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
-    gaits = read_gaits(args.gait, args.model)
+    return str(Path(args.video).with_suffix(".gif")) if args.gif else None
+
+
+def _recordings(args) -> list:
+    """The recording of each gait file (--rrd, or named from the file), each checked free or
+    that gait file's own before any work."""
+    from pathlib import Path
+
+    from validate.outputs import check_owner, output_name
+
     recordings = [
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
         for path in args.gait
@@ -368,41 +432,69 @@ def cmd_validate(args) -> int:
     for rrd, path in zip(recordings, args.gait, strict=True):
         check_output(str(rrd), "--rrd")
         check_owner(rrd, path)  # never another gait's recording
-    reports, passed = {}, 0
-    with Progress(len(args.gait), "validate") as bar:
-        for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
-            bar.update(note=path)
-            try:
-                result, reports[path] = _validate_and_record(
-                    gait,
-                    args.steps,
-                    rrd,
-                    args.video,
-                    gif,
-                    args.spawn,
-                    args.connect,
-                    path,
-                    args.model,
-                )
-            except BipedError as error:
-                raise BipedError(f"gait file {path!r}: {error}") from None
-            written = reports[path]["recording"]
-            passed += result.passed
-            bar.clear()
-            if not args.json:
-                print(f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s")
-                for check in result.checks:
-                    print("  " + check.line())
-                for line in recording_lines(written):
-                    print(line, flush=True)
-                for video in reports[path].get("video", []):
-                    print(f"video {video}", flush=True)
-            bar.advance()
-    if args.json:
-        print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
-    elif len(args.gait) > 1:
-        print(f"{passed} of {len(args.gait)} gaits pass every check")
-    return 0 if passed == len(args.gait) else 1
+    return recordings
+
+
+def _print_validation(path: str, gait, result, report: dict) -> None:
+    """The table of a gait's checks and the files written for it."""
+    from validate.workflows import files_lines
+
+    print(f"{path}: {gait.knee} knee, {gait.criterion}, {gait.speed} m/s")
+    for check in result.checks:
+        print("  " + check.line())
+    for line in files_lines(report):
+        print(line, flush=True)
+
+
+def add_validate(commands) -> None:
+    """Register ``validate`` on the ``biped`` subcommands."""
+    val = commands.add_parser(
+        "validate",
+        help="cross-check a gait in MuJoCo and record it",
+        description=cmd_validate.__doc__,
+    )
+    types.add_gaits(val)
+    types.add_steps(val)
+    val.add_argument(
+        "--rrd",
+        metavar="PATH",
+        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
+        "named from the gait file's folder and name; another gait's recording is refused; "
+        f"{types.FOLDERS_CREATED})",
+    )
+    val.add_argument(
+        "--json",
+        action="store_true",
+        help="print the report as JSON (several gaits: an object keyed by file)",
+    )
+    val.add_argument(
+        "--video",
+        metavar="FILE.mp4",
+        help="also render MuJoCo's walk of a single gait to an H.264 MP4 video, a path "
+        f"ending in .mp4 ({types.FOLDERS_CREATED}; MUJOCO_GL=egl without a display; default: "
+        "no video)",
+    )
+    val.add_argument(
+        "--gif", action="store_true", help="with --video, also an animated GIF beside it"
+    )
+    viewer = val.add_mutually_exclusive_group()
+    viewer.add_argument(
+        "--spawn",
+        action="store_true",
+        help="also stream the recording to a rerun viewer started for it",
+    )
+    viewer.add_argument(
+        "--connect",
+        metavar="URL",
+        nargs="?",
+        const="",
+        default=None,
+        type=types.viewer_url,
+        help="also stream the recording to the rerun viewer running at URL (URL left out: its "
+        "local address; default: no stream)",
+    )
+    types.add_model(val)
+    val.set_defaults(run=cmd_validate)
 
 
 def cmd_pipeline(args) -> int:
@@ -415,84 +507,67 @@ def cmd_pipeline(args) -> int:
     recording and the video (MP4, unless --no-video) in --recordings; prints where they are.
     Exits 0 only when every gait is feasible and passes every check, 1 otherwise.
     """
+    from functools import partial
     from pathlib import Path
 
-    from biped.optimization.optimize import check_speed, optimize
-    from biped.optimization.problem import GaitProblem
-    from biped.records import gait_file
-    from biped.records.comparison import DIFFERENCE, relative_change
-    from biped_cli.outputs import check_owner, recording_lines
+    from biped.optimization.optimize import check_speed
+    from biped_cli.design import design_problem
+    from validate.outputs import check_owner
+    from validate.workflows import Pipeline, run_pipeline
 
-    robot = _robot(args.robot)
-    out, recordings = Path(args.out), Path(args.recordings)
+    robot = robot_of(args)
     for knee in args.knees:
         check_speed(Biped(robot, knee), args.speed)
     for knee in args.knees:
         check_simulable(robot, knee, f"--robot {args.robot!r}" if args.robot else "robot")
     check_folder(args.out, "--out")
     check_folder(args.recordings, "--recordings")
-    for knee in args.knees:  # never another gait's recording
-        name = f"{knee}-{args.criterion}-{args.speed:.3f}"
-        check_owner(recordings / f"{name}.rrd", out / f"{name}.json", "--recordings")
-    passed, costs, written, optima = True, {}, [], {}
-    for knee in args.knees:
-        name = f"{knee}-{args.criterion}-{args.speed:.3f}"
-        print(f"[{knee}] optimizing at {args.speed} m/s ({args.criterion})...", flush=True)
-        problem = GaitProblem(Biped(robot, knee), args.speed, args.criterion, safety(args))
-        given = [o.variables for o in optima.values() if np.all(np.isfinite(o.variables))]
-        optimum = optimize(problem, given=given, **budget(args))
-        optima[knee] = optimum
-        ev = optimum.evaluation
-        print(
-            f"[{knee}] sthenic {ev.sthenic:.4g} N²·m·s, energy {ev.energy:.4g} J, period "
-            f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m "
-            f"({optimum.seconds:.1f} s)"
+    pipeline = Pipeline(
+        robot,
+        args.speed,
+        tuple(args.knees),
+        args.criterion,
+        safety(args),
+        args.steps,
+        Path(args.out),
+        Path(args.recordings),
+        budget(args),
+        video=not args.no_video,
+        design=design_problem(args, robot, args.speed) if args.design else None,
+    )
+    for name in map(pipeline.name, args.knees):  # never another gait's recording
+        check_owner(
+            pipeline.recordings / f"{name}.rrd", pipeline.out / f"{name}.json", "--recordings"
         )
-        print(f"[{knee}] {optimum.report.summary()}")
-        if not optimum.report.converged:
-            print(f"[{knee}] FAIL  the solver did not converge: {optimum.report.status}")
-            passed = False
-            continue
-        if not optimum.feasible:
-            worst = ", ".join(f"{k} = {v:.3g}" for k, v in ev.violations().items())
-            print(f"[{knee}] FAIL  optimum infeasible: {worst}")
-            passed = False
-            continue
-        costs[knee] = optimum.costs()
-        gait = gait_file.to_dict(optimum, robot, seed=args.seed)
-        gait_path = gait_file.write_json(out / f"{name}.json", gait)
-        print(f"[{knee}] validating {args.steps} steps in MuJoCo...", flush=True)
-        video = None if args.no_video else recordings / f"{name}.mp4"
-        result, report = _validate_and_record(
-            gait,  # in memory: the file written is this content
-            args.steps,
-            recordings / f"{name}.rrd",
-            video,
-            source=gait_path,
-        )
-        for check in result.checks:
-            print(f"[{knee}]   " + check.line())
-        report_path = gait_file.write_json(
-            out / f"{name}.report.json", {**report, "gait": str(gait_path)}
-        )
-        written.append((knee, gait_path, report_path, report))
-        passed = passed and result.passed
-    if getattr(args, "design", False):  # --design: the knee radii optimised too
-        from biped_cli.design import pipeline_design
+    return 0 if run_pipeline(pipeline, say=partial(print, flush=True)) else 1
 
-        passed = pipeline_design(args, robot, optima, out, recordings) and passed
-    if len(costs) == 2:
-        revolute, rolling = costs["revolute"], costs["rolling"]
-        changes = ", ".join(
-            f"{criterion} {relative_change(rolling[criterion], revolute[criterion]):+.1f} %"
-            for criterion in CRITERIA
-        )
-        print(f"rolling vs revolute knee, {args.criterion}-optimal gaits: {changes} ({DIFFERENCE})")
-    for knee, gait_path, report_path, report in written:  # every file written, once
-        print(f"{knee:9} gait {gait_path}, report {report_path}")
-        for line in recording_lines(report["recording"]):
-            print(f"{knee:9} {line}")
-        for video in report.get("video", []):
-            print(f"{knee:9} video {video}")
-    print("all checks passed" if passed else "some checks FAILED")
-    return 0 if passed else 1
+
+def add_pipeline(commands) -> None:
+    """Register ``pipeline`` on the ``biped`` subcommands."""
+    pipe = commands.add_parser(
+        "pipeline",
+        help="optimize, validate and record both knees at one speed",
+        description=cmd_pipeline.__doc__,
+    )
+    speed = f"{types.SPEED_HELP} (default %(default)s)"
+    types.add_options(pipe, ("--speed", types.speed, DEFAULT_SPEED, "V", speed))
+    types.add_knee(pipe, several=True)
+    types.add_criterion(pipe)
+    types.add_steps(pipe)
+    types.add_folder(pipe, "--out", DEFAULT_PIPELINE, "folder of the gait files and reports")
+    what = "folder of the rerun recordings and videos"
+    types.add_folder(pipe, "--recordings", DEFAULT_RECORDINGS, what)
+    pipe.add_argument(
+        "--no-video",
+        action="store_true",
+        help="skip the videos of the walks (<recordings>/<gait>.mp4)",
+    )
+    types.add_budget(pipe)
+    types.add_robot(pipe)
+    pipe.add_argument(
+        "--design",
+        action="store_true",
+        help="also optimise the rolling knee's radii with the gait, validate the designed "
+        "gait and compare revolute, Table 1 radii and optimal radii in one table",
+    )
+    pipe.set_defaults(run=cmd_pipeline)

@@ -1,13 +1,11 @@
 """``biped design`` and ``biped design-map``: the rolling knee's radii optimised with the gait
-(``biped.optimization.design``) and mapped over a grid of radii (``biped.studies.design_map``); the
-design stage
-of ``biped pipeline --design``."""
+(``biped.optimization.design``) and mapped over a grid of radii (``biped.studies.design_map``);
+the design problem of ``biped pipeline --design`` (``validate.workflows``)."""
 
 from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -17,7 +15,6 @@ from biped_cli import args as types
 DEFAULT_MAP = "logs/design-map"
 # Most grid values per radius: a map is an optimization per (r1, r2) and speed.
 MAX_GRID = 100
-CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
 
 
 def radii(text: str) -> np.ndarray:
@@ -37,49 +34,27 @@ def _add_common(parser) -> None:
     from biped.optimization.optimize import DEFAULT_STARTS
 
     types.add_criterion(parser)
-    parser.add_argument(
-        "--starts",
-        type=types.positive,
-        default=DEFAULT_STARTS,
-        metavar="N",
-        help="IPOPT starts of each optimization: the first guess (at the robot's radii) and "
-        f"N-1 random ones (default {DEFAULT_STARTS}); {types.CERTIFIED_HELP}",
-    )
-    parser.add_argument(
-        "--seed",
-        type=types.non_negative,
-        default=0,
-        metavar="N",
-        help="seed of the random starts (default 0)",
-    )
-    parser.add_argument(
-        "--clearance",
-        type=types.clearance,
-        default=0.0,
-        metavar="M",
-        help="[m] height the swing foot must keep off the ground away from the ends of the "
-        "step (default 0, the paper's z >= 0)",
-    )
-    parser.add_argument(
-        "--zmp-margin",
-        type=types.zmp_margin,
-        default=0.0,
-        metavar="M",
-        help="[m] distance the ZMP must keep inside the sole's heel and toe (default 0)",
-    )
-    for name, segment, limit in (
-        ("r1", "shank", "s1, the shank's centre of mass from the knee"),
-        ("r2", "thigh", "l2 - s2, the thigh's centre of mass from the knee"),
-    ):
-        parser.add_argument(
-            f"--max-{name}",
-            type=types.metres,
-            default=None,
-            metavar="M",
-            help=f"[m] upper bound of {name}, the {segment} circle's radius (default {limit}: "
-            f"the centre of mass stays on the segment)",
-        )
-    parser.add_argument("--robot", metavar="FILE", help=types.ROBOT_HELP)
+    types.add_options(
+        parser,
+        ("--starts", types.positive, DEFAULT_STARTS, "N", "IPOPT starts of each optimization: "
+         "the first guess (at the robot's radii) and N-1 random ones (default "
+         f"{DEFAULT_STARTS}); {types.CERTIFIED_HELP}"),
+        ("--seed", types.non_negative, 0, "N", "seed of the random starts (default 0)"),
+    )  # fmt: skip
+    types.add_safety(parser)
+    types.add_options(
+        parser,
+        *(
+            (f"--max-{name}", types.metres, None, "M", f"[m] upper bound of {name}, the "
+             f"{segment} circle's radius (default {limit}: the centre of mass stays on the "
+             "segment)")
+            for name, segment, limit in (
+                ("r1", "shank", "s1, the shank's centre of mass from the knee"),
+                ("r2", "thigh", "l2 - s2, the thigh's centre of mass from the knee"),
+            )
+        ),
+    )  # fmt: skip
+    types.add_robot(parser)
 
 
 def add_parsers(commands) -> None:
@@ -92,12 +67,7 @@ def add_parsers(commands) -> None:
     design.add_argument(
         "--speed", type=types.speed, required=True, metavar="V", help=types.SPEED_HELP
     )
-    design.add_argument(
-        "--out",
-        required=True,
-        metavar="FILE",
-        help=f"gait file to write (JSON; {types.FOLDERS_CREATED})",
-    )
+    types.add_gait_out(design)
     _add_common(design)
     design.set_defaults(run=cmd_design)
 
@@ -106,13 +76,8 @@ def add_parsers(commands) -> None:
         help="optimal gait over a grid of knee radii, and the optimal radii, per speed",
         description=cmd_design_map.__doc__,
     )
-    grid.add_argument(
-        "--speeds",
-        type=types.speeds,
-        default=np.array([0.3]),
-        metavar="S",
-        help="START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.3)",
-    )
+    speeds = "START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.3)"
+    types.add_options(grid, ("--speeds", types.speeds, np.array([0.3]), "S", speeds))
     for name in ("r1", "r2"):
         grid.add_argument(
             f"--{name}",
@@ -122,13 +87,8 @@ def add_parsers(commands) -> None:
             help=f"{name} values [m]: START:STOP:COUNT or a list (default 10 from 0 to its "
             "upper bound)",
         )
-    grid.add_argument(
-        "--out",
-        default=DEFAULT_MAP,
-        metavar="DIR",
-        help=f"folder of the map, {types.FOLDER_CREATED} (default {DEFAULT_MAP})",
-    )
-    grid.add_argument("--jobs", type=types.jobs, default=None, metavar="N", help=types.JOBS_HELP)
+    types.add_folder(grid, "--out", DEFAULT_MAP, "folder of the map")
+    types.add_jobs(grid)
     types.add_dask(grid)
     _add_common(grid)
     grid.set_defaults(run=cmd_design_map)
@@ -155,65 +115,13 @@ def _upper(args, robot) -> tuple:
     return tuple(upper)
 
 
-def _robot(path):
-    from biped.model.robot import Robot
-
-    return Robot.paper() if path is None else Robot.from_file(path)
-
-
-def _problem(args, robot, speed):
+def design_problem(args, robot, speed):
+    """The knee design of the command line at ``speed`` (``biped.optimization.design``)."""
     from biped.optimization.design import DesignProblem
 
     return DesignProblem(
         robot, speed, args.criterion, types.safety(args), upper=_upper(args, robot)
     )
-
-
-def _radii_line(comparison) -> str:
-    design = comparison.design
-    unit = CRITERION_UNITS[comparison.problem.criterion]
-    gains = comparison.gains()
-    bounds = design.at_bounds()
-    return (
-        f"optimal radii: r1 = {design.radii[0]:.4f} m, r2 = {design.radii[1]:.4f} m"
-        f"{' (' + ', '.join(bounds) + ')' if bounds else ''}; "
-        f"{comparison.problem.criterion} {design.value:.6g} {unit}: "
-        f"{gains['design_vs_revolute']:+.2f} % vs revolute, "
-        f"{gains['design_vs_table1']:+.2f} % vs Table 1 radii"
-    )
-
-
-def _bound_notes(problem, design=None) -> list[str]:
-    """What the design's bounds did: the robot's own radii moved into them (the reference
-    design of the table), and a designed radius at its lower bound (``MIN_RADIUS``)."""
-    from biped.optimization.design import MIN_RADIUS
-
-    notes = [f"note: {sentence}" for sentence in problem.moved_reference()]
-    for bound in [] if design is None else design.at_bounds():
-        if bound.endswith("lower bound"):
-            notes.append(
-                f"note: {bound} {MIN_RADIUS:g} m: the radii are bounded away from 0, where "
-                "the rolling knee is the revolute knee (the first row); the design gains "
-                "nothing by rolling on that side"
-            )
-    return notes
-
-
-def _uncertified(comparison) -> list[str]:
-    return [
-        f"{label}: {optimum.report.status if not optimum.report.converged else 'infeasible'}"
-        for label, _, optimum in comparison.rows()
-        if not optimum.certified
-    ]
-
-
-def _gait(comparison, seed: int) -> dict:
-    from biped.records import gait_file
-
-    design = comparison.design
-    content = gait_file.to_dict(design.optimum, design.robot, seed)
-    content["design"] = comparison.to_dict()
-    return content
 
 
 def cmd_design(args) -> int:
@@ -230,17 +138,18 @@ def cmd_design(args) -> int:
     """
     from biped.optimization.design import compare
     from biped.records import gait_file
+    from validate.workflows import bound_notes, designed_gait, radii_line, uncertified
 
-    robot = _robot(args.robot)
-    problem = _problem(args, robot, args.speed)
+    robot = types.robot_of(args)
+    problem = design_problem(args, robot, args.speed)
     types.check_output(args.out)
     print(f"designing the {problem.describe()} (seed {args.seed})...", file=sys.stderr)
     comparison = compare(problem, seed=args.seed, starts=args.starts)
     design = comparison.design
     print(comparison.table())
-    for note in _bound_notes(problem, design):
+    for note in bound_notes(problem, design):
         print(note)
-    print(_radii_line(comparison))
+    print(radii_line(comparison))
     print(f"design: {design.report.summary()}")
     if design.report.converged and not design.report.confirmed:
         print(
@@ -252,15 +161,13 @@ def cmd_design(args) -> int:
         reason = (
             f"the solver did not converge ({design.report.status})"
             if not design.report.converged
-            else "the design's gait is infeasible ("
-            + ", ".join(f"{k} = {v:.3g}" for k, v in design.optimum.evaluation.violations().items())
-            + ")"
+            else f"the design's gait is infeasible ({design.optimum.evaluation.violations_line()})"
         )
         print(f"biped design: {reason}; no file written", file=sys.stderr)
         return 1
-    path = gait_file.write_json(args.out, _gait(comparison, args.seed))
+    path = gait_file.write_json(args.out, designed_gait(comparison, args.seed))
     print(f"wrote {path}")
-    bad = _uncertified(comparison)
+    bad = uncertified(comparison)
     if bad:
         print(
             "biped design: compared with knees that are not certified optima ("
@@ -281,15 +188,17 @@ def cmd_design_map(args) -> int:
     to resume. Runs on all cores, or on a Dask cluster with --dask tcp://HOST:PORT. Exits 1
     when an optimization is not certified (converged and feasible).
     """
+    from biped.model.criteria import CRITERION_UNITS
     from biped.records.comparison import DIFFERENCE_VS_REVOLUTE
     from biped.runtime.runner import check_dask
     from biped.studies.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
     from biped_cli.progress import Progress
+    from validate.workflows import bound_notes
 
-    robot = _robot(args.robot)
-    problem = _problem(args, robot, float(args.speeds[0]))
+    robot = types.robot_of(args)
+    problem = design_problem(args, robot, float(args.speeds[0]))
     types.check_folder(args.out, "--out")
-    for note in _bound_notes(problem):
+    for note in bound_notes(problem):
         print(note)
     if args.dask is not None:
         check_dask(args.dask)
@@ -331,49 +240,3 @@ def cmd_design_map(args) -> int:
     print(f"vs revolute: {DIFFERENCE_VS_REVOLUTE}")
     certified = all(content["certified"] for content in results.values())
     return 0 if certified else 1
-
-
-def pipeline_design(args, robot, optima: dict, out: Path, recordings: Path) -> bool:
-    """The design stage of ``biped pipeline --design``: the radii optimised at the
-    pipeline's speed, the table of the revolute knee, the Table 1 radii and the optimal
-    radii (the pipeline's own optima where certified), and the designed gait written and
-    validated in MuJoCo as the knees' are. Returns whether every step passed."""
-    from biped.optimization.design import compare
-    from biped.records import gait_file
-    from biped_cli.commands import _validate_and_record
-    from biped_cli.outputs import check_owner, recording_lines
-
-    problem = _problem(args, robot, args.speed)
-    name = f"design-{args.criterion}-{args.speed:.3f}"
-    check_owner(recordings / f"{name}.rrd", out / f"{name}.json", "--recordings")
-    print(f"[design] optimizing the knee radii at {args.speed} m/s ({args.criterion})...")
-    given = {
-        name: optima[knee] if knee in optima and optima[knee].certified else None
-        for name, knee in (("revolute", "revolute"), ("reference", "rolling"))
-    }
-    comparison = compare(problem, seed=args.seed, starts=args.starts, **given)
-    design = comparison.design
-    for line in comparison.table().splitlines() + _bound_notes(problem, design):
-        print(f"[design] {line}")
-    print(f"[design] {_radii_line(comparison)}")
-    print(f"[design] {design.report.summary()}")
-    if not design.certified:
-        print(f"[design] FAIL  the design is not certified: {design.report.status}")
-        return False
-    gait_path = gait_file.write_json(out / f"{name}.json", _gait(comparison, args.seed))
-    print(f"[design] validating {args.steps} steps in MuJoCo...", flush=True)
-    video = None if args.no_video else recordings / f"{name}.mp4"
-    result, report = _validate_and_record(
-        gait_file.read(gait_path), args.steps, recordings / f"{name}.rrd", video, source=gait_path
-    )
-    for check in result.checks:
-        print("[design]   " + check.line())
-    report_path = gait_file.write_json(
-        out / f"{name}.report.json", {**report, "gait": str(gait_path)}
-    )
-    print(f"[design] gait {gait_path}, report {report_path}")  # every file written, once
-    for line in recording_lines(report["recording"]):
-        print(f"[design] {line}")
-    for written in report.get("video", []):
-        print(f"[design] video {written}")
-    return result.passed and not _uncertified(comparison)

@@ -5,7 +5,8 @@
 - 2: the input is wrong (one line naming the value, the option or file, and what is
   allowed), or an unexpected internal error (one line; ``--debug`` shows the traceback).
 - 130 / 143: interrupted by Ctrl-C (SIGINT) / terminated (SIGTERM), as a shell reports a
-  process killed by those signals (128 + the signal's number): one line, no traceback.
+  process killed by those signals (128 + the signal's number): one line, no traceback (the
+  whole policy of interrupts: ``biped.runtime.interrupts``).
 
 Floating-point warnings of numpy (overflow in ``expm1`` while the optimiser explores) are
 expected and handled where they matter; they never reach the terminal unless ``--debug``.
@@ -15,9 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-import signal
 import sys
-import threading
 import traceback
 import warnings
 from collections.abc import Callable, Iterator
@@ -25,34 +24,11 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from biped.errors import BipedError
+from biped.runtime.interrupts import exit_status, sigterm_interrupts
 
 EXIT_OK = 0
 EXIT_CHECK_FAILED = 1
 EXIT_BAD_INPUT = 2
-EXIT_INTERRUPTED = 128 + signal.SIGINT  # 130
-EXIT_TERMINATED = 128 + signal.SIGTERM  # 143
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM received: raised in the main thread as Ctrl-C raises KeyboardInterrupt, so the
-    same clean-up runs (``finally`` blocks, temporary files removed, worker pools closed)."""
-
-
-def _raise_terminated(signum, frame):
-    raise Terminated
-
-
-@contextlib.contextmanager
-def sigterm_interrupts() -> Iterator[None]:
-    """Within the block, SIGTERM raises ``Terminated`` in the main thread (elsewhere: no-op)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, _raise_terminated)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 @contextlib.contextmanager
@@ -101,12 +77,10 @@ def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bo
     try:
         with sigterm_interrupts(), quiet_numerics(debug):
             return run()
-    except Terminated:
-        say("interrupted (SIGTERM)")
-        return EXIT_TERMINATED
-    except KeyboardInterrupt:
-        say("interrupted (Ctrl-C)")
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM (``Terminated``)
+        status, signal_name = exit_status(interrupt)
+        say(f"interrupted ({signal_name})")
+        return status
     except BrokenPipeError as error:
         _stdout_closed()
         return fail("error", f"output closed early ({error.strerror})")

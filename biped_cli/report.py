@@ -1,7 +1,7 @@
 """``biped report GAIT.json ... [--out DIR]``: one Markdown page per gait file, with figures.
 
 The page (``biped.pages.page``) is named from the gait file's path as its recording is
-(``biped_cli.outputs``). Its validation is the report beside the gait file,
+(``validate.outputs``). Its validation is the report beside the gait file,
 ``<gait>.report.json`` (``biped pipeline`` writes it; ``biped validate GAIT.json --json >
 GAIT.report.json`` too); its links are the recording and videos that report names, or the
 recording ``biped validate`` writes by default, each only if it exists and was made from this
@@ -14,7 +14,7 @@ import json
 from pathlib import Path
 
 from biped.errors import BipedError
-from biped_cli.args import FOLDER_CREATED, check_folder
+from biped_cli.args import add_folder, add_gaits, check_folder
 from biped_cli.commands import DEFAULT_RECORDINGS
 
 DEFAULT_REPORTS = "logs/reports"
@@ -45,7 +45,7 @@ def read_validation(path: Path) -> dict | None:
 def links(gait_path: Path, validation: dict | None) -> list:
     """The recording and videos of a gait that exist and were made from it as it is now."""
     from biped.pages.page import Link
-    from biped_cli.outputs import belongs_to, open_command, output_name
+    from validate.outputs import belongs_to, open_command, output_name
 
     found = []
     recording = (validation or {}).get("recording")
@@ -79,7 +79,7 @@ def cmd_report(args) -> int:
     """
     from biped.pages.page import Page, write_pages
     from biped.records import gait_file
-    from biped_cli.outputs import output_name
+    from validate.outputs import output_name
 
     check_folder(args.out, "--out")
     pages = []
@@ -118,13 +118,6 @@ def add_parser(commands) -> None:
     parser = commands.add_parser(
         "report", help="one Markdown page per gait, with figures", description=cmd_report.__doc__
     )
-    parser.add_argument(
-        "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
-    )
-    parser.add_argument(
-        "--out",
-        default=DEFAULT_REPORTS,
-        metavar="DIR",
-        help=f"folder of the pages and their figures, {FOLDER_CREATED} (default {DEFAULT_REPORTS})",
-    )
+    add_gaits(parser)
+    add_folder(parser, "--out", DEFAULT_REPORTS, "folder of the pages and their figures")
     parser.set_defaults(run=cmd_report)

@@ -1,7 +1,7 @@
 """``biped robustness GAIT.json ... [--out DIR]``: the robustness map of gait files in MuJoCo
 (``validate.robustness``), written per gait as JSON and as a figure.
 
-The files are named from the gait file's path as its recording is (``biped_cli.outputs``):
+The files are named from the gait file's path as its recording is (``validate.outputs``):
 ``logs/robustness/<folder>-<gait>.json`` and ``.png``, written together, all or none.
 """
 
@@ -40,43 +40,19 @@ def add_parser(commands) -> None:
         help="robustness map of gaits in MuJoCo: pushes, friction, trunk mass, gains",
         description=cmd_robustness.__doc__,
     )
-    parser.add_argument(
-        "gait", metavar="GAIT.json", nargs="+", help="gait files from optimize, sweep, pipeline"
-    )
-    parser.add_argument(
-        "--steps",
-        type=types.steps,
-        default=default.steps,
-        metavar="N",
-        help=f"steps of every walk, 2 to {types.MAX_STEPS} (default {default.steps})",
-    )
-    parser.add_argument(
-        "--push-step",
-        type=types.positive,
-        default=default.push_step,
-        metavar="N",
-        help=f"the pushes act at mid-step of step N, before the last (default {default.push_step})",
-    )
-    parser.add_argument(
-        "--iterations",
-        type=types.bounded(1, MAX_ITERATIONS),
-        default=default.iterations,
-        metavar="N",
-        help=f"bisections of each limit, 1 to {MAX_ITERATIONS} (default {default.iterations})",
-    )
-    parser.add_argument(
-        "--jobs",
-        type=types.jobs,
-        default=default.jobs,
-        metavar="N",
-        help=f"processes walking the limits side by side (default {default.jobs})",
-    )
-    parser.add_argument(
-        "--model",
-        metavar="PATH",
-        help="MJCF to play the gaits on (default: mjcf/scene_<knee>.xml when the gait's robot is "
-        "Table 1, the model generated from the gait's robot otherwise)",
-    )
+    types.add_gaits(parser)
+    types.add_options(
+        parser,
+        ("--steps", types.steps, default.steps, "N",
+         f"steps of every walk, 2 to {types.MAX_STEPS} (default {default.steps})"),
+        ("--push-step", types.positive, default.push_step, "N", "the pushes act at mid-step "
+         f"of step N, before the last (default {default.push_step})"),
+        ("--iterations", types.bounded(1, MAX_ITERATIONS), default.iterations, "N",
+         f"bisections of each limit, 1 to {MAX_ITERATIONS} (default {default.iterations})"),
+        ("--jobs", types.jobs, default.jobs, "N",
+         f"processes walking the limits side by side (default {default.jobs})"),
+    )  # fmt: skip
+    types.add_model(parser)
     parser.add_argument(
         "--out",
         default=DEFAULT_ROBUSTNESS,
@@ -102,15 +78,14 @@ def _settings(args):
     return RobustnessSettings(args.steps, args.push_step, args.iterations, args.jobs)
 
 
-def model_source(gait: dict, model: str | None) -> str:
+def model_source(gait, model: str | None) -> str:
     """What the map's walks were played on: ``model`` as given, the committed model, or the
     one generated from the gait's robot."""
     from validate.model import committed_model
-    from validate.samples import gait_biped
 
     if model is not None:
         return model
-    committed = committed_model(gait_biped(gait))
+    committed = committed_model(gait.biped)
     if committed is None:
         return "generated from the gait's robot (validate.mjcf)"
     return f"mjcf/{committed.name}"  # the committed model, wherever this copy keeps it
@@ -181,6 +156,31 @@ def comparison_lines(maps: dict) -> list[str]:
     return out
 
 
+def _write_map(out: Path, name: str, path: str, gait: dict, source: str, result) -> dict:
+    """Write a gait's robustness map (``validate.robustness.RobustnessMap``) as
+    <out>/<name>.json and .png, both or neither; returns the JSON content."""
+    from biped.records.provenance import provenance
+    from biped.runtime.files import atomic_set
+    from validate.robustness_figure import DPI, robustness_figure
+
+    content = {
+        "gait": str(path),
+        "knee": gait.knee,
+        "criterion": gait.criterion,
+        "speed": gait.speed,
+        "model": source,
+        **result.to_dict(),
+    }
+    content["units"] = {"speed": "m/s", **content["units"]}
+    content["provenance"] = provenance()
+    figure = robustness_figure(content, f"{path}: {gait.knee} knee, {gait.speed} m/s")
+    with atomic_set(out, f"robustness-{name}") as staging:  # both or neither
+        text = json.dumps(content, indent=1, allow_nan=False)
+        (staging / f"{name}.json").write_text(text, encoding="utf-8")
+        figure.savefig(staging / f"{name}.png", dpi=DPI)
+    return content
+
+
 def cmd_robustness(args) -> int:
     """Map how far each gait still walks in MuJoCo from its nominal conditions: the largest
     forward and backward push on the trunk [N·s] at mid-step of --push-step, the lowest
@@ -195,13 +195,10 @@ def cmd_robustness(args) -> int:
     with the time elapsed and left (a bar on a terminal, else a line at most every 10 s).
     Exits 1 if a gait's nominal walk fails (no map is written for it), 0 otherwise.
     """
-    from biped.records.provenance import provenance
-    from biped.runtime.files import atomic_set
     from biped_cli.commands import read_gaits
-    from biped_cli.outputs import output_name
     from biped_cli.progress import Progress
     from validate import robustness
-    from validate.robustness_figure import DPI, robustness_figure
+    from validate.outputs import output_name
 
     settings = _settings(args)
     types.check_folder(args.out, "--out")  # before the gait files' checks, which take time
@@ -225,31 +222,12 @@ def cmd_robustness(args) -> int:
             wall = time.perf_counter() - began
             source = model_source(gait, args.model)
             bar.clear()
-            print(
-                f"{path}: {gait['knee']} knee, {gait['criterion']}, {gait['speed']} m/s, "
-                f"on {source}"
-            )
+            print(f"{path}: {gait.knee} knee, {gait.criterion}, {gait.speed} m/s, on {source}")
             if not result.passed:
                 print(f"  FAIL  the nominal walk: {', '.join(result.nominal_failures)}; no map")
                 failed.append(path)
                 continue
-            content = {
-                "gait": str(path),
-                "knee": gait["knee"],
-                "criterion": gait["criterion"],
-                "speed": gait["speed"],
-                "model": source,
-                **result.to_dict(),
-            }
-            content["units"] = {"speed": "m/s", **content["units"]}
-            content["provenance"] = provenance()
-            title = f"{path}: {gait['knee']} knee, {gait['speed']} m/s"
-            figure = robustness_figure(content, title)
-            with atomic_set(out, f"robustness-{name}") as staging:  # both or neither
-                text = json.dumps(content, indent=1, allow_nan=False)
-                (staging / f"{name}.json").write_text(text, encoding="utf-8")
-                figure.savefig(staging / f"{name}.png", dpi=DPI)
-            mapped[path] = content
+            mapped[path] = content = _write_map(out, name, path, gait, source, result)
             for line in lines(content):
                 print(line)
             print(

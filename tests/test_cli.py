@@ -258,7 +258,7 @@ def _replace_command(monkeypatch, body):
     def command(args):
         return body()
 
-    program = sys.modules["biped_cli.main"]  # the module, shadowed by its function main
+    program = sys.modules["biped_cli.commands"]  # where the demo's parser takes it
     monkeypatch.setattr(program, "cmd_demo", command)
 
 

@@ -62,8 +62,8 @@ def no_work(monkeypatch):
     import biped.pages.figures
     import biped.studies.design_map
     import biped.studies.sweep
-    import validate.report
     import validate.robustness
+    import validate.validation
 
     for module, name in [
         (biped.optimization.optimize, "optimize"),
@@ -71,7 +71,7 @@ def no_work(monkeypatch):
         (biped.optimization.design, "compare"),
         (biped.studies.design_map, "run_design_map"),
         (biped.pages.figures, "make_figures"),
-        (validate.report, "validate"),
+        (validate.validation, "validate"),
         (validate.robustness, "robustness_map"),
     ]:
         monkeypatch.setattr(module, name, _stand_in)

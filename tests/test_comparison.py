@@ -14,7 +14,7 @@ from biped.records.comparison import (
     SOLVER_VALUE,
     relative_change,
 )
-from biped.records.units import gait_units
+from biped.records.gait_file import Gait
 from biped.studies.sweep import Point, _line
 
 
@@ -32,7 +32,7 @@ def test_the_two_values_of_a_criterion_are_named_for_what_they_are():
     which the comparisons use; the grids are the solver's and the check's."""
     assert (SOLVER_SAMPLES_PER_STEP, CHECK_SAMPLES_PER_STEP) == (52, 202)
     for criterion, unit in (("sthenic", "N²·m·s"), ("energy", "J")):
-        units = gait_units(criterion)
+        units = Gait.units(criterion)
         assert units[f"costs.{criterion}"] == unit
         value = units["optimizer.value"]
         assert value.startswith(f"{unit} (") and SOLVER_VALUE in value and CHECKED_VALUE in value

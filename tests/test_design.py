@@ -161,7 +161,7 @@ def test_designed_robot_passes_the_inverse_dynamics_crosscheck():
     designed gait the analytical torques and wrench to rounding; the Table 1 robot's MJCF
     does not (the check tells the radii)."""
     from validate.crosscheck import load_model, mujoco_inverse_dynamics
-    from validate.report import EXACT
+    from validate.validation import EXACT
 
     design = optimal_design()
     ev = design.optimum.evaluation
@@ -255,13 +255,17 @@ def test_designed_gait_passes_validation_on_its_own_robot_only(designed):
     """The designed gait walks 20 steps in MuJoCo on the MJCF of its radii and passes every
     check; played on the Table 1 robot, the inverse-dynamics check fails."""
     from biped.records import gait_file
-    from validate.report import check_inverse_dynamics, validate
+    from validate.checks import check_inverse_dynamics
+    from validate.model import compile_spec, model_spec
+    from validate.samples import GaitSamples
+    from validate.validation import validate
 
     gait = gait_file.read(designed[3])
     result = validate(gait, steps=20)
     assert result.passed, [check.line() for check in result.checks]
     wrong = biped.Biped(ROBOT, "rolling")
-    assert not check_inverse_dynamics(wrong, gait).passed
+    on_wrong = compile_spec(model_spec(wrong))
+    assert not check_inverse_dynamics(on_wrong, wrong, GaitSamples.from_gait(gait)).passed
 
 
 @pytest.mark.parametrize(

@@ -107,7 +107,7 @@ def _other_files() -> dict:
     from biped.studies import design_map, paper_method, sweep
     from validate import robustness
     from validate.checks import Check
-    from validate.report import as_json
+    from validate.validation import as_json
 
     robot = Robot.paper()
     limits = {

@@ -11,8 +11,8 @@ import pytest
 from biped import Robot
 from biped.records import gait_file
 from biped_cli import main
-from biped_cli.outputs import belongs_to, check_owner, claim, output_name, owner
 from tests.conftest import small_optimum
+from validate.outputs import belongs_to, check_owner, claim, output_name, owner
 
 NAME = "rolling-sthenic-0.300"
 
@@ -36,11 +36,11 @@ def test_validating_a_sweep_gait_keeps_the_pipelines_recording(gaits, capsys):
     """The pipeline's recording of logs/pipeline/X.json survives 'biped validate
     logs/sweep/X.json', which records to logs/recordings/sweep-X.rrd; naming the pipeline's
     recording with --rrd is refused (exit 2); the report has a unit for every figure."""
-    from biped_cli.commands import _validate_and_record
+    from validate.workflows import validate_and_record
 
     pipeline = Path("logs/recordings") / f"{NAME}.rrd"  # as biped pipeline names it
     gait = gait_file.read(gaits["pipeline"])
-    _validate_and_record(gait, 1, pipeline, source=gaits["pipeline"])
+    validate_and_record(gait, pipeline, steps=1, source=gaits["pipeline"])
     before = _stamp(pipeline)
     assert main(["validate", str(gaits["sweep"]), "--steps", "1", "--json"]) in (0, 1)
     report = json.loads(capsys.readouterr().out)
@@ -209,7 +209,7 @@ def test_the_printed_rerun_command_is_this_environments(tmp_path, monkeypatch):
     import shutil
     import sys
 
-    from biped_cli.outputs import open_command, recording_lines, rerun_command
+    from validate.outputs import open_command, recording_lines, rerun_command
 
     command = shlex.split(rerun_command())
     assert os.access(command[0], os.X_OK), command

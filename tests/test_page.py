@@ -11,8 +11,8 @@ from biped.model.criteria import CONSTRAINTS
 from biped.model.gait import PARAMETERS
 from biped.records import gait_file
 from biped_cli import main
-from biped_cli.outputs import claim
 from tests.conftest import small_optimum
+from validate.outputs import claim
 
 NAME = "rolling-sthenic-0.300"
 
@@ -185,7 +185,7 @@ def test_page_says_where_constraints_dip_below_the_solver_margin(optimal_page):
 
     gait, text, figures = optimal_page
     model = Biped(gait["robot"], gait["knee"])
-    step = build_step(model, gait["speed"], gait_file.parameters(gait))
+    step = build_step(model, gait["speed"], gait.parameter_vector)
 
     def below(n):
         psi = evaluate_step(model, step, n, safety=gait["safety"]).constraints

@@ -18,22 +18,14 @@ ROBOT = Robot.paper()
 def recorded(tmp_path_factory):
     """Two steps of the rolling knee's gait, validated and recorded; the chunks read back."""
     from validate.record import record
-    from validate.report import validate
+    from validate.validation import validate
 
     folder = tmp_path_factory.mktemp("record")
     gait = gait_file.to_dict(small_optimum("rolling"), ROBOT, seed=0)
     gait_file.write_json(folder / "rolling.json", gait)
     gait = gait_file.read(folder / "rolling.json")
     result = validate(gait, steps=2)
-    path = record(
-        folder / "rolling.rrd",
-        result.biped,
-        result.step,
-        result.simulation,
-        result.contact,
-        result.checks,
-        gait,
-    )
+    path = record(folder / "rolling.rrd", result)
     chunks = rerun.chunk.RrdReader(path).stream().to_chunks()
     return result, chunks, folder
 
@@ -246,7 +238,7 @@ def test_time_plots_open_on_the_last_steps_legends_clear_of_the_curves(recorded)
     result, chunks, folder = recorded
     views = _views(folder / "rolling.rrd")
     end = result.simulation.time[-1]
-    start = max(result.simulation.time[0], end - SHOWN_STEPS * result.step.period)
+    start = max(result.simulation.time[0], end - SHOWN_STEPS * result.samples.period)
     for plot in PLOTS:
         shown = views[plot]["TimeAxis:view_range"]
         assert shown["start"] * 1e-9 == pytest.approx(start, abs=1e-6), plot

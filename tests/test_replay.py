@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 
 from biped.model.dynamics import JOINTS
+from biped.records.gait_file import Gait
 from tests.conftest import gait_content, optimal_gait
 from validate.checks import FEEDFORWARD_SHARE, check_feedforward
 from validate.model import model_spec
 from validate.replay import replay_model, replay_step
-from validate.samples import GaitSamples, gait_biped
+from validate.samples import GaitSamples
 
 KNEES = ("revolute", "rolling")
 
@@ -21,8 +22,8 @@ KNEES = ("revolute", "rolling")
 def optimum(request):
     """The optimal gait of a knee, its robot and its replay model."""
     gait = gait_content(optimal_gait(request.param))
-    biped = gait_biped(gait)
-    spec = model_spec(gait, biped)
+    biped = Gait.of(gait).biped
+    spec = model_spec(biped)
     return gait, biped, spec, replay_model(spec, biped.knee)
 
 

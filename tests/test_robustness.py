@@ -18,6 +18,7 @@ from biped import Robot
 from biped.errors import BipedError
 from biped.model.robot import FOOT_FRICTION
 from biped.records import gait_file
+from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import gait_content, optimal_gait
 from validate import robustness
@@ -33,7 +34,6 @@ from validate.robustness import (
     robustness_map,
     trunk_mass_spec,
 )
-from validate.samples import gait_biped
 from validate.simulate import Push, Walker, WalkSettings
 
 SETTINGS = RobustnessSettings(steps=6, push_step=2, iterations=4)
@@ -206,12 +206,12 @@ def test_trunk_mass_models_come_from_the_robot(gait):
     """The model of a trunk 10 % heavier is generated from the robot's parameters with
     trunk_mass x 1.1; scaling the trunk of the committed model gives the same masses and
     inertias, and no error gives the committed model itself."""
-    biped = gait_biped(gait)
+    biped = Gait.of(gait).biped
     committed = FOLDER / "scene_rolling.xml"
     paper = compile_spec(mujoco.MjSpec.from_file(str(committed)))
-    generated = compile_spec(trunk_mass_spec(gait, biped, 0.1))
-    scaled = compile_spec(trunk_mass_spec(gait, biped, 0.1, committed))
-    nominal = compile_spec(trunk_mass_spec(gait, biped, 0.0))
+    generated = compile_spec(trunk_mass_spec(biped, 0.1))
+    scaled = compile_spec(trunk_mass_spec(biped, 0.1, committed))
+    nominal = compile_spec(trunk_mass_spec(biped, 0.0))
     trunk = paper.body("trunk").id
     assert generated.body_mass[trunk] == pytest.approx(1.1 * Robot.paper().trunk_mass)
     np.testing.assert_allclose(generated.body_mass, scaled.body_mass, rtol=1e-12)

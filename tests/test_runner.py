@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import biped
-from biped.runtime import runner
+from biped.runtime import interrupts, runner
 from biped.runtime.files import atomic_write_text
 from biped.studies.sweep import INDEPENDENT, run_sweep
 from biped_cli import main, progress
@@ -481,7 +481,7 @@ def test_a_worker_that_swallows_its_sigterm_still_ends():
     try:
         assert ready.wait(60)
         worker.terminate()
-        worker.join(10 * runner.EXIT_AGAIN_AFTER)
+        worker.join(10 * interrupts.EXIT_AGAIN_AFTER)
         assert not worker.is_alive()
         assert worker.exitcode == 143
     finally:

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from biped.model.kinematics import ZH
+from biped.records.gait_file import Gait
 from tests.conftest import gait_content, optimal_gait, small_optimum
 from validate import contact
 from validate.checks import MAX_FOOT_TILT, MAX_SLIP, scuff_notes, walk_figures, walks
 from validate.model import model_spec
-from validate.samples import gait_biped
 from validate.simulate import FALLEN, RESYNC, Push, Walker, WalkSettings
 
 STEPS = 20
@@ -112,8 +112,8 @@ def test_a_scuff_fails_the_walk_with_its_duration_and_depth():
     1 mm): the swing foot touches it before its landing window, and the walk fails with the
     time it spent on it and how deep it went."""
     gait = gait_content(optimal_gait("revolute"))
-    biped = gait_biped(gait)
-    spec = model_spec(gait, biped)
+    biped = Gait.of(gait).biped
+    spec = model_spec(biped)
     spec.worldbody.add_geom(
         name="plank",
         type=mujoco.mjtGeom.mjGEOM_BOX,

@@ -265,6 +265,12 @@ def test_each_figure_is_drawn_with_its_labels(sweep):
         assert friction.get_ylim()[1] > max(largest, FOOT_FRICTION)
 
 
+class _Fields(dict):
+    """A gait's fields read as a ``Gait`` record's (``gait.costs``) or by name."""
+
+    __getattr__ = dict.__getitem__
+
+
 def _synthetic_series(outlier=None):
     """Both knees' optima at 13 speeds, smooth criteria; ``outlier``: (knee, index, factor)
     multiplies one gait's energy."""
@@ -273,17 +279,17 @@ def _synthetic_series(outlier=None):
     for knee in biped.KNEES:
         for criterion in ("sthenic", "energy"):
             series[(knee, criterion)] = [
-                {
-                    "knee": knee,
-                    "criterion": criterion,
-                    "speed": float(v),
-                    "feasible": True,
-                    "optimizer": {"status": "converged"},
-                    "costs": {
+                _Fields(
+                    knee=knee,
+                    criterion=criterion,
+                    speed=float(v),
+                    feasible=True,
+                    optimizer={"status": "converged"},
+                    costs={
                         "sthenic": 30.0 + 40.0 * (v - 0.3) ** 2 + (knee == "rolling"),
                         "energy": 10.0 + 5.0 * v + 0.2 * (knee == "rolling"),
                     },
-                }
+                )
                 for v in speeds
             ]
     if outlier is not None:
@@ -319,7 +325,7 @@ def test_a_gait_not_certified_is_marked_apart_from_the_curves():
     from biped.pages.figures import criterion_figure
 
     series = _synthetic_series()
-    gait = dict(series[("revolute", "sthenic")].pop(4))
+    gait = _Fields(series[("revolute", "sthenic")].pop(4))
     gait["optimizer"] = {"status": "Maximum_Iterations_Exceeded"}
     figure = criterion_figure(series, "sthenic", "energy", "Fig. 4", flagged=[gait])
     texts = _texts(figure)

@@ -11,7 +11,8 @@ import pytest
 
 from biped import Robot
 from biped.records import gait_file
-from biped.records.units import PURE, gait_units, missing, numeric_paths
+from biped.records.gait_file import Gait
+from biped.records.units import PURE, missing, numeric_paths
 from tests.conftest import small_optimum
 
 
@@ -38,7 +39,7 @@ def test_every_number_of_a_gait_file_has_a_unit(gait):
     """The units map names every numeric field (and no field the file lacks); a list of
     units has one per column of its array; the keys of the figures are unchanged."""
     units = gait["units"]
-    assert units == gait_units(gait["criterion"])
+    assert units == Gait.units(gait["criterion"])
     assert missing(gait, units) == []
     assert set(units) == set(numeric_paths(gait))
     for path, unit in units.items():
@@ -69,7 +70,7 @@ def test_robot_units_are_those_its_fields_document():
     stated = dict(re.findall(r"\n    (\w+): float(?: = [^\n]+)?\n    \"\"\"\[([^\]]+)\]", source))
     fields = [f.name for f in dataclasses.fields(Robot)]
     assert sorted(stated) == sorted(fields)
-    units = gait_units("energy")
+    units = Gait.units("energy")
     for name in fields:
         assert units[f"robot.{name}"] == stated[name], name
     assert units["optimizer.value"].startswith("J (the criterion on the solver's")

@@ -15,7 +15,7 @@ pytestmark = needs_gl
 @pytest.fixture(scope="module")
 def walk(tmp_path_factory):
     """Two steps of the rolling knee's gait at 0.3 m/s, validated (checks and simulation)."""
-    from validate.report import validate
+    from validate.validation import validate
 
     path = tmp_path_factory.mktemp("gait") / "rolling.json"
     gait_file.write_json(path, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
@@ -36,7 +36,7 @@ def test_first_frame_shows_the_robot_and_the_verdict(walk):
     is green for a gait that passed and red for one that failed."""
     from validate.video import CAPTION_HEIGHT, SIZE, Captioned, WalkRenderer, leg_pixels, verdict_of
 
-    renderer = WalkRenderer(walk.biped, walk.step, walk.simulation)
+    renderer = WalkRenderer(walk.biped, walk.samples, walk.simulation)
     try:
         verdict, passed = verdict_of(walk.checks)
         frame = Captioned(renderer, verdict, passed).frame(0)
@@ -62,7 +62,7 @@ def test_ghost_stands_on_the_stance_foot_and_follows_the_walk(walk):
     from validate.video import WalkRenderer
 
     sim = walk.simulation
-    renderer = WalkRenderer(walk.biped, walk.step, sim)
+    renderer = WalkRenderer(walk.biped, walk.samples, sim)
     model, data = sim.model, mujoco.MjData(sim.model)
     try:
         for j, start in enumerate(sim.step_starts):
@@ -94,7 +94,7 @@ def test_video_is_h264_with_a_frame_per_thirtieth_of_a_second(walk, tmp_path):
     from validate.video import CAPTION_HEIGHT, FPS, SIZE, frame_states, leg_pixels, write_video
 
     mp4, gif = tmp_path / "walk.mp4", tmp_path / "walk.gif"
-    written = write_video(mp4, walk.biped, walk.step, walk.simulation, walk.checks, gif=gif)
+    written = write_video(mp4, walk, gif=gif)
     assert written == [mp4, gif]
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
     reader = imageio_ffmpeg.read_frames(str(mp4))

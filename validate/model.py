@@ -1,6 +1,6 @@
 """The MuJoCo model a gait is validated on, and what the validation needs to find in it.
 
-    model_spec(gait, path)   the MJCF to play the gait on: ``path`` if given; otherwise the
+    model_spec(biped, path)  the MJCF to play the gait on: ``path`` if given; otherwise the
                              committed ``mjcf/scene_<knee>.xml`` when the gait's robot is
                              Table 1 (``Robot.paper()``), the model generated from the gait's
                              robot when it is another robot
@@ -71,8 +71,8 @@ def committed_model(biped: Biped) -> Path | None:
     return FOLDER / f"scene_{biped.knee}.xml" if biped.robot == Robot.paper() else None
 
 
-def model_spec(gait: dict, biped: Biped, path: str | Path | None = None) -> mujoco.MjSpec:
-    """The MJCF to play ``gait`` on (see the module docstring), as a spec to add to.
+def model_spec(biped: Biped, path: str | Path | None = None) -> mujoco.MjSpec:
+    """The MJCF to play a gait of ``biped`` on (see the module docstring), as a spec to add to.
 
     Raises BipedError naming the file if it cannot be read or compiled, or if its knee is not
     the gait's.

@@ -47,6 +47,7 @@ from biped.errors import BipedError
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.robot import SOLE_EDGES
 from biped.runtime.files import atomic_path
+from validate.checks import LANDING
 from validate.contact import SAMPLE_EVERY
 from validate.mapping import mapping
 from validate.mjcf import HIP_OFFSET, SIDES
@@ -83,8 +84,6 @@ ZMP_COLOR = (30, 200, 230)
 GROUND_COLOR = (120, 122, 128)
 # Length of the ground-reaction arrow per newton [m/N]: the weight (687 N) is 0.69 m.
 ARROW_SCALE = 1e-3
-# Fraction of a step after touchdown marked as landing (the report's comparisons skip it).
-LANDING = 0.1
 # The torque plots show the gait's torques away from the landings, widened by this fraction
 # of their span on each side, and at least this span [N·m].
 TORQUE_MARGIN = 0.25
@@ -337,28 +336,17 @@ def _value(value) -> str:
     return str(value)
 
 
-def record(
-    path: str | Path,
-    biped: Biped,
-    step: GaitSamples,
-    sim: Simulation,
-    contact: dict,
-    checks=(),
-    gait: dict | None = None,
-    spawn: bool = False,
-    connect: str | None = None,
-) -> Path:
-    """Write the recording of a validation to ``path`` (.rrd), atomically.
+def record(path: str | Path, validation, spawn: bool = False, connect: str | None = None) -> Path:
+    """Write the recording of a validation (``validate.validation.Validation``: its walk, the
+    gait's samples drawn as the ghost, the walk's contact, and for the summary the gait and
+    its checks) to ``path`` (.rrd), atomically.
 
     Args:
-        step: the gait file's samples (``validate.samples.GaitSamples``), drawn as the ghost.
-        contact: MuJoCo's stance-foot force (N, 2) and centre of pressure (N,) as
-            ``{"force": ..., "cop": ...}`` (NaN where not sampled or in double support).
-        checks: the validation's checks (``validate.report.Check``), for the summary.
-        gait: the gait file's content (``biped.records.gait_file.read``), for the summary.
         spawn: also stream to a rerun viewer started for it.
         connect: also stream to a running viewer at this URL ("" for rerun's default).
     """
+    biped, step, sim = validation.biped, validation.samples, validation.simulation
+    contact, checks, gait = validation.contact, validation.checks, validation.gait
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     q_ref, torques, wrench, zmp = reference_along(step, sim)

@@ -49,11 +49,11 @@ import mujoco
 
 from biped.errors import BipedError
 from biped.model.dynamics import Biped
+from biped.records.gait_file import Gait
 from biped.records.units import PURE
 from biped.runtime.runner import ProgressBar, run_tasks
 from validate.checks import walk_verdict
 from validate.model import compile_spec, model_spec
-from validate.samples import gait_biped
 from validate.simulate import KP, KV, Push, Walker, WalkSettings, quiet_mujoco
 
 # Far ends of the brackets: impulse [N·s] (a 70 kg robot's speed changes by 0.29 m/s), trunk
@@ -314,10 +314,8 @@ def model_friction(model: mujoco.MjModel) -> float:
     return float(model.geom_friction[collides, 0].max())
 
 
-def trunk_mass_spec(
-    gait: dict, biped: Biped, fraction: float, path: str | Path | None = None
-) -> mujoco.MjSpec:
-    """The model of ``gait``'s robot with a trunk heavier by ``fraction`` (lighter if < 0).
+def trunk_mass_spec(biped: Biped, fraction: float, path: str | Path | None = None) -> mujoco.MjSpec:
+    """The model of ``biped``'s robot with a trunk heavier by ``fraction`` (lighter if < 0).
 
     Without ``path``: the MJCF generated from the gait's robot with ``trunk_mass`` x
     (1 + fraction) (``dataclasses.replace``; at 0 the gait's own model). With ``path``: that
@@ -327,8 +325,8 @@ def trunk_mass_spec(
     if path is None:
         robot = biped.robot
         heavier = dataclasses.replace(robot, trunk_mass=robot.trunk_mass * (1.0 + fraction))
-        return model_spec(gait, Biped(heavier, biped.knee))
-    spec = model_spec(gait, biped, path)
+        return model_spec(Biped(heavier, biped.knee))
+    spec = model_spec(biped, path)
     trunk = spec.body("trunk")
     wanted = trunk.mass * (1.0 + fraction)
     trunk.mass = wanted
@@ -346,14 +344,14 @@ class _Mapper:
     """A gait prepared for the walks of its map: its walker on the model, when the pushes
     act, the model's friction and trunk mass."""
 
-    def __init__(self, gait: dict, model: str | Path | None, settings: RobustnessSettings):
+    def __init__(self, gait: Gait, model: str | Path | None, settings: RobustnessSettings):
         self.gait, self.model, self.settings = gait, model, settings
-        self.biped = gait_biped(gait)
-        spec = model_spec(gait, self.biped, model)
+        self.biped = gait.biped
+        spec = model_spec(self.biped, model)
         self.walker = Walker(gait, spec)
         self.push_time = (settings.push_step - 0.5) * self.walker.period
         for fraction in (MAX_TRUNK_MASS_ERROR, -MAX_TRUNK_MASS_ERROR):  # before any walk
-            trunk_mass_spec(gait, self.biped, fraction, model)
+            trunk_mass_spec(self.biped, fraction, model)
         compiled = compile_spec(spec)
         self.friction = model_friction(compiled)
         self.trunk_mass = float(compiled.body("trunk").mass[0])
@@ -370,7 +368,7 @@ class _Mapper:
         if name == "friction":
             return self.verdict(self.walker, WalkSettings(friction=value))
         if name.startswith("trunk_mass"):
-            spec = trunk_mass_spec(self.gait, self.biped, value, self.model)
+            spec = trunk_mass_spec(self.biped, value, self.model)
             return self.verdict(Walker(self.gait, spec))
         return self.verdict(self.walker, WalkSettings(kp_scale=value))
 
@@ -408,7 +406,7 @@ class _Mapper:
 
 
 def map_limit(
-    gait: dict,
+    gait: Gait | dict,
     name: str,
     model: str | Path | None = None,
     settings: RobustnessSettings = RobustnessSettings(),
@@ -418,7 +416,7 @@ def map_limit(
     if name not in LIMITS:
         raise BipedError(f"limit {name!r}: allowed one of {', '.join(LIMITS)}")
     with quiet_mujoco():
-        return _Mapper(gait, model, settings).limit(name)
+        return _Mapper(Gait.of(gait), model, settings).limit(name)
 
 
 # The mapper of the gait being mapped, in this process: (key, _Mapper).
@@ -436,12 +434,12 @@ def _limit_task(task: tuple) -> Limit:
 
 
 def robustness_map(
-    gait: dict,
+    gait: Gait | dict,
     model: str | Path | None = None,
     settings: RobustnessSettings = RobustnessSettings(),
     progress: ProgressBar | None = None,
 ) -> RobustnessMap:
-    """The robustness map of a gait file's content (``biped.records.gait_file.read``) on ``model``
+    """The robustness map of a gait (``Gait``, or a file's content: ``Gait.of``) on ``model``
     (a path; None: ``validate.model.model_spec``'s default).
 
     The nominal walk first, in this process; then the limits, on ``settings.jobs`` processes
@@ -454,7 +452,7 @@ def robustness_map(
     Raises BipedError if the model cannot be read, is of the other knee or its trunk's mass
     cannot be scaled.
     """
-    key = f"{os.getpid()}-{next(_MAPS)}"
+    key, gait = f"{os.getpid()}-{next(_MAPS)}", Gait.of(gait)
     mapper = _Mapper(gait, model, settings)
     _PREPARED[:] = [(key, mapper)]
     try:

@@ -1,10 +1,9 @@
 """The gait as a gait file stores it: its samples as functions of time.
 
 What MuJoCo plays is the file, not the parameters it came from: the torques Γ(t), the motion
-q(t) and the start state are read from ``samples`` (``biped.records.gait_file``), interpolated on
-each
-spline piece separately (the accelerations and torques jump at the knot t = T/2, where the
-file holds both limits):
+q(t) and the start state are read from ``samples`` (``biped.records.gait_file``), interpolated
+on each spline piece separately (the accelerations and torques jump at the knot t = T/2,
+where the file holds both limits):
 
     q(t), q̇(t)     cubic Hermite through (q, q̇), resp. (q̇, q̈), at the samples: the file holds
                   the derivatives, so the interpolation is exact to O(h⁴) between samples
@@ -20,8 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.dynamics import Biped
-from biped.model.robot import Robot
+from biped.records.gait_file import Gait
 
 FIELDS = ("q", "qd", "qdd", "torques", "wrench", "zmp")
 
@@ -51,12 +49,12 @@ class GaitSamples:
     zmp: np.ndarray
 
     @classmethod
-    def from_gait(cls, gait: dict) -> GaitSamples:
-        """The samples of a gait file's content (``gait_file.read`` or ``gait_file.to_dict``)."""
-        samples = gait["samples"]
-        arrays = {key: np.asarray(samples[key], dtype=float) for key in ("t", *FIELDS)}
+    def from_gait(cls, gait: Gait | dict) -> GaitSamples:
+        """The samples of a gait (``Gait``, or a file's content: ``Gait.of``)."""
+        gait = Gait.of(gait)
+        arrays = {key: np.asarray(gait.samples[key], dtype=float) for key in ("t", *FIELDS)}
         arrays["zmp"] = arrays["zmp"].reshape(-1, 1)
-        return cls(period=float(gait["period"]), step_length=float(gait["step_length"]), **arrays)
+        return cls(period=float(gait.period), step_length=float(gait.step_length), **arrays)
 
     def pieces(self) -> tuple[slice, slice]:
         """Rows of the left piece [0, T/2] and of the right piece [T/2, T]."""
@@ -105,11 +103,3 @@ def _hermite(times, values, slopes, t) -> np.ndarray:
     h01 = s**2 * (3 - 2 * s)
     h11 = s**2 * (s - 1)
     return h00 * values[k] + h10 * h * slopes[k] + h01 * values[k + 1] + h11 * h * slopes[k + 1]
-
-
-def gait_biped(gait: dict) -> Biped:
-    """The analytical robot of a gait file's content (its robot as read, or as a mapping)."""
-    robot = gait["robot"]
-    if not isinstance(robot, Robot):
-        robot = Robot.from_mapping(robot, source="robot")
-    return Biped(robot, gait["knee"])

@@ -214,7 +214,7 @@ class Captioned:
 
 
 def verdict_of(checks) -> tuple[str, bool]:
-    """Caption of a list of ``validate.report.Check``: PASS or the failed checks, and the
+    """Caption of a list of ``validate.validation.Check``: PASS or the failed checks, and the
     steps walked."""
     passed = all(check.passed for check in checks)
     failed = [check.name for check in checks if not check.passed]
@@ -281,24 +281,29 @@ def write_gif(path: str | Path, frames, fps: int = FPS) -> Path:
     return path
 
 
+def _captioned(validation, ghost: bool) -> Captioned:
+    """The walk of a validation (``validate.validation.Validation``) captioned with its
+    verdict; its ``renderer`` is to be closed."""
+    verdict, passed = verdict_of(validation.checks) if validation.checks else ("", None)
+    renderer = WalkRenderer(
+        validation.biped, validation.samples, validation.simulation, ghost=ghost
+    )
+    return Captioned(renderer, verdict, passed)
+
+
 def write_video(
     path: str | Path | None,
-    biped: Biped,
-    step,
-    sim: Simulation,
-    checks=(),
+    validation,
     gif: str | Path | None = None,
     ghost: bool = True,
     fps: int = FPS,
 ) -> list[Path]:
-    """Render the walk of ``sim`` to an MP4 at ``path`` and/or a GIF at ``gif`` (their missing
-    folders created); returns the files written. ``checks`` (``validate.report.Check``) give
-    the verdict in the caption."""
-    verdict, passed = verdict_of(checks) if checks else ("", None)
-    renderer = WalkRenderer(biped, step, sim, ghost=ghost)
+    """Render the walk of a validation (``validate.validation.Validation``) to an MP4 at
+    ``path`` and/or a GIF at ``gif`` (their missing folders created); returns the files
+    written. Its checks give the verdict in the caption."""
+    captioned = _captioned(validation, ghost)
     try:
-        captioned = Captioned(renderer, verdict, passed)
-        states = frame_states(sim, fps)
+        states = frame_states(validation.simulation, fps)
         written = []
         if gif is not None:
             frames = [captioned.frame(k) for k in states]
@@ -308,24 +313,22 @@ def write_video(
         elif path is not None:
             written.append(write_mp4(path, (captioned.frame(k) for k in states), fps))
     finally:
-        renderer.close()
+        captioned.renderer.close()
     return written
 
 
-def write_frame(
-    path: str | Path, biped: Biped, step, sim: Simulation, at: float, checks=(), ghost=True
-) -> Path:
-    """One captioned frame of the walk, at ``at`` seconds of simulation, as a PNG (its missing
-    folders created)."""
+def write_frame(path: str | Path, validation, at: float, ghost: bool = True) -> Path:
+    """One captioned frame of a validation's walk, at ``at`` seconds of simulation, as a PNG
+    (its missing folders created)."""
     from PIL import Image
 
-    verdict, passed = verdict_of(checks) if checks else ("", None)
-    renderer = WalkRenderer(biped, step, sim, ghost=ghost)
+    sim = validation.simulation
+    captioned = _captioned(validation, ghost)
     try:
         k = int(min(np.searchsorted(sim.time, sim.time[0] + at), len(sim.time) - 1))
-        frame = Captioned(renderer, verdict, passed).frame(k)
+        frame = captioned.frame(k)
     finally:
-        renderer.close()
+        captioned.renderer.close()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:
@@ -337,7 +340,7 @@ def main(argv=None) -> int:
     """Validate a gait file and write the video, GIF or one frame of its walk in MuJoCo."""
     from biped.errors import BipedError
     from biped.records import gait_file
-    from validate.report import validate
+    from validate.validation import validate
 
     parser = argparse.ArgumentParser(prog="python -m validate.video", description=main.__doc__)
     parser.add_argument("gait", metavar="GAIT.json", help="a gait file (optimize, pipeline)")
@@ -366,27 +369,9 @@ def main(argv=None) -> int:
         ghost = not args.no_ghost
         written = []
         if args.out or args.gif:
-            written += write_video(
-                args.out,
-                result.biped,
-                result.step,
-                result.simulation,
-                result.checks,
-                gif=args.gif,
-                ghost=ghost,
-            )
+            written += write_video(args.out, result, gif=args.gif, ghost=ghost)
         if args.frame:
-            written.append(
-                write_frame(
-                    args.frame,
-                    result.biped,
-                    result.step,
-                    result.simulation,
-                    args.at,
-                    result.checks,
-                    ghost,
-                )
-            )
+            written.append(write_frame(args.frame, result, args.at, ghost))
     except (BipedError, OSError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.integrate import simpson
@@ -41,6 +41,8 @@ CONSTRAINTS = (
     "swing_toe",
 )
 CRITERIA = ("sthenic", "energy")
+# Unit of each criterion's value: C_Γ per metre walked, C_E per step.
+CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
 PENALTY_WEIGHT = 1e6  # k of eqs. (30)-(31)
 # Err of eqs. (30)-(31) when the parameters give no posture: a large cost growing with the
 # distance [m] by which the hip is out of reach, so that the simplex is led back.
@@ -88,8 +90,8 @@ class Safety:
         zmp_margin: [m] distance the ZMP keeps inside the sole's heel and toe (Ψ2, Ψ3).
     """
 
-    clearance: float = 0.0
-    zmp_margin: float = 0.0
+    clearance: float = field(default=0.0, metadata={"unit": "m"})
+    zmp_margin: float = field(default=0.0, metadata={"unit": "m"})
 
     def __post_init__(self):
         for name, high in (("clearance", MAX_CLEARANCE), ("zmp_margin", MAX_ZMP_MARGIN)):
@@ -163,6 +165,10 @@ class StepEvaluation:
     def violations(self) -> dict:
         """Worst value of each violated constraint (Ψ_i < 0), by name."""
         return {name: float(w) for name, w in zip(CONSTRAINTS, self.worst, strict=True) if w < 0.0}
+
+    def violations_line(self) -> str:
+        """The violated constraints and worst values, as printed: 'zmp_toe = -0.0012, ...'."""
+        return ", ".join(f"{k} = {v:.3g}" for k, v in self.violations().items())
 
 
 def constraints(robot, q, torques, wrench, swing_feet_z) -> np.ndarray:

@@ -38,13 +38,13 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from biped.errors import BipedError
-from biped.model.criteria import CRITERIA
+from biped.model.criteria import CRITERIA, CRITERION_UNITS
 from biped.model.dynamics import JOINTS
 from biped.model.gait import FREE_ANGLES
 from biped.model.kinematics import ANGLES, BODY_DIRECTIONS, COORDINATES, KNEES
 from biped.model.robot import FOOT_FRICTION
-from biped.records import gait_file
 from biped.records.comparison import CERTIFIED, CHECK_GRID, DIFFERENCE, SOLVER_GRID, relative_change
+from biped.records.gait_file import Gait
 from biped.runtime.files import atomic_set
 from biped.studies.paper_method import spread_lines
 from biped.studies.sweep import MANIFEST
@@ -71,10 +71,9 @@ MIN_BULK = 5
 PAD = 0.08
 DPI = 120
 CRITERION_AXES = {
-    "sthenic": r"sthenic criterion $C_\Gamma$ per metre walked [N²·m·s]",
-    "energy": r"energy criterion $C_E$ per step [J]",
+    "sthenic": rf"sthenic criterion $C_\Gamma$ per metre walked [{CRITERION_UNITS['sthenic']}]",
+    "energy": rf"energy criterion $C_E$ per step [{CRITERION_UNITS['energy']}]",
 }
-CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
 DIFFERENCE_AXIS = "(rolling − revolute) / revolute [%]"
 DIFFERENCE_COLOR = "k"
 # Points of a difference panel labelled with their value, at most.
@@ -96,11 +95,11 @@ OTHER_NOTES = {
 TIME_AXIS = "normalised time t/T"
 
 
-def certified(gait: dict) -> bool:
+def certified(gait: Gait) -> bool:
     """Whether a gait file holds a certified optimum (``biped.records.comparison.CERTIFIED``; a
     sweep's files are its final optima): its solver converged and it is feasible on the
     check grid."""
-    return gait["feasible"] and gait["optimizer"].get("status") == "converged"
+    return gait.feasible and gait.optimizer.get("status") == "converged"
 
 
 def read_sweep(folder: str | Path) -> tuple[dict, list]:
@@ -113,13 +112,13 @@ def read_sweep(folder: str | Path) -> tuple[dict, list]:
     series: dict = {}
     flagged = []
     for path in files:
-        gait = gait_file.read_consistent(path)  # its figures its parameters'
+        gait = Gait.read(path, consistent=True)  # its figures its parameters'
         if certified(gait):
-            series.setdefault((gait["knee"], gait["criterion"]), []).append(gait)
+            series.setdefault((gait.knee, gait.criterion), []).append(gait)
         else:
             flagged.append(gait)
     for gaits in series.values():
-        gaits.sort(key=lambda g: g["speed"])
+        gaits.sort(key=lambda g: g.speed)
     return series, flagged
 
 
@@ -130,7 +129,7 @@ def load_sweep(folder: str | Path) -> dict:
 
 def _curve(series, knee, criterion, cost):
     gaits = series.get((knee, criterion), [])
-    return np.array([g["speed"] for g in gaits]), np.array([g["costs"][cost] for g in gaits])
+    return np.array([g.speed for g in gaits]), np.array([g.costs[cost] for g in gaits])
 
 
 def off_bulk(values) -> np.ndarray:
@@ -187,7 +186,7 @@ def difference_curve(series, criterion, cost) -> tuple[np.ndarray, np.ndarray]:
     """Speeds [m/s] where both knees have a certified ``criterion`` optimum, and the
     difference of their ``cost`` there [%] (``relative_change``, rolling vs revolute)."""
     values = {
-        knee: {round(g["speed"], 6): g["costs"][cost] for g in series.get((knee, criterion), [])}
+        knee: {round(g.speed, 6): g.costs[cost] for g in series.get((knee, criterion), [])}
         for knee in KNEES
     }
     speeds = sorted(set(values["revolute"]) & set(values["rolling"]))
@@ -246,11 +245,11 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
     where that needs a word (``OTHER_NOTES``)."""
     fig = Figure(figsize=(16, 5.0), layout="constrained")
     axes = fig.subplots(1, 3)
-    crosses = [g for g in flagged if g["criterion"] == criterion]
+    crosses = [g for g in flagged if g.criterion == criterion]
     for ax, cost in zip(axes, (criterion, other), strict=False):
         unit = CRITERION_UNITS[cost]
-        everything = [g["costs"][cost] for k in KNEES for g in series.get((k, criterion), [])]
-        limits = bulk_limits(everything or [g["costs"][cost] for g in crosses])
+        everything = [g.costs[cost] for k in KNEES for g in series.get((k, criterion), [])]
+        limits = bulk_limits(everything or [g.costs[cost] for g in crosses])
         for knee in KNEES:
             v, c = _curve(series, knee, criterion, cost)
             outside = (c < limits[0]) | (c > limits[1])
@@ -259,9 +258,9 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
                 text = f"{knee} {x:.3f} m/s:\n{value:.4g} {unit}, off scale"
                 _mark_off_scale(ax, x, value, limits, STYLE[knee]["color"], text)
         for i, gait in enumerate(crosses):
-            x, value = gait["speed"], gait["costs"][cost]
-            status = gait["optimizer"].get("status")
-            why = "infeasible" if not gait["feasible"] else f"solver: {status}"
+            x, value = gait.speed, gait.costs[cost]
+            status = gait.optimizer.get("status")
+            why = "infeasible" if not gait.feasible else f"solver: {status}"
             label = "not certified" if i == 0 else None
             if limits[0] <= value <= limits[1]:
                 ax.plot(
@@ -275,7 +274,7 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
                     label=label,
                 )
                 ax.annotate(
-                    f"{gait['knee']}: not certified\n({why})",
+                    f"{gait.knee}: not certified\n({why})",
                     xy=(x, value),
                     xytext=(6, 6),
                     textcoords="offset points",
@@ -283,7 +282,7 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
                     color=FLAGGED_COLOR,
                 )
             else:
-                text = f"{gait['knee']} {x:.3f} m/s: {value:.4g} {unit},\nnot certified ({why})"
+                text = f"{gait.knee} {x:.3f} m/s: {value:.4g} {unit},\nnot certified ({why})"
                 _mark_off_scale(ax, x, value, limits, FLAGGED_COLOR, text)
         ax.set_ylim(*limits)
         ax.set_ylabel(CRITERION_AXES[cost])
@@ -320,7 +319,7 @@ def _detail_gaits(series):
                 f"no certified sthenic-optimal gait of the {knee} knee in the sweep: "
                 "figures need both knees"
             )
-        gaits[knee] = min(candidates, key=lambda g: abs(g["speed"] - DETAIL_SPEED))
+        gaits[knee] = min(candidates, key=lambda g: abs(g.speed - DETAIL_SPEED))
     return gaits
 
 
@@ -347,16 +346,16 @@ def angle_label(angle: str) -> str:
 
 
 def _column(field: str, i: int):
-    return lambda gait: gait["samples"][field][:, i]
+    return lambda gait: gait.samples[field][:, i]
 
 
 def _degrees(k: int):
-    return lambda gait: np.degrees(gait["samples"]["q"][:, k])
+    return lambda gait: np.degrees(gait.samples.q[:, k])
 
 
-def friction_needed(gait: dict) -> np.ndarray:
+def friction_needed(gait: Gait) -> np.ndarray:
     """|Fx| / Fz on the samples: the least friction coefficient the stance foot needs."""
-    wrench = gait["samples"]["wrench"]
+    wrench = gait.samples.wrench
     return np.abs(wrench[:, 0]) / wrench[:, 1]
 
 
@@ -372,7 +371,7 @@ def _friction_marks(ax, gaits) -> None:
     for row, (knee, gait) in enumerate(gaits.items()):
         ratio = friction_needed(gait)
         i = int(np.argmax(ratio))
-        t = gait["samples"]["t"][i] / gait["period"]
+        t = gait.samples.t[i] / gait.period
         ax.plot(
             [t], [ratio[i]], marker="o", markersize=8, fillstyle="none", color=STYLE[knee]["color"]
         )
@@ -391,7 +390,7 @@ def _friction_marks(ax, gaits) -> None:
 
 
 def _sole_marks(ax, gaits) -> None:
-    robot = next(iter(gaits.values()))["robot"]
+    robot = next(iter(gaits.values())).robot
     for name, x in robot.sole_edges().items():
         ax.axhline(x, color="0.4", linestyle=":", linewidth=1.0)
         ax.annotate(
@@ -410,9 +409,7 @@ ANGLE_PANELS = tuple(
 GROUND_PANELS = (
     Panel("|Fx| / Fz: friction needed", "ratio [1]", friction_needed, _friction_marks),
     Panel("Fz: normal force", "force [N]", _column("wrench", 1)),
-    Panel(
-        "x_ZMP from the stance ankle", "position [m]", lambda g: g["samples"]["zmp"], _sole_marks
-    ),
+    Panel("x_ZMP from the stance ankle", "position [m]", lambda g: g.samples.zmp, _sole_marks),
 )
 
 
@@ -427,9 +424,9 @@ def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
     axes = np.atleast_1d(fig.subplots(rows, columns)).ravel()
     for ax, panel in zip(axes, panels, strict=False):
         for knee, gait in gaits.items():
-            s = gait["samples"]
+            s = gait.samples
             ax.plot(
-                s["t"] / gait["period"],
+                s.t / gait.period,
                 panel.values(gait),
                 color=STYLE[knee]["color"],
                 label=LABELS[knee],
@@ -444,7 +441,7 @@ def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
         axes[0].legend(fontsize=8)
     for ax in axes[len(panels) :]:
         ax.remove()
-    speeds = ", ".join(f"{k} {g['speed']:.3f} m/s" for k, g in gaits.items())
+    speeds = ", ".join(f"{k} {g.speed:.3f} m/s" for k, g in gaits.items())
     fig.suptitle(f"{title} ({speeds})")
     return fig
 
@@ -452,8 +449,8 @@ def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
 def compared_criteria(series: dict, flagged=()) -> tuple[tuple[str, ...], list[str]]:
     """The criteria whose figures and rows a sweep can give (certified optima of both knees),
     and a sentence for each criterion left out, saying what the sweep lacks."""
-    in_sweep = {g["criterion"] for gaits in series.values() for g in gaits}
-    in_sweep |= {g["criterion"] for g in flagged}
+    in_sweep = {g.criterion for gaits in series.values() for g in gaits}
+    in_sweep |= {g.criterion for g in flagged}
     compared, missing = [], []
     for criterion in CRITERIA:
         lacking = [knee for knee in KNEES if not series.get((knee, criterion))]
@@ -559,8 +556,7 @@ def _detail_rows(series) -> tuple[list[str], dict]:
     flexion of each [rad]."""
     detail = _detail_gaits(series)
     flexion = {
-        knee: float(np.max(g["samples"]["q"][:, 3] - g["samples"]["q"][:, 2]))
-        for knee, g in detail.items()
+        knee: float(np.max(g.samples.q[:, 3] - g.samples.q[:, 2])) for knee, g in detail.items()
     }
     rows = [
         f"| largest stance-knee flexion q2 - q1, sthenic optimum near {DETAIL_SPEED} m/s [rad] "
@@ -578,10 +574,10 @@ def comparison_table(series, flagged=()) -> str:
     """Markdown table of the headline numbers, ours beside the paper's, for the criteria
     the sweep can compare (``compared_criteria``), saying what it leaves out."""
     criteria, missing = compared_criteria(series, flagged)
-    safeties = sorted({g["safety"] for gaits in series.values() for g in gaits}, key=str)
+    safeties = sorted({g.safety for gaits in series.values() for g in gaits}, key=str)
     everything = [g for c in criteria for k in KNEES for g in series[(k, c)]]
     total = len(everything)
-    confirmed = sum(g["optimizer"]["starts_at_best"] >= 2 for g in everything)
+    confirmed = sum(g.optimizer["starts_at_best"] >= 2 for g in everything)
     safety = "; ".join(
         f"swing-foot clearance {s.clearance:g} m, ZMP margin {s.zmp_margin:g} m" for s in safeties
     )
@@ -647,7 +643,7 @@ def _explanations(flexion, series, criteria) -> list[str]:
             "  knee-link angle equals the segment angles when it is straight), so the two",
             "  robots walk almost alike.",
         ]
-    speeds = sorted({g["speed"] for gaits in series.values() for g in gaits})
+    speeds = sorted({g.speed for gaits in series.values() for g in gaits})
     best = min(_minimum(series, knee, "sthenic")[0] for knee in KNEES)
     if best <= speeds[0]:
         lines += [
@@ -672,7 +668,7 @@ def _explanations(flexion, series, criteria) -> list[str]:
 
 def _minimum_per_step(series, knee) -> float:
     """[m/s] Speed of the knee's least sthenic criterion per step (certified optima)."""
-    best = min(series[(knee, "sthenic")], key=lambda g: g["costs"]["sthenic"] * g["step_length"])
+    best = min(series[(knee, "sthenic")], key=lambda g: g.costs["sthenic"] * g.step_length)
     return float(best["speed"])
 
 
@@ -696,8 +692,7 @@ def make_figures(sweep_folder: str | Path, out_folder: str | Path, stream=None) 
         )
     figures = sweep_figures(series, flagged, criteria)
     certified_values = {
-        key: {round(g["speed"], 6): g["costs"][key[1]] for g in gaits}
-        for key, gaits in series.items()
+        key: {round(g.speed, 6): g.costs[key[1]] for g in gaits} for key, gaits in series.items()
     }
     table = "\n".join(
         [comparison_table(series, flagged), *spread_lines(sweep_folder, certified_values)]

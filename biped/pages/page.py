@@ -27,8 +27,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
-from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
-from biped.model.dynamics import JOINTS, Biped
+from biped.model.criteria import CONSTRAINTS, CRITERION_UNITS, evaluate_step, margin_profile
+from biped.model.dynamics import JOINTS
 from biped.model.gait import PARAMETERS, build_step, half_grid
 from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
 from biped.optimization.problem import SOLVER_SAMPLES_PER_HALF
@@ -43,8 +43,8 @@ from biped.pages.figures import (
     joint_label,
     time_figure,
 )
-from biped.records import gait_file
-from biped.records.units import CONSTRAINT_UNITS, CRITERION_UNITS, parameter_unit
+from biped.records.gait_file import Gait
+from biped.records.units import CONSTRAINT_UNITS, parameter_unit
 from biped.runtime.files import atomic_set
 
 # What each constraint of eq. (28) keeps.
@@ -93,15 +93,14 @@ class Tightest:
 
 
 def constraint_profile(
-    gait: dict, samples_per_half: int = CHECK_SAMPLES_PER_HALF
+    gait: Gait, samples_per_half: int = CHECK_SAMPLES_PER_HALF
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """On the optimiser's check grid (or ``samples_per_half`` samples per spline piece): the
     step's normalised times t/T (N,), Ψ1..Ψ7 (N, 7) less the gait's safety margins (NaN
     where a constraint is not checked: the swing foot at the ends) and the solver's margins
     δ (N, 7)."""
-    model = Biped(gait["robot"], gait["knee"])
-    step = build_step(model, gait["speed"], gait_file.parameters(gait))
-    evaluation = evaluate_step(model, step, samples_per_half, safety=gait["safety"])
+    step = build_step(gait.biped, gait.speed, gait.parameter_vector)
+    evaluation = evaluate_step(gait.biped, step, samples_per_half, safety=gait.safety)
     t_n = np.concatenate(half_grid(samples_per_half))
     return t_n, evaluation.constraints, margin_profile(samples_per_half)
 
@@ -127,7 +126,7 @@ def _below(psi: np.ndarray, delta: np.ndarray) -> np.ndarray:
         return (delta > 0) & (psi < delta * (1.0 - DIP_TOLERANCE))
 
 
-def margin_dips(gait: dict) -> list[Dip]:
+def margin_dips(gait: Gait) -> list[Dip]:
     """The constraints that dip below the solver's margin δ on the check grid, each at its
     deepest sample (smallest Ψ_i − δ_i), in ``CONSTRAINTS`` order."""
     t_n, psi, delta = constraint_profile(gait)
@@ -151,7 +150,7 @@ def _milli(value: float, unit: str) -> str:
     return f"{value:.3g} {unit}"
 
 
-def dip_sentence(gait: dict, dips: list[Dip]) -> str:
+def dip_sentence(gait: Gait, dips: list[Dip]) -> str:
     """Why Ψ_i reads below δ_i on the page, from the gait's dips ('' if none)."""
     if not dips:
         return ""
@@ -160,7 +159,7 @@ def dip_sentence(gait: dict, dips: list[Dip]) -> str:
         f"{d.at:.3f} (δ = {_milli(d.margin, d.unit)})"
         for d in dips
     )
-    if gait["optimizer"].get("method") != "ipopt":
+    if gait.optimizer.get("method") != "ipopt":
         why = (
             "the paper's method keeps the margins through its penalty only, not as bounds "
             "at samples"
@@ -175,7 +174,7 @@ def dip_sentence(gait: dict, dips: list[Dip]) -> str:
         why = f"{', '.join(kept)} at the solver's own samples too: the solver did not hold δ"
     verdict = (
         "Ψ ≥ 0 holds on every sample of the check grid: the gait is feasible"
-        if gait["feasible"]
+        if gait.feasible
         else "the gait is not feasible on the check grid"
     )
     return (
@@ -184,22 +183,22 @@ def dip_sentence(gait: dict, dips: list[Dip]) -> str:
     )
 
 
-def knot_index(gait: dict) -> int | None:
+def knot_index(gait: Gait) -> int | None:
     """The sample of the left limit at the mid-step knot (the next one is the right limit:
     the samples hold t = T/2 twice); None if they do not."""
-    t = gait["samples"]["t"]
-    twice = np.flatnonzero((np.diff(t) == 0.0) & np.isclose(t[1:], KNOT * gait["period"]))
+    t = gait.samples.t
+    twice = np.flatnonzero((np.diff(t) == 0.0) & np.isclose(t[1:], KNOT * gait.period))
     return int(twice[0]) if twice.size else None
 
 
-def knot_jumps(gait: dict, field: str) -> np.ndarray | None:
+def knot_jumps(gait: Gait, field: str) -> np.ndarray | None:
     """The jump (right limit − left limit) of ``samples[field]`` at the mid-step knot; None
     if the samples do not hold both limits."""
     k = knot_index(gait)
-    return None if k is None else gait["samples"][field][k + 1] - gait["samples"][field][k]
+    return None if k is None else gait.samples[field][k + 1] - gait.samples[field][k]
 
 
-def figure_captions(gait: dict) -> dict[str, str]:
+def figure_captions(gait: Gait) -> dict[str, str]:
     """The sentence above each figure that needs one, by file name: why the torques and the
     ground reaction jump at the knot (their largest jumps), why Ψ dips below δ."""
     captions = {}
@@ -224,7 +223,7 @@ def figure_captions(gait: dict) -> dict[str, str]:
     return captions
 
 
-def tightest_margins(gait: dict) -> list[Tightest]:
+def tightest_margins(gait: Gait) -> list[Tightest]:
     """The tightest sample of each constraint (its smallest Ψ_i), the tightest relative to
     the solver's margin there first."""
     t_n, psi, delta = constraint_profile(gait)
@@ -279,7 +278,7 @@ def _with_knot(panel: Panel, jump: float | None, legend: bool = False) -> Panel:
     return dataclasses.replace(panel, decorate=decorate)
 
 
-def _knot_panels(gait: dict, panels: tuple) -> tuple:
+def _knot_panels(gait: Gait, panels: tuple) -> tuple:
     """Each panel with the knot marked and its jump there (the first with the legend)."""
     k = knot_index(gait)
     return tuple(
@@ -348,16 +347,16 @@ def _dip_inset(
     ax.indicate_inset_zoom(inset, edgecolor="0.3")
 
 
-def _constraint_panels(gait: dict) -> tuple:
+def _constraint_panels(gait: Gait) -> tuple:
     t_n, psi, delta = constraint_profile(gait)
     t_s, psi_solver, _ = constraint_profile(gait, SOLVER_SAMPLES_PER_HALF)
     dips = {dip.name: dip for dip in margin_dips(gait)}
-    solver_samples = gait["optimizer"].get("method") == "ipopt"
+    solver_samples = gait.optimizer.get("method") == "ipopt"
 
     def panel(i, name):
         def mark(ax, gaits):
             k = int(np.nanargmin(psi[:, i]))
-            color = STYLE[gait["knee"]]["color"]
+            color = STYLE[gait.knee]["color"]
             ax.plot(t_n, delta[:, i], color="0.4", linestyle=":", linewidth=1.2, label="δ")
             ax.plot([t_n[k]], [psi[k, i]], marker="o", markersize=8, fillstyle="none", color=color)
             side = "right" if t_n[k] > 0.7 else "left" if t_n[k] < 0.3 else "center"
@@ -395,19 +394,19 @@ def _constraint_panels(gait: dict) -> tuple:
     return tuple(panel(i, name) for i, name in enumerate(CONSTRAINTS))
 
 
-def _constraints_title(gait: dict, dips: list[Dip]) -> str:
+def _constraints_title(gait: Gait, dips: list[Dip]) -> str:
     """The constraints figure's title, saying what its insets show (if it has any)."""
     title = "constraints Ψ (the solver's margin δ dotted"
     if not dips:
         return f"{title})"
-    between = gait["optimizer"].get("method") == "ipopt" and all(dip.kept for dip in dips)
+    between = gait.optimizer.get("method") == "ipopt" and all(dip.kept for dip in dips)
     where = " between the solver's samples, dots" if between else ""
     return f"{title}; insets: Ψ below δ{where})"
 
 
-def gait_figures(gait: dict) -> dict[str, Figure]:
+def gait_figures(gait: Gait) -> dict[str, Figure]:
     """The page's figures of one gait, by file name."""
-    gaits = {gait["knee"]: gait}
+    gaits = {gait.knee: gait}
     return {
         "torques.png": time_figure(
             gaits,
@@ -438,12 +437,12 @@ class Link:
 @dataclass
 class Page:
     """One gait's page: its name (files ``<name>.md`` and ``<name>/``), the gait file's path
-    and content (``gait_file.read``), its validation report (JSON content, or None) and the
+    and record (``Gait.read``), its validation report (JSON content, or None) and the
     report's path, and links (recording, video)."""
 
     name: str
     source: Path
-    gait: dict
+    gait: Gait
     validation: dict | None = None
     validation_source: Path | None = None
     links: list[Link] = field(default_factory=list)
@@ -468,13 +467,13 @@ def _relative(path: Path, folder: Path) -> str:
 def markdown(page: Page, folder: Path) -> str:
     """The page's Markdown, its links relative to ``folder`` (where the page is written)."""
     gait = page.gait
-    report = gait["optimizer"]
-    title = f"{gait['knee']} knee, {gait['criterion']}-optimal gait at {gait['speed']:.3f} m/s"
+    report = gait.optimizer
+    title = f"{gait.knee} knee, {gait.criterion}-optimal gait at {gait.speed:.3f} m/s"
     optimum = (
         "certified optimum"
         if certified(gait)
         else f"not a certified optimum (solver: {report.get('status')}, "
-        f"feasible: {_number(gait['feasible'])})"
+        f"feasible: {_number(gait.feasible)})"
     )
     lines = [f"# {title}", ""]
     lines += [f"Gait file [`{page.source}`]({_relative(page.source, folder)}): {optimum}."]
@@ -489,12 +488,12 @@ def markdown(page: Page, folder: Path) -> str:
         lines += [f"- {link.label}: [`{link.path}`]({_relative(link.path, folder)}){note}"]
     if page.links:
         lines += [""]
-    safety = gait["safety"]
+    safety = gait.safety
     lines += ["## Gait", "", "| | value | unit |", "|---|---|---|"]
     lines += [
-        f"| walking speed | {gait['speed']:.4g} | m/s |",
-        f"| period T | {gait['period']:.4f} | s |",
-        f"| step length | {gait['step_length']:.4f} | m |",
+        f"| walking speed | {gait.speed:.4g} | m/s |",
+        f"| period T | {gait.period:.4f} | s |",
+        f"| step length | {gait.step_length:.4f} | m |",
         f"| swing-foot clearance asked (beyond the paper's) | {safety.clearance:g} | m |",
         f"| ZMP margin asked (beyond the paper's) | {safety.zmp_margin:g} | m |",
         f"| optimiser | {report.get('method')}: {report.get('status')}, "
@@ -506,9 +505,9 @@ def markdown(page: Page, folder: Path) -> str:
         "|---|---|---|",
     ]
     for name, (label, unit) in COST_NAMES.items():
-        if name in gait["costs"]:
-            optimised = " (optimised)" if name == gait["criterion"] else ""
-            lines += [f"| {label}{optimised} | {gait['costs'][name]:.5g} | {unit} |"]
+        if name in gait.costs:
+            optimised = " (optimised)" if name == gait.criterion else ""
+            lines += [f"| {label}{optimised} | {gait.costs[name]:.5g} | {unit} |"]
     lines += [
         "",
         "## Constraints: tightest margins",
@@ -530,8 +529,7 @@ def markdown(page: Page, folder: Path) -> str:
         lines += ["", dips]
     lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [
-        f"| {name} | {gait['parameters'][name]:.6g} | {parameter_unit(name)} |"
-        for name in PARAMETERS
+        f"| {name} | {gait.parameters[name]:.6g} | {parameter_unit(name)} |" for name in PARAMETERS
     ]
     lines += ["", "## Figures", ""]
     captions = figure_captions(gait)

@@ -1,62 +1,58 @@
-"""Gait files: one optimal gait as JSON, written atomically, read back with checks.
+"""Gait files: one optimal gait as a ``Gait`` record, written as JSON atomically (SI units,
+the paper's coordinate order; ground at z = 0, stance ankle at x = 0), read back with checks.
 
-Layout (SI units, the paper's coordinate order; ground at z = 0, stance ankle at x = 0):
+``Gait`` is declared once, each field with its unit as metadata: the file holds its fields in
+their order, ``format`` first and ``units`` (``Gait.units``: the unit of every number, see
+``biped.records.units``) before ``samples``. ``costs`` are on the check grid of 202 samples
+per step (what the comparisons, tables and figures use); ``optimizer.value`` is the criterion
+on the solver's 52 samples per step, which ranked the starts. ``constraints`` hold the worst
+Ψ_i on the samples less the safety margins (>= 0 when met); ``impact.consistent``: Iz > 0 and
+the trailing foot lifts (the flat-foot impact model holds); ``provenance``: what produced the
+file (``biped.records.provenance``). The samples run from t = 0 to t = T inclusive on both
+spline pieces; t = T/2 appears twice, left and right limits, because the accelerations (and
+torques) jump at the knot.
 
-    knee, criterion, speed [m/s], period [s], step_length [m],
-    safety {clearance, zmp_margin} [m] (margins beyond the paper's constraints), feasible,
-    costs {sthenic [N²·m·s], energy [J], energy_per_metre [J/m]} (on the check grid of 202
-        samples per step: what the comparisons, tables and figures use),
-    robot {field: value}, parameters {name: value} (the 21 of ``biped.model.gait.PARAMETERS``),
-    constraints {name: worst Ψ_i on the samples, less the safety margins: >= 0 when met},
-    impact {impulse [N·s, N·s, N·m·s], trailing_foot_lift [m/s] (heel, toe), consistent
-            (Iz > 0 and the trailing foot lifts: the flat-foot impact model holds), qd_minus,
-            qd_plus},
-    optimizer {method, status ("converged" when the best start's solver converged), starts,
-               starts_at_best, iterations, constraint_violation, dual_infeasibility,
-               seconds, seed, value (the criterion on the solver's 52 samples per step, which
-               ranks the starts; it differs from costs.<criterion> by a fraction of a percent),
-               history (each start), variables (the solver's variables)},
-    provenance {package, version, python, platform, numpy, scipy, casadi, mujoco, command}
-        (``biped.records.provenance``: what produced the file),
-    units {path: unit} of every number above and below ("costs.sthenic": "N²·m·s",
-        ``biped.records.units``),
-    samples {t, q, qd, qdd, torques, wrench, zmp}
-
-The samples run from t = 0 to t = T inclusive on both spline pieces; t = T/2 appears twice,
-left and right limits, because the accelerations (and torques) jump at the knot.
-
-``read`` checks the format and names the bad field; ``read_consistent`` also recomputes what
-the parameters determine (period, step length, samples, costs, constraints, ``feasible``,
-impact) and refuses a file whose figures are not those of its parameters, naming the field:
-every command that reads a gait file a user gives reads it with ``read_consistent``.
+``Gait.read`` checks the format and names the bad field; with ``consistent=True`` it also
+recomputes what the parameters determine (``Gait.check_consistency``) and refuses a file
+whose figures are not those of its parameters, naming the field: every command that reads a
+gait file a user gives reads it so. A record also reads by its file's names
+(``gait["costs"]["energy"]``).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CONSTRAINTS, CRITERIA, Safety
+from biped.model.criteria import CONSTRAINTS, CRITERIA, CRITERION_UNITS, Safety, evaluate_step
 from biped.model.dynamics import JOINTS, Biped
-from biped.model.gait import PARAMETERS
+from biped.model.gait import PARAMETERS, build_step
 from biped.model.impact import trailing_foot_lift
 from biped.model.kinematics import COORDINATES, KNEES
 from biped.model.robot import Robot
-from biped.optimization.optimize import Optimum, check_speed
-from biped.optimization.problem import VARIABLES
+from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF, Optimum, check_speed
+from biped.optimization.problem import VARIABLES, GaitProblem
+from biped.records.comparison import CHECKED_VALUE, SOLVER_VALUE
 from biped.records.provenance import provenance as make_provenance
-from biped.records.units import gait_units
+from biped.records.units import (
+    CONSTRAINT_UNITS,
+    PURE,
+    parameter_unit,
+    per_coordinate,
+    robot_unit,
+)
 from biped.runtime.files import atomic_write_text
 
 FORMAT = "biped-gait/2"  # 2: safety margins recorded
 # Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
 MIN_STEP_LENGTH = 1e-3
-SAMPLE_FIELDS = {"t": 1, "q": 9, "qd": 9, "qdd": 9, "torques": 6, "wrench": 3, "zmp": 1}
 # What a gait file is and who writes it, for a message refusing another file.
 GAIT_FILE = f"a gait file (format {FORMAT!r}) that biped optimize, sweep, design or pipeline writes"
 # The project's other JSON files with a "format", by its prefix (the version follows "/"):
@@ -71,59 +67,309 @@ OTHER_FORMATS = {
         "paper-method/settings.json)"
     ),
 }
+# Consistency: the derived fields of a gait file against those recomputed from its parameters.
+# A file keeps every bit of its numbers (JSON), so only the rounding of another CPU or numpy
+# build (1e-13 of a field's size or so) may separate them; an edited figure differs by far
+# more. Allowed difference: CONSISTENCY_RTOL × the field's largest magnitude (at least 1 in
+# its unit, so fields near zero are not held to nothing).
+CONSISTENCY_RTOL = 1e-9
 
 
-def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None = None) -> dict:
-    """The JSON-ready content of a gait file.
+def _unit(unit, columns: tuple | None = None, **kwargs):
+    """A field with its unit (a string, one per column, a map of sub-fields to units, a
+    record type whose fields carry theirs, or a function of the gait's criterion) and, for
+    an array of samples, the names of its columns (None: one number a sample)."""
+    return field(metadata={"unit": unit, "columns": columns}, **kwargs)
 
-    Args:
-        provenance: what produced it (default: ``biped.records.provenance.provenance()`` now).
-    """
-    ev = optimum.evaluation
-    step = optimum.step
-    model = Biped(robot, optimum.knee)
-    qd_plus, _ = model.impact(*step.end)
+
+class _ByName:
+    """A record that also reads by its file's field names: ``gait["costs"]["energy"]``."""
+
+    def __getitem__(self, key: str):
+        if key not in self:
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __contains__(self, key) -> bool:
+        return any(key == f.name for f in dataclasses.fields(self))
+
+    def get(self, key: str, default=None):
+        return self[key] if key in self else default
+
+
+RATES = per_coordinate("rad/s", "m/s")
+
+
+@dataclass(frozen=True, eq=False)
+class Samples(_ByName):
+    """The gait on the check grid (N samples from t = 0 to T, T/2 twice), as numpy arrays."""
+
+    t: np.ndarray = _unit("s")
+    q: np.ndarray = _unit(per_coordinate("rad", "m"), COORDINATES)
+    qd: np.ndarray = _unit(RATES, COORDINATES)
+    qdd: np.ndarray = _unit(per_coordinate("rad/s²", "m/s²"), COORDINATES)
+    torques: np.ndarray = _unit("N·m", JOINTS)
+    wrench: np.ndarray = _unit(["N", "N", "N·m"], ("Fx", "Fz", "Cy"))
+    zmp: np.ndarray = _unit("m")
+
+    def to_dict(self) -> dict:
+        return {f.name: getattr(self, f.name).tolist() for f in dataclasses.fields(self)}
+
+
+def _optimizer_units(criterion: str) -> dict:
+    """Units of the ``optimizer`` record (``biped.optimization.optimize.Report``)."""
+    value = CRITERION_UNITS[criterion]
     return {
-        "format": FORMAT,
-        "knee": optimum.knee,
-        "criterion": optimum.criterion,
-        "speed": optimum.speed,
+        **dict.fromkeys(("starts", "starts_at_best", "iterations"), PURE),
+        "constraint_violation": "1 (the solver's scaled constraints)",
+        "dual_infeasibility": "1 (IPOPT's measure)",
+        "seconds": "s",
+        "seed": PURE,
+        "value": f"{value} ({SOLVER_VALUE}; costs.{criterion} is {CHECKED_VALUE})",
+        "history[].value": f"{value} ({SOLVER_VALUE})",
+        "history[].iterations": PURE,
+        **{f"variables.{name}": parameter_unit(name) for name in VARIABLES},
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class Gait(_ByName):
+    """One optimal gait, as its file holds it (see the module); built by ``from_optimum`` or
+    ``read``. Its ``biped``, ``problem`` and ``parameter_vector`` follow from it."""
+
+    knee: str = _unit(None)
+    criterion: str = _unit(None)
+    speed: float = _unit("m/s")
+    period: float = _unit("s")
+    step_length: float = _unit("m")
+    safety: Safety = _unit(Safety)
+    feasible: bool = _unit(None)
+    costs: dict = _unit({**CRITERION_UNITS, "energy_per_metre": "J/m"})
+    robot: Robot = _unit({f.name: robot_unit(f.name) for f in dataclasses.fields(Robot)})
+    parameters: dict = _unit({name: parameter_unit(name) for name in PARAMETERS})
+    constraints: dict = _unit(CONSTRAINT_UNITS)
+    impact: dict | None = _unit(
+        {
+            "impulse": ["N·s", "N·s", "N·m·s"],
+            "trailing_foot_lift": "m/s",
+            "qd_minus": RATES,
+            "qd_plus": RATES,
+        }
+    )
+    optimizer: dict = _unit(_optimizer_units)
+    provenance: dict = _unit(None)
+    samples: Samples = _unit(Samples)
+    design: dict | None = _unit(None, default=None)  # a designed knee's (``biped design``)
+
+    @classmethod
+    def from_optimum(cls, optimum: Optimum, robot: Robot, provenance: dict | None = None) -> Gait:
+        """The gait of an optimum of ``robot``; ``provenance``: what produced it (default:
+        ``biped.records.provenance.provenance()`` now)."""
+        ev, step = optimum.evaluation, optimum.step
+        variables = map(_finite_or_none, optimum.variables)
+        return cls(
+            knee=optimum.knee,
+            criterion=optimum.criterion,
+            speed=optimum.speed,
+            safety=optimum.safety,
+            feasible=optimum.feasible,
+            robot=robot,
+            parameters=dict(zip(PARAMETERS, map(float, optimum.parameters), strict=True)),
+            optimizer={
+                **optimum.report.to_dict(),
+                "variables": dict(zip(VARIABLES, variables, strict=True)),
+            },
+            provenance=dict(provenance) if provenance is not None else make_provenance(),
+            **_derived(Biped(robot, optimum.knee), step, ev),
+        )
+
+    @classmethod
+    def read(cls, path: str | Path, allowed: str = GAIT_FILE, consistent: bool = False) -> Gait:
+        """Read a gait file. Raises BipedError if it is not one, saying what it is if it is
+        another of this project's files and what is ``allowed`` (default a gait file: what
+        the command takes); with ``consistent``, if its figures are not its parameters'."""
+        path = Path(path)
+        try:
+            content = json.loads(path.read_text())
+        except OSError as error:
+            raise BipedError(f"gait file {str(path)!r} cannot be read: {error.strerror}") from None
+        except (ValueError, RecursionError) as error:  # JSONDecodeError, UnicodeDecodeError
+            reason = "nested too deeply" if isinstance(error, RecursionError) else error
+            raise BipedError(
+                f"gait file {str(path)!r} is not valid JSON ({reason}): allowed a gait file "
+                "written by biped optimize, sweep, design or pipeline"
+            ) from None
+        kind = other_kind(content)
+        if kind is not None:  # a valid file of another kind is not corrupt
+            raise BipedError(f"{str(path)!r} is {kind}, not a gait file: allowed {allowed}")
+        found = content.get("format") if isinstance(content, dict) else None
+        if isinstance(found, str) and found.startswith("biped-gait/") and found != FORMAT:
+            raise BipedError(
+                f"gait file {str(path)!r} has format {found!r}, another version's: "
+                f"allowed {allowed}"
+            )
+        gait = cls.from_content(content, f"gait file {str(path)!r}")
+        if consistent:
+            gait.check_consistency(f"gait file {str(path)!r}")
+        return gait
+
+    @classmethod
+    def from_content(cls, content, source: str = "gait") -> Gait:
+        """The gait of a file's JSON content (``to_dict``); a BipedError naming ``source`` and
+        the first bad field if it is not a gait's."""
+
+        def bad(what):
+            return BipedError(f"{source} is corrupt: {what}")
+
+        if not isinstance(content, dict) or content.get("format") != FORMAT:
+            raise bad(f"format is not {FORMAT!r}")
+        _check_scalars(content, bad)
+        try:
+            safety = Safety(**content["safety"])
+        except (KeyError, TypeError, BipedError) as error:
+            raise bad(f"safety {content.get('safety')!r}: {error}") from None
+        _check_kinds(content, bad)
+        try:
+            robot = Robot.from_mapping(content["robot"], source="robot")
+            names = set(content["parameters"])
+        except (KeyError, TypeError) as error:
+            raise bad(f"robot or parameters missing ({error})") from None
+        except BipedError as error:
+            raise bad(str(error)) from None
+        if (
+            not isinstance(content["parameters"], dict)
+            or names != set(PARAMETERS)
+            or not all(map(_finite_number, content["parameters"].values()))
+        ):
+            raise bad(f"parameters are not the {len(PARAMETERS)} finite numbers of the gait")
+        try:
+            check_speed(Biped(robot, content["knee"]), content["speed"])
+        except BipedError as error:
+            raise bad(str(error)) from None
+        _check_step(content, bad)
+        fields = {f.name: content.get(f.name) for f in dataclasses.fields(cls)}
+        return cls(
+            **{**fields, "safety": safety, "robot": robot, "samples": _samples(content, bad)}
+        )
+
+    @classmethod
+    def of(cls, gait: Gait | dict) -> Gait:
+        """The record itself, or that of a file's content held in memory (``to_dict``)."""
+        return gait if isinstance(gait, Gait) else cls.from_content(gait)
+
+    @staticmethod
+    def units(criterion: str) -> dict:
+        """The ``units`` map of a gait file optimised for ``criterion``, from the fields'
+        declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
+        return _units(Gait, "", criterion)
+
+    def to_dict(self) -> dict:
+        """The JSON-ready content of the gait's file."""
+        content = {"format": FORMAT}
+        for f in dataclasses.fields(self):
+            if f.name == "samples":
+                content["units"] = self.units(self.criterion)
+            value = getattr(self, f.name)
+            if value is None and f.name == "design":
+                continue
+            if isinstance(value, Samples):
+                value = value.to_dict()
+            elif dataclasses.is_dataclass(value):  # the safety margins, the robot
+                value = dataclasses.asdict(value)
+            content[f.name] = value
+        return content
+
+    @functools.cached_property
+    def biped(self) -> Biped:
+        """The analytical robot of the gait."""
+        return Biped(self.robot, self.knee)
+
+    @property
+    def problem(self) -> GaitProblem:
+        """The problem the gait solves."""
+        return GaitProblem(self.biped, self.speed, self.criterion, self.safety)
+
+    @property
+    def parameter_vector(self) -> np.ndarray:
+        """The 21 parameters in ``PARAMETERS`` order."""
+        return np.array([self.parameters[name] for name in PARAMETERS])
+
+    def check_consistency(self, source: str = "gait") -> None:
+        """Raise a ``BipedError`` naming the first field that does not belong to the gait's
+        parameters, recomputed as ``from_optimum`` computes them (no MuJoCo): period and step
+        length, the samples on the check grid, the costs, the constraints, ``feasible`` and
+        the impact. ``source`` names the file in the message."""
+
+        def bad(what):
+            return BipedError(f"{source} is inconsistent: {what}")
+
+        try:
+            step = build_step(self.biped, self.speed, self.parameter_vector)
+        except BipedError as error:
+            raise bad(f"its parameters build no step ({error})") from None
+        evaluation = evaluate_step(self.biped, step, CHECK_SAMPLES_PER_HALF, safety=self.safety)
+        expected = _derived(self.biped, step, evaluation)
+        units = self.units(self.criterion)
+        for key in ("period", "step_length"):
+            if _mismatch(self[key], expected[key]):
+                raise bad(
+                    f"{key} = {self[key]!r}{_shown(units, key)}, its parameters give "
+                    f"{expected[key]!r}"
+                )
+        _check_samples(self.samples, expected["samples"], units, bad)
+        for group in ("costs", "constraints"):
+            _check_group(self[group], group, expected[group], units, bad)
+        if self.feasible != evaluation.feasible:
+            violated = ", ".join(f"{k} = {v:.3g}" for k, v in evaluation.violations().items())
+            raise bad(
+                f"feasible = {str(self.feasible).lower()}, its parameters give "
+                f"{str(evaluation.feasible).lower()}"
+                + (f" (Ψ < 0: {violated})" if violated else "")
+            )
+        if self.impact is not None:
+            _check_impact(self.impact, expected["impact"], bad)
+
+
+def _units(record, prefix: str, criterion: str) -> dict:
+    """The units of ``record``'s fields (a record type), their paths under ``prefix``."""
+    units = {}
+    for f in dataclasses.fields(record):
+        unit = f.metadata.get("unit")
+        unit = unit(criterion) if callable(unit) and not isinstance(unit, type) else unit
+        path = f"{prefix}{f.name}"
+        if isinstance(unit, type):
+            units.update(_units(unit, f"{path}.", criterion))
+        elif isinstance(unit, dict):
+            units.update({f"{path}.{key}": value for key, value in unit.items()})
+        elif unit is not None:
+            units[path] = unit
+    return units
+
+
+def _derived(model: Biped, step, evaluation) -> dict:
+    """The fields of a gait that its parameters determine, from its step and its evaluation
+    on the check grid."""
+    qd_plus, _ = model.impact(*step.end)
+    lift = trailing_foot_lift(model, step.end[0], qd_plus)
+    return {
         "period": step.period,
         "step_length": step.step_length,
-        "safety": dataclasses.asdict(optimum.safety),
-        "feasible": optimum.feasible,
         "costs": {
-            "sthenic": ev.sthenic,
-            "energy": ev.energy,
-            "energy_per_metre": ev.energy / step.step_length,
+            "sthenic": evaluation.sthenic,
+            "energy": evaluation.energy,
+            "energy_per_metre": evaluation.energy / step.step_length,
         },
-        "robot": robot.to_dict(),
-        "parameters": dict(zip(PARAMETERS, map(float, optimum.parameters), strict=True)),
-        "constraints": dict(zip(CONSTRAINTS, map(float, ev.worst), strict=True)),
+        "constraints": dict(zip(CONSTRAINTS, map(float, evaluation.worst), strict=True)),
         "impact": {
             "impulse": step.impulse.tolist(),
-            "trailing_foot_lift": trailing_foot_lift(model, step.end[0], qd_plus).tolist(),
-            "consistent": bool(
-                step.impulse[1] > 0 and np.all(trailing_foot_lift(model, step.end[0], qd_plus) >= 0)
-            ),
+            "trailing_foot_lift": lift.tolist(),
+            "consistent": bool(step.impulse[1] > 0 and np.all(lift >= 0)),
             "qd_minus": step.end[1].tolist(),
             "qd_plus": step.start[1].tolist(),
         },
-        "optimizer": {
-            **optimum.report.to_dict(),
-            "variables": dict(zip(VARIABLES, map(_finite_or_none, optimum.variables), strict=True)),
-        },
-        "provenance": dict(provenance) if provenance is not None else make_provenance(),
-        "units": gait_units(optimum.criterion),
-        "samples": {
-            "t": ev.t.tolist(),
-            "q": ev.q.tolist(),
-            "qd": ev.qd.tolist(),
-            "qdd": ev.qdd.tolist(),
-            "torques": ev.torques.tolist(),
-            "wrench": ev.wrench.tolist(),
-            "zmp": ev.zmp.tolist(),
-        },
+        "samples": Samples(
+            **{f.name: getattr(evaluation, f.name) for f in dataclasses.fields(Samples)}
+        ),
     }
 
 
@@ -133,6 +379,15 @@ def write_json(path: str | Path, content: dict) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     return atomic_write_text(path, json.dumps(content, indent=1, allow_nan=False))
+
+
+def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None = None) -> dict:
+    """The file's content of ``optimum``'s gait (``Gait.from_optimum``; the seed is in it)."""
+    return Gait.from_optimum(optimum, robot, provenance).to_dict()
+
+
+read = Gait.read  # the format checked; read_consistent: the figures its parameters' too
+read_consistent = functools.partial(Gait.read, consistent=True)
 
 
 def _finite_number(value) -> bool:
@@ -147,15 +402,6 @@ def _finite_number(value) -> bool:
 
 def _finite_or_none(value):
     return float(value) if math.isfinite(value) else None
-
-
-def _positive_number(value) -> bool:
-    return _finite_number(value) and value > 0
-
-
-def parameters(gait: dict) -> np.ndarray:
-    """The 21 parameters (in ``PARAMETERS`` order) of a gait read by ``read``."""
-    return np.array([gait["parameters"][name] for name in PARAMETERS])
 
 
 def other_kind(content) -> str | None:
@@ -180,7 +426,7 @@ def other_kind(content) -> str | None:
 
 
 def _validation_report(content) -> bool:
-    """Whether ``content`` is a validation report (``validate.report.as_json``)."""
+    """Whether ``content`` is a validation report (``validate.validation.as_json``)."""
     return (
         isinstance(content, dict)
         and "passed" in content
@@ -188,45 +434,19 @@ def _validation_report(content) -> bool:
     )
 
 
-def read(path: str | Path, allowed: str = GAIT_FILE) -> dict:
-    """Read a gait file; samples become numpy arrays. Raises BipedError if it is not one,
-    saying what it is if it is another of this project's files and what is ``allowed``
-    (default a gait file: what the command takes)."""
-    path = Path(path)
-    try:
-        content = json.loads(path.read_text())
-    except OSError as error:
-        raise BipedError(f"gait file {str(path)!r} cannot be read: {error.strerror}") from None
-    except (ValueError, RecursionError) as error:  # JSONDecodeError and UnicodeDecodeError too
-        reason = "nested too deeply" if isinstance(error, RecursionError) else error
-        raise BipedError(
-            f"gait file {str(path)!r} is not valid JSON ({reason}): allowed a gait file "
-            "written by biped optimize, sweep, design or pipeline"
-        ) from None
-
-    def bad(what):
-        return BipedError(f"gait file {str(path)!r} is corrupt: {what}")
-
-    kind = other_kind(content)
-    if kind is not None:  # a valid file of another kind is not corrupt
-        raise BipedError(f"{str(path)!r} is {kind}, not a gait file: allowed {allowed}")
-    found = content.get("format") if isinstance(content, dict) else None
-    if isinstance(found, str) and found.startswith("biped-gait/") and found != FORMAT:
-        raise BipedError(
-            f"gait file {str(path)!r} has format {found!r}, another version's: allowed {allowed}"
-        )
-    if not isinstance(content, dict) or content.get("format") != FORMAT:
-        raise bad(f"format is not {FORMAT!r}")
+def _check_scalars(content: dict, bad) -> None:
+    """The scalar fields present; the speed, period and step length numbers > 0."""
     for key in ("knee", "criterion", "speed", "period", "step_length", "feasible", "costs"):
         if key not in content:
             raise bad(f"missing {key!r}")
     for key in ("speed", "period", "step_length"):
-        if not _positive_number(content[key]):
-            raise bad(f"{key} = {content[key]!r}, allowed a number > 0")
-    try:
-        content["safety"] = Safety(**content["safety"])
-    except (KeyError, TypeError, BipedError) as error:
-        raise bad(f"safety {content.get('safety')!r}: {error}") from None
+        value = content[key]
+        if not (_finite_number(value) and value > 0):
+            raise bad(f"{key} = {value!r}, allowed a number > 0")
+
+
+def _check_kinds(content: dict, bad) -> None:
+    """The knee, the criterion, ``feasible`` and the costs of their kinds."""
     if content["knee"] not in KNEES:
         raise bad(f"knee = {content['knee']!r}, allowed {', '.join(KNEES)}")
     if content["criterion"] not in CRITERIA:
@@ -236,23 +456,10 @@ def read(path: str | Path, allowed: str = GAIT_FILE) -> dict:
     costs = content["costs"]
     if not isinstance(costs, dict) or not all(_finite_number(costs.get(name)) for name in CRITERIA):
         raise bad(f"costs = {costs!r}, allowed finite numbers for {', '.join(CRITERIA)}")
-    try:
-        content["robot"] = Robot.from_mapping(content["robot"], source="robot")
-        names = set(content["parameters"])
-    except (KeyError, TypeError) as error:
-        raise bad(f"robot or parameters missing ({error})") from None
-    except BipedError as error:
-        raise bad(str(error)) from None
-    if (
-        not isinstance(content["parameters"], dict)
-        or names != set(PARAMETERS)
-        or not all(map(_finite_number, content["parameters"].values()))
-    ):
-        raise bad(f"parameters are not the {len(PARAMETERS)} finite numbers of the gait")
-    try:
-        check_speed(Biped(content["robot"], content["knee"]), content["speed"])
-    except BipedError as error:
-        raise bad(str(error)) from None
+
+
+def _check_step(content: dict, bad) -> None:
+    """A step length of a walk, the speed times the period."""
     speed, period, length = content["speed"], content["period"], content["step_length"]
     if length < MIN_STEP_LENGTH:
         raise bad(f"step_length = {length!r} m, allowed {MIN_STEP_LENGTH} m or more")
@@ -261,60 +468,54 @@ def read(path: str | Path, allowed: str = GAIT_FILE) -> dict:
             f"step_length = {length!r} m, allowed speed × period = {speed * period!r} m "
             f"(speed {speed!r} m/s, period {period!r} s)"
         )
+
+
+def _samples(content: dict, bad) -> Samples:
+    """The samples of a file's content, as arrays of the declared widths with one row count,
+    times rising from 0 to the period."""
     samples = content.get("samples")
     if not isinstance(samples, dict):
         raise bad("missing samples")
-    for key, width in SAMPLE_FIELDS.items():
+    arrays = {}
+    for f in dataclasses.fields(Samples):
+        key, columns = f.name, f.metadata["columns"]
         if key not in samples:
             raise bad(f"samples.{key} missing")
         try:
             array = np.asarray(samples[key], dtype=float)
         except (TypeError, ValueError, OverflowError):
             raise bad(f"samples.{key} is not an array of numbers") from None
-        shape = "(N,)" if width == 1 else f"(N, {width})"
-        if array.ndim != (1 if width == 1 else 2) or (width > 1 and array.shape[1] != width):
+        shape = "(N,)" if columns is None else f"(N, {len(columns)})"
+        if array.ndim != (1 if columns is None else 2) or (
+            columns is not None and array.shape[1] != len(columns)
+        ):
             raise bad(f"samples.{key} has shape {array.shape}, allowed {shape}")
         if not np.all(np.isfinite(array)):
             where = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
             raise bad(
                 f"samples.{key}{list(where)} = {array[where]} is not finite: allowed finite numbers"
             )
-        samples[key] = array
-    rows = {key: len(samples[key]) for key in SAMPLE_FIELDS}
+        arrays[key] = array
+    rows = {key: len(array) for key, array in arrays.items()}
     counts = list(rows.values())
     common = max(counts, key=counts.count)  # the odd one out is to blame
     for key, count in rows.items():
         if count != common:
             raise bad(f"samples.{key} has {count} rows, the other samples {common}")
-    t = samples["t"]
+    t, period = arrays["t"], content["period"]
     if common < 2 or t[0] != 0.0 or np.any(np.diff(t) < 0.0):
         raise bad("samples.t does not rise from 0: allowed 2 or more times from 0 to period")
     if not math.isclose(t[-1], period, rel_tol=1e-6):
         raise bad(f"samples.t ends at {t[-1]!r} s, allowed the period {period!r} s")
-    return content
+    return Samples(**arrays)
 
 
-# Consistency: the derived fields of a gait file against those recomputed from its parameters.
-# A file keeps every bit of its numbers (JSON), so only the rounding of another CPU or numpy
-# build (1e-13 of a field's size or so) may separate them; an edited figure differs by far
-# more. Allowed difference: CONSISTENCY_RTOL × the field's largest magnitude (at least 1 in
-# its unit, so fields near zero are not held to nothing).
-CONSISTENCY_RTOL = 1e-9
-# Names of the columns of the sample arrays, for the messages.
-_COLUMNS = {
-    "q": COORDINATES,
-    "qd": COORDINATES,
-    "qdd": COORDINATES,
-    "torques": JOINTS,
-    "wrench": ("Fx", "Fz", "Cy"),
-}
-
-
-def _unit(units: dict, field: str, column: int | None = None) -> str:
+def _shown(units: dict, field: str, column: int | None = None) -> str:
+    """A field's unit as printed after its value ("" for a pure number)."""
     unit = units.get(field, "")
     if isinstance(unit, list):
         unit = unit[column] if column is not None else ""
-    return f" {unit}" if unit and unit != "1" else ""
+    return f" {unit}" if unit and unit != PURE else ""
 
 
 def _mismatch(found, expected) -> tuple[int, float] | None:
@@ -326,102 +527,58 @@ def _mismatch(found, expected) -> tuple[int, float] | None:
     return (worst, float(difference[worst])) if difference[worst] > tolerance else None
 
 
-def check_consistency(gait: dict, source: str = "gait") -> None:
-    """Raise a ``BipedError`` naming the first field of ``gait`` (as ``read`` returns it) that
-    does not belong to its parameters, recomputed as ``to_dict`` computes them (no MuJoCo):
-    period and step length, the samples on the check grid, the costs, the constraints,
-    ``feasible`` and the impact. ``source`` names the file in the message."""
-    from biped.model.criteria import evaluate_step
-    from biped.model.gait import build_step
-    from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
-
-    def bad(what):
-        return BipedError(f"{source} is inconsistent: {what}")
-
-    model = Biped(gait["robot"], gait["knee"])
-    try:
-        step = build_step(model, gait["speed"], parameters(gait))
-    except BipedError as error:
-        raise bad(f"its parameters build no step ({error})") from None
-    evaluation = evaluate_step(model, step, CHECK_SAMPLES_PER_HALF, safety=gait["safety"])
-    units = gait_units(gait["criterion"])
-    for key in ("period", "step_length"):
-        expected = getattr(step, key)
-        if _mismatch(gait[key], expected):
-            raise bad(f"{key} = {gait[key]!r}{_unit(units, key)}, its parameters give {expected!r}")
-    samples = gait["samples"]
-    for key in SAMPLE_FIELDS:
-        expected = getattr(evaluation, key)
-        field = f"samples.{key}"
-        if samples[key].shape != expected.shape:
+def _check_samples(samples: Samples, expected: Samples, units: dict, bad) -> None:
+    """Each sample array against the parameters' (its largest difference named with its time
+    and column)."""
+    for f in dataclasses.fields(Samples):
+        key, columns, path = f.name, f.metadata["columns"], f"samples.{f.name}"
+        found, wanted = samples[key], expected[key]
+        if found.shape != wanted.shape:
             raise bad(
-                f"{field} has shape {samples[key].shape}, the parameters' samples "
-                f"{expected.shape}: {field} do not belong to the parameters"
+                f"{path} has shape {found.shape}, the parameters' samples "
+                f"{wanted.shape}: {path} do not belong to the parameters"
             )
-        found = _mismatch(samples[key], expected)
+        mismatch = _mismatch(found, wanted)
+        if mismatch:
+            index, size = mismatch
+            row, column = divmod(index, wanted.shape[1]) if wanted.ndim == 2 else (index, None)
+            where = f"t = {expected.t[row]:.4f} s" + (
+                f", {columns[column]}" if column is not None else ""
+            )
+            raise bad(
+                f"{path} do not belong to the parameters (off by {size:.3g}"
+                f"{_shown(units, path, column)} at {where})"
+            )
+
+
+def _check_group(stored, group: str, expected: dict, units: dict, bad) -> None:
+    """The costs or the constraints against the parameters'."""
+    if not isinstance(stored, dict):
+        raise bad(f"{group} missing")
+    for name, wanted in expected.items():
+        path = f"{group}.{name}"
+        value = stored.get(name)
+        if not _finite_number(value) or _mismatch(value, wanted):
+            raise bad(
+                f"{path} = {value!r}{_shown(units, path)}, its parameters give "
+                f"{wanted!r}{_shown(units, path)}"
+            )
+
+
+def _check_impact(impact, expected: dict, bad) -> None:
+    """The impact record against the parameters' (its ``consistent`` flag last)."""
+    for name in ("impulse", "qd_minus", "qd_plus", "trailing_foot_lift"):
+        path = f"impact.{name}"
+        try:
+            found = _mismatch(impact[name], expected[name])
+        except (KeyError, TypeError, ValueError):
+            raise bad(
+                f"{path} is not the {np.shape(expected[name])} numbers it should be"
+            ) from None
         if found:
-            index, size = found
-            row, column = divmod(index, expected.shape[1]) if expected.ndim == 2 else (index, None)
-            where = f"t = {evaluation.t[row]:.4f} s" + (
-                f", {_COLUMNS[key][column]}" if column is not None else ""
-            )
-            raise bad(
-                f"{field} do not belong to the parameters (off by {size:.3g}"
-                f"{_unit(units, field, column)} at {where})"
-            )
-    costs = {
-        "sthenic": evaluation.sthenic,
-        "energy": evaluation.energy,
-        "energy_per_metre": evaluation.energy / step.step_length,
-    }
-    constraints = dict(zip(CONSTRAINTS, map(float, evaluation.worst), strict=True))
-    for group, expected_values in (("costs", costs), ("constraints", constraints)):
-        stored = gait.get(group)
-        if not isinstance(stored, dict):
-            raise bad(f"{group} missing")
-        for name, expected in expected_values.items():
-            field = f"{group}.{name}"
-            value = stored.get(name)
-            if not _finite_number(value) or _mismatch(value, expected):
-                raise bad(
-                    f"{field} = {value!r}{_unit(units, field)}, its parameters give "
-                    f"{expected!r}{_unit(units, field)}"
-                )
-    if gait["feasible"] != evaluation.feasible:
-        violated = ", ".join(f"{k} = {v:.3g}" for k, v in evaluation.violations().items())
+            raise bad(f"{path} does not belong to the parameters (off by {found[1]:.3g})")
+    if impact.get("consistent") is not expected["consistent"]:
         raise bad(
-            f"feasible = {str(gait['feasible']).lower()}, its parameters give "
-            f"{str(evaluation.feasible).lower()}" + (f" (Ψ < 0: {violated})" if violated else "")
+            f"impact.consistent = {impact.get('consistent')!r}, its parameters give "
+            f"{str(expected['consistent']).lower()}"
         )
-    impact = gait.get("impact")
-    if impact is not None:
-        qd_plus, impulse = model.impact(*step.end)
-        expected_impact = {
-            "impulse": step.impulse,
-            "qd_minus": step.end[1],
-            "qd_plus": step.start[1],
-            "trailing_foot_lift": trailing_foot_lift(model, step.end[0], qd_plus),
-        }
-        for name, expected in expected_impact.items():
-            field = f"impact.{name}"
-            try:
-                found = _mismatch(impact[name], expected)
-            except (KeyError, TypeError, ValueError):
-                raise bad(f"{field} is not the {np.shape(expected)} numbers it should be") from None
-            if found:
-                raise bad(f"{field} does not belong to the parameters (off by {found[1]:.3g})")
-        lift = expected_impact["trailing_foot_lift"]
-        consistent = bool(step.impulse[1] > 0 and np.all(lift >= 0))
-        if impact.get("consistent") is not consistent:
-            raise bad(
-                f"impact.consistent = {impact.get('consistent')!r}, its parameters give "
-                f"{str(consistent).lower()}"
-            )
-
-
-def read_consistent(path: str | Path, allowed: str = GAIT_FILE) -> dict:
-    """``read``, then ``check_consistency``: a gait file whose derived fields (samples, costs,
-    constraints, feasible, impact) are those of its parameters."""
-    gait = read(path, allowed)
-    check_consistency(gait, f"gait file {str(path)!r}")
-    return gait

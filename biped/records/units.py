@@ -1,8 +1,8 @@
 """Units of the numbers in the project's JSON files: a ``units`` map beside them.
 
-Gait files (``biped.records.gait_file``) and validation reports keep their key names; their
-``units``
-object maps the path of each numeric field to its unit::
+Gait files (``biped.records.gait_file``, whose ``Gait`` declares the unit of each field) and
+validation reports keep their key names; their ``units`` object maps the path of each numeric
+field to its unit::
 
     "costs.sthenic": "N²·m·s",
     "samples.q": ["rad", "rad", "rad", "rad", "rad", "rad", "rad", "m", "m"],
@@ -20,18 +20,11 @@ not be measured) have units; texts, booleans and ``provenance`` have none.
 
 from __future__ import annotations
 
-import dataclasses
-
-from biped.model.criteria import CONSTRAINTS, CRITERIA
-from biped.model.gait import PARAMETERS
+from biped.model.criteria import CONSTRAINTS, CRITERION_UNITS  # noqa: F401 (its units, here too)
 from biped.model.kinematics import ANGLES, COORDINATES
-from biped.model.robot import Robot
-from biped.optimization.problem import VARIABLES
-from biped.records.comparison import CHECKED_VALUE, SOLVER_VALUE
 
 PURE = "1"  # a count or a ratio
 PERIOD = "T"  # a fraction of the gait's period
-CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
 # Fields without units: what produced the file, and the map itself.
 SKIPPED = ("provenance", "units")
 
@@ -103,46 +96,6 @@ def parameter_unit(name: str) -> str:
 CONSTRAINT_UNITS = dict(zip(CONSTRAINTS, ("N", "m", "m", "rad", "rad", "m", "m"), strict=True))
 
 
-def _per_coordinate(angle: str, length: str) -> list[str]:
+def per_coordinate(angle: str, length: str) -> list[str]:
+    """One unit per coordinate (``COORDINATES``): ``angle`` for the angles, else ``length``."""
     return [angle if name in ANGLES else length for name in COORDINATES]
-
-
-def gait_units(criterion: str) -> dict:
-    """The ``units`` map of a gait file optimised for ``criterion``."""
-    value = CRITERION_UNITS[criterion]
-    rates = _per_coordinate("rad/s", "m/s")
-    units = {
-        "speed": "m/s",
-        "period": "s",
-        "step_length": "m",
-        "safety.clearance": "m",
-        "safety.zmp_margin": "m",
-        **{f"costs.{name}": CRITERION_UNITS[name] for name in CRITERIA},
-        "costs.energy_per_metre": "J/m",
-        **{f"robot.{f.name}": robot_unit(f.name) for f in dataclasses.fields(Robot)},
-        **{f"parameters.{name}": parameter_unit(name) for name in PARAMETERS},
-        **{f"constraints.{name}": unit for name, unit in CONSTRAINT_UNITS.items()},
-        "impact.impulse": ["N·s", "N·s", "N·m·s"],
-        "impact.trailing_foot_lift": "m/s",
-        "impact.qd_minus": rates,
-        "impact.qd_plus": rates,
-        "optimizer.starts": PURE,
-        "optimizer.starts_at_best": PURE,
-        "optimizer.iterations": PURE,
-        "optimizer.constraint_violation": "1 (the solver's scaled constraints)",
-        "optimizer.dual_infeasibility": "1 (IPOPT's measure)",
-        "optimizer.seconds": "s",
-        "optimizer.seed": PURE,
-        "optimizer.value": f"{value} ({SOLVER_VALUE}; costs.{criterion} is {CHECKED_VALUE})",
-        "optimizer.history[].value": f"{value} ({SOLVER_VALUE})",
-        "optimizer.history[].iterations": PURE,
-        **{f"optimizer.variables.{name}": parameter_unit(name) for name in VARIABLES},
-        "samples.t": "s",
-        "samples.q": _per_coordinate("rad", "m"),
-        "samples.qd": rates,
-        "samples.qdd": _per_coordinate("rad/s²", "m/s²"),
-        "samples.torques": "N·m",
-        "samples.wrench": ["N", "N", "N·m"],
-        "samples.zmp": "m",
-    }
-    return units

@@ -1,17 +1,26 @@
-"""Interrupts that survive the solver: Ctrl-C and SIGTERM during an IPOPT solve.
+"""Ctrl-C and SIGTERM, in one place: what they do at each moment of a command.
 
-CasADi checks for signals while IPOPT iterates and stops the solver when a signal's Python
-handler raises (KeyboardInterrupt for Ctrl-C, the command line's ``Terminated`` for SIGTERM),
-but it swallows the exception: the solve returns with a status such as
-``NonIpopt_Exception_Thrown`` and the program would go on to the next start, the next point,
-as if nothing had been asked. It does the same while it builds a graph: CasADi asks Python for
-each operand's shape, and a handler that raises during that call loses its exception there
-(the build goes on to its end). ``kept_interrupts`` remembers the signal and, once the solver
-has returned, calls its handler again, so the same exception goes up as it would anywhere
-else:
+A command stopped by Ctrl-C (SIGINT) or SIGTERM ends with one line on stderr, ``biped
+COMMAND: interrupted (Ctrl-C)`` or ``(SIGTERM)``, no traceback, exit status 130 or 143 (128 +
+the signal's number, as a shell reports it), and whole files only: every output is written
+to a temporary file, renamed into place (``biped.runtime.files``) or removed on the way out.
+A campaign saves each optimization as it completes: run again, it skips the files written
+and ends with the files of an uninterrupted run. Moment by moment:
 
-    with kept_interrupts():
-        result = nlp(x0=x0, ...)
+- loading (numpy, CasADi: a second or two): the program ends at once, nothing written yet
+  (``biped_cli/__init__.py``: it must act before ``biped`` loads numpy);
+- a command, in the main thread: Ctrl-C raises ``KeyboardInterrupt``, SIGTERM ``Terminated``
+  (one, ``sigterm_interrupts``), so the same clean-up runs (``finally`` blocks, temporary
+  files, worker pools); ``biped_cli.guard`` prints the line and exits with ``exit_status``;
+- CasADi building a graph or IPOPT solving: CasADi stops at the signal but swallows the
+  exception; ``kept_interrupts`` raises it again once CasADi has returned;
+- a worker pool starting: the signal takes effect once the pool is started
+  (``starting_workers``), never between a worker's start and its first instruction;
+- a worker process (``worker_signals``): Ctrl-C is left to the main process; SIGTERM (the
+  main process terminating its pool) raises ``SystemExit(143)``, again every
+  ``EXIT_AGAIN_AFTER`` seconds until the worker has ended;
+- a Dask cluster: the futures are cancelled; a task already running on a worker finishes
+  and writes its file whole (``biped.runtime.runner``).
 """
 
 from __future__ import annotations
@@ -21,8 +30,66 @@ import signal
 import sys
 import threading
 from collections.abc import Iterator
+from multiprocessing import resource_tracker
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
+EXIT_INTERRUPTED = 128 + signal.SIGINT  # 130
+EXIT_TERMINATED = 128 + signal.SIGTERM  # 143
+# How long a worker that swallowed its SIGTERM's SystemExit runs on before it is raised again [s].
+EXIT_AGAIN_AFTER = 1.0
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM received: raised in the main thread as Ctrl-C raises KeyboardInterrupt, so the
+    same clean-up runs (``finally`` blocks, temporary files removed, worker pools closed)."""
+
+
+def exit_status(interrupt: KeyboardInterrupt) -> tuple[int, str]:
+    """The exit status of a command an interrupt stopped, and the signal's name."""
+    if isinstance(interrupt, Terminated):
+        return EXIT_TERMINATED, "SIGTERM"
+    return EXIT_INTERRUPTED, "Ctrl-C"
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated
+
+
+def _main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+@contextlib.contextmanager
+def sigterm_interrupts() -> Iterator[None]:
+    """Within the block, SIGTERM raises ``Terminated`` in the main thread (elsewhere: no-op)."""
+    if not _main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _python_handlers() -> dict:
+    """The handlers of SIGINT and SIGTERM that are Python's (not those left to the system)."""
+    return {s: h for s in SIGNALS if callable(h := signal.getsignal(s))}
+
+
+@contextlib.contextmanager
+def _replaced(handlers: dict, replacement) -> Iterator[None]:
+    """Within the block, ``replacement`` handles the signals of ``handlers``; they are back
+    after it."""
+    for number in handlers:
+        signal.signal(number, replacement)
+    try:
+        yield
+    finally:
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
+
+
 # CasADi's notice of the exception it swallowed (a line on stderr, through Python's sys.stderr):
 # the interrupt goes up instead, and the command line says it in one line.
 SOLVER_NOTICE = "KeyboardInterruptException"
@@ -67,12 +134,10 @@ def kept_interrupts() -> Iterator[None]:
     """Within the block, a SIGINT or SIGTERM whose Python handler raises is remembered;
     after the block, that handler runs again (and raises again). Elsewhere than in the main
     thread, and for signals left to the system (the process ends at once), it does nothing."""
-    if threading.current_thread() is not threading.main_thread():
+    if not _main_thread():
         yield
         return
-    handlers = {s: signal.getsignal(s) for s in SIGNALS}
-    handlers = {s: h for s, h in handlers.items() if callable(h)}
-    caught: list[int] = []
+    handlers, caught = _python_handlers(), []
 
     def remember(signum, frame):
         try:
@@ -81,17 +146,71 @@ def kept_interrupts() -> Iterator[None]:
             caught.append(signum)
             raise
 
-    for number in handlers:
-        signal.signal(number, remember)
     stderr = sys.stderr
-    sys.stderr = filtered = _WithoutSolverNotice(stderr)
-    try:
-        yield
-    finally:
-        sys.stderr = stderr
-        filtered.release()
-        for number, handler in handlers.items():
-            signal.signal(number, handler)
+    with _replaced(handlers, remember):
+        sys.stderr = filtered = _WithoutSolverNotice(stderr)
+        try:
+            yield
+        finally:
+            sys.stderr = stderr
+            filtered.release()
     if caught:
         handlers[caught[0]](caught[0], None)
         raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def deferred_signals() -> Iterator[None]:
+    """Ctrl-C and SIGTERM received in the block take effect when it ends (their handlers run
+    then), so that what the block starts is not cut in the middle. Main thread only."""
+    if not _main_thread():
+        yield
+        return
+    handlers, received = _python_handlers(), []
+    with _replaced(handlers, lambda signum, frame: received.append(signum)):
+        yield
+    for number in received[:1]:
+        handlers[number](number, None)
+
+
+@contextlib.contextmanager
+def starting_workers() -> Iterator[None]:
+    """Around the start of worker processes (``worker_signals`` in their initializer): they start
+    deaf to Ctrl-C from their first instruction, and a signal received meanwhile (by any
+    thread of this process) takes effect once the block is done.
+
+    A terminal's Ctrl-C reaches every process of its group, and a worker still importing
+    would print a traceback: the workers start with SIGINT blocked (a new process inherits
+    the signal mask of the thread that starts it; ``worker_signals`` then ignores SIGINT).
+    """
+    with deferred_signals():
+        if not hasattr(signal, "pthread_sigmask"):
+            yield
+            return
+        # The pool's locks start multiprocessing's resource tracker, which unblocks SIGINT
+        # after starting: start it first.
+        resource_tracker.ensure_running()
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def worker_signals():
+    """In a worker process: Ctrl-C is left to the main process, and SIGTERM (the main process
+    terminating its workers) raises SystemExit, so a file being written is removed, never
+    left half-written."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _end_worker)
+
+
+def _end_worker(signum, frame):
+    """SIGTERM in a worker: SystemExit. Code that calls back into Python can swallow it
+    (CasADi does, while it asks an operand's shape), and the worker would go on, then wait
+    for its next task forever: the pool's termination never ends. So the exit is raised
+    again every ``EXIT_AGAIN_AFTER`` seconds (SIGALRM) until the worker has ended."""
+    if hasattr(signal, "setitimer"):
+        signal.signal(signal.SIGALRM, _end_worker)
+        signal.setitimer(signal.ITIMER_REAL, EXIT_AGAIN_AFTER, EXIT_AGAIN_AFTER)
+    sys.exit(EXIT_TERMINATED)

@@ -17,13 +17,12 @@ The numbers are the same either way: a task's result depends only on its argumen
 files it reads, never on where or when it runs. numpy's floating-point warnings (overflow in
 ``expm1`` while an optimiser explores) stay off the terminal in every case.
 
-Interrupts: on Ctrl-C (``KeyboardInterrupt``), SIGTERM (the command line raises it as a
-``KeyboardInterrupt``) or an error of a task, the local workers are terminated (each removes
-the temporary file it was writing) or the Dask futures cancelled and the client closed, and the
-exception goes on up. A task already running on a Dask worker cannot be stopped there: it
-finishes and writes its file whole, the file a rerun would write. So a run stopped at any
-moment leaves whole files only, and a rerun that skips the tasks whose files exist ends with
-the files of an uninterrupted run.
+Interrupts (the whole policy: ``biped.runtime.interrupts``): on Ctrl-C, SIGTERM or an error
+of a task, the local workers are terminated (each removes the temporary file it was writing)
+or the Dask futures cancelled and the client closed, and the exception goes on up. A task
+already running on a Dask worker cannot be stopped there: it finishes and writes its file
+whole, the file a rerun would write. So a run stopped at any moment leaves whole files only,
+and a rerun that skips the tasks whose files exist ends with the files of an uninterrupted run.
 
     for line in run_tasks(solve_point, points, jobs=4, progress=bar):
         print(line, file=sys.stderr)
@@ -31,20 +30,17 @@ the files of an uninterrupted run.
 
 from __future__ import annotations
 
-import contextlib
 import multiprocessing
 import os
-import signal
 import sys
-import threading
 import warnings
 from collections.abc import Callable, Iterable, Iterator
-from multiprocessing import resource_tracker
 from typing import Protocol, TextIO
 
 import numpy as np
 
 from biped.errors import BipedError
+from biped.runtime.interrupts import starting_workers, worker_signals
 
 # How long to wait for a Dask scheduler to answer [s].
 CONNECT_TIMEOUT = 10.0
@@ -124,28 +120,12 @@ def _quietly(function: Callable, task):
         return function(task)
 
 
-# How long a worker that swallowed its SIGTERM's SystemExit runs on before it is raised again [s].
-EXIT_AGAIN_AFTER = 1.0
-
-
 def _worker_init():
-    """Workers leave Ctrl-C to the main process, and stop cleanly when it terminates them:
-    SIGTERM raises SystemExit, so a file being written is removed, never left half-written."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, _end_worker)
-    np.seterr(all="ignore")  # as in the command line: numpy's warnings stay off the terminal
+    """A worker's signals (``biped.runtime.interrupts.worker_signals``), and numpy's
+    floating-point warnings off the terminal, as in the command line."""
+    worker_signals()
+    np.seterr(all="ignore")
     warnings.simplefilter("ignore", RuntimeWarning)
-
-
-def _end_worker(signum, frame):
-    """SIGTERM in a worker: SystemExit. Code that calls back into Python can swallow it
-    (CasADi does, while it asks an operand's shape), and the worker would go on, then wait
-    for its next task forever: the pool's termination never ends. So the exit is raised
-    again every ``EXIT_AGAIN_AFTER`` seconds (SIGALRM) until the worker has ended."""
-    if hasattr(signal, "setitimer"):
-        signal.signal(signal.SIGALRM, _end_worker)
-        signal.setitimer(signal.ITIMER_REAL, EXIT_AGAIN_AFTER, EXIT_AGAIN_AFTER)
-    sys.exit(143)
 
 
 def _in_process(function: Callable, tasks: list) -> Iterator:
@@ -156,51 +136,13 @@ def _in_process(function: Callable, tasks: list) -> Iterator:
         yield result
 
 
-@contextlib.contextmanager
-def _signals_deferred() -> Iterator[None]:
-    """Ctrl-C and SIGTERM received in the block take effect when it ends (their handlers run
-    then), so that what the block starts is not cut in the middle. Main thread only."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
-    handlers = {s: h for s, h in handlers.items() if callable(h)}
-    received: list[int] = []
-    for number in handlers:
-        signal.signal(number, lambda signum, frame: received.append(signum))
-    try:
-        yield
-    finally:
-        for number, handler in handlers.items():
-            signal.signal(number, handler)
-    for number in received[:1]:
-        handlers[number](number, None)
-
-
 def _start_pool(jobs: int, pools: list) -> None:
     """Append to ``pools`` a pool of ``jobs`` spawned workers deaf to Ctrl-C from their first
-    instruction.
-
-    A terminal's Ctrl-C reaches every process of its group, and a worker still importing
-    would print a traceback: the workers start with SIGINT blocked (a new process inherits
-    the signal mask of the thread that starts it; ``_worker_init`` then ignores SIGINT). A
-    Ctrl-C or SIGTERM received meanwhile (by any thread of this process) takes effect once
-    the pool is started and in ``pools``, never between a worker's start and its first
-    instructions (that worker would print a traceback).
-    """
+    instruction; a Ctrl-C or SIGTERM received meanwhile takes effect once the pool is started
+    and in ``pools`` (``biped.runtime.interrupts.starting_workers``)."""
     context = multiprocessing.get_context("spawn")
-    with _signals_deferred():
-        if not hasattr(signal, "pthread_sigmask"):
-            pools.append(context.Pool(jobs, initializer=_worker_init))
-            return
-        # The pool's locks start multiprocessing's resource tracker, which unblocks SIGINT
-        # after starting: start it first.
-        resource_tracker.ensure_running()
-        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-        try:
-            pools.append(context.Pool(jobs, initializer=_worker_init))
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+    with starting_workers():
+        pools.append(context.Pool(jobs, initializer=_worker_init))
 
 
 def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:

@@ -1,9 +1,10 @@
 """The validation of a gait file: every check against MuJoCo on one model, and its report.
 
 ``validate`` runs the checks of ``validate.checks`` (the walk's contact read by
-``validate.contact``) and returns them with what the recording and the video draw;
-``as_json`` gives the report: one object per check with its ``passed`` and ``notes``
-(``Check.line`` prints one line per check).
+``validate.contact``) and returns them, with the gait and what the recording and the video
+draw, as one ``Validation`` (``validate.record.record`` and ``validate.video.write_video``
+take it whole); ``as_json`` gives the report: one object per check with its ``passed`` and
+``notes`` (``Check.line`` prints one line per check).
 """
 
 from __future__ import annotations
@@ -15,11 +16,12 @@ import mujoco
 import numpy as np
 
 from biped.model.dynamics import Biped
+from biped.records.gait_file import Gait
 from validate import DEFAULT_STEPS
 from validate import checks as c
 from validate.checks import EXACT, Check
 from validate.model import compile_spec, model_spec
-from validate.samples import GaitSamples, gait_biped
+from validate.samples import GaitSamples
 from validate.simulate import Simulation, Walker
 
 __all__ = ["EXACT", "Check", "Validation", "as_json", "validate"]
@@ -29,6 +31,7 @@ __all__ = ["EXACT", "Check", "Validation", "as_json", "validate"]
 class Validation:
     """The checks of a gait and what the recording and the video draw."""
 
+    gait: Gait  # the gait validated (its summary in the recording)
     checks: list[Check]
     biped: Biped
     samples: GaitSamples
@@ -39,26 +42,21 @@ class Validation:
     def passed(self) -> bool:
         return all(check.passed for check in self.checks)
 
-    @property
-    def step(self) -> GaitSamples:
-        """The gait's step (its ``period``, ``step_length`` and samples)."""
-        return self.samples
-
 
 def validate(
-    gait: dict, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
+    gait: Gait | dict, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
 ):
-    """All checks of a gait file's content (``biped.records.gait_file.read`` or ``to_dict``) on
-    ``model`` (``validate.model.model_spec``: by default the committed model of the gait's
-    knee for Table 1, the model generated from the gait's robot otherwise).
+    """All checks of a gait (``Gait``, or a file's content: ``Gait.of``) on ``model``
+    (``validate.model.model_spec``: by default the committed model of the gait's knee for
+    Table 1, the model generated from the gait's robot otherwise).
 
     Raises BipedError if the model cannot be read or is of the other knee.
     """
-    biped = gait_biped(gait)
-    samples = GaitSamples.from_gait(gait)
-    spec = model if isinstance(model, mujoco.MjSpec) else model_spec(gait, biped, model)
+    gait = Gait.of(gait)
+    biped, samples = gait.biped, GaitSamples.from_gait(gait)
+    spec = model if isinstance(model, mujoco.MjSpec) else model_spec(biped, model)
     robot_model = compile_spec(spec)
-    energy = gait["costs"]["energy"]
+    energy = gait.costs["energy"]
     results = [
         c.check_model(robot_model, biped),
         c.check_inverse_dynamics(robot_model, biped, samples),
@@ -68,7 +66,7 @@ def validate(
     walker = Walker(gait, spec)
     forward, sim, reaction = c.check_forward(walker, steps, energy)
     results += [forward, c.check_gains(walker, steps, energy, forward)]
-    return Validation(results, biped, samples, sim, reaction)
+    return Validation(gait, results, biped, samples, sim, reaction)
 
 
 def as_json(checks) -> dict:
@@ -94,17 +92,3 @@ def as_json(checks) -> dict:
         }
     content["passed"] = all(check.passed for check in checks)
     return content
-
-
-def __getattr__(name: str):
-    """``check_inverse_dynamics(biped, gait)``, as this module had it: the gait on the model of
-    ``biped``'s robot (``validate.checks.check_inverse_dynamics`` takes the model)."""
-    if name == "check_inverse_dynamics":
-        return _inverse_dynamics_on
-    raise AttributeError(f"module 'validate.report' has no attribute {name!r}")
-
-
-def _inverse_dynamics_on(biped, gait: dict) -> Check:
-    """The inverse-dynamics check of ``gait`` on the model of ``biped``'s robot."""
-    model = compile_spec(model_spec(gait, biped))
-    return c.check_inverse_dynamics(model, biped, GaitSamples.from_gait(gait))

@@ -1,0 +1,278 @@
+"""Workflows: a gait from the optimizer to its file, to MuJoCo, to its recording and video.
+
+``validate_and_record``: every check of one gait (``validate.validation``), its recording
+(``validate.record``) claimed by its gait file (``validate.outputs``), its video and report.
+``run_pipeline``: ``biped pipeline`` whole, each knee's optimal gait at one speed written,
+validated and recorded, the knee's radii optimised too with a design problem, the knees
+compared; it prints (``say``) as it goes. The command line checks the input before; nothing
+here parses options. May import ``biped`` and ``validate``, never ``biped_cli``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from biped.model.criteria import Safety
+from biped.model.robot import Robot
+
+
+def validate_and_record(
+    gait: dict,
+    rrd: str | Path,
+    *,
+    steps: int,
+    video: str | Path | None = None,
+    gif: str | Path | None = None,
+    spawn: bool = False,
+    connect: str | None = None,
+    source: str | Path | None = None,
+    model=None,
+):
+    """Every check of a gait (``gait_file.read`` or ``gait_file.to_dict``: in memory) on
+    ``model`` (an MJCF path; None: ``validate.model.model_spec``'s default), its recording at
+    ``rrd`` (also streamed to a viewer with ``spawn`` or ``connect``) and, if asked, the video
+    of its walk at ``video`` (MP4) and ``gif``. ``source``: the gait file, named as the
+    recording's owner (``validate.outputs``).
+
+    Returns the validation and its report (the checks as JSON with their ``units``, the
+    recording's and video's paths).
+    """
+    from biped.records.provenance import provenance
+    from validate import validation
+    from validate.outputs import claim
+    from validate.record import record
+    from validate.units import report_units
+
+    result = validation.validate(gait, steps=steps, model=model)
+    written = record(rrd, result, spawn=spawn, connect=connect)
+    if source is not None:
+        claim(written, source)
+    checks = validation.as_json(result.checks)
+    report = {
+        **checks,
+        "units": report_units(checks),
+        "recording": str(written),
+        "provenance": provenance(),
+    }
+    if video is not None or gif is not None:
+        from validate import video as videos
+
+        report["video"] = [str(path) for path in videos.write_video(video, result, gif=gif)]
+    return result, report
+
+
+def files_lines(report: dict, gait_path: Path | None = None, report_path=None) -> list[str]:
+    """What a workflow prints of the files it wrote for a gait: the gait file and its
+    report (if given), the recording (and its owner record), the videos."""
+    from validate.outputs import recording_lines
+
+    return [
+        *([f"gait {gait_path}, report {report_path}"] if gait_path is not None else []),
+        *recording_lines(report["recording"]),
+        *(f"video {video}" for video in report.get("video", [])),
+    ]
+
+
+@dataclass(frozen=True)
+class Pipeline:
+    """What ``biped pipeline`` runs: the optimal gait of each knee at one speed, validated.
+
+    Gait files and reports go to ``out``, recordings and videos to ``recordings``, each
+    named ``<knee>-<criterion>-<speed>``; ``design``: also the knee's radii optimised
+    (``biped.optimization.design``), named ``design-<criterion>-<speed>``.
+    """
+
+    robot: Robot
+    speed: float  # [m/s]
+    knees: tuple
+    criterion: str
+    safety: Safety
+    steps: int  # steps walked in MuJoCo
+    out: Path
+    recordings: Path
+    budget: dict  # ``optimize``'s keyword arguments: seed, starts, method...
+    video: bool = True  # an MP4 of each walk
+    design: object = None  # a ``biped.optimization.design.DesignProblem``, or None
+
+    def name(self, knee: str) -> str:
+        """The name of a knee's files ('design' for the designed gait)."""
+        return f"{knee}-{self.criterion}-{self.speed:.3f}"
+
+    def validated(self, label: str, gait_path: Path, gait: dict, say: Callable) -> tuple:
+        """Validate the gait written at ``gait_path`` (``gait``: its content) as the
+        pipeline's ``label`` knee; write its report. Returns (passed, its lines of the files
+        written)."""
+        from biped.records import gait_file
+
+        name = gait_path.stem
+        say(f"[{label}] validating {self.steps} steps in MuJoCo...")
+        video = self.recordings / f"{name}.mp4" if self.video else None
+        rrd = self.recordings / f"{name}.rrd"
+        result, report = validate_and_record(
+            gait, rrd, steps=self.steps, video=video, source=gait_path
+        )
+        for check in result.checks:
+            say(f"[{label}]   " + check.line())
+        report_path = gait_file.write_json(
+            self.out / f"{name}.report.json", {**report, "gait": str(gait_path)}
+        )
+        return result.passed, files_lines(report, gait_path, report_path)
+
+
+def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool:
+    """Run the pipeline (``Pipeline``), printing with ``say``; whether every gait is feasible
+    and passes every check."""
+    from biped.model.criteria import CRITERIA
+    from biped.records import gait_file
+    from biped.records.comparison import DIFFERENCE, relative_change
+
+    passed, optima, written = True, {}, {}
+    for knee in pipeline.knees:
+        optima[knee] = optimum = _optimum(pipeline, knee, optima, say)
+        if not _certified(knee, optimum, say):
+            passed = False
+            continue
+        gait = gait_file.to_dict(optimum, pipeline.robot, seed=pipeline.budget["seed"])
+        gait_path = gait_file.write_json(pipeline.out / f"{pipeline.name(knee)}.json", gait)
+        # validated in memory: the file written is this content
+        knee_passed, written[knee] = pipeline.validated(knee, gait_path, gait, say)
+        passed = passed and knee_passed
+    if pipeline.design is not None:
+        passed = _design_stage(pipeline, optima, say) and passed
+    costs = {knee: optima[knee].costs() for knee in written}
+    if len(costs) == 2:
+        revolute, rolling = costs["revolute"], costs["rolling"]
+        changes = ", ".join(
+            f"{criterion} {relative_change(rolling[criterion], revolute[criterion]):+.1f} %"
+            for criterion in CRITERIA
+        )
+        gaits = f"{pipeline.criterion}-optimal gaits"
+        say(f"rolling vs revolute knee, {gaits}: {changes} ({DIFFERENCE})")
+    for knee, lines in written.items():  # every file written, once
+        for line in lines:
+            say(f"{knee:9} {line}")
+    say("all checks passed" if passed else "some checks FAILED")
+    return passed
+
+
+def _optimum(pipeline: Pipeline, knee: str, optima: dict, say: Callable):
+    """The knee's optimal gait, also started from the optima of the knees before it."""
+    from biped.model.dynamics import Biped
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
+
+    say(f"[{knee}] optimizing at {pipeline.speed} m/s ({pipeline.criterion})...")
+    model = Biped(pipeline.robot, knee)
+    problem = GaitProblem(model, pipeline.speed, pipeline.criterion, pipeline.safety)
+    given = [o.variables for o in optima.values() if np.all(np.isfinite(o.variables))]
+    optimum = optimize(problem, given=given, **pipeline.budget)
+    ev = optimum.evaluation
+    say(
+        f"[{knee}] sthenic {ev.sthenic:.4g} N²·m·s, energy {ev.energy:.4g} J, period "
+        f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m "
+        f"({optimum.seconds:.1f} s)"
+    )
+    say(f"[{knee}] {optimum.report.summary()}")
+    return optimum
+
+
+def _certified(knee: str, optimum, say: Callable) -> bool:
+    """Whether the optimum converged and is feasible; says why not."""
+    if not optimum.report.converged:
+        say(f"[{knee}] FAIL  the solver did not converge: {optimum.report.status}")
+        return False
+    if not optimum.feasible:
+        say(f"[{knee}] FAIL  optimum infeasible: {optimum.evaluation.violations_line()}")
+        return False
+    return True
+
+
+def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
+    """The radii optimised at the pipeline's speed, the table of the revolute knee, the
+    Table 1 radii and the optimal radii (the pipeline's own optima where certified), and the
+    designed gait written and validated in MuJoCo as the knees' are. Returns whether every
+    step passed."""
+    from biped.optimization.design import compare
+    from biped.records import gait_file
+    from validate.outputs import check_owner
+
+    problem, name = pipeline.design, pipeline.name("design")
+    rrd, gait_path = pipeline.recordings / f"{name}.rrd", pipeline.out / f"{name}.json"
+    check_owner(rrd, gait_path, "--recordings")
+    say(f"[design] optimizing the knee radii at {pipeline.speed} m/s ({pipeline.criterion})...")
+    given = {
+        label: optima[knee] if knee in optima and optima[knee].certified else None
+        for label, knee in (("revolute", "revolute"), ("reference", "rolling"))
+    }
+    seed, starts = pipeline.budget["seed"], pipeline.budget["starts"]
+    comparison = compare(problem, seed=seed, starts=starts, **given)
+    design = comparison.design
+    for line in comparison.table().splitlines() + bound_notes(problem, design):
+        say(f"[design] {line}")
+    say(f"[design] {radii_line(comparison)}")
+    say(f"[design] {design.report.summary()}")
+    if not design.certified:
+        say(f"[design] FAIL  the design is not certified: {design.report.status}")
+        return False
+    gait_file.write_json(gait_path, designed_gait(comparison, seed))
+    passed, lines = pipeline.validated("design", gait_path, gait_file.read(gait_path), say)
+    for line in lines:  # every file written, once
+        say(f"[design] {line}")
+    return passed and not uncertified(comparison)
+
+
+def radii_line(comparison) -> str:
+    """The optimal radii and criterion of a design, and its gains over the revolute knee and
+    the Table 1 radii."""
+    from biped.model.criteria import CRITERION_UNITS
+
+    design = comparison.design
+    unit = CRITERION_UNITS[comparison.problem.criterion]
+    gains = comparison.gains()
+    bounds = design.at_bounds()
+    return (
+        f"optimal radii: r1 = {design.radii[0]:.4f} m, r2 = {design.radii[1]:.4f} m"
+        f"{' (' + ', '.join(bounds) + ')' if bounds else ''}; "
+        f"{comparison.problem.criterion} {design.value:.6g} {unit}: "
+        f"{gains['design_vs_revolute']:+.2f} % vs revolute, "
+        f"{gains['design_vs_table1']:+.2f} % vs Table 1 radii"
+    )
+
+
+def bound_notes(problem, design=None) -> list[str]:
+    """What the design's bounds did: the robot's own radii moved into them (the reference
+    design of the table), and a designed radius at its lower bound (``MIN_RADIUS``)."""
+    from biped.optimization.design import MIN_RADIUS
+
+    notes = [f"note: {sentence}" for sentence in problem.moved_reference()]
+    for bound in [] if design is None else design.at_bounds():
+        if bound.endswith("lower bound"):
+            notes.append(
+                f"note: {bound} {MIN_RADIUS:g} m: the radii are bounded away from 0, where "
+                "the rolling knee is the revolute knee (the first row); the design gains "
+                "nothing by rolling on that side"
+            )
+    return notes
+
+
+def uncertified(comparison) -> list[str]:
+    """The knees of a comparison that are not certified optima, each with why."""
+    return [
+        f"{label}: {optimum.report.status if not optimum.report.converged else 'infeasible'}"
+        for label, _, optimum in comparison.rows()
+        if not optimum.certified
+    ]
+
+
+def designed_gait(comparison, seed: int) -> dict:
+    """The gait file's content of a design: the designed robot's gait and the comparison."""
+    from biped.records import gait_file
+
+    design = comparison.design
+    content = gait_file.to_dict(design.optimum, design.robot, seed)
+    content["design"] = comparison.to_dict()
+    return content
