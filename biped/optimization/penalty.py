@@ -6,9 +6,8 @@ on the paper's 21 parameters, restarted from the best point with a fresh simplex
 paper suggests. The simplex works on scaled parameters so that one unit is a comparable
 change of every parameter (``SCALES``). Nelder-Mead in 21 dimensions stops far from the
 minimum (its result changes by factors of several with the budget and the seed); it is kept
-so that its results can be set beside certified optima (``biped.optimization.optimize``), and as
-one kind
-of first guess for IPOPT.
+so that its results can be set beside certified optima (``biped.optimization.optimize``),
+and as one kind of first guess for IPOPT.
 
 ``polish`` is the SLSQP refinement with finite-difference derivatives used before IPOPT, kept
 for the benchmark that compares the two.

@@ -61,8 +61,8 @@ SCALES = np.array([0.03, 0.03, 0.03] + [0.3] * 5 + [2.0] * 12 + [0.05])
 FIRST_GUESS_PERIOD = 0.6
 # Samples per spline piece where the solver imposes the constraints Ψ_i >= δ_i (each piece
 # closed: 26 samples); feasibility is then checked on a finer grid
-# (``biped.optimization.optimize.CHECK_SAMPLES_PER_HALF``), where Ψ_i may dip below δ_i between
-# them.
+# (``biped.optimization.optimize.CHECK_SAMPLES_PER_HALF``), where Ψ_i may dip below δ_i
+# between them.
 SOLVER_SAMPLES_PER_HALF = 25
 
 

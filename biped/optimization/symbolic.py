@@ -17,8 +17,8 @@ the same numbers (a test holds them equal to 1e-12). From the variables z
 The speed is a parameter of the graph, so one built graph serves every speed of a sweep.
 With ``design=True`` the knee radii (r1, r2) are symbols too: the constants that depend on
 them (directions, point coefficients, W, g) are built by the numeric model's own point table
-(``biped.model.kinematics.point_table``) from the symbols, so the knee can be optimised with the
-gait (``biped.optimization.design``).
+(``biped.model.kinematics.point_table``) from the symbols, so the knee can be optimised with
+the gait (``biped.optimization.design``).
 """
 
 from __future__ import annotations
