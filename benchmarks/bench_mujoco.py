@@ -28,7 +28,6 @@ from mujoco import rollout  # noqa: E402
 import biped  # noqa: E402
 from biped.optimization.optimize import optimize  # noqa: E402
 from biped.optimization.problem import GaitProblem  # noqa: E402
-from biped.records import gait_file  # noqa: E402
 from biped.records.gait_file import Gait  # noqa: E402
 from validate import mjcf, simulate  # noqa: E402
 from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
@@ -132,8 +131,8 @@ def main():
     for knee in biped.KNEES:
         robot = biped.Robot.paper()
         optimum = optimize(GaitProblem(biped.Biped(robot, knee), 0.3))
-        gait = gaits[knee] = gait_file.to_dict(optimum, robot, seed=0)
-        spec = model_spec(Gait.of(gait).biped)
+        gait = gaits[knee] = Gait.from_optimum(optimum, robot)
+        spec = model_spec(gait.biped)
         factors = {}
         for name, settings in (("committed", spec), ("previous", previous_settings(spec, robot))):
             walker = Walker(gait, settings)

@@ -1,9 +1,12 @@
-"""Argument types of the ``biped`` command: each refuses a bad value with one line naming it."""
+"""Options of the ``biped`` command, one helper per option that commands share, and their
+argument types: each refuses a bad value with one line naming it."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import tempfile
+from pathlib import Path
 
 import numpy as np
 
@@ -42,18 +45,41 @@ CRITERION_HELP = (
 CERTIFIED_HELP = f"certified: {CERTIFIED}"
 
 
+def add_command(commands, name: str, help: str, run):
+    """The parser of the subcommand ``name`` running ``run``, whose docstring describes it."""
+    parser = commands.add_parser(name, help=help, description=run.__doc__)
+    parser.set_defaults(run=run)
+    return parser
+
+
+# Gait files whose outputs share a name (named from their folder and file names).
+SAME_FOLDERS = "gait files in folders of the same name"
+
+
+def distinct_outputs(names: list, what: str, gaits: str = SAME_FOLDERS) -> None:
+    """Refuse ``gaits`` that would write the same output: ``what``, named ``names``."""
+    repeated = sorted({str(name) for name in names if names.count(name) > 1})
+    if repeated:
+        raise BipedError(
+            f"{gaits} would share the {what} {repeated[0]!r}: allowed gait files of distinct "
+            "folder or file names"
+        )
+
+
+@contextlib.contextmanager
+def naming(prefix: str):
+    """Within the block, a BipedError's line begins with ``prefix`` (``gait file 'a.json'``)."""
+    try:
+        yield
+    except BipedError as error:
+        raise BipedError(f"{prefix}: {error}") from None
+
+
 def add_knee(parser, several: bool = False, **kwargs) -> None:
     """``--knee`` (one, required unless ``kwargs`` say otherwise) or ``--knees`` (one or both,
     default both), each knee defined in the help."""
     if several:
-        parser.add_argument(
-            "--knees",
-            nargs="+",
-            choices=KNEES,
-            default=list(KNEES),
-            action=Distinct,
-            help=f"knees to optimise, one or both; {KNEE_HELP} (default: both)",
-        )
+        _add_several(parser, "--knees", KNEES, f"knees to optimise, one or both; {KNEE_HELP}")
     else:
         parser.add_argument("--knee", choices=KNEES, help=f"knee kinematic; {KNEE_HELP}", **kwargs)
 
@@ -62,21 +88,19 @@ def add_criterion(parser, several: bool = False) -> None:
     """``--criterion`` (default sthenic) or ``--criteria`` (one or both, default both), each
     criterion defined with its unit in the help."""
     if several:
-        parser.add_argument(
-            "--criteria",
-            nargs="+",
-            choices=CRITERIA,
-            default=list(CRITERIA),
-            action=Distinct,
-            help=f"criteria to minimise, one or both; {CRITERION_HELP} (default: both)",
-        )
+        help = f"criteria to minimise, one or both; {CRITERION_HELP}"
+        _add_several(parser, "--criteria", CRITERIA, help)
     else:
-        parser.add_argument(
-            "--criterion",
-            choices=CRITERIA,
-            default="sthenic",
-            help=f"criterion to minimise; {CRITERION_HELP} (default %(default)s)",
-        )
+        help = f"criterion to minimise; {CRITERION_HELP} (default %(default)s)"
+        parser.add_argument("--criterion", choices=CRITERIA, default="sthenic", help=help)
+
+
+def _add_several(parser, option: str, choices: tuple, help: str) -> None:
+    """``option``: distinct ``choices``, one or more (default: all)."""
+    help += " (default: both)"
+    parser.add_argument(
+        option, nargs="+", choices=choices, default=list(choices), action=Distinct, help=help
+    )
 
 
 def speed(text: str) -> float:
@@ -125,8 +149,6 @@ def speeds(text: str) -> np.ndarray:
 
 def check_output(path: str, option: str = "--out") -> None:
     """Fail before any work if ``path`` cannot become a file."""
-    from pathlib import Path
-
     target = Path(path)
     if target.is_dir():
         raise BipedError(f"{option} {path!r} is a folder: allowed a file path")
@@ -135,8 +157,6 @@ def check_output(path: str, option: str = "--out") -> None:
 
 def check_folder(path: str, option: str, of: str | None = None) -> None:
     """Fail before any work if ``path`` cannot be (or become) a writable folder."""
-    from pathlib import Path
-
     folder = Path(path)
     named = of if of is not None else path
     existing = folder
@@ -243,6 +263,20 @@ def add_folder(parser, option: str, default: str, what: str) -> None:
     """An output folder, ``--out DIR`` or ``--recordings DIR``: ``what`` it holds."""
     help = f"{what}, {FOLDER_CREATED} (default {default})"
     parser.add_argument(option, default=default, metavar="DIR", help=help)
+
+
+def add_speed(parser, default: float | None = None) -> None:
+    """``--speed V`` [m/s], required without a ``default``."""
+    help = SPEED_HELP + ("" if default is None else " (default %(default)s)")
+    parser.add_argument(
+        "--speed", type=speed, default=default, required=default is None, metavar="V", help=help
+    )
+
+
+def add_speeds(parser, default: np.ndarray, shown: str) -> None:
+    """``--speeds S`` [m/s], a range or a list (``speeds``)."""
+    help = f"START:STOP:COUNT or a list V1,V2,... [m/s] (default {shown})"
+    parser.add_argument("--speeds", type=speeds, default=default, metavar="S", help=help)
 
 
 def add_gait_out(parser) -> None:
@@ -389,6 +423,14 @@ def viewer_url(text: str) -> str:
             "local address"
         )
     return text
+
+
+def campaign(args, label: str) -> dict:
+    """A campaign's ``jobs`` and ``dask`` given on the command line, and its ``progress``: a
+    bar named ``label``."""
+    from biped_cli.progress import Progress
+
+    return {"jobs": args.jobs, "dask": args.dask, "progress": lambda n: Progress(n, label)}
 
 
 def add_dask(parser):

@@ -80,28 +80,18 @@ def cmd_demo(args) -> int:
 
 
 def add_demo(commands) -> None:
-    """Register ``demo`` on the ``biped`` subcommands."""
-    demo = commands.add_parser(
-        "demo",
-        help="torques, ground wrench and ZMP of a one-leg posture",
-        description=cmd_demo.__doc__,
-    )
+    help = "torques, ground wrench and ZMP of a one-leg posture"
+    demo = types.add_command(commands, "demo", help, cmd_demo)
     demo.add_argument(
         "--knee", choices=KNEES, help=f"one knee kinematic; {types.KNEE_HELP} (default: both)"
     )
     types.add_robot(demo)
-    types.add_options(
-        demo,
-        (
-            "--hip-ahead",
-            types.metres,
-            0.05,
-            "M",
-            "[m] hip ahead of the stance ankle (default 0.05)",
-        ),
-        ("--hip-height", types.metres, 0.86, "M", "[m] hip above the ground (default 0.86)"),
-    )
-    demo.set_defaults(run=cmd_demo)
+    for option, default, where in (
+        ("--hip-ahead", 0.05, "ahead of the stance ankle"),
+        ("--hip-height", 0.86, "above the ground"),
+    ):
+        help = f"[m] hip {where} (default {default})"
+        demo.add_argument(option, type=types.metres, default=default, metavar="M", help=help)
 
 
 def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
@@ -166,7 +156,7 @@ def cmd_optimize(args) -> int:
     if not report.converged:
         message = f"biped optimize: the solver did not converge ({report.method}: {report.status})"
         if optimum.feasible:
-            path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
+            path = gait_file.Gait.from_optimum(optimum, robot).write(args.out)
             message += f"; {path} is written but is not a certified optimum"
         else:
             worst = ev.violations_line()
@@ -175,29 +165,24 @@ def cmd_optimize(args) -> int:
         return 1
     if not optimum.feasible:
         print(
-            f"biped optimize: infeasible optimum, violated constraints (Ψ < 0): "
-            f"{ev.violations_line()}; "
-            f"no file written",
+            "biped optimize: infeasible optimum, violated constraints (Ψ < 0): "
+            f"{ev.violations_line()}; no file written",
             file=sys.stderr,
         )
         return 1
-    path = gait_file.write_json(args.out, gait_file.to_dict(optimum, robot, args.seed))
+    path = gait_file.Gait.from_optimum(optimum, robot).write(args.out)
     print(f"wrote {path}")
     return 0
 
 
 def add_optimize(commands) -> None:
-    """Register ``optimize`` on the ``biped`` subcommands."""
-    opt = commands.add_parser(
-        "optimize", help="optimal gait at one speed", description=cmd_optimize.__doc__
-    )
+    opt = types.add_command(commands, "optimize", "optimal gait at one speed", cmd_optimize)
     types.add_knee(opt, required=True)
     types.add_criterion(opt)
-    opt.add_argument("--speed", type=types.speed, required=True, metavar="V", help=types.SPEED_HELP)
+    types.add_speed(opt)
     types.add_gait_out(opt)
     types.add_budget(opt)
     types.add_robot(opt)
-    opt.set_defaults(run=cmd_optimize)
 
 
 def cmd_sweep(args) -> int:
@@ -212,7 +197,6 @@ def cmd_sweep(args) -> int:
     from biped.studies.paper_method import FOLDER, SETTINGS, check_paper_method, run_paper_method
     from biped.studies.paper_method import SPEED as PAPER_METHOD_SPEED
     from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep
-    from biped_cli.progress import Progress
 
     robot = robot_of(args)
     check_folder(args.out, "--out")
@@ -231,9 +215,7 @@ def cmd_sweep(args) -> int:
         seed=args.seed,
         starts=args.starts,
         safety=safety(args),
-        jobs=args.jobs,
-        dask=args.dask,
-        progress=lambda total: Progress(total, "sweep"),
+        **types.campaign(args, "sweep"),
     )
     runs = []
     if args.paper_seeds:
@@ -245,9 +227,7 @@ def cmd_sweep(args) -> int:
             knees=args.knees,
             criteria=args.criteria,
             safety=safety(args),
-            jobs=args.jobs,
-            dask=args.dask,
-            progress=lambda total: Progress(total, "paper's method"),
+            **types.campaign(args, "paper's method"),
         )
 
     def files(n: int) -> str:
@@ -262,14 +242,11 @@ def cmd_sweep(args) -> int:
 
 
 def add_sweep(commands) -> None:
-    """Register ``sweep`` on the ``biped`` subcommands."""
     from biped.studies.sweep import DEFAULT_SPEEDS
 
-    sweep = commands.add_parser(
-        "sweep", help="optimal gaits over speeds, knees, criteria", description=cmd_sweep.__doc__
-    )
-    speeds = "START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.15:0.45:13)"
-    types.add_options(sweep, ("--speeds", types.speeds, DEFAULT_SPEEDS, "S", speeds))
+    help = "optimal gaits over speeds, knees, criteria"
+    sweep = types.add_command(commands, "sweep", help, cmd_sweep)
+    types.add_speeds(sweep, DEFAULT_SPEEDS, "0.15:0.45:13")
     types.add_knee(sweep, several=True)
     types.add_criterion(sweep, several=True)
     types.add_folder(sweep, "--out", DEFAULT_SWEEP, "folder of the sweep")
@@ -283,7 +260,6 @@ def add_sweep(commands) -> None:
          "from N seeds at the speed nearest 0.3 m/s, for every knee and criterion, for "
          "comparison.md (default 5; 0: none)"),
     )  # fmt: skip
-    sweep.set_defaults(run=cmd_sweep)
 
 
 def cmd_figures(args) -> int:
@@ -303,10 +279,7 @@ def cmd_figures(args) -> int:
 
 
 def add_figures(commands) -> None:
-    """Register ``figures`` on the ``biped`` subcommands."""
-    fig = commands.add_parser(
-        "figures", help="figures and table of the comparison", description=cmd_figures.__doc__
-    )
+    fig = types.add_command(commands, "figures", "figures and table of the comparison", cmd_figures)
     fig.add_argument(
         "--sweep",
         default=DEFAULT_SWEEP,
@@ -314,7 +287,6 @@ def add_figures(commands) -> None:
         help="folder of a sweep's results, as biped sweep --out writes it (default %(default)s)",
     )
     types.add_folder(fig, "--out", DEFAULT_FIGURES, "folder of the figures and comparison.md")
-    fig.set_defaults(run=cmd_figures)
 
 
 def read_gaits(paths: list, model: str | None = None) -> list:
@@ -333,10 +305,8 @@ def read_gaits(paths: list, model: str | None = None) -> list:
         from validate.model import model_spec
 
         for path, gait in zip(paths, gaits, strict=True):
-            try:
+            with types.naming(f"--model, gait file {path!r}"):
                 model_spec(gait.biped, model)
-            except BipedError as error:
-                raise BipedError(f"--model, gait file {path!r}: {error}") from None
     return gaits
 
 
@@ -367,7 +337,7 @@ def cmd_validate(args) -> int:
     with Progress(len(args.gait), "validate") as bar:
         for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
             bar.update(note=path)
-            try:
+            with types.naming(f"gait file {path!r}"):
                 result, reports[path] = validate_and_record(
                     gait,
                     rrd,
@@ -379,8 +349,6 @@ def cmd_validate(args) -> int:
                     source=path,
                     model=args.model,
                 )
-            except BipedError as error:
-                raise BipedError(f"gait file {path!r}: {error}") from None
             passed += result.passed
             bar.clear()
             if not args.json:
@@ -423,12 +391,7 @@ def _recordings(args) -> list:
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
         for path in args.gait
     ]
-    duplicated = {str(p) for p in recordings if recordings.count(p) > 1}
-    if duplicated:
-        raise BipedError(
-            f"gait files in folders of the same name would share the recording "
-            f"{sorted(duplicated)[0]!r}: allowed gait files of distinct folder or file names"
-        )
+    types.distinct_outputs(recordings, "recording")
     for rrd, path in zip(recordings, args.gait, strict=True):
         check_output(str(rrd), "--rrd")
         check_owner(rrd, path)  # never another gait's recording
@@ -447,12 +410,8 @@ def _print_validation(path: str, gait, result, report: dict) -> None:
 
 
 def add_validate(commands) -> None:
-    """Register ``validate`` on the ``biped`` subcommands."""
-    val = commands.add_parser(
-        "validate",
-        help="cross-check a gait in MuJoCo and record it",
-        description=cmd_validate.__doc__,
-    )
+    help = "cross-check a gait in MuJoCo and record it"
+    val = types.add_command(commands, "validate", help, cmd_validate)
     types.add_gaits(val)
     types.add_steps(val)
     val.add_argument(
@@ -494,7 +453,6 @@ def add_validate(commands) -> None:
         "local address; default: no stream)",
     )
     types.add_model(val)
-    val.set_defaults(run=cmd_validate)
 
 
 def cmd_pipeline(args) -> int:
@@ -543,14 +501,9 @@ def cmd_pipeline(args) -> int:
 
 
 def add_pipeline(commands) -> None:
-    """Register ``pipeline`` on the ``biped`` subcommands."""
-    pipe = commands.add_parser(
-        "pipeline",
-        help="optimize, validate and record both knees at one speed",
-        description=cmd_pipeline.__doc__,
-    )
-    speed = f"{types.SPEED_HELP} (default %(default)s)"
-    types.add_options(pipe, ("--speed", types.speed, DEFAULT_SPEED, "V", speed))
+    help = "optimize, validate and record both knees at one speed"
+    pipe = types.add_command(commands, "pipeline", help, cmd_pipeline)
+    types.add_speed(pipe, DEFAULT_SPEED)
     types.add_knee(pipe, several=True)
     types.add_criterion(pipe)
     types.add_steps(pipe)
@@ -570,4 +523,3 @@ def add_pipeline(commands) -> None:
         help="also optimise the rolling knee's radii with the gait, validate the designed "
         "gait and compare revolute, Table 1 radii and optimal radii in one table",
     )
-    pipe.set_defaults(run=cmd_pipeline)

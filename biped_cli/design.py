@@ -58,26 +58,15 @@ def _add_common(parser) -> None:
 
 
 def add_parsers(commands) -> None:
-    """Register ``design`` and ``design-map`` on the ``biped`` subcommands."""
-    design = commands.add_parser(
-        "design",
-        help="optimal rolling-knee radii with the gait at one speed",
-        description=cmd_design.__doc__,
-    )
-    design.add_argument(
-        "--speed", type=types.speed, required=True, metavar="V", help=types.SPEED_HELP
-    )
+    help = "optimal rolling-knee radii with the gait at one speed"
+    design = types.add_command(commands, "design", help, cmd_design)
+    types.add_speed(design)
     types.add_gait_out(design)
     _add_common(design)
-    design.set_defaults(run=cmd_design)
 
-    grid = commands.add_parser(
-        "design-map",
-        help="optimal gait over a grid of knee radii, and the optimal radii, per speed",
-        description=cmd_design_map.__doc__,
-    )
-    speeds = "START:STOP:COUNT or a list V1,V2,... [m/s] (default 0.3)"
-    types.add_options(grid, ("--speeds", types.speeds, np.array([0.3]), "S", speeds))
+    help = "optimal gait over a grid of knee radii, and the optimal radii, per speed"
+    grid = types.add_command(commands, "design-map", help, cmd_design_map)
+    types.add_speeds(grid, np.array([0.3]), "0.3")
     for name in ("r1", "r2"):
         grid.add_argument(
             f"--{name}",
@@ -91,27 +80,22 @@ def add_parsers(commands) -> None:
     types.add_jobs(grid)
     types.add_dask(grid)
     _add_common(grid)
-    grid.set_defaults(run=cmd_design_map)
 
 
 def _upper(args, robot) -> tuple:
     """The upper bounds of the radii given on the command line (default the limits)."""
     from biped.optimization.design import MIN_RADIUS, radius_limits
 
-    limits = radius_limits(robot)
     upper = []
-    for name, limit in zip(("r1", "r2"), limits, strict=True):
+    for name, limit in zip(("r1", "r2"), radius_limits(robot), strict=True):
         value = getattr(args, f"max_{name}", None)  # the pipeline has none
-        if value is None:
-            upper.append(limit)
-        elif not MIN_RADIUS < value <= limit:
+        if value is not None and not MIN_RADIUS < value <= limit:
             raise BipedError(
                 f"--max-{name} {value:g} m: allowed > {MIN_RADIUS:g} m (the radii's lower "
                 f"bound) and <= {limit:.4g} m (beyond, the "
                 f"{'shank' if name == 'r1' else 'thigh'}'s centre of mass leaves the segment)"
             )
-        else:
-            upper.append(value)
+        upper.append(limit if value is None else value)
     return tuple(upper)
 
 
@@ -137,7 +121,6 @@ def cmd_design(args) -> int:
     knee it is compared with is not certified.
     """
     from biped.optimization.design import compare
-    from biped.records import gait_file
     from validate.workflows import bound_notes, designed_gait, radii_line, uncertified
 
     robot = types.robot_of(args)
@@ -165,7 +148,7 @@ def cmd_design(args) -> int:
         )
         print(f"biped design: {reason}; no file written", file=sys.stderr)
         return 1
-    path = gait_file.write_json(args.out, designed_gait(comparison, args.seed))
+    path = designed_gait(comparison).write(args.out)
     print(f"wrote {path}")
     bad = uncertified(comparison)
     if bad:
@@ -192,7 +175,6 @@ def cmd_design_map(args) -> int:
     from biped.records.comparison import DIFFERENCE_VS_REVOLUTE
     from biped.runtime.runner import check_dask
     from biped.studies.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
-    from biped_cli.progress import Progress
     from validate.workflows import bound_notes
 
     robot = types.robot_of(args)
@@ -213,9 +195,7 @@ def cmd_design_map(args) -> int:
         upper=problem.upper,
         seed=args.seed,
         starts=args.starts,
-        jobs=args.jobs,
-        dask=args.dask,
-        progress=lambda total: Progress(total, "design map"),
+        **types.campaign(args, "design map"),
     )
     for path in draw(args.out):
         print(f"wrote {path}")

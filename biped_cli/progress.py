@@ -52,10 +52,8 @@ class Progress:
     Args:
         total: units of work (files, optimizations of a sweep).
         label: what is being done, first on the line.
-        stream: where to write (default: ``sys.stderr``).
-        terminal: draw one line redrawn in place (True) or log a line per completed unit, at
-            most one every ``interval`` seconds (False); default: whether ``stream`` is a
-            terminal.
+        stream: where to write (default: ``sys.stderr``); on a terminal, one line redrawn in
+            place, else a line per completed unit, at most one every ``interval`` seconds.
         interval: shortest time between two logged lines [s] (default ``LOG_INTERVAL``).
     """
 
@@ -64,15 +62,12 @@ class Progress:
         total: int,
         label: str = "",
         stream: TextIO | None = None,
-        terminal: bool | None = None,
         interval: float | None = None,
     ):
         self.total, self.label = max(int(total), 0), label
         self.stream = sys.stderr if stream is None else stream
-        if terminal is None:
-            isatty = getattr(self.stream, "isatty", None)
-            terminal = bool(isatty and isatty())
-        self.terminal = terminal
+        isatty = getattr(self.stream, "isatty", None)
+        self.terminal = bool(isatty and isatty())
         self.interval = LOG_INTERVAL if interval is None else interval
         self.done = 0
         self.note = ""

@@ -14,7 +14,7 @@ import json
 from pathlib import Path
 
 from biped.errors import BipedError
-from biped_cli.args import add_folder, add_gaits, check_folder
+from biped_cli.args import add_command, add_folder, add_gaits, check_folder, distinct_outputs
 from biped_cli.commands import DEFAULT_RECORDINGS
 
 DEFAULT_REPORTS = "logs/reports"
@@ -101,23 +101,13 @@ def cmd_report(args) -> int:
                 links=links(Path(path), validation),
             )
         )
-    names = [page.name for page in pages]
-    repeated = sorted({name for name in names if names.count(name) > 1})
-    if repeated:
-        raise BipedError(
-            f"gait files would share the page {repeated[0]!r}: allowed gait files of distinct "
-            "folder or file names"
-        )
+    distinct_outputs([page.name for page in pages], "page", gaits="gait files")
     for written in write_pages(pages, args.out):
         print(f"wrote {written}")
     return 0
 
 
 def add_parser(commands) -> None:
-    """Register ``biped report`` with the subcommands' parser."""
-    parser = commands.add_parser(
-        "report", help="one Markdown page per gait, with figures", description=cmd_report.__doc__
-    )
+    parser = add_command(commands, "report", "one Markdown page per gait, with figures", cmd_report)
     add_gaits(parser)
     add_folder(parser, "--out", DEFAULT_REPORTS, "folder of the pages and their figures")
-    parser.set_defaults(run=cmd_report)

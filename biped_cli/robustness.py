@@ -31,15 +31,11 @@ SHOWN = {
 
 
 def add_parser(commands) -> None:
-    """Register ``robustness`` on the ``biped`` subcommands."""
     from validate.robustness import RobustnessSettings
 
     default = RobustnessSettings()
-    parser = commands.add_parser(
-        "robustness",
-        help="robustness map of gaits in MuJoCo: pushes, friction, trunk mass, gains",
-        description=cmd_robustness.__doc__,
-    )
+    help = "robustness map of gaits in MuJoCo: pushes, friction, trunk mass, gains"
+    parser = types.add_command(commands, "robustness", help, cmd_robustness)
     types.add_gaits(parser)
     types.add_options(
         parser,
@@ -60,7 +56,6 @@ def add_parser(commands) -> None:
         help=f"folder of the maps, {types.FOLDER_CREATED} (default {DEFAULT_ROBUSTNESS}): "
         "<folder>-<gait>.json and .png",
     )
-    parser.set_defaults(run=cmd_robustness)
 
 
 def _settings(args):
@@ -95,8 +90,7 @@ def _value(name: str, value: float | None) -> str:
     _, factor, unit, sign = SHOWN[name]
     if value is None:
         return "n/a"
-    text = f"{factor * value:{sign if value else ''}.3g}"
-    return f"{text} {unit}".rstrip() if unit != "x" else f"{text} x"
+    return f"{factor * value:{sign if value else ''}.3g} {unit}".rstrip()
 
 
 def lines(content: dict) -> list[str]:
@@ -156,7 +150,7 @@ def comparison_lines(maps: dict) -> list[str]:
     return out
 
 
-def _write_map(out: Path, name: str, path: str, gait: dict, source: str, result) -> dict:
+def _write_map(out: Path, name: str, path: str, gait, source: str, result) -> dict:
     """Write a gait's robustness map (``validate.robustness.RobustnessMap``) as
     <out>/<name>.json and .png, both or neither; returns the JSON content."""
     from biped.records.provenance import provenance
@@ -204,21 +198,14 @@ def cmd_robustness(args) -> int:
     types.check_folder(args.out, "--out")  # before the gait files' checks, which take time
     gaits = read_gaits(args.gait, args.model)
     names = [output_name(path) for path in args.gait]
-    repeated = sorted({name for name in names if names.count(name) > 1})
-    if repeated:
-        raise BipedError(
-            f"gait files in folders of the same name would share the map {repeated[0]!r}: "
-            "allowed gait files of distinct folder or file names"
-        )
+    types.distinct_outputs(names, "map")
     out, failed, mapped = Path(args.out), [], {}
     with Progress(len(gaits) * (1 + len(robustness.LIMITS)), "robustness") as bar:
         for path, gait, name in zip(args.gait, gaits, names, strict=True):
             bar.update(note=path)
             began = time.perf_counter()
-            try:
+            with types.naming(f"gait file {path!r}"):
                 result = robustness.robustness_map(gait, args.model, settings, progress=bar)
-            except BipedError as error:
-                raise BipedError(f"gait file {path!r}: {error}") from None
             wall = time.perf_counter() - began
             source = model_source(gait, args.model)
             bar.clear()

@@ -71,8 +71,16 @@ def optimal_gait(knee: str):
     return _OPTIMA[knee]
 
 
-def gait_content(optimum, robot=None) -> dict:
-    """The content of the gait file of ``optimum`` (``gait_file.to_dict``, seed 0), in memory."""
-    from biped.records import gait_file
+def gait_of(optimum, robot=None):
+    """The gait of ``optimum`` (``Gait.from_optimum``), in memory."""
+    from biped.records.gait_file import Gait
 
-    return gait_file.to_dict(optimum, robot or biped.Robot.paper(), seed=0)
+    return Gait.from_optimum(optimum, robot or biped.Robot.paper())
+
+
+def with_torques(gait, torques):
+    """``gait`` with its sample torques (N, 6) replaced by ``torques``."""
+    import dataclasses
+
+    samples = dataclasses.replace(gait.samples, torques=np.asarray(torques, dtype=float))
+    return dataclasses.replace(gait, samples=samples)

@@ -49,11 +49,13 @@ FAST = ["--starts", "1"]
 
 def test_optimize_writes_a_complete_gait_file(tmp_path, capsys):
     """optimize writes every documented field, ≥ 200 samples from t = 0 to T inclusive."""
+    import json
+
     from biped.records import gait_file
 
     out = tmp_path / "gait.json"
     assert main(["optimize", "--knee", "rolling", "--speed", "0.3", "--out", str(out), *FAST]) == 0
-    gait = gait_file.read(out)
+    gait, content = gait_file.read(out), json.loads(out.read_text())
     for key in (
         "knee",
         "criterion",
@@ -66,21 +68,17 @@ def test_optimize_writes_a_complete_gait_file(tmp_path, capsys):
         "parameters",
         "samples",
     ):
-        assert key in gait
-    assert gait["knee"] == "rolling" and gait["feasible"] is True and gait["speed"] == 0.3
+        assert key in content
+    assert gait.knee == "rolling" and gait.feasible is True and gait.speed == 0.3
     assert (
-        isinstance(gait["impact"]["consistent"], bool)
-        and len(gait["impact"]["trailing_foot_lift"]) == 2
+        isinstance(gait.impact["consistent"], bool) and len(gait.impact["trailing_foot_lift"]) == 2
     )
-    assert set(gait["costs"]) >= {"sthenic", "energy"}
-    assert gait["robot"].r1 == 0.05 and len(gait["parameters"]) == 21
-    t = gait["samples"]["t"]
-    assert len(t) >= 200 and t[0] == 0.0 and t[-1] == pytest.approx(gait["period"])
-    assert gait["step_length"] == pytest.approx(gait["speed"] * gait["period"])
-    assert gait["samples"]["q"].shape == (len(t), 9) and gait["samples"]["torques"].shape == (
-        len(t),
-        6,
-    )
+    assert set(gait.costs) >= {"sthenic", "energy"}
+    assert gait.robot.r1 == 0.05 and len(gait.parameters) == 21
+    t = gait.samples.t
+    assert len(t) >= 200 and t[0] == 0.0 and t[-1] == pytest.approx(gait.period)
+    assert gait.step_length == pytest.approx(gait.speed * gait.period)
+    assert gait.samples.q.shape == (len(t), 9) and gait.samples.torques.shape == (len(t), 6)
     assert "wrote" in capsys.readouterr().out
 
 
@@ -162,14 +160,14 @@ def test_pipeline_writes_gait_report_and_recording(tmp_path, capsys, monkeypatch
     printed = capsys.readouterr().out
     monkeypatch.setattr(gait_file, "read", read)
     gait = gait_file.read(out / "rolling-sthenic-0.300.json")
-    assert gait["knee"] == "rolling" and gait["speed"] == 0.3
+    assert gait.knee == "rolling" and gait.speed == 0.3
     report = json.loads((out / "rolling-sthenic-0.300.report.json").read_text())
     assert code == (0 if report["passed"] else 1)
     assert report["inverse_dynamics"]["max_torque_error"] < 1e-6
     assert report["forward"]["steps"] == 2 and not report["forward"]["fell"]
     recording = rrd / "rolling-sthenic-0.300.rrd"
     assert recording.stat().st_size > 0 and str(recording) in printed
-    for record in (gait["provenance"], report["provenance"]):
+    for record in (gait.provenance, report["provenance"]):
         assert record["command"].startswith("biped pipeline --knees rolling")
         assert record["version"] and record["numpy"] and record["mujoco"]
 

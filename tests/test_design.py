@@ -235,9 +235,9 @@ def test_design_command_writes_the_designed_robot_and_compares(designed):
     code, out, err, path = designed
     assert code == 0, err
     gait = gait_file.read(path)
-    radii = gait["design"]["radii"]
-    assert (gait["robot"].r1, gait["robot"].r2) == (radii["r1"], radii["r2"])
-    assert gait["knee"] == "rolling" and gait["optimizer"]["status"] == "converged"
+    radii = gait.design["radii"]
+    assert (gait.robot.r1, gait.robot.r2) == (radii["r1"], radii["r2"])
+    assert gait.knee == "rolling" and gait.optimizer["status"] == "converged"
     rows = {line[:24].strip(): line.split() for line in out.splitlines()[1:4]}
     assert set(rows) == {"revolute", "rolling, Table 1 radii", "rolling, optimal radii"}
     revolute = float(rows["revolute"][3])
@@ -245,7 +245,7 @@ def test_design_command_writes_the_designed_robot_and_compares(designed):
         sthenic, change = float(rows[label][-4]), float(rows[label][-2])
         assert change == pytest.approx(100 * (sthenic / revolute - 1), abs=0.01)
     design = float(rows["rolling, optimal radii"][-4])
-    assert design == pytest.approx(gait["costs"]["sthenic"], rel=1e-4)
+    assert design == pytest.approx(gait.costs["sthenic"], rel=1e-4)
     assert design <= float(rows["rolling, Table 1 radii"][-4]) <= revolute
     assert revolute == pytest.approx(optimal_gait("revolute").evaluation.sthenic, rel=1e-6)
     assert f"r1 = {radii['r1']:.4f} m" in out and "vs Table 1 radii" in out
@@ -332,11 +332,11 @@ def test_pipeline_with_design_compares_three_knees_in_one_table(tmp_path, capsys
     labels = [line[9:33].strip() for line in table]
     assert {"revolute", "rolling, Table 1 radii", "rolling, optimal radii"} <= set(labels)
     gait = gait_file.read(out / "design-sthenic-0.300.json")
-    radii = gait["design"]["radii"]
-    assert (gait["robot"].r1, gait["robot"].r2) == (radii["r1"], radii["r2"])
+    radii = gait.design["radii"]
+    assert (gait.robot.r1, gait.robot.r2) == (radii["r1"], radii["r2"])
     revolute = gait_file.read(out / "revolute-sthenic-0.300.json")
-    compared = {knee["knee"]: knee for knee in gait["design"]["compared"]}
-    assert compared["revolute"]["sthenic"] == revolute["costs"]["sthenic"]
+    compared = {knee["knee"]: knee for knee in gait.design["compared"]}
+    assert compared["revolute"]["sthenic"] == revolute.costs["sthenic"]
     report = json.loads((out / "design-sthenic-0.300.report.json").read_text())
     assert report["inverse_dynamics"]["passed"] and report["impact"]["passed"]
     knee_report = json.loads((out / "revolute-sthenic-0.300.report.json").read_text())
@@ -377,8 +377,8 @@ def test_a_design_against_a_bound_is_said_and_validated(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "note: the robot's own r1 = 0.05 m lies beyond its upper bound 0.03 m" in out
     gait = gait_file.read(path)
-    radii = gait["design"]["radii"]
-    assert min(radii.values()) >= MIN_RADIUS and gait["design"]["reference_moved"]
+    radii = gait.design["radii"]
+    assert min(radii.values()) >= MIN_RADIUS and gait.design["reference_moved"]
     for name, value in radii.items():
         if value == MIN_RADIUS:
             assert f"note: {name} at its lower bound 0.001 m" in out

@@ -12,6 +12,7 @@ import pytest
 from biped import Robot
 from biped.errors import BipedError
 from biped.records import gait_file
+from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import small_optimum
 
@@ -20,7 +21,7 @@ from tests.conftest import small_optimum
 def content():
     """The JSON content of a rolling-knee gait file at 0.3 m/s."""
     optimum = small_optimum("rolling")
-    return json.loads(json.dumps(gait_file.to_dict(optimum, Robot.paper(), seed=0)))
+    return json.loads(json.dumps(Gait.from_optimum(optimum, Robot.paper()).to_dict()))
 
 
 def _write(content, tmp_path, change=None, name="gait.json"):
@@ -45,7 +46,7 @@ def _refusal(path) -> str:
 def test_an_untouched_file_is_consistent(content, tmp_path):
     """A file as written reads back consistent."""
     gait = gait_file.read_consistent(_write(content, tmp_path))
-    assert gait["knee"] == "rolling"
+    assert gait.knee == "rolling"
 
 
 def test_a_file_is_consistent_on_other_cpu_features(content, tmp_path):

@@ -7,6 +7,7 @@ import pytest
 from biped import Robot
 from biped.errors import BipedError
 from biped.records import gait_file
+from biped.records.gait_file import Gait
 from biped.records.provenance import PACKAGE
 from tests.conftest import small_optimum
 
@@ -15,15 +16,15 @@ from tests.conftest import small_optimum
 def content():
     """The JSON content of a rolling-knee gait file at 0.3 m/s."""
     optimum = small_optimum("rolling")
-    return json.loads(json.dumps(gait_file.to_dict(optimum, Robot.paper(), seed=0)))
+    return json.loads(json.dumps(Gait.from_optimum(optimum, Robot.paper()).to_dict()))
 
 
 def test_gait_file_round_trip_with_provenance(content, tmp_path):
     """A written gait file reads back; it records the versions that produced it."""
     path = gait_file.write_json(tmp_path / "g.json", content)
     gait = gait_file.read(path)
-    assert gait["knee"] == "rolling" and gait["samples"]["q"].shape[1] == 9
-    record = gait["provenance"]
+    assert gait.knee == "rolling" and gait.samples.q.shape[1] == 9
+    record = gait.provenance
     assert record["package"] == PACKAGE and record["version"]
     assert record["numpy"] and record["scipy"] and record["python"] and record["command"]
     assert {"casadi", "mujoco", "platform"} <= set(record)

@@ -256,17 +256,16 @@ def test_rolling_knee_discs_are_drawn(knee):
             assert model.geom_group[disc.id] == 2  # shown by default
 
 
-def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
+def fine_spec(gait, factor: int = 4) -> mujoco.MjSpec:
     """The committed scene of ``gait``'s knee at 1/``factor`` of its time step, each sole a box
     on the floor (four contact points) instead of its heel and toe points, the contacts and
     the knee equality as stiff as that step allows, friction harder than the normal force
     (``IMPRATIO_HARD``): the physics the committed model's cheaper settings (2 ms, two points
     a sole, friction as soft as the normal force) stand for."""
-    from biped.records.gait_file import Gait
     from validate import mjcf
     from validate.model import model_spec
 
-    spec = mjcf.with_box_soles(model_spec(Gait.of(gait).biped), ROBOT)
+    spec = mjcf.with_box_soles(model_spec(gait.biped), ROBOT)
     step = mjcf.TIMESTEP / factor
     spec.option.timestep = step
     spec.option.impratio = mjcf.IMPRATIO_HARD
@@ -282,8 +281,7 @@ def fine_spec(gait: dict, factor: int = 4) -> mujoco.MjSpec:
 def _physics(knee: str, spec_of) -> tuple:
     """MuJoCo's inverse-dynamics torques of the optimal gait's samples and the figures of
     its 10-step walk (``validate.checks.walk_figures``) on the model ``spec_of(gait)``."""
-    from biped.records.gait_file import Gait
-    from tests.conftest import gait_content, optimal_gait
+    from tests.conftest import gait_of, optimal_gait
     from validate.checks import walk_figures
     from validate.contact import ground_reaction
     from validate.crosscheck import mujoco_inverse_dynamics, rigid_copy
@@ -292,8 +290,8 @@ def _physics(knee: str, spec_of) -> tuple:
     from validate.simulate import Walker
 
     optimum = optimal_gait(knee)
-    gait = gait_content(optimum)
-    model = Gait.of(gait).biped
+    gait = gait_of(optimum)
+    model = gait.biped
     samples = GaitSamples.from_gait(gait)
     spec = spec_of(gait)
     exact = rigid_copy(compile_spec(spec))
@@ -350,23 +348,21 @@ def test_cheaper_settings_leave_the_physics(knee):
     (``settings_differences``: the same inverse dynamics, the rigid bodies being one robot,
     and the same 10-step walk within stated bounds), and the finer model walks without
     slipping."""
-    from biped.records.gait_file import Gait
     from validate.checks import MAX_SLIP, walks
     from validate.model import model_spec
 
     _, fine, _ = _fine_physics(knee)
     assert walks(fine, 10) and fine["max_slip"] < MAX_SLIP, fine
-    assert settings_differences(knee, lambda gait: model_spec(Gait.of(gait).biped)) == []
+    assert settings_differences(knee, lambda gait: model_spec(gait.biped)) == []
 
 
 def test_settings_too_coarse_are_told_from_the_finer_model():
     """The comparison of settings can fail: a 5 ms step (contacts and knee equality as stiff
     as it allows) lets the rolling knee's stance foot slip and the walk go 3 % further."""
-    from biped.records.gait_file import Gait
     from validate.model import model_spec
 
     def coarse(gait):
-        spec = model_spec(Gait.of(gait).biped)
+        spec = model_spec(gait.biped)
         spec.option.timestep = 0.005
         for geom in spec.geoms:
             if geom.contype or geom.conaffinity:

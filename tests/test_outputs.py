@@ -10,6 +10,7 @@ import pytest
 
 from biped import Robot
 from biped.records import gait_file
+from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import small_optimum
 from validate.outputs import belongs_to, check_owner, claim, output_name, owner
@@ -25,10 +26,10 @@ def _stamp(path: Path):
 def gaits(tmp_path, monkeypatch):
     """The same gait file name in logs/pipeline and logs/sweep, run from tmp_path."""
     monkeypatch.chdir(tmp_path)
-    content = gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0)
+    gait = Gait.from_optimum(small_optimum("rolling"), Robot.paper())
     paths = {}
     for folder in ("pipeline", "sweep"):
-        paths[folder] = gait_file.write_json(Path("logs") / folder / f"{NAME}.json", content)
+        paths[folder] = gait.write(Path("logs") / folder / f"{NAME}.json")
     return paths
 
 
@@ -227,9 +228,7 @@ def test_the_printed_rerun_command_is_this_environments(tmp_path, monkeypatch):
 def test_a_model_of_something_else_is_named(tmp_path, capsys):
     """--model naming a valid MJCF of another mechanism (a pendulum) is one line naming the
     file and what is allowed."""
-    gait = gait_file.write_json(
-        tmp_path / "g.json", gait_file.to_dict(small_optimum("revolute"), Robot.paper(), 0)
-    )
+    gait = Gait.from_optimum(small_optimum("revolute"), Robot.paper()).write(tmp_path / "g.json")
     pendulum = tmp_path / "pendulum.xml"
     pendulum.write_text(
         '<mujoco model="pendulum"><worldbody><body name="pole" pos="0 0 1">'

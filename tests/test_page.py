@@ -10,6 +10,7 @@ from biped import Robot
 from biped.model.criteria import CONSTRAINTS
 from biped.model.gait import PARAMETERS
 from biped.records import gait_file
+from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import small_optimum
 from validate.outputs import claim
@@ -23,7 +24,7 @@ def written(tmp_path_factory):
     video beside; its page written by 'biped report' into logs/reports."""
     root = tmp_path_factory.mktemp("page")
     gait_path = root / "logs/pipeline" / f"{NAME}.json"
-    gait_file.write_json(gait_path, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), 0))
+    Gait.from_optimum(small_optimum("rolling"), Robot.paper()).write(gait_path)
     recording = root / "logs/recordings" / f"{NAME}.rrd"
     recording.parent.mkdir(parents=True)
     recording.write_bytes(b"recording")
@@ -59,12 +60,12 @@ def test_page_states_the_gait_by_name_with_units(written):
     gait = gait_file.read(gait_path)
     for name in PARAMETERS:
         unit = "s" if name == "period" else "m" if name.endswith("_hip") else "rad"
-        assert f"| {name} | {gait['parameters'][name]:.6g} | {unit}" in text
-    assert f"| {gait['costs']['sthenic']:.5g} | N²·m·s |" in text
-    assert f"| {gait['costs']['energy']:.5g} | J |" in text
+        assert f"| {name} | {gait.parameters[name]:.6g} | {unit}" in text
+    assert f"| {gait.costs['sthenic']:.5g} | N²·m·s |" in text
+    assert f"| {gait.costs['energy']:.5g} | J |" in text
     t_n, psi, _ = constraint_profile(gait)
     for i, name in enumerate(CONSTRAINTS):
-        worst = gait["constraints"][name]
+        worst = gait.constraints[name]
         assert np.nanmin(psi[:, i]) == pytest.approx(worst, rel=1e-9, abs=1e-12)
         at = t_n[int(np.nanargmin(psi[:, i]))]
         assert f"| {worst:.4g} |" in text and f"| {at:.3f} |" in text
@@ -146,7 +147,7 @@ def optimal_page(tmp_path_factory):
     from tests.conftest import optimal_gait
 
     path = tmp_path_factory.mktemp("optimal") / f"{NAME}.json"
-    gait_file.write_json(path, gait_file.to_dict(optimal_gait("rolling"), Robot.paper(), 0))
+    Gait.from_optimum(optimal_gait("rolling"), Robot.paper()).write(path)
     gait = gait_file.read(path)
     return gait, markdown(Page(NAME, path, gait), path.parent), gait_figures(gait)
 
@@ -157,9 +158,9 @@ def test_page_says_why_the_torques_jump_at_the_knot(optimal_page):
     from matplotlib.lines import Line2D
 
     gait, text, figures = optimal_page
-    t, torques = gait["samples"]["t"], gait["samples"]["torques"]
+    t, torques = gait.samples.t, gait.samples.torques
     k = int(np.flatnonzero(np.diff(t) == 0.0)[0])
-    assert t[k] == pytest.approx(gait["period"] / 2)
+    assert t[k] == pytest.approx(gait.period / 2)
     jumps = torques[k + 1] - torques[k]
     largest = jumps[int(np.argmax(np.abs(jumps)))]
     assert abs(largest) > 0.1  # the paper's C¹ spline: a jump worth saying
@@ -184,11 +185,11 @@ def test_page_says_where_constraints_dip_below_the_solver_margin(optimal_page):
     from biped.pages.page import CONSTRAINT_MEANING
 
     gait, text, figures = optimal_page
-    model = Biped(gait["robot"], gait["knee"])
-    step = build_step(model, gait["speed"], gait.parameter_vector)
+    model = Biped(gait.robot, gait.knee)
+    step = build_step(model, gait.speed, gait.parameter_vector)
 
     def below(n):
-        psi = evaluate_step(model, step, n, safety=gait["safety"]).constraints
+        psi = evaluate_step(model, step, n, safety=gait.safety).constraints
         delta = margin_profile(n)
         with np.errstate(invalid="ignore"):
             return psi, (delta > 0) & (psi < delta * (1 - 1e-6))

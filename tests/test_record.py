@@ -9,6 +9,7 @@ import rerun.chunk
 from biped import Robot
 from biped.model.dynamics import JOINTS
 from biped.records import gait_file
+from biped.records.gait_file import Gait
 from tests.conftest import small_optimum
 
 ROBOT = Robot.paper()
@@ -21,8 +22,7 @@ def recorded(tmp_path_factory):
     from validate.validation import validate
 
     folder = tmp_path_factory.mktemp("record")
-    gait = gait_file.to_dict(small_optimum("rolling"), ROBOT, seed=0)
-    gait_file.write_json(folder / "rolling.json", gait)
+    Gait.from_optimum(small_optimum("rolling"), ROBOT).write(folder / "rolling.json")
     gait = gait_file.read(folder / "rolling.json")
     result = validate(gait, steps=2)
     path = record(folder / "rolling.rrd", result)

@@ -2,14 +2,12 @@
 torques pass; for the optimal gaits at 0.3 m/s, any one joint's torques 20 % off, the torques
 played 10 % of a period late, or every torque but the stance ankle's zeroed, fail."""
 
-import copy
-
 import numpy as np
 import pytest
 
 from biped.model.dynamics import JOINTS
 from biped.records.gait_file import Gait
-from tests.conftest import gait_content, optimal_gait
+from tests.conftest import gait_of, optimal_gait, with_torques
 from validate.checks import FEEDFORWARD_SHARE, check_feedforward
 from validate.model import model_spec
 from validate.replay import replay_model, replay_step
@@ -21,8 +19,8 @@ KNEES = ("revolute", "rolling")
 @pytest.fixture(scope="module", params=KNEES)
 def optimum(request):
     """The optimal gait of a knee, its robot and its replay model."""
-    gait = gait_content(optimal_gait(request.param))
-    biped = Gait.of(gait).biped
+    gait = gait_of(optimal_gait(request.param))
+    biped = gait.biped
     spec = model_spec(biped)
     return gait, biped, spec, replay_model(spec, biped.knee)
 
@@ -32,12 +30,10 @@ def shares(gait, biped, model) -> np.ndarray:
     return replay_step(model, GaitSamples.from_gait(gait), biped, "left").shares()
 
 
-def mutated(gait: dict, change) -> dict:
+def mutated(gait: Gait, change) -> Gait:
     """A copy of ``gait`` whose sample torques (N, 6) are ``change(torques, samples)``."""
-    gait = copy.deepcopy(gait)
-    torques = np.array(gait["samples"]["torques"], dtype=float)
-    gait["samples"]["torques"] = change(torques, GaitSamples.from_gait(gait)).tolist()
-    return gait
+    torques = np.array(gait.samples.torques, dtype=float)
+    return with_torques(gait, change(torques, GaitSamples.from_gait(gait)))
 
 
 def test_exact_torques_pass(optimum):

@@ -3,7 +3,6 @@ it the gait fails), the friction limit is no lower than what the gait's own grou
 needs, wrong torques show in a narrower map and a shifted trunk-mass window, the map is the
 same on one process or two and on a rerun, and bad input is one line."""
 
-import copy
 import dataclasses
 import json
 import os
@@ -17,10 +16,9 @@ import pytest
 from biped import Robot
 from biped.errors import BipedError
 from biped.model.robot import FOOT_FRICTION
-from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped_cli import main
-from tests.conftest import gait_content, optimal_gait
+from tests.conftest import gait_of, optimal_gait, with_torques
 from validate import robustness
 from validate.checks import walk_verdict
 from validate.mjcf import FOLDER
@@ -43,7 +41,7 @@ OPTIONS = ["--steps", "6", "--push-step", "2", "--iterations", "4"]
 @pytest.fixture(scope="module")
 def gait():
     """The optimal rolling-knee gait at 0.3 m/s, in memory."""
-    return gait_content(optimal_gait("rolling"))
+    return gait_of(optimal_gait("rolling"))
 
 
 @pytest.fixture(scope="module")
@@ -61,10 +59,8 @@ def _fails(walker, settings: WalkSettings) -> list[str]:
     return walk_verdict(walker, walker.walk(SETTINGS.steps, settings), SETTINGS.steps)
 
 
-def _with_torques(gait: dict, scale: float) -> dict:
-    wrong = copy.deepcopy(gait)
-    wrong["samples"]["torques"] = (scale * np.asarray(gait["samples"]["torques"])).tolist()
-    return wrong
+def _with_torques(gait: Gait, scale: float) -> Gait:
+    return with_torques(gait, scale * gait.samples.torques)
 
 
 def test_every_limit_is_a_closed_bisection(mapped):
@@ -102,7 +98,7 @@ def test_friction_limit_lies_between_the_gait_s_need_and_the_model_s(mapped, gai
     FOOT_FRICTION) and no lower than the largest |Fx| / Fz of the gait's own ground force;
     on half of it the stance foot slips."""
     limit = mapped.limits["friction"]
-    wrench = np.asarray(gait["samples"]["wrench"])
+    wrench = gait.samples.wrench
     needed = float(np.max(np.abs(wrench[:, 0]) / wrench[:, 1]))
     assert mapped.friction == FOOT_FRICTION
     assert needed <= limit.limit < FOOT_FRICTION
@@ -206,7 +202,7 @@ def test_trunk_mass_models_come_from_the_robot(gait):
     """The model of a trunk 10 % heavier is generated from the robot's parameters with
     trunk_mass x 1.1; scaling the trunk of the committed model gives the same masses and
     inertias, and no error gives the committed model itself."""
-    biped = Gait.of(gait).biped
+    biped = gait.biped
     committed = FOLDER / "scene_rolling.xml"
     paper = compile_spec(mujoco.MjSpec.from_file(str(committed)))
     generated = compile_spec(trunk_mass_spec(biped, 0.1))
@@ -232,7 +228,7 @@ def test_the_map_is_the_same_on_two_processes(gait, mapped):
 
 @pytest.fixture(scope="module")
 def gait_path(gait, tmp_path_factory):
-    return gait_file.write_json(tmp_path_factory.mktemp("gaits") / "rolling.json", gait)
+    return gait.write(tmp_path_factory.mktemp("gaits") / "rolling.json")
 
 
 @pytest.fixture(scope="module")

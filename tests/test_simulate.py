@@ -2,15 +2,12 @@
 gain from half to twice the default, and a walk that scuffs, rolls its foot, slides or
 shuffles is told apart from one that walks."""
 
-import copy
-
 import mujoco
 import numpy as np
 import pytest
 
 from biped.model.kinematics import ZH
-from biped.records.gait_file import Gait
-from tests.conftest import gait_content, optimal_gait, small_optimum
+from tests.conftest import gait_of, optimal_gait, small_optimum, with_torques
 from validate import contact
 from validate.checks import MAX_FOOT_TILT, MAX_SLIP, scuff_notes, walk_figures, walks
 from validate.model import model_spec
@@ -23,7 +20,7 @@ STEPS = 20
 def walk(request):
     """Both robots' optimal gaits at 0.3 m/s walked for 20 steps, with their figures."""
     optimum = optimal_gait(request.param)
-    walker = Walker(gait_content(optimum))
+    walker = Walker(gait_of(optimum))
     sim = walker.walk(STEPS)
     figures = walk_figures(
         walker.biped, walker.samples, sim, optimum.costs()["energy"], contact.ground_reaction(sim)
@@ -82,8 +79,8 @@ def test_walk_holds_over_the_gains(walk, scale):
 def test_fall_ends_the_simulation():
     """Without torques and feedback the robot collapses: the simulation stops once the hip
     has dropped by a quarter, within two steps, and the report says fell."""
-    gait = copy.deepcopy(gait_content(small_optimum("revolute")))
-    gait["samples"]["torques"] = np.zeros_like(gait["samples"]["torques"]).tolist()
+    gait = gait_of(small_optimum("revolute"))
+    gait = with_torques(gait, np.zeros_like(gait.samples.torques))
     walker = Walker(gait)
     sim = walker.walk(3, WalkSettings(kp_scale=0.0, kv_scale=0.0))
     assert len(sim.landed) <= 2 and not sim.landed[-1]
@@ -96,8 +93,8 @@ def test_flipped_torques_roll_the_stance_foot():
     """With every torque of the file's sign flipped, the stance foot rolls onto its heel
     within the first step, the hip still up (its toe lifts by centimetres): the foot check
     fails before any fall."""
-    gait = copy.deepcopy(gait_content(optimal_gait("revolute")))
-    gait["samples"]["torques"] = (-np.asarray(gait["samples"]["torques"])).tolist()
+    gait = gait_of(optimal_gait("revolute"))
+    gait = with_torques(gait, -gait.samples.torques)
     walker = Walker(gait)
     sim = walker.walk(2)
     first = contact.foot_tilt(sim, walker.period)
@@ -111,8 +108,8 @@ def test_a_scuff_fails_the_walk_with_its_duration_and_depth():
     """A plank 4 mm high on the floor in the left foot's path (the gait clears the floor by
     1 mm): the swing foot touches it before its landing window, and the walk fails with the
     time it spent on it and how deep it went."""
-    gait = gait_content(optimal_gait("revolute"))
-    biped = Gait.of(gait).biped
+    gait = gait_of(optimal_gait("revolute"))
+    biped = gait.biped
     spec = model_spec(biped)
     spec.worldbody.add_geom(
         name="plank",
@@ -136,7 +133,7 @@ def test_a_scuff_fails_the_walk_with_its_duration_and_depth():
 def test_low_friction_slips():
     """On a floor of friction coefficient 0.05 (the gait needs |Fx| / Fz up to about 0.1)
     the stance foot slides by centimetres: no step counts."""
-    walker = Walker(gait_content(optimal_gait("revolute")))
+    walker = Walker(gait_of(optimal_gait("revolute")))
     sim = walker.walk(6, WalkSettings(friction=0.05))
     figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
     assert figures["max_slip"] > 10 * MAX_SLIP and figures["steps"] == 0
@@ -145,7 +142,7 @@ def test_low_friction_slips():
 def test_push_gives_its_impulse():
     """A push gives the trunk the impulse asked for, over one reading period, and moves the
     robot's centre of mass the way it pushes."""
-    walker = Walker(gait_content(small_optimum("rolling")))
+    walker = Walker(gait_of(small_optimum("rolling")))
     free = walker.walk(3)
     after = int(np.searchsorted(free.time, 0.3 + 2 * RESYNC))
     for impulse in (-5.0, 5.0):
@@ -159,7 +156,7 @@ def test_shuffling_is_a_fall():
     """Landings that do not carry the hip forward by half a step length are not steps: a walk
     whose hip is held in place from its second step (a robot shuffling) walked one step and
     fell."""
-    walker = Walker(gait_content(small_optimum("revolute")))
+    walker = Walker(gait_of(small_optimum("revolute")))
     sim = walker.walk(4)
     held = sim.step_slices()[1].start
     qpos = sim.qpos.copy()
@@ -174,7 +171,7 @@ def test_phase_follows_the_hip():
     """The controller's phase is the gait's time at the hip's advance over the stance ankle:
     0 at the start of the walk, through the whole step by its touchdown, and moving back
     only by what a reading of the state every 20 ms corrects."""
-    walker = Walker(gait_content(small_optimum("rolling")))
+    walker = Walker(gait_of(small_optimum("rolling")))
     sim = walker.walk(1)
     assert sim.landed == [True]
     assert sim.phase[0] == pytest.approx(0.0, abs=1e-9)
@@ -188,7 +185,7 @@ def test_walk_spends_the_gait_energy(knee):
     MuJoCo's actuators spend per step, feedback and landings included, is the gait's
     energy criterion to a few per cent."""
     optimum = small_optimum(knee)
-    walker = Walker(gait_content(optimum))
+    walker = Walker(gait_of(optimum))
     sim = walker.walk(4)
     figures = walk_figures(walker.biped, walker.samples, sim, optimum.costs()["energy"])
     assert figures["steps"] == 4
@@ -198,7 +195,7 @@ def test_walk_spends_the_gait_energy(knee):
 
 def test_simulation_is_deterministic():
     """The same gait simulated twice gives the same states, bit for bit."""
-    walker = Walker(gait_content(small_optimum("rolling")))
+    walker = Walker(gait_of(small_optimum("rolling")))
     first, second = (walker.walk(2) for _ in range(2))
     assert np.array_equal(first.qpos, second.qpos) and np.array_equal(first.ctrl, second.ctrl)
 
@@ -209,7 +206,7 @@ def test_an_unstable_walk_counts_its_warnings_and_writes_no_log(tmp_path, monkey
     MuJoCo's warning handler is the caller's again after it."""
     monkeypatch.chdir(tmp_path)
     before = mujoco.get_mju_user_warning()
-    walker = Walker(gait_content(small_optimum("revolute")))
+    walker = Walker(gait_of(small_optimum("revolute")))
     sim = walker.walk(1, WalkSettings(kp_scale=1e4))
     assert sim.warnings > 0
     assert not walks(walk_figures(walker.biped, walker.samples, sim, 1.0), 1)

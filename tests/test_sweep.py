@@ -4,6 +4,7 @@ come from them."""
 
 import io
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -35,11 +36,11 @@ def test_sweep_saves_every_point_certified(sweep):
     assert len(files) == 2 * 2 * len(SPEEDS)
     for path in files:
         gait = gait_file.read(path)
-        assert path.name == f"{gait['knee']}-{gait['criterion']}-{gait['speed']:.3f}.json"
-        assert gait["optimizer"]["status"] == "converged" and gait["feasible"]
+        assert path.name == f"{gait.knee}-{gait.criterion}-{gait.speed:.3f}.json"
+        assert gait.optimizer["status"] == "converged" and gait.feasible
         # its own start, its one neighbouring speed's and the other knee's, and for the
         # energy criterion the sthenic optimum of its own problem under both barriers
-        assert gait["optimizer"]["starts"] == 3 + 2 * (gait["criterion"] == "energy")
+        assert gait.optimizer["starts"] == 3 + 2 * (gait.criterion == "energy")
     assert "16 optimizations for 8 points" in log
     assert "0 already done (0 of stage 1, 0 of stage 2), 16 to run" in log
     assert "8 of 8 points certified" in log
@@ -169,14 +170,12 @@ def test_figures_and_table(sweep, tmp_path):
     best = {}
     for knee in biped.KNEES:
         gaits = [gait_file.read(p) for p in folder.glob(f"{knee}-sthenic-*.json")]
-        best[knee] = min(gaits, key=lambda g: g["costs"]["sthenic"])
-    difference = 100 * (
-        best["rolling"]["costs"]["sthenic"] / best["revolute"]["costs"]["sthenic"] - 1
-    )
+        best[knee] = min(gaits, key=lambda g: g.costs["sthenic"])
+    difference = 100 * (best["rolling"].costs["sthenic"] / best["revolute"].costs["sthenic"] - 1)
     assert f"| -17.0 % | {difference:+.1f} % |" in table
-    assert f"| 0.27 | {best['revolute']['speed']:.3f} |" in table
+    assert f"| 0.27 | {best['revolute'].speed:.3f} |" in table
     gaits = [gait_file.read(p) for p in folder.glob("*-*.json")]
-    confirmed = sum(g["optimizer"]["starts_at_best"] >= 2 for g in gaits)
+    confirmed = sum(g.optimizer["starts_at_best"] >= 2 for g in gaits)
     assert f"{confirmed} of 8 optima were reached by at least two starts" in table
 
 
@@ -248,27 +247,21 @@ def test_each_figure_is_drawn_with_its_labels(sweep):
     angles = figures["fig6.png"]
     names = ["swing foot qp2", "stance shank q1", "stance thigh q2", "swing thigh q3"]
     assert {*names, "swing shank q4", "trunk q5", "angle from the vertical [°]"} <= _texts(angles)
-    gait = next(g for g in series[("rolling", "sthenic")] if g["speed"] == 0.3)
+    gait = next(g for g in series[("rolling", "sthenic")] if g.speed == 0.3)
     for title, k in (("stance shank q1", 2), ("swing thigh q3", 4), ("trunk q5", 6)):
         drawn = [line.get_ydata() for line in _panel(angles, title).get_lines()]
-        assert any(np.allclose(y, np.degrees(gait["samples"]["q"][:, k])) for y in drawn), title
+        assert any(np.allclose(y, np.degrees(gait.samples.q[:, k])) for y in drawn), title
     ground = figures["fig7.png"]
     texts = _texts(ground)
     assert f"μ = {FOOT_FRICTION:g}, the model's friction" in texts
     friction = _panel(ground, "|Fx| / Fz: friction needed")
     assert any(np.allclose(line.get_ydata(), FOOT_FRICTION) for line in friction.get_lines())
     for knee in biped.KNEES:
-        gait = next(g for g in series[(knee, "sthenic")] if g["speed"] == 0.3)
-        wrench = gait["samples"]["wrench"]
+        gait = next(g for g in series[(knee, "sthenic")] if g.speed == 0.3)
+        wrench = gait.samples.wrench
         largest = np.max(np.abs(wrench[:, 0]) / wrench[:, 1])
         assert f"largest |Fx|/Fz {largest:.3f}" in texts
         assert friction.get_ylim()[1] > max(largest, FOOT_FRICTION)
-
-
-class _Fields(dict):
-    """A gait's fields read as a ``Gait`` record's (``gait.costs``) or by name."""
-
-    __getattr__ = dict.__getitem__
 
 
 def _synthetic_series(outlier=None):
@@ -279,7 +272,7 @@ def _synthetic_series(outlier=None):
     for knee in biped.KNEES:
         for criterion in ("sthenic", "energy"):
             series[(knee, criterion)] = [
-                _Fields(
+                SimpleNamespace(  # the fields of a ``Gait`` the figures read
                     knee=knee,
                     criterion=criterion,
                     speed=float(v),
@@ -294,7 +287,7 @@ def _synthetic_series(outlier=None):
             ]
     if outlier is not None:
         knee, index, factor = outlier
-        series[(knee, "sthenic")][index]["costs"]["energy"] *= factor
+        series[(knee, "sthenic")][index].costs["energy"] *= factor
     return series
 
 
@@ -305,10 +298,10 @@ def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
     from biped.pages.figures import criterion_figure
 
     series = _synthetic_series(("rolling", 12, 30.0))
-    value = series[("rolling", "sthenic")][12]["costs"]["energy"]
+    value = series[("rolling", "sthenic")][12].costs["energy"]
     figure = criterion_figure(series, "sthenic", "energy", "Fig. 4")
     energy = _panel(figure, "energy criterion of the same gaits")
-    others = [g["costs"]["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]][:-1]
+    others = [g.costs["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]][:-1]
     low, high = energy.get_ylim()
     assert high < value and low <= min(others) and max(others) <= high
     assert max(others) - min(others) > 0.5 * (high - low)  # the bulk fills the axis
@@ -316,7 +309,7 @@ def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
     plain = criterion_figure(_synthetic_series(), "sthenic", "energy", "Fig. 4")
     assert not [t for t in _texts(plain) if "off scale" in t]
     low, high = _panel(plain, "energy criterion of the same gaits").get_ylim()
-    everything = [g["costs"]["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]]
+    everything = [g.costs["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]]
     assert low <= min(everything) and sorted(everything)[-2] <= high
 
 
@@ -325,15 +318,15 @@ def test_a_gait_not_certified_is_marked_apart_from_the_curves():
     from biped.pages.figures import criterion_figure
 
     series = _synthetic_series()
-    gait = _Fields(series[("revolute", "sthenic")].pop(4))
-    gait["optimizer"] = {"status": "Maximum_Iterations_Exceeded"}
+    gait = series[("revolute", "sthenic")].pop(4)
+    gait.optimizer = {"status": "Maximum_Iterations_Exceeded"}
     figure = criterion_figure(series, "sthenic", "energy", "Fig. 4", flagged=[gait])
     texts = _texts(figure)
     assert "revolute: not certified\n(solver: Maximum_Iterations_Exceeded)" in texts
     assert "not certified" in texts  # the legend
     panel = _panel(figure, "optimal sthenic criterion")
     curve = next(line for line in panel.get_lines() if line.get_label() == LABELS["revolute"])
-    assert gait["speed"] not in list(curve.get_xdata())
+    assert gait.speed not in list(curve.get_xdata())
 
 
 def test_figures_are_written_all_or_none(sweep, tmp_path, monkeypatch):
@@ -439,8 +432,7 @@ def test_every_difference_between_the_knees_has_one_sign(sweep, tmp_path):
     figures = sweep_figures(series, flagged)
     for criterion, name in (("sthenic", "fig4.png"), ("energy", "fig8.png")):
         best = {
-            knee: min(g["costs"][criterion] for g in series[(knee, criterion)])
-            for knee in biped.KNEES
+            knee: min(g.costs[criterion] for g in series[(knee, criterion)]) for knee in biped.KNEES
         }
         change = relative_change(best["rolling"], best["revolute"])
         assert f"| {change:+.1f} % |" in table
@@ -449,7 +441,7 @@ def test_every_difference_between_the_knees_has_one_sign(sweep, tmp_path):
         expected = [
             relative_change(
                 *(
-                    next(g for g in series[(k, criterion)] if g["speed"] == v)["costs"][criterion]
+                    next(g for g in series[(k, criterion)] if g.speed == v).costs[criterion]
                     for k in ("rolling", "revolute")
                 )
             )

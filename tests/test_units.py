@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from biped import Robot
-from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped.records.units import PURE, missing, numeric_paths
 from tests.conftest import small_optimum
@@ -20,7 +19,7 @@ from tests.conftest import small_optimum
 def gait(tmp_path_factory):
     """A gait file's JSON content, as written."""
     path = tmp_path_factory.mktemp("units") / "rolling.json"
-    gait_file.write_json(path, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
+    Gait.from_optimum(small_optimum("rolling"), Robot.paper()).write(path)
     return json.loads(path.read_text())
 
 

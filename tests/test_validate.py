@@ -7,7 +7,7 @@ import pytest
 import rerun.chunk
 
 from biped import Robot
-from biped.records import gait_file
+from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import small_optimum
 
@@ -17,7 +17,7 @@ def gait_path(tmp_path_factory):
     """A gait file of the rolling knee at 0.3 m/s, produced by the optimiser."""
     optimum = small_optimum("rolling")
     path = tmp_path_factory.mktemp("gait") / "rolling.json"
-    gait_file.write_json(path, gait_file.to_dict(optimum, Robot.paper(), seed=0))
+    Gait.from_optimum(optimum, Robot.paper()).write(path)
     return path
 
 
@@ -136,7 +136,7 @@ def heavy_gait(tmp_path_factory):
     robot = dataclasses.replace(paper, trunk_mass=1.1 * paper.trunk_mass)
     optimum = optimize(GaitProblem(Biped(robot, "revolute"), 0.3))
     path = tmp_path_factory.mktemp("heavy") / "heavy.json"
-    return gait_file.write_json(path, gait_file.to_dict(optimum, robot, seed=0))
+    return Gait.from_optimum(optimum, robot).write(path)
 
 
 def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_path, capsys):
@@ -302,7 +302,7 @@ def test_a_gait_under_other_gravity_passes_on_its_own_model(knee):
     from biped import Biped
     from biped.optimization.optimize import optimize
     from biped.optimization.problem import GaitProblem
-    from tests.conftest import gait_content
+    from tests.conftest import gait_of
     from validate import checks
     from validate.mjcf import FOLDER
     from validate.model import compile_spec, model_spec
@@ -313,7 +313,7 @@ def test_a_gait_under_other_gravity_passes_on_its_own_model(knee):
     optimum = optimize(
         GaitProblem(biped, 0.3), method="nelder-mead", max_restarts=0, evaluations_per_run=100
     )
-    gait = gait_content(optimum, robot)
+    gait = gait_of(optimum, robot)
     samples = GaitSamples.from_gait(gait)
     own = compile_spec(model_spec(biped))
     assert own.opt.gravity[2] == -9.5

@@ -6,6 +6,7 @@ import pytest
 
 from biped import Robot
 from biped.records import gait_file
+from biped.records.gait_file import Gait
 from tests.conftest import small_optimum
 from tests.test_mjcf import needs_gl
 
@@ -18,7 +19,7 @@ def walk(tmp_path_factory):
     from validate.validation import validate
 
     path = tmp_path_factory.mktemp("gait") / "rolling.json"
-    gait_file.write_json(path, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
+    Gait.from_optimum(small_optimum("rolling"), Robot.paper()).write(path)
     return validate(gait_file.read(path), steps=2)
 
 
@@ -124,7 +125,7 @@ def test_validate_command_writes_the_video_and_a_gif(tmp_path, capsys):
     from biped_cli import main
 
     gait = tmp_path / "rolling.json"
-    gait_file.write_json(gait, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
+    Gait.from_optimum(small_optimum("rolling"), Robot.paper()).write(gait)
     mp4 = tmp_path / "walk.mp4"
     args = ["validate", str(gait), "--steps", "1", "--rrd", str(tmp_path / "r.rrd")]
     assert main([*args, "--video", str(mp4), "--gif", "--json"]) in (0, 1)
@@ -144,7 +145,7 @@ def test_frame_command_writes_a_png_of_the_walk(tmp_path):
     from validate.video import CAPTION_HEIGHT, leg_pixels, main
 
     gait = tmp_path / "rolling.json"
-    gait_file.write_json(gait, gait_file.to_dict(small_optimum("rolling"), Robot.paper(), seed=0))
+    Gait.from_optimum(small_optimum("rolling"), Robot.paper()).write(gait)
     png = tmp_path / "walk.png"
     assert main([str(gait), "--steps", "1", "--frame", str(png), "--at", "0"]) == 0
     image = np.asarray(Image.open(png).convert("RGB"))

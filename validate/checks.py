@@ -34,6 +34,7 @@ import numpy as np
 
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import ZH
+from biped.records.gait_file import Gait
 from biped.records.units import PURE
 from validate import contact
 from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
@@ -161,7 +162,7 @@ def check_inverse_dynamics(model: mujoco.MjModel, biped: Biped, samples: GaitSam
     return Check("inverse_dynamics", passed and figures["max_zmp_error"] < EXACT, figures)
 
 
-def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait: dict) -> Check:
+def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait: Gait) -> Check:
     """MuJoCo's impact map of the file's end state against the file's start velocities (the
     legs swapped: the new stance leg is the old swing leg) and its impulse."""
     exact = rigid_copy(model)

@@ -46,6 +46,7 @@ import rerun.blueprint as rrb
 from biped.errors import BipedError
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.robot import SOLE_EDGES
+from biped.records.gait_file import Gait
 from biped.runtime.files import atomic_path
 from validate.checks import LANDING
 from validate.contact import SAMPLE_EVERY
@@ -289,32 +290,25 @@ def _body_poses(model: mujoco.MjModel, qpos: np.ndarray, bodies: list) -> tuple:
     return positions, quaternions
 
 
-def summary(
-    biped: Biped, step: GaitSamples, sim: Simulation, checks=(), gait: dict | None = None
-) -> str:
+def summary(biped: Biped, step: GaitSamples, sim: Simulation, checks, gait: Gait) -> str:
     """Markdown: the gait's parameters and criteria, then every check with its verdict."""
     lines = [f"# {biped.knee} knee, {'PASS' if all(c.passed for c in checks) else 'FAIL'}"]
     if not checks:
         lines[0] = f"# {biped.knee} knee"
     lines += ["", "## Gait", "", "| | |", "|---|---|"]
-    rows = [("knee", biped.knee)]
-    if gait is not None:
-        rows += [
-            ("criterion", gait.get("criterion")),
-            ("speed [m/s]", f"{gait['speed']:.3f}"),
-            ("feasible", "yes" if gait.get("feasible") else "no"),
-        ]
-    rows += [
+    rows = [
+        ("knee", biped.knee),
+        ("criterion", gait.criterion),
+        ("speed [m/s]", f"{gait.speed:.3f}"),
+        ("feasible", "yes" if gait.feasible else "no"),
         ("period T [s]", f"{step.period:.4f}"),
         ("step length [m]", f"{step.step_length:.4f}"),
         ("steps simulated", str(len(sim.stances))),
     ]
-    if gait is not None:
-        rows += [(f"criterion {name}", f"{value:.4g}") for name, value in gait["costs"].items()]
-        rows += [
-            (f"constraint {name}", f"{value:.4g}")
-            for name, value in (gait.get("constraints") or {}).items()
-        ]
+    rows += [(f"criterion {name}", f"{value:.4g}") for name, value in gait.costs.items()]
+    rows += [
+        (f"constraint {name}", f"{value:.4g}") for name, value in (gait.constraints or {}).items()
+    ]
     lines += [f"| {name} | {value} |" for name, value in rows]
     if checks:
         lines += ["", "## Checks", ""]

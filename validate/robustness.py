@@ -69,17 +69,7 @@ MAX_GAIN_SCALE = 16.0
 MACHINE_STEPS = 1
 # The nominal walk's settings (the validation's walk).
 NOMINAL = WalkSettings()
-# The limits, in the order of the map.
-LIMITS = (
-    "push_forward",
-    "push_backward",
-    "friction",
-    "trunk_mass_heavier",
-    "trunk_mass_lighter",
-    "kp_scale_low",
-    "kp_scale_high",
-)
-# Unit of each limit's values.
+# The limits, in the order of the map, and the unit of each one's values.
 LIMIT_UNITS = {
     "push_forward": "N·s",
     "push_backward": "N·s",
@@ -89,6 +79,7 @@ LIMIT_UNITS = {
     "kp_scale_low": PURE,
     "kp_scale_high": PURE,
 }
+LIMITS = tuple(LIMIT_UNITS)
 
 
 @dataclass(frozen=True)
@@ -406,7 +397,7 @@ class _Mapper:
 
 
 def map_limit(
-    gait: Gait | dict,
+    gait: Gait,
     name: str,
     model: str | Path | None = None,
     settings: RobustnessSettings = RobustnessSettings(),
@@ -416,7 +407,7 @@ def map_limit(
     if name not in LIMITS:
         raise BipedError(f"limit {name!r}: allowed one of {', '.join(LIMITS)}")
     with quiet_mujoco():
-        return _Mapper(Gait.of(gait), model, settings).limit(name)
+        return _Mapper(gait, model, settings).limit(name)
 
 
 # The mapper of the gait being mapped, in this process: (key, _Mapper).
@@ -434,13 +425,13 @@ def _limit_task(task: tuple) -> Limit:
 
 
 def robustness_map(
-    gait: Gait | dict,
+    gait: Gait,
     model: str | Path | None = None,
     settings: RobustnessSettings = RobustnessSettings(),
     progress: ProgressBar | None = None,
 ) -> RobustnessMap:
-    """The robustness map of a gait (``Gait``, or a file's content: ``Gait.of``) on ``model``
-    (a path; None: ``validate.model.model_spec``'s default).
+    """The robustness map of a gait on ``model`` (a path; None: ``validate.model.model_spec``'s
+    default).
 
     The nominal walk first, in this process; then the limits, on ``settings.jobs`` processes
     (``biped.runtime.runner.run_tasks``: Ctrl-C or SIGTERM stops them all).
@@ -452,7 +443,7 @@ def robustness_map(
     Raises BipedError if the model cannot be read, is of the other knee or its trunk's mass
     cannot be scaled.
     """
-    key, gait = f"{os.getpid()}-{next(_MAPS)}", Gait.of(gait)
+    key = f"{os.getpid()}-{next(_MAPS)}"
     mapper = _Mapper(gait, model, settings)
     _PREPARED[:] = [(key, mapper)]
     try:

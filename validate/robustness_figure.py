@@ -11,7 +11,7 @@ from __future__ import annotations
 from matplotlib.figure import Figure
 
 WALKS = "#2a9d8f"
-UNSURE = "#e9c46a"
+UNSURE_BAR = dict(color="#e9c46a", hatch="///", edgecolor="0.3")
 BRACKET = "0.6"
 DPI = 120
 
@@ -25,8 +25,15 @@ ROWS = (
 )
 
 
-def _nominal(content: dict, name: str) -> float:
-    return content["limits"][name]["bracket"][0]
+def _end(limit: dict, factor: float) -> tuple:
+    """A limit's end of its row: (the value found to walk, the first value found to fail or
+    None, the bracket's far end), each times ``factor``."""
+    fails = limit["fails_at"]
+    return (
+        factor * limit["limit"],
+        None if fails is None else factor * fails,
+        factor * limit["bracket"][1],
+    )
 
 
 def robustness_figure(content: dict, title: str) -> Figure:
@@ -35,47 +42,21 @@ def robustness_figure(content: dict, title: str) -> Figure:
     figure = Figure(figsize=(8.0, 6.0), layout="constrained")
     axes = figure.subplots(len(ROWS), 1)
     for ax, (label, low, high, factor, scale) in zip(axes, ROWS, strict=True):
-        nominal = factor * _nominal(content, low)
-        ends = []
-        for name in (low, high):
-            if name is None:  # the nominal value is that end: not searched
-                ends.append(None)
-                continue
-            limit = limits[name]
-            fails = limit["fails_at"]
-            ends.append(
-                (
-                    factor * limit["limit"],
-                    None if fails is None else factor * fails,
-                    factor * limit["bracket"][1],
-                )
-            )
-        searched = [end for end in ends if end is not None]
-        ends = [(nominal, None, nominal) if end is None else end for end in ends]
-        (low_walks, _, low_far), (high_walks, _, high_far) = ends
+        nominal = factor * limits[low]["bracket"][0]
+        searched = [_end(limits[name], factor) for name in (low, high) if name is not None]
+        (low_walks, _, low_far), (high_walks, _, high_far) = (
+            (nominal, None, nominal) if name is None else _end(limits[name], factor)
+            for name in (low, high)  # None: the nominal value is that end, not searched
+        )
         ax.set_xscale(scale)
         ax.plot([low_far, high_far], [0, 0], color=BRACKET, linewidth=1, zorder=1)
         ax.barh(0, high_walks - low_walks, left=low_walks, height=0.5, color=WALKS, zorder=2)
         for walks, fails, _ in searched:
             if fails is not None:
                 start, stop = sorted((walks, fails))
-                ax.barh(
-                    0,
-                    stop - start,
-                    left=start,
-                    height=0.5,
-                    color=UNSURE,
-                    hatch="///",
-                    edgecolor="0.3",
-                    zorder=2,
-                )
-            ax.annotate(
-                f"{walks:.3g}" if fails is not None else f"≥ {walks:.3g} (bracket end walks)",
-                (walks, 0.3),
-                ha="center",
-                va="bottom",
-                fontsize=8,
-            )
+                ax.barh(0, stop - start, left=start, height=0.5, zorder=2, **UNSURE_BAR)
+            text = f"{walks:.3g}" if fails is not None else f"≥ {walks:.3g} (bracket end walks)"
+            ax.annotate(text, (walks, 0.3), ha="center", va="bottom", fontsize=8)
         ax.axvline(nominal, color="k", linewidth=1.5, zorder=3)
         ax.annotate(f"nominal {nominal:g}", (nominal, -0.3), ha="center", va="top", fontsize=8)
         ax.set_ylim(-0.8, 0.8)

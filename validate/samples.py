@@ -49,10 +49,9 @@ class GaitSamples:
     zmp: np.ndarray
 
     @classmethod
-    def from_gait(cls, gait: Gait | dict) -> GaitSamples:
-        """The samples of a gait (``Gait``, or a file's content: ``Gait.of``)."""
-        gait = Gait.of(gait)
-        arrays = {key: np.asarray(gait.samples[key], dtype=float) for key in ("t", *FIELDS)}
+    def from_gait(cls, gait: Gait) -> GaitSamples:
+        """The samples of a gait."""
+        arrays = {key: np.asarray(getattr(gait.samples, key), float) for key in ("t", *FIELDS)}
         arrays["zmp"] = arrays["zmp"].reshape(-1, 1)
         return cls(period=float(gait.period), step_length=float(gait.step_length), **arrays)
 

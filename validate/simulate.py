@@ -346,14 +346,14 @@ class Walker:
     """A gait file prepared for walking on one MuJoCo model.
 
     Args:
-        gait: the gait (``Gait``, or a file's content: ``Gait.of``).
+        gait: the gait (``Gait``).
         model: the scene to walk on (``validate.model.model_spec``: a file, or by default the
             committed model of the gait's knee for Table 1, the generated one otherwise);
             a spec, or a path.
     """
 
-    def __init__(self, gait: Gait | dict, model: mujoco.MjSpec | str | None = None):
-        self.gait = Gait.of(gait)
+    def __init__(self, gait: Gait, model: mujoco.MjSpec | str | None = None):
+        self.gait = gait
         self.biped: Biped = self.gait.biped
         self.samples = GaitSamples.from_gait(self.gait)
         spec = model if isinstance(model, mujoco.MjSpec) else model_spec(self.biped, model)
@@ -374,7 +374,7 @@ class Walker:
 
 
 def simulate(
-    gait: Gait | dict,
+    gait: Gait,
     steps: int = DEFAULT_STEPS,
     settings: WalkSettings = WalkSettings(),
     model=None,

@@ -44,15 +44,14 @@ class Validation:
 
 
 def validate(
-    gait: Gait | dict, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
+    gait: Gait, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
 ):
-    """All checks of a gait (``Gait``, or a file's content: ``Gait.of``) on ``model``
+    """All checks of a gait on ``model``
     (``validate.model.model_spec``: by default the committed model of the gait's knee for
     Table 1, the model generated from the gait's robot otherwise).
 
     Raises BipedError if the model cannot be read or is of the other knee.
     """
-    gait = Gait.of(gait)
     biped, samples = gait.biped, GaitSamples.from_gait(gait)
     spec = model if isinstance(model, mujoco.MjSpec) else model_spec(biped, model)
     robot_model = compile_spec(spec)

@@ -18,6 +18,7 @@ before any work (``check_suffix``).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from functools import lru_cache
 from pathlib import Path
@@ -88,14 +89,7 @@ def leg_pixels(image: np.ndarray) -> dict:
 class WalkRenderer:
     """Frames of a simulated walk, with the gait's ghost, from the model's tracking camera."""
 
-    def __init__(
-        self,
-        biped: Biped,
-        step,
-        sim: Simulation,
-        size: tuple[int, int] = SIZE,
-        ghost: bool = True,
-    ):
+    def __init__(self, biped: Biped, step, sim: Simulation, ghost: bool = True):
         self.biped, self.step, self.sim = biped, step, sim
         self.model = sim.model
         self.data = mujoco.MjData(self.model)
@@ -104,15 +98,14 @@ class WalkRenderer:
         kept = quality.shadowsize, quality.offsamples
         quality.shadowsize, quality.offsamples = SHADOW_SIZE, OFFSCREEN_SAMPLES
         try:
-            self.renderer = mujoco.Renderer(self.model, height=size[1], width=size[0])
+            self.renderer = mujoco.Renderer(self.model, height=SIZE[1], width=SIZE[0])
         finally:
             quality.shadowsize, quality.offsamples = kept
         self.option = mujoco.MjvOption()
         self.perturb = mujoco.MjvPerturb()
         self.maps = {side: mapping(self.model, side, biped.radii) for side in SIDES}
-        self.ankle_x = {
-            side: sim.sensor(f"{side}_ankle_pos")[:, 0] for side in SIDES
-        }  # MuJoCo's ankles [m]
+        # MuJoCo's ankles [m]
+        self.ankle_x = {side: sim.sensor(f"{side}_ankle_pos")[:, 0] for side in SIDES}
 
     def close(self) -> None:
         self.renderer.close()
@@ -143,13 +136,9 @@ class WalkRenderer:
             mujoco.mj_kinematics(self.model, self.ghost_data)
             scene = self.renderer.scene
             first = scene.ngeom
+            dynamic = mujoco.mjtCatBit.mjCAT_DYNAMIC
             mujoco.mjv_addGeoms(
-                self.model,
-                self.ghost_data,
-                self.option,
-                self.perturb,
-                mujoco.mjtCatBit.mjCAT_DYNAMIC,
-                scene,
+                self.model, self.ghost_data, self.option, self.perturb, dynamic, scene
             )
             for i in range(first, scene.ngeom):
                 scene.geoms[i].rgba[:] = GHOST_RGBA
@@ -182,9 +171,9 @@ def caption_band(left: str, right: str, passed: bool | None, width: int) -> np.n
     return np.asarray(band)
 
 
-def frame_states(sim: Simulation, fps: int = FPS) -> np.ndarray:
-    """Indices of the simulation states shown at ``fps`` frames per second."""
-    times = np.arange(sim.time[0], sim.time[-1] + 1e-9, 1.0 / fps)
+def frame_states(sim: Simulation) -> np.ndarray:
+    """Indices of the simulation states shown at ``FPS`` frames per second."""
+    times = np.arange(sim.time[0], sim.time[-1] + 1e-9, 1.0 / FPS)
     return np.minimum(np.searchsorted(sim.time, times), len(sim.time) - 1)
 
 
@@ -225,7 +214,7 @@ def verdict_of(checks) -> tuple[str, bool]:
     return text, passed
 
 
-def write_mp4(path: str | Path, frames, fps: int = FPS) -> Path:
+def write_mp4(path: str | Path, frames) -> Path:
     """Write frames (iterable of equal (H, W, 3) uint8 arrays) as an H.264 MP4, atomically
     (its missing folders created)."""
     import imageio_ffmpeg
@@ -239,7 +228,7 @@ def write_mp4(path: str | Path, frames, fps: int = FPS) -> Path:
         writer = imageio_ffmpeg.write_frames(
             str(tmp),
             (width, height),
-            fps=fps,
+            fps=FPS,
             codec="libx264",
             pix_fmt_out="yuv420p",
             quality=7,
@@ -256,7 +245,7 @@ def write_mp4(path: str | Path, frames, fps: int = FPS) -> Path:
     return path
 
 
-def write_gif(path: str | Path, frames, fps: int = FPS) -> Path:
+def write_gif(path: str | Path, frames) -> Path:
     """Write frames as an animated GIF (every GIF_EVERY-th, scaled by GIF_SCALE), atomically
     (its missing folders created)."""
     from PIL import Image
@@ -275,45 +264,42 @@ def write_gif(path: str | Path, frames, fps: int = FPS) -> Path:
             format="GIF",
             save_all=True,
             append_images=images[1:],
-            duration=round(1000 * GIF_EVERY / fps),
+            duration=round(1000 * GIF_EVERY / FPS),
             loop=0,
         )
     return path
 
 
-def _captioned(validation, ghost: bool) -> Captioned:
+@contextlib.contextmanager
+def _captioned(validation, ghost: bool):
     """The walk of a validation (``validate.validation.Validation``) captioned with its
-    verdict; its ``renderer`` is to be closed."""
+    verdict, its renderer closed after the block."""
     verdict, passed = verdict_of(validation.checks) if validation.checks else ("", None)
     renderer = WalkRenderer(
         validation.biped, validation.samples, validation.simulation, ghost=ghost
     )
-    return Captioned(renderer, verdict, passed)
+    try:
+        yield Captioned(renderer, verdict, passed)
+    finally:
+        renderer.close()
 
 
 def write_video(
-    path: str | Path | None,
-    validation,
-    gif: str | Path | None = None,
-    ghost: bool = True,
-    fps: int = FPS,
+    path: str | Path | None, validation, gif: str | Path | None = None, ghost: bool = True
 ) -> list[Path]:
     """Render the walk of a validation (``validate.validation.Validation``) to an MP4 at
     ``path`` and/or a GIF at ``gif`` (their missing folders created); returns the files
     written. Its checks give the verdict in the caption."""
-    captioned = _captioned(validation, ghost)
-    try:
-        states = frame_states(validation.simulation, fps)
-        written = []
+    states = frame_states(validation.simulation)
+    written = []
+    with _captioned(validation, ghost) as captioned:
         if gif is not None:
             frames = [captioned.frame(k) for k in states]
             if path is not None:
-                written.append(write_mp4(path, frames, fps))
-            written.append(write_gif(gif, frames, fps))
+                written.append(write_mp4(path, frames))
+            written.append(write_gif(gif, frames))
         elif path is not None:
-            written.append(write_mp4(path, (captioned.frame(k) for k in states), fps))
-    finally:
-        captioned.renderer.close()
+            written.append(write_mp4(path, (captioned.frame(k) for k in states)))
     return written
 
 
@@ -323,12 +309,9 @@ def write_frame(path: str | Path, validation, at: float, ghost: bool = True) -> 
     from PIL import Image
 
     sim = validation.simulation
-    captioned = _captioned(validation, ghost)
-    try:
-        k = int(min(np.searchsorted(sim.time, sim.time[0] + at), len(sim.time) - 1))
+    k = int(min(np.searchsorted(sim.time, sim.time[0] + at), len(sim.time) - 1))
+    with _captioned(validation, ghost) as captioned:
         frame = captioned.frame(k)
-    finally:
-        captioned.renderer.close()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:

@@ -10,6 +10,7 @@ here parses options. May import ``biped`` and ``validate``, never ``biped_cli``.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,10 +19,11 @@ import numpy as np
 
 from biped.model.criteria import Safety
 from biped.model.robot import Robot
+from biped.records.gait_file import Gait, write_json
 
 
 def validate_and_record(
-    gait: dict,
+    gait: Gait,
     rrd: str | Path,
     *,
     steps: int,
@@ -32,11 +34,10 @@ def validate_and_record(
     source: str | Path | None = None,
     model=None,
 ):
-    """Every check of a gait (``gait_file.read`` or ``gait_file.to_dict``: in memory) on
-    ``model`` (an MJCF path; None: ``validate.model.model_spec``'s default), its recording at
-    ``rrd`` (also streamed to a viewer with ``spawn`` or ``connect``) and, if asked, the video
-    of its walk at ``video`` (MP4) and ``gif``. ``source``: the gait file, named as the
-    recording's owner (``validate.outputs``).
+    """Every check of a gait on ``model`` (an MJCF path; None: ``validate.model.model_spec``'s
+    default), its recording at ``rrd`` (also streamed to a viewer with ``spawn`` or
+    ``connect``) and, if asked, the video of its walk at ``video`` (MP4) and ``gif``.
+    ``source``: the gait file, named as the recording's owner (``validate.outputs``).
 
     Returns the validation and its report (the checks as JSON with their ``units``, the
     recording's and video's paths).
@@ -102,12 +103,10 @@ class Pipeline:
         """The name of a knee's files ('design' for the designed gait)."""
         return f"{knee}-{self.criterion}-{self.speed:.3f}"
 
-    def validated(self, label: str, gait_path: Path, gait: dict, say: Callable) -> tuple:
-        """Validate the gait written at ``gait_path`` (``gait``: its content) as the
+    def validated(self, label: str, gait_path: Path, gait: Gait, say: Callable) -> tuple:
+        """Validate the gait written at ``gait_path`` (``gait``: its record) as the
         pipeline's ``label`` knee; write its report. Returns (passed, its lines of the files
         written)."""
-        from biped.records import gait_file
-
         name = gait_path.stem
         say(f"[{label}] validating {self.steps} steps in MuJoCo...")
         video = self.recordings / f"{name}.mp4" if self.video else None
@@ -117,7 +116,7 @@ class Pipeline:
         )
         for check in result.checks:
             say(f"[{label}]   " + check.line())
-        report_path = gait_file.write_json(
+        report_path = write_json(
             self.out / f"{name}.report.json", {**report, "gait": str(gait_path)}
         )
         return result.passed, files_lines(report, gait_path, report_path)
@@ -127,7 +126,6 @@ def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool
     """Run the pipeline (``Pipeline``), printing with ``say``; whether every gait is feasible
     and passes every check."""
     from biped.model.criteria import CRITERIA
-    from biped.records import gait_file
     from biped.records.comparison import DIFFERENCE, relative_change
 
     passed, optima, written = True, {}, {}
@@ -136,9 +134,9 @@ def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool
         if not _certified(knee, optimum, say):
             passed = False
             continue
-        gait = gait_file.to_dict(optimum, pipeline.robot, seed=pipeline.budget["seed"])
-        gait_path = gait_file.write_json(pipeline.out / f"{pipeline.name(knee)}.json", gait)
-        # validated in memory: the file written is this content
+        gait = Gait.from_optimum(optimum, pipeline.robot)
+        gait_path = gait.write(pipeline.out / f"{pipeline.name(knee)}.json")
+        # validated in memory: the file written is this record
         knee_passed, written[knee] = pipeline.validated(knee, gait_path, gait, say)
         passed = passed and knee_passed
     if pipeline.design is not None:
@@ -197,7 +195,6 @@ def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
     designed gait written and validated in MuJoCo as the knees' are. Returns whether every
     step passed."""
     from biped.optimization.design import compare
-    from biped.records import gait_file
     from validate.outputs import check_owner
 
     problem, name = pipeline.design, pipeline.name("design")
@@ -218,8 +215,8 @@ def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
     if not design.certified:
         say(f"[design] FAIL  the design is not certified: {design.report.status}")
         return False
-    gait_file.write_json(gait_path, designed_gait(comparison, seed))
-    passed, lines = pipeline.validated("design", gait_path, gait_file.read(gait_path), say)
+    designed_gait(comparison).write(gait_path)
+    passed, lines = pipeline.validated("design", gait_path, Gait.read(gait_path), say)
     for line in lines:  # every file written, once
         say(f"[design] {line}")
     return passed and not uncertified(comparison)
@@ -268,11 +265,8 @@ def uncertified(comparison) -> list[str]:
     ]
 
 
-def designed_gait(comparison, seed: int) -> dict:
-    """The gait file's content of a design: the designed robot's gait and the comparison."""
-    from biped.records import gait_file
-
+def designed_gait(comparison) -> Gait:
+    """The gait of a design: the designed robot's gait and the comparison."""
     design = comparison.design
-    content = gait_file.to_dict(design.optimum, design.robot, seed)
-    content["design"] = comparison.to_dict()
-    return content
+    gait = Gait.from_optimum(design.optimum, design.robot)
+    return dataclasses.replace(gait, design=comparison.to_dict())

@@ -63,6 +63,7 @@ STYLE = {
     "rolling": dict(color="tab:red", marker="s"),
 }
 FLAGGED_COLOR = "0.35"
+FLAGGED_MARK = dict(linestyle="none", marker="x", markersize=9, markeredgewidth=2)
 # A value is off the bulk of its panel beyond FENCE interquartile ranges below the first
 # quartile or above the third (Tukey's "far out"), judged only with MIN_BULK values or more.
 FENCE = 3.0
@@ -122,11 +123,6 @@ def read_sweep(folder: str | Path) -> tuple[dict, list]:
     return series, flagged
 
 
-def load_sweep(folder: str | Path) -> dict:
-    """{(knee, criterion): [gait, ...] sorted by speed}, certified optima only."""
-    return read_sweep(folder)[0]
-
-
 def _curve(series, knee, criterion, cost):
     gaits = series.get((knee, criterion), [])
     return np.array([g.speed for g in gaits]), np.array([g.costs[cost] for g in gaits])
@@ -155,31 +151,20 @@ def bulk_limits(values) -> tuple[float, float]:
     return low - pad, high + pad
 
 
+def note(ax, text: str, xy, offset, **style) -> None:
+    """``text`` ``offset`` points away from ``xy`` (data units), in 8 pt unless ``style`` says."""
+    ax.annotate(text, xy=xy, xytext=offset, textcoords="offset points", **{"fontsize": 8, **style})
+
+
 def _mark_off_scale(ax, x, value, limits, color, text) -> None:
     """A value outside the axis limits: a triangle at the edge, its value beside it."""
     low, high = limits
     above = value > high
     edge = high if above else low
-    ax.plot(
-        [x],
-        [edge],
-        linestyle="none",
-        marker="^" if above else "v",
-        markersize=9,
-        color=color,
-        clip_on=False,
-    )
-    ax.annotate(
-        text,
-        xy=(x, edge),
-        xytext=(0, -16 if above else 16),
-        textcoords="offset points",
-        ha="center",
-        va="top" if above else "bottom",
-        fontsize=8,
-        color=color,
-        bbox=dict(boxstyle="round,pad=0.2", fc="white", ec=color, alpha=0.85),
-    )
+    marker, va = ("^", "top") if above else ("v", "bottom")
+    ax.plot([x], [edge], linestyle="none", marker=marker, markersize=9, color=color, clip_on=False)
+    box = dict(boxstyle="round,pad=0.2", fc="white", ec=color, alpha=0.85)
+    note(ax, text, (x, edge), (0, -16 if above else 16), ha="center", va=va, color=color, bbox=box)
 
 
 def difference_curve(series, criterion, cost) -> tuple[np.ndarray, np.ndarray]:
@@ -208,33 +193,13 @@ def _difference_panel(ax, series, criterion) -> None:
         if out:
             _mark_off_scale(ax, x, value, limits, DIFFERENCE_COLOR, f"{x:.3f} m/s: {value:+.1f} %")
         elif len(speeds) <= MAX_LABELLED:
-            ax.annotate(
-                f"{value:+.1f} %",
-                xy=(x, value),
-                xytext=(0, 7),
-                textcoords="offset points",
-                ha="center",
-                fontsize=7,
-            )
+            note(ax, f"{value:+.1f} %", (x, value), (0, 7), ha="center", fontsize=7)
     if len(speeds) == 0:
-        ax.text(
-            0.5,
-            0.5,
-            "no speed where both knees\nhave a certified optimum",
-            ha="center",
-            va="center",
-            transform=ax.transAxes,
-            fontsize=9,
-        )
+        empty = "no speed where both knees\nhave a certified optimum"
+        ax.text(0.5, 0.5, empty, ha="center", va="center", transform=ax.transAxes, fontsize=9)
     ax.set_ylim(*limits)
-    ax.text(
-        0.02,
-        0.02,
-        "below 0: the rolling knee needs less",
-        transform=ax.transAxes,
-        fontsize=8,
-        color="0.3",
-    )
+    sign = "below 0: the rolling knee needs less"
+    ax.text(0.02, 0.02, sign, transform=ax.transAxes, fontsize=8, color="0.3")
 
 
 def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
@@ -263,24 +228,9 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
             why = "infeasible" if not gait.feasible else f"solver: {status}"
             label = "not certified" if i == 0 else None
             if limits[0] <= value <= limits[1]:
-                ax.plot(
-                    [x],
-                    [value],
-                    linestyle="none",
-                    marker="x",
-                    markersize=9,
-                    markeredgewidth=2,
-                    color=FLAGGED_COLOR,
-                    label=label,
-                )
-                ax.annotate(
-                    f"{gait.knee}: not certified\n({why})",
-                    xy=(x, value),
-                    xytext=(6, 6),
-                    textcoords="offset points",
-                    fontsize=8,
-                    color=FLAGGED_COLOR,
-                )
+                ax.plot([x], [value], color=FLAGGED_COLOR, label=label, **FLAGGED_MARK)
+                text = f"{gait.knee}: not certified\n({why})"
+                note(ax, text, (x, value), (6, 6), color=FLAGGED_COLOR)
             else:
                 text = f"{gait.knee} {x:.3f} m/s: {value:.4g} {unit},\nnot certified ({why})"
                 _mark_off_scale(ax, x, value, limits, FLAGGED_COLOR, text)
@@ -308,6 +258,11 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
 
 def _wrap(text: str, width: int = 170) -> str:
     return "\n".join(textwrap.wrap(text, width, break_on_hyphens=False))
+
+
+def _bullet(text: str) -> list[str]:
+    """A Markdown list item ``text`` ("- ...") in lines of 88 characters at most."""
+    return textwrap.wrap(text, 88, subsequent_indent="  ", break_on_hyphens=False)
 
 
 def _detail_gaits(series):
@@ -346,7 +301,7 @@ def angle_label(angle: str) -> str:
 
 
 def _column(field: str, i: int):
-    return lambda gait: gait.samples[field][:, i]
+    return lambda gait: getattr(gait.samples, field)[:, i]
 
 
 def _degrees(k: int):
@@ -360,30 +315,17 @@ def friction_needed(gait: Gait) -> np.ndarray:
 
 
 def _friction_marks(ax, gaits) -> None:
-    ax.axhline(
-        FOOT_FRICTION,
-        color="k",
-        linestyle="--",
-        linewidth=1.2,
-        label=f"μ = {FOOT_FRICTION:g}, the model's friction",
-    )
+    label = f"μ = {FOOT_FRICTION:g}, the model's friction"
+    ax.axhline(FOOT_FRICTION, color="k", linestyle="--", linewidth=1.2, label=label)
     top = FOOT_FRICTION
     for row, (knee, gait) in enumerate(gaits.items()):
         ratio = friction_needed(gait)
         i = int(np.argmax(ratio))
         t = gait.samples.t[i] / gait.period
-        ax.plot(
-            [t], [ratio[i]], marker="o", markersize=8, fillstyle="none", color=STYLE[knee]["color"]
-        )
-        ax.annotate(
-            f"largest |Fx|/Fz {ratio[i]:.3f}",
-            xy=(t, ratio[i]),
-            xytext=(-8, 8 + 12 * row),
-            textcoords="offset points",
-            ha="right",
-            fontsize=8,
-            color=STYLE[knee]["color"],
-        )
+        color = STYLE[knee]["color"]
+        ax.plot([t], [ratio[i]], marker="o", markersize=8, fillstyle="none", color=color)
+        text = f"largest |Fx|/Fz {ratio[i]:.3f}"
+        note(ax, text, (t, ratio[i]), (-8, 8 + 12 * row), ha="right", color=color)
         top = max(top, float(ratio[i]))
     ax.set_ylim(0.0, 1.15 * top)
     ax.legend(fontsize=8, loc="center left")
@@ -393,9 +335,7 @@ def _sole_marks(ax, gaits) -> None:
     robot = next(iter(gaits.values())).robot
     for name, x in robot.sole_edges().items():
         ax.axhline(x, color="0.4", linestyle=":", linewidth=1.0)
-        ax.annotate(
-            name, xy=(0.0, x), xytext=(2, 2), textcoords="offset points", fontsize=8, color="0.4"
-        )
+        note(ax, name, (0.0, x), (2, 2), color="0.4")
 
 
 TORQUE_PANELS = tuple(
@@ -485,24 +425,18 @@ def sweep_figures(series: dict, flagged=(), criteria=CRITERIA) -> dict:
     figures = {}
     if "sthenic" in criteria:
         gaits = _detail_gaits(series)
-        figures |= {
-            "fig4.png": criterion_figure(
-                series, "sthenic", "energy", "Fig. 4: sthenic optimisation", flagged
-            ),
-            "fig5.png": time_figure(
-                gaits, "Fig. 5: joint torques of the sthenic-optimal gaits", TORQUE_PANELS
-            ),
-            "fig6.png": time_figure(
-                gaits, "Fig. 6: absolute angles of the sthenic-optimal gaits", ANGLE_PANELS
-            ),
-            "fig7.png": time_figure(
-                gaits, "Fig. 7: ground reaction of the sthenic-optimal gaits", GROUND_PANELS
-            ),
-        }
+        title = "Fig. 4: sthenic optimisation"
+        figures["fig4.png"] = criterion_figure(series, "sthenic", "energy", title, flagged)
+        for number, what, panels in (
+            (5, "joint torques", TORQUE_PANELS),
+            (6, "absolute angles", ANGLE_PANELS),
+            (7, "ground reaction", GROUND_PANELS),
+        ):
+            title = f"Fig. {number}: {what} of the sthenic-optimal gaits"
+            figures[f"fig{number}.png"] = time_figure(gaits, title, panels)
     if "energy" in criteria:
-        figures["fig8.png"] = criterion_figure(
-            series, "energy", "sthenic", "Fig. 8: energy optimisation", flagged
-        )
+        title = "Fig. 8: energy optimisation"
+        figures["fig8.png"] = criterion_figure(series, "energy", "sthenic", title, flagged)
     return figures
 
 
@@ -563,7 +497,7 @@ def _detail_rows(series) -> tuple[list[str], dict]:
         f"| | {flexion['revolute']:.3f} / {flexion['rolling']:.3f} |",
         *(
             f"| period / step length of that gait, {knee} [s / m] | | "
-            f"{detail[knee]['period']:.3f} / {detail[knee]['step_length']:.3f} |"
+            f"{detail[knee].period:.3f} / {detail[knee].step_length:.3f} |"
             for knee in KNEES
         ),
     ]
@@ -607,22 +541,14 @@ def comparison_table(series, flagged=()) -> str:
         "",
         "- d of eq. (30) is read as the swing foot's travel in one step, twice the step length,",
         "  so C_Γ is per metre walked; C_E of eq. (31) is per step, as printed.",
-        *textwrap.wrap(
+        *_bullet(
             f"- Every value is the criterion on {CHECK_GRID} (the gait files' `costs`); "
             f"the value on {SOLVER_GRID}, `optimizer.value`, only ranks the starts of an "
-            "optimization.",
-            88,
-            subsequent_indent="  ",
-            break_on_hyphens=False,
+            "optimization."
         ),
         "- The speed grid is the sweep's; a minimum between grid points is reported at the",
         "  nearest grid speed.",
-        *textwrap.wrap(
-            f"- Every value is certified: {CERTIFIED}.",
-            88,
-            subsequent_indent="  ",
-            break_on_hyphens=False,
-        ),
+        *_bullet(f"- Every value is certified: {CERTIFIED}."),
         f"  {confirmed} of {total} optima were reached by at least two starts (the neighbouring",
         "  speeds' optima among them).",
         "",
@@ -657,19 +583,14 @@ def _explanations(flexion, series, criteria) -> list[str]:
         f"{per_step['rolling']:.3f} m/s (rolling).",
     ]
     if "energy" in criteria:
-        lines += textwrap.wrap(
-            f"- Fig. 8, middle: {OTHER_NOTES['energy']}",
-            88,
-            subsequent_indent="  ",
-            break_on_hyphens=False,
-        )
+        lines += _bullet(f"- Fig. 8, middle: {OTHER_NOTES['energy']}")
     return [*lines, ""]
 
 
 def _minimum_per_step(series, knee) -> float:
     """[m/s] Speed of the knee's least sthenic criterion per step (certified optima)."""
     best = min(series[(knee, "sthenic")], key=lambda g: g.costs["sthenic"] * g.step_length)
-    return float(best["speed"])
+    return float(best.speed)
 
 
 def make_figures(sweep_folder: str | Path, out_folder: str | Path, stream=None) -> list[Path]:

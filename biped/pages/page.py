@@ -41,6 +41,7 @@ from biped.pages.figures import (
     Panel,
     certified,
     joint_label,
+    note,
     time_figure,
 )
 from biped.records.gait_file import Gait
@@ -106,17 +107,12 @@ def constraint_profile(
 
 
 @dataclass(frozen=True)
-class Dip:
-    """A constraint below the solver's margin on the check grid: its smallest Ψ_i − δ_i
-    there, Ψ_i [unit] at that sample, at t/T, δ_i there; and ``kept``: whether the solver's
-    own samples (``SOLVER_SAMPLES_PER_HALF`` per piece) all hold Ψ_i >= δ_i, so that the
-    dip lies between them."""
+class Dip(Tightest):
+    """A constraint below the solver's margin on the check grid, at its smallest Ψ_i − δ_i
+    there (Ψ_i, t/T and δ_i of that sample); and ``kept``: whether the solver's own samples
+    (``SOLVER_SAMPLES_PER_HALF`` per piece) all hold Ψ_i >= δ_i, so that the dip lies between
+    them."""
 
-    name: str
-    value: float
-    unit: str
-    at: float
-    margin: float
     kept: bool
 
 
@@ -195,7 +191,8 @@ def knot_jumps(gait: Gait, field: str) -> np.ndarray | None:
     """The jump (right limit − left limit) of ``samples[field]`` at the mid-step knot; None
     if the samples do not hold both limits."""
     k = knot_index(gait)
-    return None if k is None else gait.samples[field][k + 1] - gait.samples[field][k]
+    values = getattr(gait.samples, field)
+    return None if k is None else values[k + 1] - values[k]
 
 
 def figure_captions(gait: Gait) -> dict[str, str]:
@@ -362,17 +359,10 @@ def _constraint_panels(gait: Gait) -> tuple:
             side = "right" if t_n[k] > 0.7 else "left" if t_n[k] < 0.3 else "center"
             low, high = ax.get_ylim()
             below = psi[k, i] > (low + high) / 2  # the text inside the axes
-            ax.annotate(
-                f"smallest {psi[k, i]:.3g} {CONSTRAINT_UNITS[name]}\nat t/T = {t_n[k]:.2f}",
-                xy=(t_n[k], psi[k, i]),
-                xytext=(0, -12 if below else 12),
-                textcoords="offset points",
-                ha=side,
-                va="top" if below else "bottom",
-                fontsize=8,
-                color=color,
-                bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.8),
-            )
+            text = f"smallest {psi[k, i]:.3g} {CONSTRAINT_UNITS[name]}\nat t/T = {t_n[k]:.2f}"
+            xy, va = (t_n[k], psi[k, i]), "top" if below else "bottom"
+            box = dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.8)
+            note(ax, text, xy, (0, -12 if below else 12), ha=side, va=va, color=color, bbox=box)
             if name in dips:
                 _dip_inset(
                     ax,

@@ -15,8 +15,7 @@ torques) jump at the knot.
 ``Gait.read`` checks the format and names the bad field; with ``consistent=True`` it also
 recomputes what the parameters determine (``Gait.check_consistency``) and refuses a file
 whose figures are not those of its parameters, naming the field: every command that reads a
-gait file a user gives reads it so. A record also reads by its file's names
-(``gait["costs"]["energy"]``).
+gait file a user gives reads it so.
 """
 
 from __future__ import annotations
@@ -82,26 +81,11 @@ def _unit(unit, columns: tuple | None = None, **kwargs):
     return field(metadata={"unit": unit, "columns": columns}, **kwargs)
 
 
-class _ByName:
-    """A record that also reads by its file's field names: ``gait["costs"]["energy"]``."""
-
-    def __getitem__(self, key: str):
-        if key not in self:
-            raise KeyError(key)
-        return getattr(self, key)
-
-    def __contains__(self, key) -> bool:
-        return any(key == f.name for f in dataclasses.fields(self))
-
-    def get(self, key: str, default=None):
-        return self[key] if key in self else default
-
-
 RATES = per_coordinate("rad/s", "m/s")
 
 
 @dataclass(frozen=True, eq=False)
-class Samples(_ByName):
+class Samples:
     """The gait on the check grid (N samples from t = 0 to T, T/2 twice), as numpy arrays."""
 
     t: np.ndarray = _unit("s")
@@ -133,7 +117,7 @@ def _optimizer_units(criterion: str) -> dict:
 
 
 @dataclass(frozen=True, eq=False)
-class Gait(_ByName):
+class Gait:
     """One optimal gait, as its file holds it (see the module); built by ``from_optimum`` or
     ``read``. Its ``biped``, ``problem`` and ``parameter_vector`` follow from it."""
 
@@ -252,11 +236,6 @@ class Gait(_ByName):
             **{**fields, "safety": safety, "robot": robot, "samples": _samples(content, bad)}
         )
 
-    @classmethod
-    def of(cls, gait: Gait | dict) -> Gait:
-        """The record itself, or that of a file's content held in memory (``to_dict``)."""
-        return gait if isinstance(gait, Gait) else cls.from_content(gait)
-
     @staticmethod
     def units(criterion: str) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion``, from the fields'
@@ -278,6 +257,10 @@ class Gait(_ByName):
                 value = dataclasses.asdict(value)
             content[f.name] = value
         return content
+
+    def write(self, path: str | Path) -> Path:
+        """Write the gait's file at ``path`` (``write_json``); returns the path."""
+        return write_json(path, self.to_dict())
 
     @functools.cached_property
     def biped(self) -> Biped:
@@ -311,14 +294,14 @@ class Gait(_ByName):
         expected = _derived(self.biped, step, evaluation)
         units = self.units(self.criterion)
         for key in ("period", "step_length"):
-            if _mismatch(self[key], expected[key]):
+            if _mismatch(getattr(self, key), expected[key]):
                 raise bad(
-                    f"{key} = {self[key]!r}{_shown(units, key)}, its parameters give "
+                    f"{key} = {getattr(self, key)!r}{_shown(units, key)}, its parameters give "
                     f"{expected[key]!r}"
                 )
         _check_samples(self.samples, expected["samples"], units, bad)
         for group in ("costs", "constraints"):
-            _check_group(self[group], group, expected[group], units, bad)
+            _check_group(getattr(self, group), group, expected[group], units, bad)
         if self.feasible != evaluation.feasible:
             violated = ", ".join(f"{k} = {v:.3g}" for k, v in evaluation.violations().items())
             raise bad(
@@ -379,11 +362,6 @@ def write_json(path: str | Path, content: dict) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     return atomic_write_text(path, json.dumps(content, indent=1, allow_nan=False))
-
-
-def to_dict(optimum: Optimum, robot: Robot, seed: int, provenance: dict | None = None) -> dict:
-    """The file's content of ``optimum``'s gait (``Gait.from_optimum``; the seed is in it)."""
-    return Gait.from_optimum(optimum, robot, provenance).to_dict()
 
 
 read = Gait.read  # the format checked; read_consistent: the figures its parameters' too
@@ -532,7 +510,7 @@ def _check_samples(samples: Samples, expected: Samples, units: dict, bad) -> Non
     and column)."""
     for f in dataclasses.fields(Samples):
         key, columns, path = f.name, f.metadata["columns"], f"samples.{f.name}"
-        found, wanted = samples[key], expected[key]
+        found, wanted = getattr(samples, key), getattr(expected, key)
         if found.shape != wanted.shape:
             raise bad(
                 f"{path} has shape {found.shape}, the parameters' samples "

@@ -86,7 +86,7 @@ def _solve(task: Task) -> str:
         Biped(settings.robot, run.knee), run.speed, run.criterion, settings.safety
     )
     optimum = optimize(problem, seed=run.seed, method="nelder-mead")
-    gait_file.write_json(task.path, gait_file.to_dict(optimum, settings.robot, run.seed))
+    gait_file.Gait.from_optimum(optimum, settings.robot).write(task.path)
     return (
         f"[paper method {run.knee:8} {run.criterion:7}] {run.speed:.3f} m/s seed "
         f"{run.seed}: C = {optimum.value:12.6f}  {optimum.report.status}"
@@ -167,7 +167,7 @@ def read_runs(sweep_folder: str | Path) -> dict:
                 if not file.exists():
                     break
                 gait = gait_file.read(file)
-                values.append(float(gait["costs"][criterion]))
+                values.append(float(gait.costs[criterion]))
             if len(values) == seeds:
                 runs[(knee, criterion)] = values
     return runs, speed

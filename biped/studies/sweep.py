@@ -86,8 +86,8 @@ def _read_gait(path: Path, point: Point, settings: Settings):
         gait = gait_file.read(path)
     except BipedError:
         return None
-    found = (gait["knee"], gait["criterion"], gait["speed"])
-    same = gait["robot"] == settings.robot and gait["safety"] == settings.safety
+    found = (gait.knee, gait.criterion, gait.speed)
+    same = gait.robot == settings.robot and gait.safety == settings.safety
     if found != (point.knee, point.criterion, point.speed) or not same:
         raise BipedError(
             f"{path} holds a gait of another robot, safety or point ({found[0]}, "
@@ -96,16 +96,11 @@ def _read_gait(path: Path, point: Point, settings: Settings):
     return gait
 
 
-def _optimum_of(gait: dict, settings: Settings, point: Point) -> Optimum:
+def _optimum_of(gait: gait_file.Gait, settings: Settings, point: Point) -> Optimum:
     """The ``Optimum`` stored in a gait file (same numbers: JSON keeps every bit)."""
-    variables = np.array([gait["optimizer"]["variables"][name] for name in VARIABLES], float)
-    report = Report.from_dict(gait["optimizer"])
+    variables = np.array([gait.optimizer["variables"][name] for name in VARIABLES], float)
+    report = Report.from_dict(gait.optimizer)
     return checked(_problem(settings, point), variables, report)
-
-
-def _save(task: Task, optimum: Optimum) -> None:
-    content = gait_file.to_dict(optimum, task.settings.robot, task.settings.seed)
-    gait_file.write_json(task.path, content)
 
 
 def _solve_independent(task: Task) -> str:
@@ -115,11 +110,11 @@ def _solve_independent(task: Task) -> str:
     sthenic = None
     for twin in task.given:
         gait = gait_file.read(Path(task.folder) / twin.filename())
-        if campaign.variables(gait["optimizer"]["variables"]) is not None:  # else computed again
+        if campaign.variables(gait.optimizer["variables"]) is not None:  # else computed again
             sthenic = _optimum_of(gait, settings, twin)
     problem = _problem(settings, point)
     optimum = optimize(problem, seed=settings.seed, starts=settings.starts, sthenic=sthenic)
-    _save(task, optimum)
+    gait_file.Gait.from_optimum(optimum, settings.robot).write(task.path)
     return _line("independent", point, optimum)
 
 
@@ -128,7 +123,7 @@ def _solve_with_neighbours(task: Task) -> str:
     settings, point, stage = task.settings, task.point, Path(task.folder) / INDEPENDENT
     own = _optimum_of(gait_file.read(stage / point.filename()), settings, point)
     given = [
-        campaign.variables(gait_file.read(stage / p.filename())["optimizer"]["variables"])
+        campaign.variables(gait_file.read(stage / p.filename()).optimizer["variables"])
         for p in task.given
     ]
     given = [variables for variables in given if variables is not None]
@@ -137,7 +132,7 @@ def _solve_with_neighbours(task: Task) -> str:
     if given:
         again = optimize(problem, seed=settings.seed, starts=0, given=given)
         optimum = best_of(problem, [own, again])
-    _save(task, optimum)
+    gait_file.Gait.from_optimum(optimum, settings.robot).write(task.path)
     return _line("final", point, optimum)
 
 
@@ -286,13 +281,13 @@ def summarize(folder: Path, points, settings: Settings) -> str:
         gait = gaits[p]
         if gait is None:
             return "missing"
-        status = gait["optimizer"].get("status")
-        return None if status == "converged" and gait["feasible"] else str(status)
+        status = gait.optimizer.get("status")
+        return None if status == "converged" and gait.feasible else str(status)
 
     single = [
         p.filename()
         for p in points
-        if why_not(p) is None and gaits[p]["optimizer"]["starts_at_best"] < 2
+        if why_not(p) is None and gaits[p].optimizer["starts_at_best"] < 2
     ]
     note = f"; {len(single)} of them {SINGLE_START}: " + ", ".join(single) if single else ""
     counted = "points certified (final optima, solver converged, feasible on the check grid)"
