@@ -196,12 +196,14 @@ def cmd_sweep(args) -> int:
     from biped.runtime.runner import check_dask
     from biped.studies.paper_method import FOLDER, SETTINGS, check_paper_method, run_paper_method
     from biped.studies.paper_method import SPEED as PAPER_METHOD_SPEED
-    from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep
+    from biped.studies.sweep import INDEPENDENT, MANIFEST, check_sweep, run_sweep
 
     robot = robot_of(args)
     check_folder(args.out, "--out")
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - PAPER_METHOD_SPEED)))
+    # the sweep's own settings first: the paper's method's follow from them
+    check_sweep(args.out, robot, args.speeds, args.knees, args.seed, args.starts, safety(args))
     if args.paper_seeds:  # refused before the sweep runs, not after
         check_paper_method(args.out, robot, paper_speed, args.paper_seeds, args.knees, safety(args))
     if args.dask is not None:

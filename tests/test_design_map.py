@@ -104,3 +104,12 @@ def test_map_legend_lies_outside_the_plot(small_map):
     assert not box.overlaps(plot) and box.y1 <= plot.y0
     labels = {text.get_text() for text in legends[0].get_texts()}
     assert {"Table 1 radii", "joint optimum"} <= labels
+
+
+def test_every_optimization_line_gives_its_criterion_with_its_unit(small_map):
+    """Each optimization's line in the map's log gives its criterion value with its unit
+    (the sthenic criterion's, N²·m·s)."""
+    lines = [
+        line for line in (small_map.parent / "log.txt").read_text().splitlines() if "C = " in line
+    ]
+    assert lines and all("N²·m·s" in line.split("C = ")[1] for line in lines), lines

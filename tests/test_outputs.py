@@ -339,3 +339,21 @@ def test_sweep_names_the_files_of_its_folder(tmp_path, capsys):
         f"sweep results in {out}: sweep.json, 1 gait file <knee>-<criterion>-<speed>.json, "
         ".independent/ (each point's first solve), paper-method/ (settings.json and 1 gait file)"
     )
+
+
+def test_a_frame_outside_the_walk_is_refused_naming_its_span():
+    """--at beyond the walk's span, or before its start, is refused naming the value and the
+    span; a time inside it picks the recorded state at that time."""
+    from types import SimpleNamespace
+
+    import numpy
+
+    from biped.errors import BipedError
+    from validate.video import frame_index
+
+    walk = SimpleNamespace(simulation=SimpleNamespace(time=numpy.linspace(0.0, 12.1, 606)))
+    assert frame_index(walk, 3.1) == int(numpy.searchsorted(walk.simulation.time, 3.1))
+    assert frame_index(walk, 12.1) == 605
+    for at in (99.0, -1.0, 12.2):
+        with pytest.raises(BipedError, match=rf"--at {at!r} s: allowed 0 to 12.10 s"):
+            frame_index(walk, at)

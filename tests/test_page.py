@@ -209,3 +209,19 @@ def test_page_says_where_constraints_dip_below_the_solver_margin(optimal_page):
             assert len(insets) == 1, name
         else:
             assert not insets, name
+
+
+def test_the_table_gives_each_constraint_where_it_binds(optimal_page):
+    """Each constraint's row is its smallest Ψ / δ where the solver keeps a margin: the swing
+    foot's heel and toe, whose smallest Ψ lies at the step's ends where δ ramps to 0 and
+    binds nothing, are given mid-step, where they bind the optimum (Ψ / δ about 1)."""
+    from biped.pages.page import constraint_profile, tightest_margins
+
+    gait, _, _ = optimal_page
+    t_n, psi, delta = constraint_profile(gait)
+    rows = {row.name: row for row in tightest_margins(gait)}
+    for i, name in enumerate(CONSTRAINTS):
+        held = delta[:, i] > 0
+        assert rows[name].ratio == pytest.approx(np.nanmin(psi[held, i] / delta[held, i]))
+    for name in ("swing_heel", "swing_toe"):
+        assert 0.1 < rows[name].at < 0.9 and rows[name].ratio == pytest.approx(1.0, abs=0.02)

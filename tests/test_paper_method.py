@@ -17,10 +17,22 @@ SEEDS = 2
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     folder = tmp_path_factory.mktemp("sweep")
-    files = run_paper_method(
-        folder, biped.Robot.paper(), seeds=SEEDS, criteria=("sthenic",), jobs=1, stream=None
-    )
+    with open(folder.parent / "log.txt", "w") as stream:
+        files = run_paper_method(
+            folder, biped.Robot.paper(), seeds=SEEDS, criteria=("sthenic",), jobs=1, stream=stream
+        )
     return folder, files
+
+
+def test_every_run_line_gives_its_criterion_with_its_unit_and_grid(runs):
+    """Each run's line gives its criterion with its unit, on the check grid with the
+    penalty included (the paper's method may end infeasible)."""
+    folder, _ = runs
+    lines = [
+        line for line in (folder.parent / "log.txt").read_text().splitlines() if "C = " in line
+    ]
+    assert len(lines) == 2 * SEEDS, lines
+    assert all("N²·m·s on the check grid, penalty included" in line for line in lines), lines
 
 
 def _certified():

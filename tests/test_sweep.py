@@ -476,3 +476,22 @@ def test_criterion_figures_say_their_units_and_sign_and_why_fig8_middle_scatters
         panel = _panel(figure, f"rolling vs revolute knee, optimal {criterion} criterion")
         assert any(np.allclose(line.get_ydata(), 0.0) for line in panel.get_lines())
         _pixels(figure)  # the mathtext renders
+
+
+def test_a_resume_with_other_speeds_is_refused_naming_the_speeds(tmp_path, capsys):
+    """A sweep folder resumed with other speeds is refused naming the speeds, the option the
+    user changed, before the paper's method's settings (which follow from them) are checked;
+    nothing is written."""
+    from biped.model.criteria import PAPER_SAFETY
+    from biped.studies import paper_method, sweep
+    from biped_cli import main
+
+    robot = biped.Robot.paper()
+    sweep.SWEEP.claim(tmp_path, sweep.Settings(robot, PAPER_SAFETY, (0.25, 0.3), 0, 3))
+    runs = paper_method.PaperMethod(robot, PAPER_SAFETY, 0.3, 5)
+    paper_method.PAPER.claim(tmp_path / paper_method.FOLDER, runs)
+    before = sorted(tmp_path.rglob("*"))
+    assert main(["sweep", "--speeds", "0.25,0.35", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "speeds = [0.25, 0.3]" in err[0] and "[0.25, 0.35]" in err[0], err
+    assert sorted(tmp_path.rglob("*")) == before

@@ -303,13 +303,24 @@ def write_video(
     return written
 
 
+def frame_index(validation, at: float) -> int:
+    """The recorded state at ``at`` seconds of the walk; BipedError naming ``at`` and the
+    walk's span if it lies outside it."""
+    from biped.errors import BipedError
+
+    time = validation.simulation.time
+    span = float(time[-1] - time[0])
+    if not 0.0 <= at <= span:
+        raise BipedError(f"--at {at!r} s: allowed 0 to {span:.2f} s, the walk's span")
+    return int(min(np.searchsorted(time, time[0] + at), len(time) - 1))
+
+
 def write_frame(path: str | Path, validation, at: float, ghost: bool = True) -> Path:
     """One captioned frame of a validation's walk, at ``at`` seconds of simulation, as a PNG
     (its missing folders created)."""
     from PIL import Image
 
-    sim = validation.simulation
-    k = int(min(np.searchsorted(sim.time, sim.time[0] + at), len(sim.time) - 1))
+    k = frame_index(validation, at)
     with _captioned(validation, ghost) as captioned:
         frame = captioned.frame(k)
     path = Path(path)
@@ -350,6 +361,8 @@ def main(argv=None) -> int:
                 check_suffix(path, option, suffix)
         result = validate(gait_file.read_consistent(args.gait), steps=args.steps)
         ghost = not args.no_ghost
+        if args.frame:
+            frame_index(result, args.at)  # before anything is written
         written = []
         if args.out or args.gif:
             written += write_video(args.out, result, gif=args.gif, ghost=ghost)

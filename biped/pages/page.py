@@ -221,12 +221,16 @@ def figure_captions(gait: Gait) -> dict[str, str]:
 
 
 def tightest_margins(gait: Gait) -> list[Tightest]:
-    """The tightest sample of each constraint (its smallest Ψ_i), the tightest relative to
-    the solver's margin there first."""
+    """The tightest sample of each constraint, the tightest relative to the solver's margin
+    first: its smallest Ψ_i / δ_i where the solver keeps a margin (δ_i > 0; the swing foot's
+    margin ramps from 0 at the ends of the step, where its smallest Ψ_i binds nothing), its
+    smallest Ψ_i where it keeps none."""
     t_n, psi, delta = constraint_profile(gait)
     rows = []
     for i, name in enumerate(CONSTRAINTS):
-        k = int(np.nanargmin(psi[:, i]))
+        held = delta[:, i] > 0.0
+        tightness = np.where(held, psi[:, i] / np.where(held, delta[:, i], 1.0), np.inf)
+        k = int(np.nanargmin(tightness if held.any() else psi[:, i]))
         unit = CONSTRAINT_UNITS[name]
         rows.append(Tightest(name, float(psi[k, i]), unit, float(t_n[k]), float(delta[k, i])))
     return sorted(rows, key=lambda row: row.ratio)
@@ -502,17 +506,21 @@ def markdown(page: Page, folder: Path) -> str:
         "",
         "## Constraints: tightest margins",
         "",
-        "Each constraint Ψ_i ≥ 0 of eq. (28) at its smallest on the step (where, in t/T), "
-        "beside the margin δ_i the solver keeps from it there; the tightest relative to δ "
-        "first (Ψ / δ near 1: the constraint binds the optimum).",
+        "Each constraint Ψ_i ≥ 0 of eq. (28) at its smallest on the step (where, in t/T), and "
+        "where it is tightest relative to the margin δ_i the solver keeps from it (the swing "
+        "foot's margin ramps from 0 at the ends of the step, where its smallest Ψ binds "
+        "nothing); the tightest first (Ψ / δ near 1: the constraint binds the optimum).",
         "",
-        "| constraint | smallest Ψ | unit | at t/T | δ there | Ψ / δ |",
-        "|---|---|---|---|---|---|",
+        "| constraint | smallest Ψ | unit | at t/T | tightest Ψ / δ | at t/T | δ there |",
+        "|---|---|---|---|---|---|---|",
     ]
+    t_n, psi, _ = constraint_profile(gait)
     for row in tightest_margins(gait):
+        column = psi[:, CONSTRAINTS.index(row.name)]
+        k = int(np.nanargmin(column))
         lines += [
-            f"| {CONSTRAINT_MEANING[row.name]} | {row.value:.4g} | {row.unit} | {row.at:.3f} | "
-            f"{row.margin:g} | {row.ratio:.3g} |"
+            f"| {CONSTRAINT_MEANING[row.name]} | {column[k]:.4g} | {row.unit} | {t_n[k]:.3f} | "
+            f"{row.ratio:.3g} | {row.at:.3f} | {row.margin:g} |"
         ]
     dips = dip_sentence(gait, margin_dips(gait))
     if dips:

@@ -161,14 +161,16 @@ def _save(folder: Path, point: MapPoint, optimum, radii, report_seconds: float) 
     return content
 
 
-def _line(point: MapPoint, content: dict) -> str:
+def _line(point: MapPoint, content: dict, unit: str) -> str:
+    """One optimization's line: its criterion on the check grid with its ``unit``, where,
+    what it is, and the starts at its value."""
     status = campaign.failure(content["status"], content["feasible"]) or "certified"
     value = content["value"]
     radii = content["radii"]
     where = "" if radii is None else f" at r1 {radii[0]:.4f} m, r2 {radii[1]:.4f} m"
     return (
         f"[{point.kind:8} {point.speed:.3f} m/s] {point.label():30} "
-        f"C = {value if value is not None else float('nan'):12.6f}{where}  {status}  "
+        f"C = {value if value is not None else float('nan'):12.6f} {unit}{where}  {status}  "
         f"{content['starts_at_best']}/{content['starts']} starts at best  "
         f"{content['seconds']:5.1f} s"
     )
@@ -197,7 +199,7 @@ def solve_point(task: Task) -> str:
         gait = problem.gait_problem(problem.reference_radii, knee)
         optimum = optimize(gait, seed=settings.seed, starts=settings.starts)
     content = _save(folder, point, optimum, radii, time.perf_counter() - began)
-    return _line(point, content)
+    return _line(point, content, CRITERION_UNITS[problem.criterion])
 
 
 def _stage_one(folder: Path, settings: MapSettings, speed: float) -> list[dict]:

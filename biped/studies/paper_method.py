@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CRITERIA, PAPER_SAFETY, Safety
+from biped.model.criteria import CRITERIA, CRITERION_UNITS, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
@@ -89,7 +89,8 @@ def _solve(task: Task) -> str:
     gait_file.Gait.from_optimum(optimum, settings.robot).write(task.path)
     return (
         f"[paper method {run.knee:8} {run.criterion:7}] {run.speed:.3f} m/s seed "
-        f"{run.seed}: C = {optimum.value:12.6f}  {optimum.report.status}"
+        f"{run.seed}: C = {optimum.value:12.6f} {CRITERION_UNITS[run.criterion]} on the check "
+        f"grid, penalty included: {optimum.report.status}"
     )
 
 

@@ -169,6 +169,21 @@ def check_speeds(robot: Robot, speeds, knees) -> list[float]:
     return campaign.distinct_speeds(speeds)
 
 
+def check_sweep(
+    folder,
+    robot: Robot,
+    speeds,
+    knees=KNEES,
+    seed=0,
+    starts=DEFAULT_STARTS,
+    safety: Safety = PAPER_SAFETY,
+) -> None:
+    """Raise the BipedError ``run_sweep`` would raise on its settings (speeds, the folder's
+    record), writing nothing: a command checks the sweep before what follows from it."""
+    speeds = check_speeds(robot, speeds, knees)
+    SWEEP.check(folder, Settings(robot, safety, tuple(speeds), int(seed), int(starts)).to_dict())
+
+
 def run_sweep(
     folder: Path,
     robot: Robot,
