@@ -47,9 +47,9 @@ def main():
         q, qd, qdd = random_states(model, rng, BATCH)
         torques, wrench = model.inverse_dynamics(q, qd, qdd)
         assert np.allclose(np.concatenate([torques, wrench], -1), reference(model, q, qd, qdd))
-        fast = median_time(model.inverse_dynamics, q, qd, qdd, repeats=REPEATS, warm_up=True)
-        slow = median_time(reference, model, q, qd, qdd, repeats=20, warm_up=True)
-        fast, slow = fast[0] / BATCH, slow[0] / BATCH
+        fast, _ = median_time(model.inverse_dynamics, q, qd, qdd, repeats=REPEATS, warm_up=True)
+        slow, _ = median_time(reference, model, q, qd, qdd, repeats=20, warm_up=True)
+        fast, slow = fast / BATCH, slow / BATCH
         print(f"{knee:10}{fast * 1e6:13.3f} µs{slow * 1e6:13.3f} µs{slow / fast:9.1f}x")
     print("target: under 5 µs per sample")
 

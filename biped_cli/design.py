@@ -140,7 +140,7 @@ def cmd_design(args) -> int:
             "a better one",
             file=sys.stderr,
         )
-    if not design.report.converged or not design.optimum.feasible:
+    if not design.certified:
         reason = (
             f"the solver did not converge ({design.report.status})"
             if not design.report.converged

@@ -505,10 +505,11 @@ class PhaseController:
         # The table's rows at the period's points, over their increments to the next point.
         self.gathered = np.empty((2 * CONTROLS, chunk))
         self.rows, self.increments = self.gathered[:CONTROLS], self.gathered[CONTROLS:]
-        named = (self.rows[columns] for columns in (TORQUES, REFERENCES, RATES, ROTORS))
+        named = (self.rows[part] for part in (TORQUES, REFERENCES, RATES, ROTORS))
         self.torques, self.references, self.rates, self.rotors = named
-        self.commands = self.rows[COMMANDS].T  # (chunk, 18): in ``columns`` order
+        self.rotor_torques = np.empty_like(self.rotors)
         columns = np.concatenate([layout.motors, layout.positions, layout.velocities])
+        self.commands = self.rows[COMMANDS].T  # (chunk, 18): in ``columns`` order
         ordered = np.array_equal(columns, np.arange(len(columns)))  # as validate.model does
         self.columns = slice(0, len(columns)) if ordered else columns
         self.hip_x_at, self.hip_speed_at = map(layout.state_index, ("hip_x", "hip_speed"))
@@ -527,7 +528,10 @@ class PhaseController:
         here = log.state.item(k, self.hip_x_at) - log.sensors.item(max(k - 1, 0), self.ankle_at)
         period = slice(k, k + len(self.ticks))
         where = log.where[period]
-        where[:] = (self.ticks * hip_speed + here - self.x0) * self.per_metre
+        np.multiply(self.ticks, hip_speed, out=where)  # in place: no temporaries per period
+        where += here
+        where -= self.x0
+        where *= self.per_metre
         a, b = self._gather(where)
         if self.last_tick * hip_speed + here > self.x_end:  # the last of ``advance``, below
             # Past the end of the step the reference goes on at the end's rates: the swing
@@ -537,7 +541,7 @@ class PhaseController:
         planned = self.speeds[a] + (self.speeds[a + 1] - self.speeds[a]) * b
         rate = min(max(hip_speed / planned, RATE_RANGE[0]), RATE_RANGE[1])
         self.rates *= rate
-        self.torques += self.rotors * (rate * rate)
+        self.torques += np.multiply(self.rotors, rate * rate, out=self.rotor_torques)
         # The ankle strategy: the stance ankle's torque grows with the hip's excess speed
         # (its centre of pressure moves forward and slows the robot down).
         speed_torque = log.speed_torque[period] = SPEED_GAIN * (hip_speed - planned)

@@ -12,14 +12,9 @@ import dataclasses
 from dataclasses import dataclass
 
 from biped.model.dynamics import JOINTS
-from biped.records.units import PERIOD, PURE
+from biped.records.units import PERIOD, PURE, declared_units, unit_field
 
 GAIN_KEYS = ("0_5", "1", "2")  # validate.checks.GAIN_SCALES and the default, as keys
-
-
-def _figure(unit: str | None, **kwargs):
-    """A figure with its unit (None: a verdict, no number)."""
-    return dataclasses.field(metadata={"unit": unit}, **kwargs)
 
 
 @dataclass(frozen=True)
@@ -27,34 +22,34 @@ class WalkFigures:
     """The figures of a forward walk (``validate.checks.walk_figures``), each with its unit, in
     the report's order; ``max_knee_equality_violation`` for the rolling knee only."""
 
-    steps: int = _figure(PURE)
-    fell: bool = _figure(None)
-    max_slip: float = _figure("m")
-    step_duration_range: list = _figure(PERIOD)
-    step_advance_range: list = _figure("S")
-    max_landing_slide: float = _figure("m")
-    max_foot_tilt: float = _figure("rad")
-    max_heel_lift: float = _figure("m")
-    max_toe_lift: float = _figure("m")
-    scuff_steps: int = _figure(PURE)
-    scuff_duration: float = _figure("s")
-    scuff_depth: float = _figure("m")
-    swing_clearance: float = _figure("m")
-    gait_swing_clearance: float = _figure("m")
-    zmp_rms_error: float = _figure("m")
-    zmp_relative_error: float = _figure(PURE)
-    touchdown_jump_error: float = _figure(PURE)
-    ground_force_rms_error: float = _figure("weight")
-    feedforward_rms: float = _figure("N·m")
-    feedback_rms: float = _figure("N·m")
-    feedback_share: float = _figure(PURE)
-    landing_feedback_rms: float = _figure("N·m")
-    energy_per_step: float = _figure("J")
-    analytic_energy_per_step: float = _figure("J")
-    warnings: int = _figure(PURE)
-    distance: float = _figure("m")
-    seconds_simulated: float = _figure("s")
-    max_knee_equality_violation: float | None = _figure("rad", default=None)
+    steps: int = unit_field(PURE)
+    fell: bool = unit_field(None)
+    max_slip: float = unit_field("m")
+    step_duration_range: list = unit_field(PERIOD)
+    step_advance_range: list = unit_field("S")
+    max_landing_slide: float = unit_field("m")
+    max_foot_tilt: float = unit_field("rad")
+    max_heel_lift: float = unit_field("m")
+    max_toe_lift: float = unit_field("m")
+    scuff_steps: int = unit_field(PURE)
+    scuff_duration: float = unit_field("s")
+    scuff_depth: float = unit_field("m")
+    swing_clearance: float = unit_field("m")
+    gait_swing_clearance: float = unit_field("m")
+    zmp_rms_error: float = unit_field("m")
+    zmp_relative_error: float = unit_field(PURE)
+    touchdown_jump_error: float = unit_field(PURE)
+    ground_force_rms_error: float = unit_field("weight")
+    feedforward_rms: float = unit_field("N·m")
+    feedback_rms: float = unit_field("N·m")
+    feedback_share: float = unit_field(PURE)
+    landing_feedback_rms: float = unit_field("N·m")
+    energy_per_step: float = unit_field("J")
+    analytic_energy_per_step: float = unit_field("J")
+    warnings: int = unit_field(PURE)
+    distance: float = unit_field("m")
+    seconds_simulated: float = unit_field("s")
+    max_knee_equality_violation: float | None = unit_field("rad", default=None)
 
     def to_dict(self) -> dict:
         """The figures by name (those not measured left out)."""
@@ -83,11 +78,7 @@ FIGURE_UNITS = {
         **{f"torque_rms_{joint}": "N·m" for joint in JOINTS},
     },
     "forward": {
-        **{
-            f.name: f.metadata["unit"]
-            for f in dataclasses.fields(WalkFigures)
-            if f.metadata["unit"]
-        },
+        **declared_units(WalkFigures),
         "real_time_factor": PURE,
     },
     "gains": {

@@ -215,8 +215,9 @@ def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
     if not design.certified:
         say(f"[design] FAIL  the design is not certified: {design.report.status}")
         return False
-    designed_gait(comparison).write(gait_path)
-    passed, lines = pipeline.validated("design", gait_path, Gait.read(gait_path), say)
+    gait = designed_gait(comparison)
+    gait.write(gait_path)
+    passed, lines = pipeline.validated("design", gait_path, gait, say)  # in memory, as the knees
     for line in lines:  # every file written, once
         say(f"[design] {line}")
     return passed and not uncertified(comparison)

@@ -262,11 +262,10 @@ def solver_for(problem: DesignProblem) -> Solver:
 
 
 # Starts of a design, in order: first guesses of the gait at the robot's radii with these step
-# periods [s] (``biped.optimization.optimize.GUESS_PERIODS``), or None for a random start (radii
-# uniform in
-# the bounds, the gait's first guess there perturbed); random starts after these. The short
-# period comes late: from it IPOPT takes several times the iterations of the others (388
-# against 26-88 at 0.3 m/s) to the same design.
+# periods [s] (``biped.optimization.optimize.GUESS_PERIODS``), or None for a random start
+# (radii uniform in the bounds, the gait's first guess there perturbed); random starts after
+# these. The short period comes late: from it IPOPT takes several times the iterations of
+# the others (388 against 26-88 at 0.3 m/s) to the same design.
 DESIGN_STARTS = (GUESS_PERIODS[0], GUESS_PERIODS[1], None, GUESS_PERIODS[2])
 
 
@@ -341,9 +340,8 @@ def optimize_at(
     problem: DesignProblem, radii, seed: int = 0, starts: int = DEFAULT_STARTS, given=()
 ) -> Optimum:
     """The optimal gait of ``problem``'s robot with the radii held at ``radii`` (r1, r2) [m]:
-    ``biped.optimization.optimize.optimize`` (same starts, same report) on the design graph, so
-    that a
-    map of many radii builds one graph per process."""
+    ``biped.optimization.optimize.optimize`` (same starts, same report) on the design graph,
+    so that a map of many radii builds one graph per process."""
     radii = check_radii(problem.robot, radii)
     gait = problem.gait_problem(radii)
     return optimize(gait, seed=seed, starts=starts, given=given, solvers=_HeldRadii(problem, radii))

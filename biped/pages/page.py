@@ -19,6 +19,7 @@ on the grid the optimiser checks feasibility on (``CHECK_SAMPLES_PER_HALF``).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -77,9 +78,10 @@ KNOT_WHY = (
 
 @dataclass(frozen=True)
 class Tightest:
-    """The tightest sample of one constraint: the smallest Ψ_i [unit], at t/T, and δ_i
-    there, the margin the solver keeps from it (``biped.model.criteria.margin_profile``: constant,
-    but ramping from 0 at the ends of the step for the swing foot)."""
+    """The tightest sample of one constraint relative to its margin: Ψ_i [unit] there, at
+    t/T, and δ_i there, the margin the solver keeps from it
+    (``biped.model.criteria.margin_profile``: constant, but ramping from 0 at the ends of the
+    step for the swing foot)."""
 
     name: str
     value: float
@@ -93,17 +95,24 @@ class Tightest:
         return self.value / self.margin
 
 
+@functools.lru_cache(maxsize=8)  # a page's table, captions and figures all read it
 def constraint_profile(
     gait: Gait, samples_per_half: int = CHECK_SAMPLES_PER_HALF
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """On the optimiser's check grid (or ``samples_per_half`` samples per spline piece): the
     step's normalised times t/T (N,), Ψ1..Ψ7 (N, 7) less the gait's safety margins (NaN
     where a constraint is not checked: the swing foot at the ends) and the solver's margins
-    δ (N, 7)."""
+    δ (N, 7); read-only, computed once per gait record and grid."""
     step = build_step(gait.biped, gait.speed, gait.parameter_vector)
     evaluation = evaluate_step(gait.biped, step, samples_per_half, safety=gait.safety)
-    t_n = np.concatenate(half_grid(samples_per_half))
-    return t_n, evaluation.constraints, margin_profile(samples_per_half)
+    arrays = (
+        np.concatenate(half_grid(samples_per_half)),
+        evaluation.constraints,
+        margin_profile(samples_per_half),
+    )
+    for array in arrays:
+        array.setflags(write=False)
+    return arrays
 
 
 @dataclass(frozen=True)
@@ -404,13 +413,13 @@ def gait_figures(gait: Gait) -> dict[str, Figure]:
     return {
         "torques.png": time_figure(
             gaits,
-            "joint torques, jumping at the knot t/T = 0.5 where the spline is C¹",
+            f"joint torques, jumping at the knot t/T = {KNOT:g} where the spline is C¹",
             _knot_panels(gait, TORQUE_PANELS),
         ),
         "angles.png": time_figure(gaits, "absolute angles", ANGLE_PANELS),
         "ground.png": time_figure(
             gaits,
-            "ground reaction on the stance foot, jumping at the knot t/T = 0.5",
+            f"ground reaction on the stance foot, jumping at the knot t/T = {KNOT:g}",
             _knot_panels(gait, GROUND_PANELS),
         ),
         "constraints.png": time_figure(

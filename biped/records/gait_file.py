@@ -24,7 +24,7 @@ import dataclasses
 import functools
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -43,9 +43,11 @@ from biped.records.provenance import provenance as make_provenance
 from biped.records.units import (
     CONSTRAINT_UNITS,
     PURE,
+    declared_units,
     parameter_unit,
     per_coordinate,
     robot_unit,
+    unit_field,
 )
 from biped.runtime.files import atomic_write_text
 
@@ -74,13 +76,6 @@ OTHER_FORMATS = {
 CONSISTENCY_RTOL = 1e-9
 
 
-def _unit(unit, columns: tuple | None = None, **kwargs):
-    """A field with its unit (a string, one per column, a map of sub-fields to units, a
-    record type whose fields carry theirs, or a function of the gait's criterion) and, for
-    an array of samples, the names of its columns (None: one number a sample)."""
-    return field(metadata={"unit": unit, "columns": columns}, **kwargs)
-
-
 RATES = per_coordinate("rad/s", "m/s")
 
 
@@ -88,13 +83,13 @@ RATES = per_coordinate("rad/s", "m/s")
 class Samples:
     """The gait on the check grid (N samples from t = 0 to T, T/2 twice), as numpy arrays."""
 
-    t: np.ndarray = _unit("s")
-    q: np.ndarray = _unit(per_coordinate("rad", "m"), COORDINATES)
-    qd: np.ndarray = _unit(RATES, COORDINATES)
-    qdd: np.ndarray = _unit(per_coordinate("rad/s²", "m/s²"), COORDINATES)
-    torques: np.ndarray = _unit("N·m", JOINTS)
-    wrench: np.ndarray = _unit(["N", "N", "N·m"], ("Fx", "Fz", "Cy"))
-    zmp: np.ndarray = _unit("m")
+    t: np.ndarray = unit_field("s")
+    q: np.ndarray = unit_field(per_coordinate("rad", "m"), COORDINATES)
+    qd: np.ndarray = unit_field(RATES, COORDINATES)
+    qdd: np.ndarray = unit_field(per_coordinate("rad/s²", "m/s²"), COORDINATES)
+    torques: np.ndarray = unit_field("N·m", JOINTS)
+    wrench: np.ndarray = unit_field(["N", "N", "N·m"], ("Fx", "Fz", "Cy"))
+    zmp: np.ndarray = unit_field("m")
 
     def to_dict(self) -> dict:
         return {f.name: getattr(self, f.name).tolist() for f in dataclasses.fields(self)}
@@ -121,18 +116,18 @@ class Gait:
     """One optimal gait, as its file holds it (see the module); built by ``from_optimum`` or
     ``read``. Its ``biped``, ``problem`` and ``parameter_vector`` follow from it."""
 
-    knee: str = _unit(None)
-    criterion: str = _unit(None)
-    speed: float = _unit("m/s")
-    period: float = _unit("s")
-    step_length: float = _unit("m")
-    safety: Safety = _unit(Safety)
-    feasible: bool = _unit(None)
-    costs: dict = _unit({**CRITERION_UNITS, "energy_per_metre": "J/m"})
-    robot: Robot = _unit({f.name: robot_unit(f.name) for f in dataclasses.fields(Robot)})
-    parameters: dict = _unit({name: parameter_unit(name) for name in PARAMETERS})
-    constraints: dict = _unit(CONSTRAINT_UNITS)
-    impact: dict | None = _unit(
+    knee: str = unit_field(None)
+    criterion: str = unit_field(None)
+    speed: float = unit_field("m/s")
+    period: float = unit_field("s")
+    step_length: float = unit_field("m")
+    safety: Safety = unit_field(Safety)
+    feasible: bool = unit_field(None)
+    costs: dict = unit_field({**CRITERION_UNITS, "energy_per_metre": "J/m"})
+    robot: Robot = unit_field({f.name: robot_unit(f.name) for f in dataclasses.fields(Robot)})
+    parameters: dict = unit_field({name: parameter_unit(name) for name in PARAMETERS})
+    constraints: dict = unit_field(CONSTRAINT_UNITS)
+    impact: dict | None = unit_field(
         {
             "impulse": ["N·s", "N·s", "N·m·s"],
             "trailing_foot_lift": "m/s",
@@ -140,10 +135,10 @@ class Gait:
             "qd_plus": RATES,
         }
     )
-    optimizer: dict = _unit(_optimizer_units)
-    provenance: dict = _unit(None)
-    samples: Samples = _unit(Samples)
-    design: dict | None = _unit(None, default=None)  # a designed knee's (``biped design``)
+    optimizer: dict = unit_field(_optimizer_units)
+    provenance: dict = unit_field(None)
+    samples: Samples = unit_field(Samples)
+    design: dict | None = unit_field(None, default=None)  # a designed knee's (``biped design``)
 
     @classmethod
     def from_optimum(cls, optimum: Optimum, robot: Robot, provenance: dict | None = None) -> Gait:
@@ -180,8 +175,7 @@ class Gait:
         except (ValueError, RecursionError) as error:  # JSONDecodeError, UnicodeDecodeError
             reason = "nested too deeply" if isinstance(error, RecursionError) else error
             raise BipedError(
-                f"gait file {str(path)!r} is not valid JSON ({reason}): allowed a gait file "
-                "written by biped optimize, sweep, design or pipeline"
+                f"gait file {str(path)!r} is not valid JSON ({reason}): allowed {allowed}"
             ) from None
         kind = other_kind(content)
         if kind is not None:  # a valid file of another kind is not corrupt
@@ -240,7 +234,7 @@ class Gait:
     def units(criterion: str) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion``, from the fields'
         declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
-        return _units(Gait, "", criterion)
+        return declared_units(Gait, "", criterion)
 
     def to_dict(self) -> dict:
         """The JSON-ready content of the gait's file."""
@@ -303,7 +297,7 @@ class Gait:
         for group in ("costs", "constraints"):
             _check_group(getattr(self, group), group, expected[group], units, bad)
         if self.feasible != evaluation.feasible:
-            violated = ", ".join(f"{k} = {v:.3g}" for k, v in evaluation.violations().items())
+            violated = evaluation.violations_line()
             raise bad(
                 f"feasible = {str(self.feasible).lower()}, its parameters give "
                 f"{str(evaluation.feasible).lower()}"
@@ -311,22 +305,6 @@ class Gait:
             )
         if self.impact is not None:
             _check_impact(self.impact, expected["impact"], bad)
-
-
-def _units(record, prefix: str, criterion: str) -> dict:
-    """The units of ``record``'s fields (a record type), their paths under ``prefix``."""
-    units = {}
-    for f in dataclasses.fields(record):
-        unit = f.metadata.get("unit")
-        unit = unit(criterion) if callable(unit) and not isinstance(unit, type) else unit
-        path = f"{prefix}{f.name}"
-        if isinstance(unit, type):
-            units.update(_units(unit, f"{path}.", criterion))
-        elif isinstance(unit, dict):
-            units.update({f"{path}.{key}": value for key, value in unit.items()})
-        elif unit is not None:
-            units[path] = unit
-    return units
 
 
 def _derived(model: Biped, step, evaluation) -> dict:

@@ -20,7 +20,9 @@ not be measured) have units; texts, booleans and ``provenance`` have none.
 
 from __future__ import annotations
 
-from biped.model.criteria import CONSTRAINTS, CRITERION_UNITS  # noqa: F401 (its units, here too)
+import dataclasses
+
+from biped.model.criteria import CONSTRAINTS
 from biped.model.kinematics import ANGLES, COORDINATES
 
 PURE = "1"  # a count or a ratio
@@ -99,3 +101,28 @@ CONSTRAINT_UNITS = dict(zip(CONSTRAINTS, ("N", "m", "m", "rad", "rad", "m", "m")
 def per_coordinate(angle: str, length: str) -> list[str]:
     """One unit per coordinate (``COORDINATES``): ``angle`` for the angles, else ``length``."""
     return [angle if name in ANGLES else length for name in COORDINATES]
+
+
+def unit_field(unit, columns: tuple | None = None, **kwargs):
+    """A record's field with its unit (a string, one per column, a map of sub-fields to
+    units, a record type whose fields carry theirs, a function of the gait's criterion, or
+    None: no number) and, for an array of samples, the names of its columns (None: one
+    number a sample)."""
+    return dataclasses.field(metadata={"unit": unit, "columns": columns}, **kwargs)
+
+
+def declared_units(record, prefix: str = "", criterion: str | None = None) -> dict:
+    """The units of ``record``'s fields (a record type, fields made by ``unit_field``), their
+    paths under ``prefix``; a field without a number (unit None) has none."""
+    units = {}
+    for f in dataclasses.fields(record):
+        unit = f.metadata.get("unit")
+        unit = unit(criterion) if callable(unit) and not isinstance(unit, type) else unit
+        path = f"{prefix}{f.name}"
+        if isinstance(unit, type):
+            units.update(declared_units(unit, f"{path}.", criterion))
+        elif isinstance(unit, dict):
+            units.update({f"{path}.{key}": value for key, value in unit.items()})
+        elif unit is not None:
+            units[path] = unit
+    return units

@@ -4,21 +4,21 @@ several speeds, with the joint optimum of radii and gait (``biped.optimization.d
 At each speed the map holds, each an independent optimization:
 
 - ``grid``: the optimal gait of the rolling knee at every (r1, r2) of the grid
-  (``biped.optimization.design.optimize_at``: ``biped.optimization.optimize.optimize``'s starts on
-  the design graph
-  with the radii held, one graph per process for every radius);
+  (``biped.optimization.design.optimize_at``: ``biped.optimization.optimize.optimize``'s
+  starts on the design graph with the radii held, one graph per process for every radius);
 - ``revolute``: the optimal gait of the revolute knee, the map's reference contour (the
   grid's rows r1 = 0 and r2 = 0 are hinges too: a circle rolling on a point turns about it);
 - ``table1``: the rolling knee at the robot's own radii (Table 1: 5 cm);
 - ``design``: the radii and gait optimised together, in a second stage that also starts
   from the best grid point and the Table 1 and revolute gaits at that speed.
 
-The optimizations run through ``biped.runtime.runner.run_tasks``: local processes, or the workers of
-a Dask cluster. Each writes its result as one small JSON file (``biped.runtime.files``: whole or not
-at all), so a map stopped at any moment and run again ends with the files of an
-uninterrupted run; the folder's ``design-map.json`` records what shapes the numbers and
-resuming with any of it changed is refused. Points whose solver did not converge, or whose
-optimum is infeasible, are kept with their status and left out of the figures.
+The optimizations run through ``biped.runtime.runner.run_tasks``: local processes, or the
+workers of a Dask cluster. Each writes its result as one small JSON file
+(``biped.runtime.files``: whole or not at all), so a map stopped at any moment and run
+again ends with the files of an uninterrupted run; the folder's ``design-map.json``
+records what shapes the numbers and resuming with any of it changed is refused. Points
+whose solver did not converge, or whose optimum is infeasible, are kept with their status
+and left out of the figures.
 
 Figures (``draw``): per speed, ``map-<speed>.png``, the criterion over (r1, r2) with the
 joint optimum and the Table 1 point marked and the revolute knee's value as a contour; with
@@ -300,7 +300,7 @@ def summarize(folder, settings: MapSettings) -> str:
         content = read_point(Path(folder), point)
         if content is None:
             return "missing"
-        return None if content["certified"] else content["status"]
+        return campaign.failure(content["status"], content["feasible"])
 
     counted = "optimizations certified (converged and feasible)"
     return campaign.tally(first + second, why_not, counted, most=5)

@@ -2,9 +2,8 @@
 
 Every point (knee, criterion, speed) is solved twice:
 
-1. independent: IPOPT from the point's own starts (``biped.optimization.optimize.optimize``); the
-result
-   is kept in the hidden folder ``.independent/``. The energy criterion also starts from
+1. independent: IPOPT from the point's own starts (``biped.optimization.optimize.optimize``);
+   the result is kept in the hidden folder ``.independent/``. The energy criterion also starts from
    the sthenic optimum of its problem: the sthenic point's independent optimum, read from
    there (the same numbers as computed again);
 2. neighbours: IPOPT again from the independent optima of the neighbouring speeds of the
@@ -15,13 +14,12 @@ The solves run in three stages, each task of a stage independent of the others, 
 in parallel (``biped.runtime.runner``: on all cores, or on the workers of a Dask cluster): the
 sthenic independent optima; the energy independent optima with the sthenic neighbours'
 solves; the energy neighbours' solves. Each result depends only on files of the stages
-before, which are written whole
-(``biped.runtime.files``), so a sweep stopped at any moment and run again ends with exactly the
-files
-of an uninterrupted sweep. The folder's ``sweep.json`` records what shapes the numbers
-(robot, safety, speeds, seed, starts, method, versions); resuming with any of them changed is
-refused. Points whose solver did not converge, or whose optimum is infeasible, are saved
-with their status and counted in the summary; they are not optimised again.
+before, which are written whole (``biped.runtime.files``), so a sweep stopped at any moment
+and run again ends with exactly the files of an uninterrupted sweep. The folder's
+``sweep.json`` records what shapes the numbers (robot, safety, speeds, seed, starts,
+method, versions); resuming with any of them changed is refused. Points whose solver did
+not converge, or whose optimum is infeasible, are saved with their status and counted in
+the summary; they are not optimised again.
 """
 
 from __future__ import annotations
@@ -296,8 +294,7 @@ def summarize(folder: Path, points, settings: Settings) -> str:
         gait = gaits[p]
         if gait is None:
             return "missing"
-        status = gait.optimizer.get("status")
-        return None if status == "converged" and gait.feasible else str(status)
+        return campaign.failure(str(gait.optimizer.get("status")), gait.feasible)
 
     single = [
         p.filename()
