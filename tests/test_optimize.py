@@ -352,3 +352,50 @@ def test_solver_that_does_not_converge_fails_loudly(tmp_path, monkeypatch, capsy
         assert "Maximum_Iterations_Exceeded" in capsys.readouterr().err
     finally:
         solver._solver.cache_clear()
+
+
+@pytest.mark.parametrize(
+    "knee, criterion, radii",
+    [("revolute", "sthenic", None), ("rolling", "energy", None), ("rolling", "sthenic", "design")],
+)
+def test_hessian_built_sample_by_sample_is_casadis_hessian(knee, criterion, radii):
+    """The Hessian of the Lagrangian that IPOPT uses (built per sample and chained through
+    the head, ``biped.optimization.hessian``) equals CasADi's own Hessian of the whole NLP
+    to 1e-12 at random variables and multipliers, with a clearance margin, a design's radii
+    and the energy criterion's slacks; another robot's differs."""
+    from biped.optimization.hessian import dense, full_hessian
+    from biped.optimization.solver import Solver
+
+    model = biped.Biped(UNEQUAL, knee)
+    bounds_ = ((0.001, 0.001), (0.15, 0.2)) if radii else None
+    solver = Solver(model, criterion, Safety(clearance=0.02), 6, radius_bounds=bounds_)
+    oracle = solver.nlp.oracle()
+    x, p = oracle.sx_in(0), oracle.sx_in(1)
+    f, g = oracle.call([x, p])[:2]
+    reference = full_hessian(x, p, f, g)
+    rng = np.random.default_rng(4)
+    problem = GaitProblem(model, 0.3, criterion)
+    for _ in range(2):
+        z = random_variables(problem, rng) / SCALES
+        xs = np.concatenate([z, rng.uniform(0.5, 2.0, 2 * bool(radii)), rng.random(solver.slacks)])
+        lam_g = rng.standard_normal(g.shape[0])
+        expected = dense(reference(xs, 0.3, 1.7, lam_g))
+        found = dense(solver.hessian(xs, 0.3, 1.7, lam_g))
+        np.testing.assert_allclose(found, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+    heavier = dataclasses.replace(UNEQUAL, trunk_mass=1.1 * UNEQUAL.trunk_mass)
+    other = Solver(biped.Biped(heavier, knee), criterion, Safety(clearance=0.02), 6, bounds_)
+    wrong = dense(other.hessian(xs, 0.3, 1.7, lam_g))  # another robot's: told apart
+    assert np.abs(wrong - expected).max() > 1e-6 * np.abs(expected).max()
+
+
+def test_hessian_needs_an_nlp_linear_in_the_samples_quantities():
+    """The sample-by-sample Hessian holds only for an objective linear in the samples'
+    quantities; another is refused, not differentiated wrongly."""
+    from biped.optimization.hessian import lagrangian_hessian
+
+    graph = StepGraph(biped.Biped(ROBOT, "revolute"), 4, PAPER_SAFETY)
+    x = ca.SX.sym("x", 21)
+    head = ca.substitute(graph.head, graph.z, x)
+    squares = ca.sumsqr(graph.rows("torques"))
+    with pytest.raises(ValueError, match="not linear"):
+        lagrangian_hessian(graph, x, graph.speed, head, squares, graph.on_symbols["constraints"])

@@ -32,6 +32,7 @@ from biped.errors import BipedError
 from biped.model.criteria import Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import Robot
+from biped.optimization.hessian import lagrangian_hessian
 from biped.optimization.problem import N_VARIABLES, SCALES, GaitProblem, bounds
 from biped.optimization.symbolic import StepGraph
 from biped.runtime.interrupts import kept_interrupts
@@ -139,28 +140,19 @@ class Solver:
         self.criterion = criterion
         self.design = design
         y = ca.SX.sym("y", N_VARIABLES)
-        z = ca.DM(SCALES) * y
-        unknowns, scaled = [graph.z], [z]
+        unknowns, scaled = [graph.z], [ca.DM(SCALES) * y]
         if design:
             rho = ca.SX.sym("rho", 2)
             y = ca.vertcat(y, rho)
             unknowns.append(graph.radii)
             scaled.append(RADIUS_SCALE * rho)
-        constraints = ca.vertcat(graph.constraints, graph.hip_height)
-        if criterion == "sthenic":
-            x, objective, g = y, graph.sthenic, constraints
-            self.slacks = 0
-        else:
-            power = ca.vec(graph.power)  # Γ_i θ̇_i, sample-major
-            slack = ca.SX.sym("s", power.shape[0])
-            self.slacks = power.shape[0]
-            weights = ca.repmat(graph.weights, graph.power.shape[0], 1)
-            objective = graph.period * ca.dot(ca.vec(weights), slack)
-            x = ca.vertcat(y, slack)
-            g = ca.vertcat(constraints, slack - power, slack + power)
-        substituted = ca.substitute([objective, g], unknowns, scaled)
-        nlp = {"x": x, "p": graph.speed, "f": substituted[0], "g": substituted[1]}
-        self.nlp = ca.nlpsol("design" if design else "gait", "ipopt", nlp, _options("adaptive"))
+        x, objective, g = self._objective_and_constraints(graph, criterion, y)
+        head = ca.substitute(graph.head, ca.vertcat(*unknowns), ca.vertcat(*scaled))
+        flat = ca.substitute([graph.flat(ca.vertcat(objective, g))], unknowns, scaled)[0]
+        self.hessian = lagrangian_hessian(graph, x, graph.speed, head, objective, g)
+        nlp = {"x": x, "p": graph.speed, "f": flat[0], "g": flat[1:]}
+        name = "design" if design else "gait"
+        self.nlp = ca.nlpsol(name, "ipopt", nlp, self._options("adaptive"))
         self._nlps = {"adaptive": self.nlp}  # and the other barriers', built when first used
         self.evaluate = ca.Function(
             "evaluate", graph.inputs, [graph.sthenic, graph.energy, graph.power]
@@ -174,6 +166,22 @@ class Solver:
         self.lbx = np.concatenate([lower, np.zeros(self.slacks)])
         self.ubx = np.concatenate([upper, np.full(self.slacks, np.inf)])
         self.n_constraints = g.shape[0]
+
+    def _objective_and_constraints(self, graph: StepGraph, criterion: str, y):
+        """The NLP's variables x, objective and constraints, on the graph's symbols (the
+        samples' quantities, the head; ``StepGraph.on_symbols``) and the slacks."""
+        period, hip_height = graph.head_symbol[graph.period_index], graph.head_symbol[-1]
+        constraints = ca.vertcat(graph.on_symbols["constraints"], hip_height)
+        if criterion == "sthenic":
+            self.slacks = 0
+            return y, graph.on_symbols["sthenic"], constraints
+        power = ca.vec(graph.on_symbols["power"])  # Γ_i θ̇_i, sample-major
+        slack = ca.SX.sym("s", power.shape[0])
+        self.slacks = power.shape[0]
+        weights = ca.vec(ca.repmat(graph.weights, graph.on_symbols["power"].shape[0], 1))
+        objective = period * ca.dot(weights, slack)
+        constraints = ca.vertcat(constraints, slack - power, slack + power)
+        return ca.vertcat(y, slack), objective, constraints
 
     def solve(
         self, problem, start, radii=None, hold_radii: bool = False, barrier: str = "adaptive"
@@ -190,9 +198,16 @@ class Solver:
     def _nlp(self, barrier: str):
         if barrier not in self._nlps:  # the same problem (IPOPT's oracle), other settings
             self._nlps[barrier] = ca.nlpsol(
-                f"{self.nlp.name()}_{barrier}", "ipopt", self.nlp.oracle(), _options(barrier)
+                f"{self.nlp.name()}_{barrier}", "ipopt", self.nlp.oracle(), self._options(barrier)
             )
         return self._nlps[barrier]
+
+    def _options(self, barrier: str) -> dict:
+        """nlpsol's options: ``IPOPT_OPTIONS`` with those of ``barrier``, the Hessian built
+        sample by sample (``biped.optimization.hessian``)."""
+        options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
+        options.update({f"ipopt.{key}": value for key, value in BARRIERS[barrier].items()})
+        return {**options, "print_time": False, "hess_lag": self.hessian}
 
     def _solve(self, problem, start, radii, hold_radii, barrier) -> Solution:
         began = time.perf_counter()
@@ -239,14 +254,6 @@ class Solver:
             dual_infeasibility=float(dual[-1]),
             seconds=time.perf_counter() - began,
         )
-
-
-def _options(barrier: str) -> dict:
-    """nlpsol's options: ``IPOPT_OPTIONS`` with those of ``barrier``."""
-    options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
-    options.update({f"ipopt.{key}": value for key, value in BARRIERS[barrier].items()})
-    options["print_time"] = False
-    return options
 
 
 @functools.lru_cache(maxsize=8)

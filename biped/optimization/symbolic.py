@@ -244,6 +244,55 @@ def _reach_squared(c: _Constants, bend):
     return value
 
 
+# The quantities of one sample (``sample_function``), in order, with their row counts: the
+# stance state, the inverse dynamics, Ψ1-Ψ7 with the ZMP margin (the swing foot's clearance,
+# which varies over the step, is taken off afterwards), ΓᵀΓ and the joints' powers Γ_i θ̇_i.
+QUANTITIES = (
+    ("q", 9),
+    ("qd", 9),
+    ("torques", 6),
+    ("wrench", 3),
+    ("psi", 7),
+    ("squared", 1),
+    ("power", 6),
+)
+_ROWS, _COUNT = {}, 0
+for _name, _n in QUANTITIES:
+    _ROWS[_name], _COUNT = slice(_COUNT, _COUNT + _n), _COUNT + _n
+N_QUANTITIES = _COUNT  # 41
+# A sample's inputs: the free angles and their first and second derivatives in normalised
+# time (6 each), then the period T [s], then (design) the knee radii.
+SAMPLE_MOTION = 18
+
+
+def sample_function(c: _Constants, robot, safety, radii=None) -> ca.Function:
+    """One sample of the step as a CasADi function: v = [angles, d/dt_n, d²/dt_n² (6 each),
+    T (, r1, r2)] -> the ``QUANTITIES`` (41,). Every sample of a step is this function of a
+    linear map of the step's head (``StepGraph.basis``), which lets the solver build the
+    Hessian of its Lagrangian sample by sample (``biped.optimization.hessian``)."""
+    motion, period = ca.SX.sym("motion", SAMPLE_MOTION), ca.SX.sym("period")
+    angles = motion[:6]
+    rates, accels = motion[6:12] / period, motion[12:] / period**2
+    q, qd, qdd, phid, phidd, s, co = _stance_state(c, angles, rates, accels)
+    torques, wrench = _torques_and_wrench(c, qdd, phid, phidd, s, co)
+    heel_a, heel_b = c.point("swing_heel")
+    toe_a, toe_b = c.point("swing_toe")
+    zmp = (torques[0] - robot.ankle_height * wrench[0]) / wrench[1]
+    psi = ca.vertcat(
+        wrench[1],
+        zmp + robot.foot_heel - safety.zmp_margin,
+        robot.foot_length - robot.foot_heel - zmp - safety.zmp_margin,
+        q[Q2] - q[Q1],
+        q[Q3] - q[Q4],
+        q[ZH] - ca.dot(co, heel_a) + ca.dot(s, heel_b),
+        q[ZH] - ca.dot(co, toe_a) + ca.dot(s, toe_b),
+    )
+    power = torques * (ca.DM(JOINT_MATRIX) @ qd)
+    quantities = ca.vertcat(q, qd, torques, wrench, psi, ca.sumsqr(torques), power)
+    inputs = [motion, period] + ([radii] if radii is not None else [])
+    return ca.Function("sample", [ca.vertcat(*inputs)], [quantities], ["v"], ["quantities"])
+
+
 class StepGraph:
     """One step of one robot as a CasADi graph of the variables z and the speed V.
 
@@ -255,8 +304,15 @@ class StepGraph:
             links always present: ``model`` gives every other constant (its radii and knee
             are not used). At r1 = r2 = 0 the graph is the revolute knee's.
 
-    Attributes (SX expressions of ``z`` (21), ``speed`` (1) and, with ``design``,
-    ``radii`` (2) [m]):
+    The graph has two parts. The head, SX expressions of ``z`` (21), ``speed`` (1) and, with
+    ``design``, ``radii`` (2) [m]: ``head`` = [the spline coefficients (8 x 6, column by
+    column), T (, r1, r2), the hip height constraint]. The samples: sample j is
+    ``sample_function`` of v_j = ``basis_j`` @ head (a constant matrix), giving the
+    ``QUANTITIES`` of the samples, ``quantities`` (41, N) as a symbol. The criteria and
+    constraints are written on the symbols ``quantities`` and ``head_symbol`` (``on_symbols``,
+    linear in the quantities) and, substituted (``flat``), as expressions of the variables:
+
+    Attributes (SX expressions of z, speed (, radii)):
         parameters (21): the paper's parameters; torques (6, N); wrench (3, N); q (9, N);
         qd (9, N); power (6, N) Γ_i θ̇_i; sthenic, energy: eqs. (30)-(31) without penalty;
         constraints (M): (Ψ_i − δ_i − safety) / scale at the checked samples, >= 0 when met;
@@ -276,10 +332,11 @@ class StepGraph:
         self.length = self.speed * self.period  # S [m]
         start_angles = self._start_posture(c)
         end_angles, end_rates, start_rates = self._impact(c, start_angles)
-        motion = self._splines(start_angles, start_rates, end_angles, end_rates)
-        feet = self._samples(c, *motion)
-        self._criteria()
-        self._constraints(feet)
+        coefficients = self._splines(start_angles, start_rates, end_angles, end_rates)
+        self._samples(c, coefficients)
+        self.on_symbols = self._criteria_and_constraints()
+        for name, value in self.on_symbols.items():
+            setattr(self, name, self.flat(value))
 
     def _start_posture(self, c: _Constants):
         """1. The hip at the start of the step from the knee bends (``biped.optimization.problem``,
@@ -316,8 +373,8 @@ class StepGraph:
         return end_angles, end_rates, start_rates
 
     def _splines(self, start_angles, start_rates, end_angles, end_rates):
-        """3. The spline coefficients (25)-(26), as in ``biped.model.gait.build_step``: the
-        angles, rates and accelerations (6, N) of the free angles at the samples."""
+        """3. The spline coefficients (25)-(26) [a0..a3, b0..b3] (8, 6) of the free angles in
+        normalised time, as in ``biped.model.gait.build_step``."""
         z, period = self.z, self.period
         acc0 = z[index("start_accel_qp2") : index("start_accel_q5") + 1]
         acc1 = z[index("end_accel_qp2") : index("end_accel_q5") + 1]
@@ -327,68 +384,62 @@ class StepGraph:
         r2 = -(b1 + b2) - a1 - a2
         a3 = 4 * r1 + 2 * r2 / 3
         b3 = 2 * r2 / 3 - 4 * r1
-        coefficients = ca.horzcat(a0, a1, a2, a3, b0, b1, b2, b3).T  # (8, 6)
-        _, (values, rates, accels) = spline_basis(self.samples_per_half)
-        angles = (ca.DM(values) @ coefficients).T  # (6, N)
-        rates = (ca.DM(rates) @ coefficients).T / period
-        accels = (ca.DM(accels) @ coefficients).T / period**2
-        return angles, rates, accels
+        return ca.horzcat(a0, a1, a2, a3, b0, b1, b2, b3).T
 
-    def _samples(self, c: _Constants, angles, rates, accels):
-        """3. At each sample the stance state, the one-pass inverse dynamics and the heights
-        of the swing foot's heel and toe (2, N), returned. Sets ``q``, ``qd``, ``torques``,
-        ``wrench`` and ``power``."""
-        heel_a, heel_b = c.point("swing_heel")
-        toe_a, toe_b = c.point("swing_toe")
-        columns = {name: [] for name in ("q", "qd", "torques", "wrench", "feet")}
-        for j in range(angles.shape[1]):
-            q, qd, qdd, phid, phidd, s, co = _stance_state(
-                c, angles[:, j], rates[:, j], accels[:, j]
-            )
-            torques, wrench = _torques_and_wrench(c, qdd, phid, phidd, s, co)
-            feet = ca.vertcat(
-                q[ZH] - ca.dot(co, heel_a) + ca.dot(s, heel_b),
-                q[ZH] - ca.dot(co, toe_a) + ca.dot(s, toe_b),
-            )
-            for name, value in zip(columns, (q, qd, torques, wrench, feet), strict=True):
-                columns[name].append(value)
-        self.q, self.qd, self.torques, self.wrench, feet = (
-            ca.horzcat(*columns[name]) for name in columns
+    def _samples(self, c: _Constants, coefficients):
+        """3. The head (coefficients, T (, radii), hip height), the constant ``basis`` that
+        maps it to each sample's inputs, the ``sample`` function, and the samples'
+        ``QUANTITIES`` as a symbol (``quantities``) and as expressions (``flat``)."""
+        radii = [self.radii] if self.design else []
+        self.head = ca.vertcat(ca.vec(coefficients), self.period, *radii, self.hip_height)
+        self.period_index = _PERIOD
+        self.head_symbol = ca.SX.sym("head", self.head.shape[0])
+        self.sample = sample_function(c, self.model.robot, self.safety, self.radii)
+        self.basis = _sample_basis(self.samples_per_half, self.head.shape[0], self.design)
+        n = self.basis.shape[0] // self.sample.size1_in(0)
+        self.quantities = ca.SX.sym("quantities", N_QUANTITIES, n)
+        inputs = ca.reshape(ca.DM(self.basis) @ self.head, self.sample.size1_in(0), n)
+        self._flat_quantities = self.sample.map(n)(inputs)
+
+    def flat(self, expression):
+        """``expression`` of the symbols ``quantities`` and ``head_symbol`` as an expression of
+        the variables (z, speed (, radii))."""
+        return ca.substitute(
+            expression,
+            ca.vertcat(ca.vec(self.quantities), self.head_symbol),
+            ca.vertcat(ca.vec(self._flat_quantities), self.head),
         )
-        joint_rates = ca.DM(JOINT_MATRIX) @ self.qd
-        self.power = self.torques * joint_rates
-        return feet
 
-    def _criteria(self):
-        """4. The criteria (Simpson's rule per piece), eqs. (30)-(31) without penalty."""
-        period = self.period
-        self.weights = ca.DM(simpson_weights(self.samples_per_half)).T  # (1, N)
-        squared = ca.sum1(self.torques**2)
-        self.sthenic = period * (self.weights @ squared.T) / self.length
-        self.energy = period * (self.weights @ ca.sum1(ca.fabs(self.power)).T)
+    def rows(self, name: str):
+        """The rows of the quantity ``name`` (``QUANTITIES``) of ``quantities`` (symbols)."""
+        return self.quantities[_ROWS[name], :]
 
-    def _constraints(self, feet):
-        """4. The constraints Ψ_i − δ_i (``psi``: Ψ_i with the safety margins, without δ_i),
-        scaled by ``CONSTRAINT_SCALES``, at the checked samples in constraint-major order."""
-        robot, safety, samples = self.model.robot, self.safety, self.samples_per_half
-        zmp = (self.torques[0, :] - robot.ankle_height * self.wrench[0, :]) / self.wrench[1, :]
-        if safety.clearance:
-            required = ca.DM(clearance_profile(samples, safety.clearance)).T
-            feet = feet - ca.repmat(required, 2, 1)
-        self.psi = ca.vertcat(
-            self.wrench[1, :],
-            zmp + robot.foot_heel - safety.zmp_margin,
-            robot.foot_length - robot.foot_heel - zmp - safety.zmp_margin,
-            self.q[Q2, :] - self.q[Q1, :],
-            self.q[Q3, :] - self.q[Q4, :],
-            feet,
-        )  # (7, N)
-        n = self.psi.shape[1]
+    def _criteria_and_constraints(self) -> dict:
+        """4. On the symbols: the criteria (Simpson's rule per piece, eqs. (30)-(31) without
+        penalty) and the constraints Ψ_i − δ_i (``psi``: Ψ_i with the safety margins,
+        without δ_i), scaled by ``CONSTRAINT_SCALES``, at the checked samples in
+        constraint-major order; the samples' quantities by name."""
+        samples, period = self.samples_per_half, self.head_symbol[_PERIOD]
+        self.weights = ca.DM(simpson_weights(samples)).T  # (1, N)
+        power = self.rows("power")
+        psi = self.rows("psi")
+        if self.safety.clearance:
+            required = ca.DM(clearance_profile(samples, self.safety.clearance)).T
+            psi = ca.vertcat(psi[:5, :], psi[5:, :] - ca.repmat(required, 2, 1))
+        n = psi.shape[1]
         margins = ca.DM(margin_profile(samples)).T
-        scaled = (self.psi - margins) / ca.repmat(ca.DM(CONSTRAINT_SCALES), 1, n)
+        scaled = (psi - margins) / ca.repmat(ca.DM(CONSTRAINT_SCALES), 1, n)
         rows, cols = np.nonzero(checked_mask(samples).T)  # constraint-major order
-        self.constraints = ca.vertcat(*[scaled[i, j] for i, j in zip(rows, cols, strict=True)])
         self.constraint_names = [CONSTRAINTS[i] for i in rows]
+        named = {name: self.rows(name) for name in ("q", "qd", "torques", "wrench")}
+        return {
+            **named,
+            "power": power,
+            "psi": psi,
+            "sthenic": (self.weights @ self.rows("squared").T) / self.speed,
+            "energy": period * (self.weights @ ca.sum1(ca.fabs(power)).T),
+            "constraints": ca.vertcat(*[scaled[i, j] for i, j in zip(rows, cols, strict=True)]),
+        }
 
     @property
     def inputs(self) -> list:
@@ -406,3 +457,22 @@ class StepGraph:
             ["z", "speed", "radii"][: len(self.inputs)],
             list(names),
         )
+
+
+_PERIOD = 48  # T's place in the head, after the 8 x 6 spline coefficients
+
+
+def _sample_basis(samples_per_half: int, head_size: int, design: bool) -> np.ndarray:
+    """The constant matrix (N · inputs, head) that maps the head to the stacked inputs of
+    the samples (``sample_function``): the spline bases (``biped.model.gait.spline_basis``)
+    on each angle's coefficients, then T and the radii passed on."""
+    _, bases = spline_basis(samples_per_half)
+    n = bases[0].shape[0]
+    width = SAMPLE_MOTION + 1 + 2 * design
+    matrix = np.zeros((n, width, head_size))
+    for k, basis in enumerate(bases):  # values, rates, accels
+        for angle in range(6):
+            matrix[:, 6 * k + angle, 8 * angle : 8 * angle + 8] = basis
+    for extra in range(width - SAMPLE_MOTION):  # T (, r1, r2)
+        matrix[:, SAMPLE_MOTION + extra, _PERIOD + extra] = 1.0
+    return matrix.reshape(n * width, head_size)
