@@ -1,104 +1,204 @@
-"""One optimisation: IPOPT with exact derivatives from several starts, beside the previous
-method in the same process (the paper's Nelder-Mead, then an SLSQP polish with finite
-differences): value reached and seconds. ``--sweep`` also times the default sweep.
+"""One optimisation, IPOPT with exact derivatives from several starts, beside the method of
+an earlier version kept here ("before": CasADi's Hessian of the whole graph, IPOPT's
+gradient scaling, the first guesses and, for the energy criterion, the sthenic optimum under
+both barriers, one start after the other), in the same process: setup, solve, value, starts
+at the best value, ratios. ``biped optimize`` is timed as a whole process; ``--sweep`` times
+the default sweep both ways, ``--pipeline`` the pipeline without videos.
 
-    python benchmarks/bench_optimize.py [--repeats N] [--sweep]
+    python benchmarks/bench_optimize.py [--repeats N] [--sweep] [--pipeline]
 """
 
 import os
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"  # one core, set before numpy loads its BLAS
+    os.environ[_var] = "1"  # one BLAS thread, set before numpy loads its BLAS
 
 import argparse  # noqa: E402
+import contextlib  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
+from unittest import mock  # noqa: E402
 
 import numpy as np  # noqa: E402
 from timing import median_time  # noqa: E402
 
 import biped  # noqa: E402
-from biped.optimization.optimize import first_guesses, optimize  # noqa: E402
-from biped.optimization.penalty import nelder_mead, polish  # noqa: E402
+from biped.optimization import optimize as optimize_module  # noqa: E402
+from biped.optimization import solver as solver_module  # noqa: E402
+from biped.optimization.optimize import (  # noqa: E402
+    first_guesses,
+    multistart,
+    optimize,
+    prepare,
+    sthenic_starts,
+)
 from biped.optimization.problem import GaitProblem  # noqa: E402
-from biped.optimization.solver import solver_for  # noqa: E402
+from biped.runtime.runner import free_cores  # noqa: E402
 from biped.studies.sweep import run_sweep  # noqa: E402
 
 SPEED = 0.3
+TARGETS = {"sthenic": 0.5, "energy": 1.5}  # [s] of a solve once set up
+BIPED = [sys.executable, "-m", "biped"]
 
 
-def previous_method(problem):
-    """Nelder-Mead (1500 evaluations, one restart) then SLSQP (200 iterations)."""
-    start = problem.first_parameters()
-    p, _, count, _ = nelder_mead(problem, start, np.random.default_rng(0))
-    polished, more, message = polish(problem, p)
-    from biped.optimization.optimize import Report, checked
+class Before(solver_module.Solver):
+    """The solver before: CasADi's Hessian of the whole graph, IPOPT scaling the gradients."""
 
-    report = Report("nelder-mead+slsqp", message, 1, 1, count + more, np.nan, np.nan, 0.0, 0)
-    return checked(problem, None, report, polished)
-
-
-def _function_seconds(stats: dict):
-    """Seconds IPOPT spent in each of CasADi's functions (criterion, constraints and their
-    derivatives) in the last solve."""
-    return [value for key, value in stats.items() if key.startswith("t_wall_nlp")]
+    def _options(self, barrier):
+        options = super()._options(barrier)
+        for key in ("hess_lag", "jac_g", "grad_f"):
+            options.pop(key, None)
+        options["ipopt.nlp_scaling_method"] = "gradient-based"
+        return options
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=5, help="optimisations per case (median)")
-    parser.add_argument("--sweep", action="store_true", help="also time the default sweep")
-    args = parser.parse_args()
-    print(f"one optimisation at {SPEED} m/s, default starts, median of {args.repeats}")
-    print(
-        f"{'knee':10}{'criterion':10}{'build [s]':>10}{'IPOPT [s]':>11}{'value':>12}"
-        f"{'starts at best':>16}{'previous [s]':>14}{'value':>12}{'ratio':>8}"
+def build_before(problem) -> Before:
+    """The solver before, built without the sample-by-sample Hessian it does not use."""
+    with mock.patch.object(solver_module, "lagrangian_hessian", lambda *args: None):
+        return Before(problem.model, problem.criterion, problem.safety, problem.samples_per_half)
+
+
+def optimize_before(problem, solvers: dict):
+    """The starts before, one after the other: the first guesses; for the energy criterion
+    also the sthenic optimum of the same problem (itself optimized so) under both barriers."""
+    began = time.perf_counter()
+    solver = solvers[problem.criterion]
+    candidates = first_guesses(problem, 3, 0)
+    if problem.criterion == "energy":
+        twin = GaitProblem(problem.model, problem.speed, "sthenic", problem.safety)
+        sthenic = optimize_before(twin, solvers)
+        candidates += sthenic_starts(sthenic.report, sthenic.variables)
+    best, report = multistart(
+        candidates, lambda z, barrier: solver.solve(problem, z, barrier=barrier), 0, began, jobs=1
     )
-    hessians = []
+    return optimize_module.checked(problem, best.variables, report)
+
+
+def whole_process(knee: str, criterion: str, repeats: int) -> float:
+    """Median wall time [s] of ``biped optimize`` as a process (imports included)."""
+    with tempfile.TemporaryDirectory() as folder:
+        argv = BIPED + ["optimize", "--knee", knee, "--criterion", criterion]
+        argv += ["--speed", str(SPEED), "--out", f"{folder}/gait.json"]
+        seconds, _ = median_time(
+            lambda: subprocess.run(argv, check=True, capture_output=True), repeats=repeats
+        )
+    return seconds
+
+
+def one_optimization(repeats: int) -> None:
+    print(
+        f"one optimisation at {SPEED} m/s, default starts, median of {repeats}; "
+        f"{free_cores()} cores"
+    )
+    print(
+        f"{'':18}{'setup [s]':>20}{'solve [s]':>20}{'value':>24}{'starts at best':>18}"
+        f"{'process [s]':>13}"
+    )
+    print(
+        f"{'knee, criterion':18}{'before':>10}{'now':>7}{'ratio':>6}{'before':>10}{'now':>7}"
+        f"{'ratio':>6}{'before':>12}{'now':>12}{'before':>9}{'now':>9}{'now':>13}"
+    )
     for criterion in ("sthenic", "energy"):
         for knee in biped.KNEES:
             problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), SPEED, criterion)
             began = time.perf_counter()
-            solver_for(problem)
-            build = time.perf_counter() - began
-            seconds, optimum = median_time(optimize, problem, repeats=args.repeats)
-            report = optimum.report
-            nlp = solver_for(problem).nlp
-            hessian = nlp.get_function("nlp_hess_l").n_instructions()
-            shares = []  # of each first-guess start's solve, in derivatives and functions
-            for _, start in first_guesses(problem, 3, 0):
-                solution = solver_for(problem).solve(problem, start)
-                spent = sum(_function_seconds(nlp.stats()))
-                shares.append(spent / solution.seconds)
-            stats = nlp.stats()  # of the last of them
-            calls = max(stats["n_call_nlp_hess_l"], 1)
-            hessians.append(
-                f"{knee:10}{criterion:10}{hessian / 1e6:9.2f} M SX instructions"
-                f"{stats['t_wall_nlp_hess_l'] / calls * 1e3:8.2f} ms a call; the last start: "
-                f"{stats['iter_count']} iterations, Hessians {stats['t_wall_nlp_hess_l']:.2f} s, "
-                f"all derivatives and functions {sum(_function_seconds(stats)):.2f} s; "
-                f"derivatives and functions over the 3 first guesses: "
-                f"{min(shares):.0%}-{max(shares):.0%} of a solve"
-            )
-            began = time.perf_counter()
-            old = previous_method(problem)
-            old_seconds = time.perf_counter() - began
+            before = {
+                c: build_before(GaitProblem(problem.model, SPEED, c))
+                for c in ("sthenic", criterion)
+            }
+            for solver in before.values():
+                solver.prepare(("adaptive", "monotone"))
+            setup_before = time.perf_counter() - began
+            setup_now = prepare(problem)
+            solve_before, old = median_time(optimize_before, problem, before, repeats=repeats)
+            solve_now, new = median_time(optimize, problem, repeats=repeats)
+            process = whole_process(knee, criterion, repeats)
             print(
-                f"{knee:10}{criterion:10}{build:10.2f}{seconds:11.2f}"
-                f"{optimum.value:12.5f}{f'{report.starts_at_best}/{report.starts}':>16}"
-                f"{old_seconds:14.2f}{old.value:12.5f}{old.value / optimum.value:8.3f}"
+                f"{knee + ', ' + criterion:18}{setup_before:10.2f}{setup_now:7.2f}"
+                f"{setup_now / setup_before:6.2f}{solve_before:10.2f}{solve_now:7.2f}"
+                f"{solve_now / solve_before:6.2f}{old.report.value:12.6f}{new.report.value:12.6f}"
+                f"{f'{old.report.starts_at_best}/{old.report.starts}':>9}"
+                f"{f'{new.report.starts_at_best}/{new.report.starts}':>9}{process:13.2f}"
             )
-    print("target: one optimisation (all starts) <= 0.5 s median once the graph is built")
-    print("\nIPOPT's exact Hessian of the Lagrangian (CasADi SX virtual machine)")
-    print("\n".join(hessians))
-    if args.sweep:
+    print(
+        "targets: a solve (all starts) <= "
+        + ", ".join(f"{t} s {c}" for c, t in TARGETS.items())
+        + " once set up; biped optimize <= 2 s as a process"
+    )
+
+
+@contextlib.contextmanager
+def solvers_before():
+    """Within the block, every optimization runs the method before (its solvers, its starts)."""
+    cache = {}
+
+    def before(problem):
+        key = (problem.knee, problem.criterion, problem.safety, problem.samples_per_half)
+        if key not in cache:
+            cache[key] = build_before(problem)
+        return cache[key]
+
+    def optimize_old(problem, seed=0, starts=3, given=(), sthenic=None, **kwargs):
         began = time.perf_counter()
-        with tempfile.TemporaryDirectory() as folder:
-            run_sweep(folder, biped.Robot.paper(), stream=open(os.devnull, "w"))  # noqa: SIM115
-        print(
-            f"\ndefault sweep (2 knees x 2 criteria x 13 speeds, all cores): "
-            f"{time.perf_counter() - began:.1f} s (target 60 s)"
+        solver = before(problem)
+        candidates = first_guesses(problem, starts, seed)
+        candidates += [("given", np.asarray(z, dtype=float)) for z in given]
+        if problem.criterion == "energy" and starts > 0:
+            if sthenic is None:
+                twin = GaitProblem(problem.model, problem.speed, "sthenic", problem.safety)
+                sthenic = optimize_old(twin, seed, starts)
+            candidates += sthenic_starts(sthenic.report, sthenic.variables)
+        best, report = multistart(
+            candidates, lambda z, b: solver.solve(problem, z, barrier=b), seed, began, jobs=1
         )
+        return optimize_module.checked(problem, best.variables, report)
+
+    with mock.patch("biped.studies.sweep.optimize", optimize_old):
+        yield
+
+
+def sweep() -> None:
+    """The default sweep (both knees, both criteria, 13 speeds) on all cores, both ways; the
+    method before runs in this process (``--jobs 1``), so its time is given per core too."""
+    with tempfile.TemporaryDirectory() as folder:
+        began = time.perf_counter()
+        with open(os.devnull, "w") as null:
+            run_sweep(f"{folder}/now", biped.Robot.paper(), stream=null)
+        now = time.perf_counter() - began
+        began = time.perf_counter()
+        with solvers_before(), open(os.devnull, "w") as null:
+            run_sweep(f"{folder}/before", biped.Robot.paper(), stream=null, jobs=1)
+        before = time.perf_counter() - began
+    cores = free_cores()
+    print(
+        f"\ndefault sweep (2 knees x 2 criteria x 13 speeds): now {now:.1f} s on {cores} "
+        f"processes; before {before:.1f} s on one process, {before / cores:.1f} s per core of "
+        f"{cores}; ratio {now / (before / cores):.2f} (target 60 s)"
+    )
+
+
+def pipeline(repeats: int) -> None:
+    with tempfile.TemporaryDirectory() as folder:
+        argv = BIPED + ["pipeline", "--no-video", "--out", folder, "--recordings", folder]
+        seconds, _ = median_time(
+            lambda: subprocess.run(argv, check=True, capture_output=True), repeats=repeats
+        )
+    print(f"\nbiped pipeline --no-video as a process: {seconds:.1f} s (target 25 s)")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3, help="runs per figure (median)")
+    parser.add_argument("--sweep", action="store_true", help="also time the default sweep")
+    parser.add_argument("--pipeline", action="store_true", help="also time the pipeline")
+    args = parser.parse_args()
+    one_optimization(args.repeats)
+    if args.pipeline:
+        pipeline(args.repeats)
+    if args.sweep:
+        sweep()
 
 
 if __name__ == "__main__":

@@ -134,19 +134,27 @@ def cmd_optimize(args) -> int:
     status) or the optimum is infeasible (naming the violated constraints); the file is
     written only when feasible, with the solver's status in it.
     """
-    from biped.optimization.optimize import optimize
+    from biped.optimization.optimize import optimize, prepare
     from biped.optimization.problem import GaitProblem
     from biped.records import gait_file
+    from biped.runtime.runner import free_cores
 
     robot = robot_of(args)
     problem = GaitProblem(Biped(robot, args.knee), args.speed, args.criterion, safety(args))
     check_output(args.out)
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
+    setup = prepare(problem) if args.method == "ipopt" else 0.0
     optimum = optimize(problem, **budget(args))
     ev = optimum.evaluation
     print(optimum_line(args.knee, args.criterion, args.speed, optimum))
     report = optimum.report
     print(report.summary())
+    if args.method == "ipopt":
+        print(
+            f"time: setup {setup:.2f} s (IPOPT and its exact derivatives built), solve "
+            f"{report.seconds:.2f} s ({report.starts} starts on {min(free_cores(), report.starts)} "
+            "processes)"
+        )
     if report.converged and report.method == "ipopt" and not report.confirmed:
         print(
             "warning: the best value was reached by a single start; more --starts may "
@@ -289,6 +297,42 @@ def add_figures(commands) -> None:
         help="folder of a sweep's results, as biped sweep --out writes it (default %(default)s)",
     )
     types.add_folder(fig, "--out", DEFAULT_FIGURES, "folder of the figures and comparison.md")
+
+
+def cmd_table(args) -> int:
+    """The table of optima over speed that starts every optimization (one more start: the
+    optima at the neighbouring speeds, interpolated), from a sweep's certified final optima,
+    as JSON. The package ships one, made by 'biped sweep && biped table --out
+    biped/optimization/optima.json'."""
+    from biped.records.gait_file import write_json
+    from biped.studies.sweep import optima_table
+
+    check_output(args.out)
+    content = optima_table(args.sweep)
+    counts = ", ".join(
+        f"{len(s['speeds'])} {s['knee']} {s['criterion']}" for s in content["series"]
+    )
+    print(f"wrote {write_json(args.out, content)} ({counts} optima)")
+    return 0
+
+
+def add_table(commands) -> None:
+    table = types.add_command(
+        commands, "table", "table of optima that starts optimizations", cmd_table
+    )
+    table.add_argument(
+        "--sweep",
+        default=DEFAULT_SWEEP,
+        metavar="DIR",
+        help="folder of a sweep's results, as biped sweep --out writes it, whose certified "
+        f"optima the table holds (default %(default)s); {types.CERTIFIED_HELP}",
+    )
+    table.add_argument(
+        "--out",
+        default="logs/optima.json",
+        metavar="FILE",
+        help=f"the table written (JSON), {types.FOLDERS_CREATED} (default %(default)s)",
+    )
 
 
 def read_gaits(paths: list, model: str | None = None) -> list:

@@ -56,6 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
         commands.add_validate,
         commands.add_pipeline,
         commands.add_figures,
+        commands.add_table,
         design.add_parsers,
         report.add_parser,
         robustness.add_parser,

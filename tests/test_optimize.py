@@ -16,6 +16,8 @@ from biped.model.criteria import PAPER_SAFETY, Safety, clearance_profile, evalua
 from biped.model.gait import build_step
 from biped.optimization.optimize import (
     AGREEMENT,
+    GUESS_PERIODS,
+    MONOTONE,
     MONOTONE_START,
     STHENIC_START,
     Report,
@@ -26,6 +28,7 @@ from biped.optimization.optimize import (
 from biped.optimization.problem import SCALES, GaitProblem, bounds, max_walking_speed
 from biped.optimization.solver import solver_for
 from biped.optimization.symbolic import StepGraph
+from biped.optimization.table import OTHER_KNEE_START, TABLE_START
 from tests.conftest import optimal_gait
 
 ROBOT = biped.Robot.paper()
@@ -178,10 +181,18 @@ def test_energy_optimum_spends_no_more_than_the_gait_of_least_torque():
     optimum = optimize(energy, starts=1)
     assert optimum.report.converged
     kinds = [s.kind for s in optimum.report.history]
-    assert kinds == ["first guess", "sthenic optimum", MONOTONE_START]
+    assert kinds == [
+        "first guess S = 0.1 m" + MONOTONE,
+        TABLE_START,
+        TABLE_START + MONOTONE,
+        OTHER_KNEE_START,
+        STHENIC_START,
+        MONOTONE_START,
+    ]
     assert optimum.report.value <= ev.energy
-    first_guess_only = optimize(energy, starts=0, given=[energy.first_guess()])
-    assert first_guess_only.report.value > 2 * optimum.report.value
+    for period in GUESS_PERIODS:  # the sthenic criterion's first guesses, adaptive barrier
+        first_guess_only = optimize(energy, starts=0, given=[energy.first_guess(period)])
+        assert first_guess_only.report.value > 2 * optimum.report.value
 
 
 def test_the_energy_criterion_starts_from_the_sthenic_optimum_under_both_barriers():
@@ -222,6 +233,9 @@ def test_one_point_solved_under_both_barriers_is_one_start_at_the_best():
     pair = [start(STHENIC_START), start(MONOTONE_START, value * (1 + 1e-8))]
     assert starts_at_value(pair, value) == 1
     assert starts_at_value([*pair, start("first guess")], value) == 2
+    table = [start(TABLE_START), start(TABLE_START + MONOTONE)]
+    assert starts_at_value(table, value) == 1 and starts_at_value(table + pair, value) == 2
+    assert starts_at_value([start("first guess S = 0.1 m" + MONOTONE)] + pair, value) == 2
     assert starts_at_value([start("first guess"), start("given")], value) == 2
     assert starts_at_value([start(MONOTONE_START), start("given", 2.0)], value) == 1
 
@@ -399,3 +413,12 @@ def test_hessian_needs_an_nlp_linear_in_the_samples_quantities():
     squares = ca.sumsqr(graph.rows("torques"))
     with pytest.raises(ValueError, match="not linear"):
         lagrangian_hessian(graph, x, graph.speed, head, squares, graph.on_symbols["constraints"])
+
+
+def test_starts_solved_on_several_processes_end_as_on_one():
+    """The starts of one optimization forked to two processes end where they end one after
+    the other, every start to the bit (only the seconds differ)."""
+    problem = GaitProblem(biped.Biped(ROBOT, "revolute"), 0.3)
+    serial, forked = (optimize(problem, jobs=jobs) for jobs in (1, 2))
+    assert forked.report.history == serial.report.history
+    np.testing.assert_array_equal(forked.variables, serial.variables)

@@ -488,3 +488,24 @@ def test_a_worker_that_swallows_its_sigterm_still_ends():
         if worker.is_alive():
             worker.kill()
             worker.join()
+
+
+def test_forked_runs_give_the_results_in_order_and_raise_errors():
+    """``run_forked`` calls any callable (a closure: nothing but the results is pickled) on
+    forked processes and returns its results in the order of the arguments, as one process
+    would; an error of a call goes up; in a campaign's worker there is one core to use."""
+    from biped.runtime import runner
+
+    offset = 10
+    assert runner.run_forked(lambda x: (x + offset, os.getpid()), [], 2) == []
+    results = runner.run_forked(lambda x: (x + offset, os.getpid()), list(range(6)), 2)
+    assert [r for r, _ in results] == list(range(10, 16))
+    assert {pid for _, pid in results} - {os.getpid()}  # forked
+    with pytest.raises(ZeroDivisionError):
+        runner.run_forked(lambda x: 1 / (x - 3), list(range(5)), 2)
+    assert runner.free_cores() >= 1
+    runner._IN_WORKER, before = True, runner._IN_WORKER
+    try:
+        assert runner.free_cores() == 1
+    finally:
+        runner._IN_WORKER = before

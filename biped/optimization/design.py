@@ -59,6 +59,7 @@ from biped.optimization.optimize import (
     DEFAULT_STARTS,
     GUESS_PERIODS,
     Optimum,
+    barrier_of,
     best_of,
     checked,
     multistart,
@@ -309,6 +310,7 @@ def optimize_design(
     def solve(start, barrier):
         return solver.solve(problem, *start, barrier=barrier)
 
+    solver.prepare({barrier_of(kind) for kind, _ in candidates})
     best, report = multistart(candidates, solve, seed, began)
     # IPOPT may end a hair outside a bound (its bound_relax_factor): back inside
     radii = tuple(
@@ -329,10 +331,19 @@ class _HeldRadii:
     radii: tuple
 
     def __call__(self, gait: GaitProblem):
-        return self  # one held solver serves the gait problems of every criterion
+        """The held solver of ``gait``'s criterion (one graph serves every radius)."""
+        return dataclasses.replace(
+            self, problem=dataclasses.replace(self.problem, criterion=gait.criterion)
+        )
+
+    def _design(self, criterion: str) -> Solver:
+        return solver_for(dataclasses.replace(self.problem, criterion=criterion))
+
+    def prepare(self, barriers) -> None:
+        self._design(self.problem.criterion).prepare(barriers)
 
     def solve(self, gait: GaitProblem, start, barrier: str = "adaptive"):
-        design = solver_for(dataclasses.replace(self.problem, criterion=gait.criterion))
+        design = self._design(gait.criterion)
         return design.solve(gait, start, self.radii, hold_radii=True, barrier=barrier)
 
 

@@ -35,6 +35,7 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.criteria import StepEvaluation, evaluate_step
 from biped.model.gait import Step, build_step
+from biped.optimization import table
 from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
 from biped.optimization.problem import (  # noqa: F401 (re-exported)
     FIRST_GUESS_PERIOD,
@@ -46,6 +47,8 @@ from biped.optimization.problem import (  # noqa: F401 (re-exported)
     max_walking_speed,
 )
 from biped.optimization.solver import CONVERGED, solver_for
+from biped.optimization.table import OTHER_KNEE_START, TABLE_START
+from biped.runtime.runner import free_cores, run_forked
 
 METHODS = ("ipopt", "nelder-mead")
 # Starts of IPOPT by default (``first_guesses``).
@@ -233,13 +236,42 @@ def start_schedule(starts: int, seed: int, periods) -> list[tuple[str, float | N
 def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[str, np.ndarray]]:
     """``starts`` first guesses in the bounds: the default first guess, then first guesses of
     other step periods (``GUESS_PERIODS``: the step length a gait settles on is its largest
-    choice, and the basins of the optima follow it), then perturbations of the default."""
+    choice, and the basins of the optima follow it), then perturbations of the default. For
+    the energy criterion, the family of short steps ``ENERGY_GUESS_LENGTHS`` under the
+    monotone barrier instead (``energy_first_guesses``)."""
+    if problem.criterion == "energy":
+        return energy_first_guesses(problem, starts, seed)
     schedule = start_schedule(starts, seed, GUESS_PERIODS)
     guess, rng = problem.first_guess(), np.random.default_rng(seed)
     return [
         (kind, perturbed(guess, rng) if period is None else problem.first_guess(period))
         for kind, period in schedule
     ]
+
+
+# Step lengths [m] of the energy criterion's first guesses, in order. Its optima take short
+# steps (0.06-0.11 m at 0.15-0.45 m/s, against 0.13-0.25 m for the sthenic criterion), and
+# from a first guess of the sthenic criterion's periods, or under the adaptive barrier from
+# any first guess, IPOPT ends in a basin of 2-7 times the least energy at every speed of the
+# default sweep; under the monotone barrier from these lengths it reaches the least at some.
+ENERGY_GUESS_LENGTHS = (0.1, 0.08, 0.12)
+
+
+def energy_first_guesses(problem: GaitProblem, starts: int, seed: int) -> list:
+    """``starts`` first guesses of the energy criterion, each solved under the monotone
+    barrier: steps of the lengths ``ENERGY_GUESS_LENGTHS`` at the problem's speed, then
+    perturbations of the first."""
+    lengths = ENERGY_GUESS_LENGTHS[:starts]
+    guesses = [
+        (f"first guess S = {length:g} m{MONOTONE}", problem.first_guess(length / problem.speed))
+        for length in lengths
+    ]
+    rng = np.random.default_rng(seed)
+    base = guesses[0][1] if guesses else problem.first_guess()
+    guesses += [
+        (f"perturbed{MONOTONE}", perturbed(base, rng)) for _ in range(starts - len(lengths))
+    ]
+    return guesses
 
 
 def perturbed(guess, rng: np.random.Generator) -> np.ndarray:
@@ -250,7 +282,7 @@ def perturbed(guess, rng: np.random.Generator) -> np.ndarray:
     return np.clip(z, lower, upper)
 
 
-def multistart(candidates, solve, seed: int, began: float):
+def multistart(candidates, solve, seed: int, began: float, jobs: int | None = None):
     """The best solution from the starts ``candidates`` and its ``Report``: the multistart of
     gaits (``optimize``) and designs (``biped.optimization.design``), each giving its starts
     and what solves one.
@@ -260,6 +292,8 @@ def multistart(candidates, solve, seed: int, began: float):
         solve: ``solve(start, barrier)`` -> ``biped.optimization.solver.Solution``.
         seed: recorded in the report.
         began: ``time.perf_counter()`` when the search began, for the report's seconds.
+        jobs: processes solving the starts at once (``biped.runtime.runner.run_forked``;
+            default ``biped.runtime.runner.free_cores()``); the result is the same.
 
     Returns:
         (best, report): the converged solution of least value (of every solution when none
@@ -267,7 +301,9 @@ def multistart(candidates, solve, seed: int, began: float):
     """
     if not candidates:
         raise BipedError("no start: allowed starts >= 1 or given starts")
-    solutions = [(kind, solve(start, barrier_of(kind))) for kind, start in candidates]
+    jobs = free_cores() if jobs is None else jobs
+    ends = run_forked(lambda c: solve(c[1], barrier_of(c[0])), list(candidates), jobs)
+    solutions = list(zip([kind for kind, _ in candidates], ends, strict=True))
     converged = [s for _, s in solutions if s.converged]
     pool = converged or [s for _, s in solutions]
     best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
@@ -288,6 +324,19 @@ def multistart(candidates, solve, seed: int, began: float):
     return best, report
 
 
+def prepare(problem: GaitProblem) -> float:
+    """Build the solvers an optimization of ``problem`` needs (``solver_for``, once per
+    process: the energy criterion's sthenic twin's too) with both barriers; returns the
+    seconds it took (0 when they were built already)."""
+    began = time.perf_counter()
+    twins = [problem] + (
+        [dataclasses.replace(problem, criterion="sthenic")] * (problem.criterion == "energy")
+    )
+    for twin in twins:
+        solver_for(twin).prepare(("adaptive", "monotone"))
+    return time.perf_counter() - began
+
+
 def optimize(
     problem: GaitProblem,
     seed: int = 0,
@@ -299,6 +348,7 @@ def optimize(
     evaluations_per_run: int = EVALUATIONS_PER_RUN,
     solvers=None,
     sthenic: Optimum | None = None,
+    jobs: int | None = None,
 ) -> Optimum:
     """The best gait of ``problem``.
 
@@ -320,6 +370,8 @@ def optimize(
         sthenic: for the energy criterion, the sthenic optimum of the same problem with
             the same ``seed`` and ``starts``, if already known (a sweep's): it starts the
             energy criterion as the one this call would compute (None: computed here).
+        jobs: processes solving the starts at once (default: the cores free,
+            ``biped.runtime.runner.free_cores``); the optimum is the same.
     """
     check_method(method)
     if not isinstance(problem, GaitProblem):
@@ -328,10 +380,10 @@ def optimize(
     if method == "nelder-mead":
         return _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began)
     solver = (solver_for if solvers is None else solvers)(problem)
-    candidates = first_guesses(problem, starts, seed)
+    candidates = first_guesses(problem, starts, seed) + table_starts(problem, starts)
     candidates += [("given", np.asarray(z, dtype=float)) for z in given]
     if problem.criterion == "energy" and starts > 0:
-        candidates += _sthenic_start(problem, seed, starts, solvers, sthenic)
+        candidates += _sthenic_start(problem, seed, starts, solvers, sthenic, jobs)
     for k in range(nelder_mead_starts):
         parameters, *_ = nelder_mead(
             problem,
@@ -344,21 +396,42 @@ def optimize(
             candidates.append(("nelder-mead", problem.from_parameters(parameters)))
         except BipedError:
             continue  # a Nelder-Mead point out of reach starts nothing
+    solver.prepare({barrier_of(kind) for kind, _ in candidates})
     best, report = multistart(
-        candidates, lambda z, barrier: solver.solve(problem, z, barrier=barrier), seed, began
+        candidates, lambda z, barrier: solver.solve(problem, z, barrier=barrier), seed, began, jobs
     )
     return checked(problem, best.variables, report)
+
+
+def table_starts(problem: GaitProblem, starts: int) -> list:
+    """The start of the table of optima at the neighbouring speeds
+    (``biped.optimization.table``), with ``starts`` > 0, when the table has the problem's
+    knee and criterion; for the energy criterion under both barriers, whose paths from it
+    may end in different local minima."""
+    if starts == 0:
+        return []
+    found = [
+        (TABLE_START, table.start(problem)),
+        (OTHER_KNEE_START, table.other_knee_start(problem)),
+    ]
+    found = [(kind, start) for kind, start in found if start is not None]
+    if problem.criterion == "energy" and found and found[0][0] == TABLE_START:
+        found.insert(1, (TABLE_START + MONOTONE, found[0][1]))
+    return found
 
 
 # The energy criterion's starts from the sthenic optimum, under IPOPT's adaptive and its
 # monotone barrier: from the same point they may end in different local minima (0.1 % apart
 # for the revolute knee at 0.3 m/s, tests/test_optimize.py), and either may be the lower.
 STHENIC_START = "sthenic optimum"
-MONOTONE_START = "sthenic optimum, monotone barrier"
+# A start solved under the monotone barrier is named as its twin under the adaptive one, then
+# this; the two are one start when both reach a value (``starts_at_value``).
+MONOTONE = ", monotone barrier"
+MONOTONE_START = STHENIC_START + MONOTONE
 
 
 def _sthenic_start(
-    problem: GaitProblem, seed: int, starts: int, solvers=None, sthenic: Optimum | None = None
+    problem: GaitProblem, seed, starts, solvers=None, sthenic: Optimum | None = None, jobs=None
 ) -> list:
     """The sthenic optimum of the same problem (``sthenic``, or computed), a start of the
     energy criterion: its landscape has basins of short fast steps (3-7 times the minimum)
@@ -370,7 +443,7 @@ def _sthenic_start(
             f"sthenic = {sthenic!r}: allowed a biped.optimization.optimize.Optimum or None"
         )
     if sthenic is None:
-        sthenic = optimize(twin, seed, starts, solvers=solvers)
+        sthenic = optimize(twin, seed, starts, solvers=solvers, jobs=jobs)
     elif _family(sthenic.problem) != _family(twin):
         raise BipedError(
             f"sthenic = the optimum of {sthenic.problem.criterion} at {sthenic.problem.speed} "
@@ -389,7 +462,7 @@ def sthenic_starts(report: Report, start) -> list:
 def barrier_of(kind: str) -> str:
     """The barrier strategy (``biped.optimization.solver.BARRIERS``) a start of this kind is solved
     with."""
-    return "monotone" if kind == MONOTONE_START else "adaptive"
+    return "monotone" if kind.endswith(MONOTONE) else "adaptive"
 
 
 def _family(problem: GaitProblem) -> tuple:
@@ -405,14 +478,19 @@ def _family(problem: GaitProblem) -> tuple:
 
 
 def starts_at_value(history, value: float) -> int:
-    """Converged starts within ``AGREEMENT`` of ``value``; the sthenic optimum's two solves
-    (both barriers) are one start: one point does not confirm itself."""
+    """Converged starts within ``AGREEMENT`` of ``value``; one point solved under both
+    barriers (kinds "X" and "X, monotone barrier") is one start: it does not confirm itself."""
     kinds = [
         s.kind
         for s in history
         if s.status in CONVERGED and abs(s.value - value) <= AGREEMENT * abs(value)
     ]
-    return len(kinds) - (STHENIC_START in kinds and MONOTONE_START in kinds)
+    twins = sum(
+        min(kinds.count(kind[: -len(MONOTONE)]), kinds.count(kind))
+        for kind in set(kinds)
+        if kind.endswith(MONOTONE)
+    )
+    return len(kinds) - twins
 
 
 def best_of(problem: GaitProblem, optima) -> Optimum:

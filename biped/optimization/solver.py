@@ -46,6 +46,11 @@ IPOPT_OPTIONS = {
     "print_level": 0,
     "sb": "yes",
     "mu_strategy": "adaptive",
+    # The criteria and constraints are of order one in the solver's scaled variables
+    # (``biped.optimization.problem.SCALES``, ``CONSTRAINT_SCALES``); IPOPT's own gradient
+    # scaling then takes about twice the iterations to the same optima
+    # (``benchmarks/bench_optimize.py``).
+    "nlp_scaling_method": "none",
 }
 # The barrier strategies a start can be solved with: IPOPT's adaptive one (the default) and
 # its monotone one from mu = 0.01. From the same start they follow other paths through the
@@ -195,6 +200,12 @@ class Solver:
         with kept_interrupts():  # CasADi stops at Ctrl-C but swallows it: raised again
             return self._solve(problem, start, radii, hold_radii, barrier)
 
+    def prepare(self, barriers) -> None:
+        """Build IPOPT's instances of ``barriers`` now (before starts are forked to other
+        processes, which then share them)."""
+        for barrier in barriers:
+            self._nlp(barrier)
+
     def _nlp(self, barrier: str):
         if barrier not in self._nlps:  # the same problem (IPOPT's oracle), other settings
             self._nlps[barrier] = ca.nlpsol(
@@ -207,7 +218,11 @@ class Solver:
         sample by sample (``biped.optimization.hessian``)."""
         options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
         options.update({f"ipopt.{key}": value for key, value in BARRIERS[barrier].items()})
-        return {**options, "print_time": False, "hess_lag": self.hessian}
+        derivatives = {"hess_lag": self.hessian}
+        if hasattr(self, "nlp"):  # another barrier's: the same derivatives, built once
+            derivatives["jac_g"] = self.nlp.get_function("nlp_jac_g")
+            derivatives["grad_f"] = self.nlp.get_function("nlp_grad_f")
+        return {**options, "print_time": False, **derivatives}
 
     def _solve(self, problem, start, radii, hold_radii, barrier) -> Solution:
         began = time.perf_counter()

@@ -26,6 +26,11 @@ and a rerun that skips the tasks whose files exist ends with the files of an uni
 
     for line in run_tasks(solve_point, points, jobs=4, progress=bar):
         print(line, file=sys.stderr)
+
+Within one task, the starts of one optimization may run on the cores left free
+(``run_forked``: processes forked from this one, which inherit its built solvers): all cores
+in a command's own process, none in a campaign's worker, whose siblings use them
+(``free_cores``).
 """
 
 from __future__ import annotations
@@ -113,9 +118,27 @@ def run_tasks(
         results.close()  # stops the workers now, also when the caller stops early
 
 
+# Whether this process is one of a campaign's workers (a pool's or a Dask worker): its
+# siblings use the other cores (``free_cores``).
+_IN_WORKER = False
+
+
+def free_cores() -> int:
+    """How many processes one computation of this process may run at once: the cores this
+    process may use in a command's own process, 1 in a campaign's worker."""
+    if _IN_WORKER:
+        return 1
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
 def _quietly(function: Callable, task):
     """``function(task)`` with numpy's floating-point warnings off (thread-safe: a Dask worker
-    runs tasks in threads)."""
+    runs tasks in threads), in a worker (``free_cores``)."""
+    global _IN_WORKER
+    _IN_WORKER = True
     with np.errstate(all="ignore"):
         return function(task)
 
@@ -123,6 +146,8 @@ def _quietly(function: Callable, task):
 def _worker_init():
     """A worker's signals (``biped.runtime.interrupts.worker_signals``), and numpy's
     floating-point warnings off the terminal, as in the command line."""
+    global _IN_WORKER
+    _IN_WORKER = True
     worker_signals()
     np.seterr(all="ignore")
     warnings.simplefilter("ignore", RuntimeWarning)
@@ -158,6 +183,43 @@ def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
     finally:
         for pool in pools:
             pool.join()
+
+
+# What the forked workers of ``run_forked`` call: (function, arguments), set before the fork.
+_FORKED: tuple = (None, ())
+
+
+def run_forked(function: Callable, arguments: list, jobs: int) -> list:
+    """``[function(a) for a in arguments]``, on ``jobs`` processes forked from this one when
+    ``jobs`` > 1 and the platform forks: they inherit this process's memory (a built solver),
+    so ``function`` may be any callable and only the results are pickled. The results are
+    those of the calls in this process, in order. Interrupts as ``run_tasks``' pool: the
+    workers are terminated and the exception goes on up."""
+    jobs = max(1, min(jobs, len(arguments)))
+    if jobs == 1 or "fork" not in multiprocessing.get_all_start_methods():
+        return [function(a) for a in arguments]
+    global _FORKED
+    _FORKED = (function, arguments)
+    pools: list = []
+    try:
+        with starting_workers():
+            pools.append(multiprocessing.get_context("fork").Pool(jobs, _worker_init))
+        results = pools[0].map(_call_forked, range(len(arguments)), chunksize=1)
+        pools[0].close()
+        return results
+    except BaseException:
+        for pool in pools:
+            pool.terminate()
+        raise
+    finally:
+        for pool in pools:
+            pool.join()
+        _FORKED = (None, ())
+
+
+def _call_forked(index: int):
+    function, arguments = _FORKED
+    return function(arguments[index])
 
 
 def _connect(address: str):

@@ -26,6 +26,7 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.criteria import Safety
 from biped.model.robot import Robot
+from biped.optimization import table
 from biped.optimization.problem import VARIABLES
 from biped.records.provenance import version
 from biped.runtime.files import atomic_write_text, clean_stale_temporaries, distinct_values
@@ -49,8 +50,14 @@ class Settings:
     FORMAT: ClassVar[str]
 
     def stamp(self) -> dict:
-        """The method and the versions that made the numbers (an IPOPT campaign's)."""
-        return {"method": "ipopt", "version": version(), "casadi": version("casadi")}
+        """The method, the versions and the table of optima that starts every optimization
+        (``biped.optimization.table``): what made the numbers (an IPOPT campaign's)."""
+        return {
+            "method": "ipopt",
+            "version": version(),
+            "casadi": version("casadi"),
+            "optima_table": table.digest(),
+        }
 
     def to_dict(self) -> dict:
         content = {"format": self.FORMAT}

@@ -35,6 +35,7 @@ from biped.model.criteria import CRITERIA, CRITERION_UNITS, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
+from biped.optimization import table
 from biped.optimization.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, optimize
 from biped.optimization.problem import VARIABLES, GaitProblem, check_speed
 from biped.records import gait_file
@@ -284,6 +285,28 @@ def _neighbours(point: Point, speeds, knees) -> list[Point]:
         for j in (i - 1, i + 1)
         if 0 <= j < len(speeds)
     ] + [Point(k, point.criterion, point.speed) for k in knees if k != point.knee]
+
+
+def optima_table(folder) -> dict:
+    """The table of optima (``biped.optimization.table``) of the sweep in ``folder``: its
+    final optima that are certified, by knee and criterion."""
+    folder = Path(folder)
+    found = SWEEP.read(folder)
+    if found is None:
+        raise BipedError(f"{folder} has no {MANIFEST}: allowed a folder biped sweep wrote")
+    settings = Settings.from_dict(found)
+    series: dict = {}
+    for criterion in CRITERIA:
+        for knee in KNEES:
+            for speed in settings.speeds:
+                point = Point(knee, criterion, speed)
+                gait = _read_gait(folder / point.filename(), point, settings)
+                if gait is None or campaign.failure(gait.optimizer["status"], gait.feasible):
+                    continue
+                optimum = campaign.variables(gait.optimizer["variables"])
+                series.setdefault((knee, criterion), []).append((speed, optimum))
+    source = f"the certified final optima of the sweep in {folder.name}/ ({MANIFEST})"
+    return table.content(series, settings.robot, settings.safety, source)
 
 
 def summarize(folder: Path, points, settings: Settings) -> str:

@@ -1,0 +1,127 @@
+"""A table of certified optima over speed, shipped with the package: one more start.
+
+``optima.json`` beside this module holds, for each knee and criterion of one robot and safety
+(the paper's by default), the solvers' variables (``biped.optimization.problem.VARIABLES``) of
+the certified optima of a sweep at its speeds. ``biped table`` writes it from a sweep's
+folder (``from_sweep``); the shipped file is made by
+
+    biped sweep && biped table --out biped/optimization/optima.json
+
+An optimization starts from the table's optima at the neighbouring speeds (``start``): the
+optima interpolated linearly in speed between the nearest tabled speeds below and above, the
+speed itself left out, so a tabled optimum never starts its own point: the start is the
+neighbours', a start independent of the point's own, reaching the point's basin where the
+optima change smoothly with speed (the energy criterion's basins follow the step period).
+Beyond the table's speeds, the nearest tabled optimum. The table's fingerprint (``digest``)
+is recorded by the campaigns whose numbers it shapes.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+
+from biped.errors import BipedError
+from biped.optimization.problem import VARIABLES, GaitProblem
+
+FORMAT = "biped-optima-table/1"
+SHIPPED = Path(__file__).with_name("optima.json")
+TABLE_START = "optima table at neighbouring speeds"
+OTHER_KNEE_START = "optima table, other knee"
+# Two speeds [m/s] are the same point of the table when closer than this.
+SAME_SPEED = 1e-9
+
+
+@functools.cache
+def _read(path: str) -> dict:
+    """The table's series {(knee, criterion): (speeds (K,), variables (K, 21))}, or {} when
+    the file is missing; a BipedError naming the file when it is not a table."""
+    file = Path(path)
+    if not file.exists():
+        return {}
+    try:
+        content = json.loads(file.read_text())
+        if content.get("format") != FORMAT or content.get("variables") != list(VARIABLES):
+            raise ValueError(f"format is not {FORMAT!r} with the solvers' variables")
+        series = {}
+        for entry in content["series"]:
+            speeds = np.array(entry["speeds"], dtype=float)
+            optima = np.array(entry["optima"], dtype=float).reshape(len(speeds), len(VARIABLES))
+            order = np.argsort(speeds)
+            series[(entry["knee"], entry["criterion"])] = (speeds[order], optima[order])
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise BipedError(f"{file}: not a table of optima ({error})") from None
+    return series
+
+
+def digest(path: Path = SHIPPED) -> str | None:
+    """The first 16 hex digits of the table's SHA-256, None without a table."""
+    path = Path(path)
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:16] if path.exists() else None
+
+
+def start(problem: GaitProblem, path: Path = SHIPPED) -> np.ndarray | None:
+    """The table's start of ``problem`` (variables (21,)): its knee's and criterion's optima
+    at the tabled speeds other than its own, interpolated at its speed (the nearest beyond
+    them); None when the table has no such series (or only the speed itself)."""
+    return _interpolated(_read(str(path)).get((problem.knee, problem.criterion)), problem, True)
+
+
+def other_knee_start(problem: GaitProblem, path: Path = SHIPPED) -> np.ndarray | None:
+    """The table's optimum of the other knee for ``problem``'s criterion at its speed
+    (interpolated between tabled speeds): the variables mean the same for both knees. None
+    when the table has no such series."""
+    others = [
+        entry
+        for (knee, criterion), entry in _read(str(path)).items()
+        if knee != problem.knee and criterion == problem.criterion
+    ]
+    return _interpolated(others[0] if others else None, problem, False)
+
+
+def _interpolated(entry, problem: GaitProblem, others_only: bool) -> np.ndarray | None:
+    """The optima of ``entry`` (speeds, variables) interpolated linearly at the problem's
+    speed, the nearest beyond the tabled speeds; with ``others_only``, the problem's own
+    speed left out."""
+    if entry is None:
+        return None
+    speeds, optima = entry
+    if others_only:
+        keep = np.abs(speeds - problem.speed) > SAME_SPEED
+        speeds, optima = speeds[keep], optima[keep]
+    if len(speeds) == 0:
+        return None
+    exact = np.abs(speeds - problem.speed) <= SAME_SPEED
+    if np.any(exact):
+        return optima[int(np.argmax(exact))].copy()
+    above = int(np.searchsorted(speeds, problem.speed))
+    if above == 0 or above == len(speeds):
+        return optima[min(above, len(speeds) - 1)].copy()
+    low, high = speeds[above - 1], speeds[above]
+    share = (problem.speed - low) / (high - low)
+    return (1.0 - share) * optima[above - 1] + share * optima[above]
+
+
+def content(series: dict, robot, safety, source: str) -> dict:
+    """A table's JSON content: ``series`` {(knee, criterion): [(speed, variables (21,)), ...]}
+    of ``robot`` and ``safety``, made from ``source``."""
+    return {
+        "format": FORMAT,
+        "source": source,
+        "robot": robot.to_dict(),
+        "safety": {"clearance": safety.clearance, "zmp_margin": safety.zmp_margin},
+        "variables": list(VARIABLES),
+        "series": [
+            {
+                "knee": knee,
+                "criterion": criterion,
+                "speeds": [float(speed) for speed, _ in points],
+                "optima": [[float(v) for v in variables] for _, variables in points],
+            }
+            for (knee, criterion), points in sorted(series.items())
+        ],
+    }

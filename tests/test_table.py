@@ -1,0 +1,87 @@
+"""The table of optima that starts every optimization: the neighbours' optima, never the
+point's own; the shipped table holds certified optima of its robot."""
+
+import json
+
+import numpy as np
+import pytest
+
+import biped
+from biped.model.criteria import PAPER_SAFETY, evaluate_step
+from biped.model.gait import build_step
+from biped.optimization import table
+from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF, optimize
+from biped.optimization.problem import VARIABLES, GaitProblem
+
+ROBOT = biped.Robot.paper()
+
+
+def _write(path, series):
+    content = table.content(series, ROBOT, PAPER_SAFETY, "a test")
+    path.write_text(json.dumps(content))
+    return path
+
+
+@pytest.fixture
+def small(tmp_path):
+    """A table of three speeds whose optima are the numbers 1, 2, 3 (every variable)."""
+    series = {
+        ("rolling", "energy"): [(s, np.full(21, k + 1.0)) for k, s in enumerate((0.2, 0.3, 0.4))]
+    }
+    series[("revolute", "energy")] = [(0.3, np.full(21, 7.0))]
+    return _write(tmp_path / "table.json", series)
+
+
+def _problem(knee, speed, criterion="energy"):
+    return GaitProblem(biped.Biped(ROBOT, knee), speed, criterion)
+
+
+def test_a_tabled_speed_starts_from_its_neighbours_not_itself(small):
+    """At a tabled speed the start is the mean of the two neighbours (2 at 0.3 m/s is left
+    out); between speeds the interpolation; beyond them the nearest; another knee's optimum
+    at the speed itself is the other-knee start."""
+    assert np.allclose(table.start(_problem("rolling", 0.3), small), 2.0, rtol=1e-12)  # (1 + 3) / 2
+    assert np.allclose(table.start(_problem("rolling", 0.25), small), 1.5)
+    assert np.all(table.start(_problem("rolling", 0.2), small) == 2.0)  # itself left out: 0.3
+    assert np.all(table.start(_problem("rolling", 0.5), small) == 3.0)
+    assert np.all(table.other_knee_start(_problem("rolling", 0.3), small) == 7.0)
+    assert np.all(table.other_knee_start(_problem("revolute", 0.3), small) == 2.0)
+    assert table.start(_problem("revolute", 0.3), small) is None  # its only speed is its own
+    assert table.start(_problem("rolling", 0.3, "sthenic"), small) is None
+
+
+def test_a_file_that_is_no_table_is_named(tmp_path):
+    path = tmp_path / "other.json"
+    path.write_text(json.dumps({"format": "biped-gait/2"}))
+    with pytest.raises(biped.BipedError, match="other.json: not a table of optima"):
+        table.start(_problem("rolling", 0.3), path)
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_shipped_table_holds_certified_optima(knee):
+    """Every optimum of the shipped table is feasible on the check grid for its robot, both
+    criteria of each knee are there, and the campaigns can record its fingerprint."""
+    content = json.loads(table.SHIPPED.read_text())
+    assert content["variables"] == list(VARIABLES)
+    robot = biped.Robot.from_mapping(content["robot"], source="robot")
+    series = [s for s in content["series"] if s["knee"] == knee]
+    assert {s["criterion"] for s in series} == {"sthenic", "energy"}
+    for entry in series:
+        for speed, variables in zip(entry["speeds"], entry["optima"], strict=True):
+            problem = GaitProblem(biped.Biped(robot, knee), speed, entry["criterion"])
+            step = build_step(problem.model, speed, problem.to_parameters(np.array(variables)))
+            evaluation = evaluate_step(problem.model, step, CHECK_SAMPLES_PER_HALF)
+            assert evaluation.feasible, (knee, entry["criterion"], speed)
+    assert table.digest() == table.digest(table.SHIPPED) is not None
+
+
+def test_optimization_starts_from_the_table():
+    """The sthenic optimum at 0.3 m/s is reached from the table's start too (the optima at
+    0.275 and 0.325 m/s interpolated); a solve from given starts alone (starts = 0, a
+    sweep's second stage) takes none from the table."""
+    problem = _problem("revolute", 0.3, "sthenic")
+    optimum = optimize(problem)
+    kinds = {s.kind: s for s in optimum.report.history}
+    assert abs(kinds[table.TABLE_START].value / optimum.report.value - 1) < 1e-6
+    again = optimize(problem, starts=0, given=[optimum.variables])
+    assert [s.kind for s in again.report.history] == ["given"]
