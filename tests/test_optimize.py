@@ -240,6 +240,26 @@ def test_one_point_solved_under_both_barriers_is_one_start_at_the_best():
     assert starts_at_value([start(MONOTONE_START), start("given", 2.0)], value) == 1
 
 
+def test_a_single_start_says_which_start_and_how_far_the_next_optimum_lies():
+    """A best value one start reached is named with that start and the next optimum's
+    distance and starts (the two barriers of one point counted once)."""
+    from biped.optimization.optimize import single_start_note
+
+    def start(kind, v):
+        return Start(kind, v, "Solve_Succeeded", 50)
+
+    history = (
+        start(TABLE_START, 1.0),
+        start(STHENIC_START, 1.001),
+        start(MONOTONE_START, 1.001),
+        start("given", 1.001),
+        Start("given", 0.5, "Infeasible_Problem_Detected", 9),
+    )
+    report = Report("ipopt", "converged", 5, 1, 50, 1e-9, 1e-9, 1.0, 0, 1.0, history)
+    note = single_start_note(report)
+    assert note == f"by the {TABLE_START} alone; the next optimum +0.1 %, by 2 starts"
+
+
 def test_report_read_back_from_its_json_is_the_report():
     """A report written as JSON and read back is the same report: a value that is not
     finite written as null and read as NaN, a file without the best value read as NaN."""

@@ -36,7 +36,15 @@ from biped.model.dynamics import Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization import table
-from biped.optimization.optimize import DEFAULT_STARTS, Optimum, Report, best_of, checked, optimize
+from biped.optimization.optimize import (
+    DEFAULT_STARTS,
+    Optimum,
+    Report,
+    best_of,
+    checked,
+    optimize,
+    single_start_note,
+)
 from biped.optimization.problem import VARIABLES, GaitProblem, check_speed
 from biped.records import gait_file
 from biped.records.comparison import SINGLE_START
@@ -320,7 +328,7 @@ def summarize(folder: Path, points, settings: Settings) -> str:
         return campaign.failure(str(gait.optimizer.get("status")), gait.feasible)
 
     single = [
-        p.filename()
+        f"{p.filename()} ({single_start_note(Report.from_dict(gaits[p].optimizer))})"
         for p in points
         if why_not(p) is None and gaits[p].optimizer["starts_at_best"] < 2
     ]
