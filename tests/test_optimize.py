@@ -389,10 +389,15 @@ def test_solver_that_does_not_converge_fails_loudly(tmp_path, monkeypatch, capsy
 
 
 @pytest.mark.parametrize(
-    "knee, criterion, radii",
-    [("revolute", "sthenic", None), ("rolling", "energy", None), ("rolling", "sthenic", "design")],
+    "knee, criterion, radii, knots",
+    [
+        ("revolute", "sthenic", None, 1),
+        ("rolling", "energy", None, 1),
+        ("rolling", "sthenic", "design", 1),
+        ("rolling", "energy", None, 3),
+    ],
 )
-def test_hessian_built_sample_by_sample_is_casadis_hessian(knee, criterion, radii):
+def test_hessian_built_sample_by_sample_is_casadis_hessian(knee, criterion, radii, knots):
     """The Hessian of the Lagrangian that IPOPT uses (built per sample and chained through
     the head, ``biped.optimization.hessian``) equals CasADi's own Hessian of the whole NLP
     to 1e-12 at random variables and multipliers, with a clearance margin, a design's radii
@@ -402,22 +407,22 @@ def test_hessian_built_sample_by_sample_is_casadis_hessian(knee, criterion, radi
 
     model = biped.Biped(UNEQUAL, knee)
     bounds_ = ((0.001, 0.001), (0.15, 0.2)) if radii else None
-    solver = Solver(model, criterion, Safety(clearance=0.02), 6, radius_bounds=bounds_)
+    solver = Solver(model, criterion, Safety(clearance=0.02), 6, bounds_, knots)
     oracle = solver.nlp.oracle()
     x, p = oracle.sx_in(0), oracle.sx_in(1)
     f, g = oracle.call([x, p])[:2]
     reference = full_hessian(x, p, f, g)
     rng = np.random.default_rng(4)
-    problem = GaitProblem(model, 0.3, criterion)
+    problem = GaitProblem(model, 0.3, criterion, knots=knots)
     for _ in range(2):
-        z = random_variables(problem, rng) / SCALES
+        z = problem.embedded(random_variables(GaitProblem(model, 0.3), rng)) / solver.scales
         xs = np.concatenate([z, rng.uniform(0.5, 2.0, 2 * bool(radii)), rng.random(solver.slacks)])
         lam_g = rng.standard_normal(g.shape[0])
         expected = dense(reference(xs, 0.3, 1.7, lam_g))
         found = dense(solver.hessian(xs, 0.3, 1.7, lam_g))
         np.testing.assert_allclose(found, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
     heavier = dataclasses.replace(UNEQUAL, trunk_mass=1.1 * UNEQUAL.trunk_mass)
-    other = Solver(biped.Biped(heavier, knee), criterion, Safety(clearance=0.02), 6, bounds_)
+    other = Solver(biped.Biped(heavier, knee), criterion, Safety(clearance=0.02), 6, bounds_, knots)
     wrong = dense(other.hessian(xs, 0.3, 1.7, lam_g))  # another robot's: told apart
     assert np.abs(wrong - expected).max() > 1e-6 * np.abs(expected).max()
 

@@ -28,7 +28,7 @@ from scipy.integrate import simpson
 
 from biped.errors import BipedError
 from biped.model.dynamics import Biped, zmp_from
-from biped.model.gait import Step, half_grid, sample
+from biped.model.gait import Step, breakpoints, piece_grid, sample
 from biped.model.kinematics import Q1, Q2, Q3, Q4
 
 CONSTRAINTS = (
@@ -60,9 +60,9 @@ FOOT_MARGIN_RAMP = 0.1  # fraction of the step
 
 
 @functools.cache
-def margin_profile(samples_per_half: int) -> np.ndarray:
+def margin_profile(samples_per_half: int, knots: int = 1) -> np.ndarray:
     """δ (N, 7) on the time grid of ``biped.model.gait.sample``."""
-    t_n = np.concatenate(half_grid(samples_per_half))
+    t_n = np.concatenate(piece_grid(samples_per_half, knots))
     ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / FOOT_MARGIN_RAMP, 0.0, 1.0)
     profile = np.tile(MARGINS, (len(t_n), 1))
     profile[:, 5:] *= ramp[:, None]
@@ -107,11 +107,11 @@ PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
 
 
 @functools.cache
-def clearance_profile(samples_per_half: int, clearance: float) -> np.ndarray:
+def clearance_profile(samples_per_half: int, clearance: float, knots: int = 1) -> np.ndarray:
     """Required height (N,) [m] of the swing heel and toe: none for the first and last
     ``CLEARANCE_DELAY`` of the step (lift-off and touchdown), then ``clearance`` reached
     linearly at ``CLEARANCE_RAMP``."""
-    t_n = np.concatenate(half_grid(samples_per_half))
+    t_n = np.concatenate(piece_grid(samples_per_half, knots))
     x = (np.minimum(t_n, 1.0 - t_n) - CLEARANCE_DELAY) / (CLEARANCE_RAMP - CLEARANCE_DELAY)
     profile = clearance * np.clip(x, 0.0, 1.0)
     profile.setflags(write=False)
@@ -119,15 +119,15 @@ def clearance_profile(samples_per_half: int, clearance: float) -> np.ndarray:
 
 
 @functools.cache
-def simpson_weights(samples_per_half: int) -> np.ndarray:
-    """Weights w with Σ w f(t_n) = Simpson's rule on both pieces of the normalised grid.
+def simpson_weights(samples_per_half: int, knots: int = 1) -> np.ndarray:
+    """Weights w with Σ w f(t_n) = Simpson's rule on every piece of the normalised grid.
 
     Simpson's rule is linear in the samples, so scipy's rule applied to the identity gives
     its weights once for all.
     """
     n = samples_per_half + 1
-    half = simpson(np.eye(n), x=np.linspace(0.0, 0.5, n), axis=-1)
-    return np.concatenate([half, half])
+    piece = simpson(np.eye(n), x=np.linspace(0.0, breakpoints(knots)[1], n), axis=-1)
+    return np.concatenate([piece] * (knots + 1))
 
 
 @dataclass(frozen=True)
@@ -198,9 +198,9 @@ def penalty_rate(psi, checked) -> np.ndarray:
 
 
 @functools.cache
-def checked_mask(samples_per_half: int) -> np.ndarray:
+def checked_mask(samples_per_half: int, knots: int = 1) -> np.ndarray:
     """Which Ψ_i are checked at which sample (N, 7): all but the swing foot at t = 0, T."""
-    mask = np.ones((2 * (samples_per_half + 1), len(CONSTRAINTS)), dtype=bool)
+    mask = np.ones(((knots + 1) * (samples_per_half + 1), len(CONSTRAINTS)), dtype=bool)
     mask[[0, -1], 5:] = False  # both feet on the ground by construction
     mask.setflags(write=False)
     return mask
@@ -224,15 +224,16 @@ def evaluate_step(
     )
     robot = model.robot
     feet_z = feet[..., 1]
+    knots = step.knots
     if safety.clearance:
-        feet_z = feet_z - clearance_profile(samples_per_half, safety.clearance)[:, None]
+        feet_z = feet_z - clearance_profile(samples_per_half, safety.clearance, knots)[:, None]
     psi = constraints(robot, q, torques, wrench, feet_z)
     psi[:, 1:3] -= safety.zmp_margin
-    checked = checked_mask(samples_per_half)
-    seen = psi - margin_profile(samples_per_half) if margins else psi
+    checked = checked_mask(samples_per_half, knots)
+    seen = psi - margin_profile(samples_per_half, knots) if margins else psi
     power = np.abs(model.joint_angles(qd) * torques).sum(-1)
     squared = (torques**2).sum(-1)
-    weights = step.period * simpson_weights(samples_per_half)
+    weights = step.period * simpson_weights(samples_per_half, knots)
     finite = bool(np.all(np.isfinite(psi[checked])) and np.all(np.isfinite(squared)))
     return StepEvaluation(
         t=t,

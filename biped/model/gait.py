@@ -24,6 +24,15 @@ Parameters (21, the paper's vector p; physical units):
     q̈p2, q̈1..q̈5 (T)               end accelerations [rad/s²]
     T                             duration of the step [s]
 
+Richer families (``knots`` = K interior knots, at t_n = k / (K + 1)): a C¹ cubic spline per
+angle on K + 1 pieces, each piece the cubic Hermite polynomial of the values and rates at its
+ends; the parameters replace the 12 accelerations by the six angles and their rates at each
+interior knot (``parameter_names``): 21 + 12 (K − 1) parameters, with the same conditions at
+both ends (flat feet, leg swap, impact map). A family contains the paper's when its knots
+include t_n = 0.5 (K = 3, 5: ``KNOTS``): the paper's spline, smooth on each half, is the
+Hermite spline of its own values and rates at those knots (``embedded``), so a richer
+family's optimum is never worse.
+
 Step length and speed ("d" of the paper): the walking speed V is given; the hip advances by
 the step length S = V T in one step, which is the distance between the two ankles in double
 support (swing ankle at x = -S at the start, +S at the end). The swing foot thus travels
@@ -51,6 +60,40 @@ PARAMETERS = (
 )
 N_PARAMETERS = len(PARAMETERS)  # 21
 FREE_ANGLES = ("qp2", "q1", "q2", "q3", "q4", "q5")
+# Interior knots of the gait families: the paper's spline (1) and two richer ones holding it.
+KNOTS = (1, 3, 5)
+
+
+def check_knots(knots) -> int:
+    """``knots`` if it names a family (``KNOTS``), else a clear error."""
+    if isinstance(knots, bool) or knots not in KNOTS:
+        raise BipedError(
+            f"knots = {knots!r}: allowed {', '.join(map(str, KNOTS))} interior knots (1: the "
+            "paper's spline)"
+        )
+    return int(knots)
+
+
+@functools.cache
+def parameter_names(knots: int = 1) -> tuple:
+    """The parameters of the family of ``knots`` interior knots, in order: the paper's 21
+    (``PARAMETERS``) for 1; for more, the accelerations replaced by each knot's angles [rad]
+    and rates [rad/s]."""
+    if check_knots(knots) == 1:
+        return PARAMETERS
+    at_knots = tuple(
+        f"knot{k}_{kind}{a}"
+        for k in range(1, knots + 1)
+        for kind in ("", "rate_")
+        for a in FREE_ANGLES
+    )
+    return PARAMETERS[:8] + at_knots + ("period",)
+
+
+def breakpoints(knots: int = 1) -> np.ndarray:
+    """Normalised times [0, knots..., 1] of the pieces' ends."""
+    return np.linspace(0.0, 1.0, check_knots(knots) + 2)
+
 
 # The leg swap (``biped.model.kinematics.LEG_SWAP``) of the free angles: the end posture is
 # start[FREE_SWAP] (qp2 -> qp2, q1 <-> q4, q2 <-> q3, q5 -> q5), the swing foot flat at both
@@ -63,7 +106,10 @@ class Step:
     """One step built from the parameters: spline coefficients and boundary states.
 
     Attributes:
-        a, b: (6, 4) coefficients of eqs. (25), (26) per free angle (normalised time).
+        pieces: (K + 1, 6, 4) coefficients of each piece's cubic per free angle, in the
+            piece's normalised time (``piece_variable``): for the paper's spline the
+            coefficients a, b of eqs. (25), (26).
+        knots: interior knots K of the family.
         period: T [s].
         step_length: S [m].
         start: q, q̇ (9,) just after the impact at t = 0 (stance foot fixed).
@@ -71,13 +117,36 @@ class Step:
         impulse: I_R (3,) of the landing at t = T [N·s, N·s, N·m·s].
     """
 
-    a: np.ndarray
-    b: np.ndarray
+    pieces: np.ndarray
+    knots: int
     period: float
     step_length: float
     start: tuple
     end: tuple
     impulse: np.ndarray
+
+    @property
+    def a(self) -> np.ndarray:
+        """(6, 4) coefficients of eq. (25) (the paper's spline)."""
+        return self.pieces[0]
+
+    @property
+    def b(self) -> np.ndarray:
+        """(6, 4) coefficients of eq. (26) (the paper's spline)."""
+        return self.pieces[1]
+
+    @property
+    def coefficients(self) -> np.ndarray:
+        """The pieces' coefficients stacked (4 (K + 1), 6): [a0..a3, b0..b3] for the paper's."""
+        return np.concatenate(list(self.pieces), axis=1).T
+
+
+def piece_variable(knots: int, piece: int) -> tuple[float, float]:
+    """(origin, sign) of a piece's normalised time u = sign (t_n − origin): the paper's
+    second piece runs backwards from t_n = 1 (eq. 26), every other forwards from its start."""
+    if knots == 1 and piece == 1:
+        return 1.0, -1.0
+    return float(breakpoints(knots)[piece]), 1.0
 
 
 class StepBuildError(BipedError):
@@ -88,17 +157,18 @@ class StepBuildError(BipedError):
         self.excess = excess  # how far outside the allowed set, for a graded penalty
 
 
-def build_step(model: Biped, speed: float, p) -> Step:
-    """Spline coefficients of one step from the 21 parameters at walking speed ``speed``."""
+def build_step(model: Biped, speed: float, p, knots: int = 1) -> Step:
+    """Spline coefficients of one step from the parameters (``parameter_names(knots)``; the
+    paper's 21 for 1 knot) at walking speed ``speed``."""
     p = np.asarray(p, dtype=float)
-    if p.shape != (N_PARAMETERS,):
-        raise BipedError(f"gait parameters have shape {p.shape}: allowed ({N_PARAMETERS},)")
+    size = len(parameter_names(knots))
+    if p.shape != (size,):
+        raise BipedError(f"gait parameters have shape {p.shape}: allowed ({size},)")
     if not np.all(np.isfinite(p)):
         raise StepBuildError("gait parameters are not all finite", excess=1.0)
     x_hip, z_hip, trunk = p[0:3]
     end_rates = np.concatenate([[0.0], p[3:8]])
-    acc0, acc1 = p[8:14], p[14:20]
-    period = p[20]
+    period = p[-1]
     if not period > 0.0:
         raise StepBuildError(f"period = {period!r} s: allowed > 0", excess=-period + 1.0)
     length = speed * period
@@ -116,7 +186,25 @@ def build_step(model: Biped, speed: float, p) -> Step:
     qd_plus, impulse = model.impact(q_end, qd_end)
     q_start, qd_start = swap_legs(model, q_end, qd_plus)
     start_rates = qd_start[1:7]
+    ends = (start_angles, start_rates, end_angles, end_rates)
+    if knots == 1:
+        pieces = _paper_pieces(period, *ends, p[8:14], p[14:20])
+    else:
+        pieces = _hermite_pieces(period, *ends, p[8:-1].reshape(knots, 2, 6))
+    return Step(
+        pieces=pieces,
+        knots=knots,
+        period=float(period),
+        step_length=float(length),
+        start=(q_start, qd_start),
+        end=(q_end, qd_end),
+        impulse=impulse,
+    )
 
+
+def _paper_pieces(period, start_angles, start_rates, end_angles, end_rates, acc0, acc1):
+    """The coefficients a, b (2, 6, 4) of eqs. (25)-(26): the ends' angles, rates and
+    accelerations, C⁰ and C¹ at t_n = 0.5."""
     a = np.empty((6, 4))
     b = np.empty((6, 4))
     a[:, 0] = start_angles
@@ -131,40 +219,61 @@ def build_step(model: Biped, speed: float, p) -> Step:
     r2 = -(b[:, 1] + b[:, 2]) - a[:, 1] - a[:, 2]
     a[:, 3] = 4 * r1 + 2 * r2 / 3
     b[:, 3] = 2 * r2 / 3 - 4 * r1
-    return Step(
-        a=a,
-        b=b,
-        period=float(period),
-        step_length=float(length),
-        start=(q_start, qd_start),
-        end=(q_end, qd_end),
-        impulse=impulse,
+    return np.stack([a, b])
+
+
+def hermite(h, y0, m0, y1, m1):
+    """Coefficients [c0, c1, c2, c3] of the cubic c0 + c1 u + c2 u² + c3 u³ on [0, h] with
+    value ``y0`` and slope ``m0`` at u = 0, ``y1`` and ``m1`` at u = h (arrays or CasADi
+    expressions alike)."""
+    rise = (y1 - y0) / h
+    return [y0, m0, (3 * rise - 2 * m0 - m1) / h, (m0 + m1 - 2 * rise) / h**2]
+
+
+def _hermite_pieces(period, start_angles, start_rates, end_angles, end_rates, at_knots):
+    """The pieces (K + 1, 6, 4) of the Hermite spline through the ends' and the knots'
+    angles and rates (``at_knots`` (K, 2, 6)), slopes in normalised time (T × rate)."""
+    values = [start_angles, *at_knots[:, 0], end_angles]
+    slopes = [period * start_rates, *(period * at_knots[:, 1]), period * end_rates]
+    h = 1.0 / (len(values) - 1)
+    return np.stack(
+        [
+            np.column_stack(hermite(h, values[j], slopes[j], values[j + 1], slopes[j + 1]))
+            for j in range(len(values) - 1)
+        ]
     )
 
 
 def half_grid(samples_per_half: int):
     """Normalised times of the two spline pieces, each closed: (t_left, t_right)."""
-    t = np.linspace(0.0, 0.5, samples_per_half + 1)
-    return t, t + 0.5
+    return piece_grid(samples_per_half, 1)
 
 
-def evaluate(step: Step, t_n, piece: str):
+def piece_grid(samples_per_piece: int, knots: int = 1) -> tuple:
+    """Normalised times of each piece of the family of ``knots`` interior knots, each closed
+    (``samples_per_piece`` + 1 times)."""
+    ends = breakpoints(knots)
+    t = np.linspace(0.0, ends[1], samples_per_piece + 1)
+    return tuple(t + origin for origin in ends[:-1])
+
+
+def evaluate(step: Step, t_n, piece):
     """Angles, rates, accelerations (..., 6) of the free angles at normalised times t_n.
 
     Args:
-        piece: ``"left"`` for eq. (25) (t_n in [0, 0.5]), ``"right"`` for eq. (26).
+        piece: the piece's index (0 to K), or for the paper's spline ``"left"`` for eq. (25)
+            (t_n in [0, 0.5]) and ``"right"`` for eq. (26).
     Derivatives are with respect to physical time [rad/s, rad/s²].
     """
     t_n = np.asarray(t_n, dtype=float)[..., None]
+    index = {"left": 0, "right": 1}.get(piece, piece) if step.knots == 1 else piece
+    if isinstance(index, str) or not (isinstance(index, int) and 0 <= index <= step.knots):
+        allowed = "'left', 'right'" if step.knots == 1 else f"0 to {step.knots}"
+        raise BipedError(f"piece = {piece!r}: allowed {allowed}")
+    c = step.pieces[index]
+    origin, sign = piece_variable(step.knots, index)
+    u = sign * (t_n - origin)
     period = step.period
-    if piece == "left":
-        c = step.a
-        u, sign = t_n, 1.0
-    elif piece == "right":
-        c = step.b
-        u, sign = 1.0 - t_n, -1.0
-    else:
-        raise BipedError(f"piece = {piece!r}: allowed 'left', 'right'")
     value = c[:, 0] + u * (c[:, 1] + u * (c[:, 2] + u * c[:, 3]))
     rate = sign * (c[:, 1] + u * (2 * c[:, 2] + 3 * u * c[:, 3])) / period
     accel = (2 * c[:, 2] + 6 * u * c[:, 3]) / period**2
@@ -172,39 +281,41 @@ def evaluate(step: Step, t_n, piece: str):
 
 
 @functools.cache
-def spline_basis(samples_per_half: int):
-    """The normalised times of both pieces of ``half_grid`` (2 (n + 1),) and the matrices [-]
-    mapping the stacked coefficients [a0..a3, b0..b3] (8, 6) to the values and the first and
-    second derivatives in normalised time there: (t_n, (values, rates, accels)).
+def spline_basis(samples_per_piece: int, knots: int = 1):
+    """The normalised times of every piece of ``piece_grid`` ((K + 1) (n + 1),) and the
+    matrices [-] mapping the stacked coefficients (``Step.coefficients``, 4 (K + 1) x 6) to
+    the values and the first and second derivatives in normalised time there:
+    (t_n, (values, rates, accels)).
 
-    Piece (26) is a polynomial in u = 1 - t_n, so d/dt_n = -d/du there.
+    A piece's polynomial is in u = sign (t_n − origin) (``piece_variable``), so d/dt_n =
+    sign d/du there (the paper's second piece: u = 1 − t_n).
     """
-    left, right = half_grid(samples_per_half)
-    n = len(left)
-    u = np.concatenate([left, 1.0 - right])[:, None]
-    zero, one = np.zeros_like(u), np.ones_like(u)
-    value = np.hstack([one, u, u**2, u**3])
-    rate = np.hstack([zero, one, 2 * u, 3 * u**2])
-    accel = np.hstack([zero, zero, 2 * one, 6 * u])
-    bases = []
-    for matrix, sign in ((value, 1.0), (rate, -1.0), (accel, 1.0)):
-        block = np.zeros((2 * n, 8))
-        block[:n, :4] = matrix[:n]
-        block[n:, 4:] = sign * matrix[n:]
+    grids = piece_grid(samples_per_piece, knots)
+    n, pieces = len(grids[0]), len(grids)
+    bases = [np.zeros((pieces * n, 4 * pieces)) for _ in range(3)]
+    for j, t in enumerate(grids):
+        origin, sign = piece_variable(knots, j)
+        u = (sign * (t - origin))[:, None]
+        zero, one = np.zeros_like(u), np.ones_like(u)
+        value = np.hstack([one, u, u**2, u**3])
+        rate = np.hstack([zero, one, 2 * u, 3 * u**2])
+        accel = np.hstack([zero, zero, 2 * one, 6 * u])
+        for block, matrix, scale in zip(bases, (value, rate, accel), (1.0, sign, 1.0), strict=True):
+            block[j * n : (j + 1) * n, 4 * j : 4 * j + 4] = scale * matrix
+    for block in bases:
         block.setflags(write=False)
-        bases.append(block)
-    return np.concatenate([left, right]), bases
+    return np.concatenate(grids), bases
 
 
 def sample(model: Biped, step: Step, samples_per_half: int, points=()):
-    """Motion and inverse dynamics on both pieces; t = T/2 appears twice (both sides).
+    """Motion and inverse dynamics on every piece; each knot appears twice (both sides).
 
     Returns:
         t [s] (N,), q, q̇, q̈ (N, 9), torques (N, 6), wrench (N, 3), positions of ``points``
-        (N, P, 2), N = 2 (n + 1).
+        (N, P, 2), N = (K + 1) (n + 1).
     """
-    t_n, (values, rates, accels) = spline_basis(samples_per_half)
-    coefficients = np.concatenate([step.a, step.b], axis=1).T  # (8, 6)
+    t_n, (values, rates, accels) = spline_basis(samples_per_half, step.knots)
+    coefficients = step.coefficients
     period = step.period
     return (t_n * period,) + model.single_support(
         values @ coefficients,
@@ -212,6 +323,31 @@ def sample(model: Biped, step: Step, samples_per_half: int, points=()):
         (accels @ coefficients) / period**2,
         points,
     )
+
+
+def embedded(step: Step, knots: int) -> np.ndarray:
+    """The knots' angles and rates (``knots``, 2, 6) of ``step``'s spline: the parameters
+    beyond the ends' of the family of ``knots`` interior knots that holds it (its knots
+    include ``step``'s: ``check_embedding``)."""
+    check_embedding(step.knots, knots)
+    times = breakpoints(knots)[1:-1]
+    ends = breakpoints(step.knots)
+    rows = []
+    for t in times:
+        piece = min(int(np.searchsorted(ends, t, side="right")) - 1, step.knots)
+        angles, rates, _ = evaluate(step, t, piece)
+        rows.append([angles, rates])
+    return np.array(rows)
+
+
+def check_embedding(knots: int, richer: int) -> None:
+    """Raise unless the family of ``richer`` interior knots holds that of ``knots``."""
+    small, large = breakpoints(knots)[1:-1], breakpoints(richer)[1:-1]
+    if not all(np.any(np.isclose(t, large, rtol=0.0, atol=1e-12)) for t in small):
+        raise BipedError(
+            f"knots = {richer}: its knots do not include those of {knots} knot(s), so its "
+            "family does not hold the other's"
+        )
 
 
 def angles_at(step: Step, t_n):

@@ -45,6 +45,7 @@ from biped.optimization.problem import (  # noqa: F401 (re-exported)
     check_criterion,
     check_speed,
     max_walking_speed,
+    scales,
 )
 from biped.optimization.solver import CONVERGED, solver_for
 from biped.optimization.table import OTHER_KNEE_START, TABLE_START
@@ -59,8 +60,10 @@ GUESS_PERIODS = (FIRST_GUESS_PERIOD, 0.8, 0.45)
 PERTURBATION = 1.0
 # Two starts reach the same optimum when their values agree to this, relative.
 AGREEMENT = 1e-6
-# Samples per spline piece of the feasibility check of an optimum (202 per step).
+# Samples per spline piece of the feasibility check of an optimum (202 per step), and the same
+# per piece of each family (``biped.model.gait.KNOTS``), about as many per step.
 CHECK_SAMPLES_PER_HALF = 100
+CHECK_SAMPLES = {1: CHECK_SAMPLES_PER_HALF, 3: 50, 5: 34}
 
 
 @dataclass(frozen=True)
@@ -244,7 +247,10 @@ def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[st
     schedule = start_schedule(starts, seed, GUESS_PERIODS)
     guess, rng = problem.first_guess(), np.random.default_rng(seed)
     return [
-        (kind, perturbed(guess, rng) if period is None else problem.first_guess(period))
+        (
+            kind,
+            perturbed(guess, rng, problem.knots) if period is None else problem.first_guess(period),
+        )
         for kind, period in schedule
     ]
 
@@ -269,15 +275,17 @@ def energy_first_guesses(problem: GaitProblem, starts: int, seed: int) -> list:
     rng = np.random.default_rng(seed)
     base = guesses[0][1] if guesses else problem.first_guess()
     guesses += [
-        (f"perturbed{MONOTONE}", perturbed(base, rng)) for _ in range(starts - len(lengths))
+        (f"perturbed{MONOTONE}", perturbed(base, rng, problem.knots))
+        for _ in range(starts - len(lengths))
     ]
     return guesses
 
 
-def perturbed(guess, rng: np.random.Generator) -> np.ndarray:
-    """``guess`` (variables) perturbed by ``PERTURBATION`` x ``SCALES``, in the bounds."""
-    lower, upper = bounds()
-    z = guess + PERTURBATION * SCALES * rng.standard_normal(np.shape(guess))
+def perturbed(guess, rng: np.random.Generator, knots: int = 1) -> np.ndarray:
+    """``guess`` (variables of the family of ``knots``) perturbed by ``PERTURBATION`` x its
+    scales (``biped.optimization.problem.scales``), in the bounds."""
+    lower, upper = bounds(knots)
+    z = guess + PERTURBATION * scales(knots) * rng.standard_normal(np.shape(guess))
     z[:2] = np.abs(z[:2])  # the knee bends stay bends
     return np.clip(z, lower, upper)
 
@@ -329,11 +337,17 @@ def prepare(problem: GaitProblem) -> float:
     process: the energy criterion's sthenic twin's too) with both barriers; returns the
     seconds it took (0 when they were built already)."""
     began = time.perf_counter()
-    twins = [problem] + (
-        [dataclasses.replace(problem, criterion="sthenic")] * (problem.criterion == "energy")
+    criteria = (
+        {problem.criterion, "sthenic"} if problem.criterion == "energy" else {problem.criterion}
     )
-    for twin in twins:
-        solver_for(twin).prepare(("adaptive", "monotone"))
+    for criterion in sorted(criteria):
+        for knots in sorted({problem.knots, 1}):
+            family = dataclasses.replace(
+                problem, criterion=criterion, knots=knots, samples_per_half=None
+            )
+            solver_for(family if knots == 1 or family == problem else family).prepare(
+                ("adaptive", "monotone")
+            )
     return time.perf_counter() - began
 
 
@@ -377,11 +391,18 @@ def optimize(
     if not isinstance(problem, GaitProblem):
         raise BipedError(f"problem = {problem!r}: allowed a biped.optimization.problem.GaitProblem")
     began = time.perf_counter()
+    if problem.knots != 1 and (method == "nelder-mead" or nelder_mead_starts):
+        raise BipedError(
+            f"knots = {problem.knots} with the paper's Nelder-Mead: allowed knots = 1 (its "
+            "method optimizes the paper's spline)"
+        )
     if method == "nelder-mead":
         return _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began)
     solver = (solver_for if solvers is None else solvers)(problem)
     candidates = first_guesses(problem, starts, seed) + table_starts(problem, starts)
     candidates += [("given", np.asarray(z, dtype=float)) for z in given]
+    if problem.knots != 1 and starts > 0:
+        candidates += _paper_start(problem, seed, starts, solvers, jobs)
     if problem.criterion == "energy" and starts > 0:
         candidates += _sthenic_start(problem, seed, starts, solvers, sthenic, jobs)
     for k in range(nelder_mead_starts):
@@ -411,13 +432,30 @@ def table_starts(problem: GaitProblem, starts: int) -> list:
     if starts == 0:
         return []
     found = [
-        (TABLE_START, table.start(problem)),
-        (OTHER_KNEE_START, table.other_knee_start(problem)),
+        (TABLE_START, _embedded(problem, table.start(problem))),
+        (OTHER_KNEE_START, _embedded(problem, table.other_knee_start(problem))),
     ]
     found = [(kind, start) for kind, start in found if start is not None]
     if problem.criterion == "energy" and found and found[0][0] == TABLE_START:
         found.insert(1, (TABLE_START + MONOTONE, found[0][1]))
     return found
+
+
+def _embedded(problem: GaitProblem, variables):
+    """The paper spline's ``variables`` in the problem's family (None stays None)."""
+    return None if variables is None else problem.embedded(variables)
+
+
+# A richer family's start from the optimum of the paper's spline (its family holds it).
+PAPER_START = "optimum of the paper's spline"
+
+
+def _paper_start(problem: GaitProblem, seed, starts, solvers=None, jobs=None) -> list:
+    """The optimum of the same problem with the paper's spline, the same gait in the
+    problem's richer family: from it the richer family's optimum is never worse."""
+    paper = dataclasses.replace(problem, knots=1, samples_per_half=None)
+    optimum = optimize(paper, seed, starts, solvers=solvers, jobs=jobs)
+    return [(PAPER_START, problem.embedded(optimum.variables))] if optimum.report.converged else []
 
 
 # The energy criterion's starts from the sthenic optimum, under IPOPT's adaptive and its
@@ -474,6 +512,7 @@ def _family(problem: GaitProblem) -> tuple:
         problem.criterion,
         problem.safety,
         problem.samples_per_half,
+        problem.knots,
     )
 
 
@@ -563,8 +602,9 @@ def checked(problem: GaitProblem, variables, report: Report, parameters=None) ->
             variables = problem.from_parameters(parameters)
         except BipedError:
             variables = np.full(len(parameters), np.nan)
-    step = build_step(problem.model, problem.speed, parameters)
-    evaluation = evaluate_step(problem.model, step, CHECK_SAMPLES_PER_HALF, safety=problem.safety)
+    step = build_step(problem.model, problem.speed, parameters, problem.knots)
+    samples = CHECK_SAMPLES[problem.knots]
+    evaluation = evaluate_step(problem.model, step, samples, safety=problem.safety)
     return Optimum(
         problem=problem,
         variables=np.asarray(variables, dtype=float),

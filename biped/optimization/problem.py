@@ -26,6 +26,8 @@ parameters (``to_parameters``, ``from_parameters``).
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
@@ -34,7 +36,14 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.criteria import CRITERIA, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
-from biped.model.gait import N_PARAMETERS, PARAMETERS
+from biped.model.gait import (
+    N_PARAMETERS,
+    PARAMETERS,
+    build_step,
+    check_knots,
+    embedded,
+    parameter_names,
+)
 
 # Decision variables of the solvers: the paper's parameters with the hip replaced by the
 # two knee bends at the start of the step.
@@ -64,14 +73,39 @@ FIRST_GUESS_PERIOD = 0.6
 # (``biped.optimization.optimize.CHECK_SAMPLES_PER_HALF``), where Ψ_i may dip below δ_i
 # between them.
 SOLVER_SAMPLES_PER_HALF = 25
+# The same per piece of each family (``biped.model.gait.KNOTS``), about as many per step.
+SOLVER_SAMPLES = {1: SOLVER_SAMPLES_PER_HALF, 3: 13, 5: 9}
+# Scales and bounds of a richer family's knot angles [rad] and rates [rad/s].
+KNOT_SCALES = {"": 0.03, "rate_": 0.3}
+KNOT_ANGLE_BOUND = np.pi
 
 
-def bounds() -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bounds (21,) of the variables, in ``VARIABLES`` order."""
-    lower = np.empty(N_VARIABLES)
-    upper = np.empty(N_VARIABLES)
-    for i, name in enumerate(VARIABLES):
-        if name.startswith("end_rate"):
+@functools.cache
+def variable_names(knots: int = 1) -> tuple:
+    """The solvers' variables of the family of ``knots`` interior knots: its parameters
+    (``biped.model.gait.parameter_names``) with the hip replaced by the two knee bends."""
+    return ("stance_knee_bend", "swing_knee_bend") + parameter_names(knots)[2:]
+
+
+@functools.cache
+def scales(knots: int = 1) -> np.ndarray:
+    """``SCALES`` of the family: the paper's, the accelerations' replaced by the knots'."""
+    if knots == 1:
+        return SCALES
+    at_knots = [KNOT_SCALES[kind] for _ in range(knots) for kind in KNOT_SCALES for _ in range(6)]
+    return np.concatenate([SCALES[:8], at_knots, SCALES[-1:]])
+
+
+def bounds(knots: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of the variables, in ``variable_names(knots)`` order."""
+    names = variable_names(knots)
+    lower = np.empty(len(names))
+    upper = np.empty(len(names))
+    for i, name in enumerate(names):
+        if name.startswith("knot"):
+            limit = RATE_BOUND if "_rate_" in name else KNOT_ANGLE_BOUND
+            lower[i], upper[i] = -limit, limit
+        elif name.startswith("end_rate"):
             lower[i], upper[i] = -RATE_BOUND, RATE_BOUND
         elif "accel" in name:
             lower[i], upper[i] = -ACCEL_BOUND, ACCEL_BOUND
@@ -131,13 +165,17 @@ class GaitProblem:
     speed: float
     criterion: str = "sthenic"
     safety: Safety = PAPER_SAFETY
-    samples_per_half: int = SOLVER_SAMPLES_PER_HALF
+    samples_per_half: int | None = None
+    knots: int = 1
 
     def __post_init__(self):
         object.__setattr__(self, "speed", check_speed(self.model, self.speed))
         check_criterion(self.criterion)
         if not isinstance(self.safety, Safety):
             raise BipedError(f"safety = {self.safety!r}: allowed a biped.model.criteria.Safety")
+        check_knots(self.knots)
+        if self.samples_per_half is None:
+            object.__setattr__(self, "samples_per_half", SOLVER_SAMPLES[self.knots])
         n = self.samples_per_half
         if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 1000:
             raise BipedError(f"samples_per_half = {n!r}: allowed an integer from 2 to 1000")
@@ -146,9 +184,14 @@ class GaitProblem:
     def knee(self) -> str:
         return self.model.knee
 
+    @property
+    def variables(self) -> tuple:
+        """The names of the solvers' variables (``variable_names``)."""
+        return variable_names(self.knots)
+
     def at_speed(self, speed: float) -> GaitProblem:
         """The same problem at another speed."""
-        return GaitProblem(self.model, speed, self.criterion, self.safety, self.samples_per_half)
+        return dataclasses.replace(self, speed=speed)
 
     def describe(self) -> str:
         margins = ""
@@ -156,7 +199,10 @@ class GaitProblem:
             margins = (
                 f", clearance {self.safety.clearance:g} m, ZMP margin {self.safety.zmp_margin:g} m"
             )
-        return f"{self.knee} knee, {self.criterion} criterion, {self.speed:.3f} m/s{margins}"
+        family = f", {self.knots} knots" if self.knots != 1 else ""
+        return (
+            f"{self.knee} knee, {self.criterion} criterion, {self.speed:.3f} m/s{margins}{family}"
+        )
 
     # ------------------------------------------------------------------ variables <-> parameters
     def hip_start(self, stance_bend, swing_bend, period):
@@ -176,20 +222,23 @@ class GaitProblem:
         return x, chain.robot.ankle_height + math.sqrt(height2)
 
     def to_parameters(self, variables) -> np.ndarray:
-        """The paper's 21 parameters (``biped.model.gait.PARAMETERS``) of the solvers' variables."""
+        """The parameters (``biped.model.gait.parameter_names``: the paper's 21 for its
+        spline) of the solvers' variables."""
         z = np.asarray(variables, dtype=float)
-        if z.shape != (N_VARIABLES,):
-            raise BipedError(f"variables have shape {z.shape}: allowed ({N_VARIABLES},)")
-        x, height = self.hip_start(z[0], z[1], z[index("period")])
+        size = len(self.variables)
+        if z.shape != (size,):
+            raise BipedError(f"variables have shape {z.shape}: allowed ({size},)")
+        x, height = self.hip_start(z[0], z[1], z[-1])
         return np.concatenate([[x, height], z[2:]])
 
     def from_parameters(self, parameters) -> np.ndarray:
-        """The solvers' variables of the paper's 21 parameters (the knee bends at the start
-        of the step from the inverse geometric model)."""
+        """The solvers' variables of the parameters (the knee bends at the start of the step
+        from the inverse geometric model)."""
         p = np.asarray(parameters, dtype=float)
-        if p.shape != (N_PARAMETERS,):
-            raise BipedError(f"gait parameters have shape {p.shape}: allowed ({N_PARAMETERS},)")
-        x, height, period = p[0], p[1], p[PARAMETERS.index("period")]
+        size = len(parameter_names(self.knots))
+        if p.shape != (size,):
+            raise BipedError(f"gait parameters have shape {p.shape}: allowed ({size},)")
+        x, height, period = p[0], p[1], p[-1]
         lift = height - self.model.robot.ankle_height
         hips = np.array([[x, lift], [x + self.speed * period, lift]])
         (q1, q2), (q4, q3) = self.model.leg_angles(hips)
@@ -197,7 +246,8 @@ class GaitProblem:
 
     def first_guess(self, period: float = FIRST_GUESS_PERIOD) -> np.ndarray:
         """A walkable first guess (variables): knees bent a little, the hip midway between
-        the feet, legs turning as stiff pendulums.
+        the feet, legs turning as stiff pendulums; for a richer family, that gait of the
+        paper's spline (``embedded``).
 
         Args:
             period: duration of the step T [s]; the step length is speed x T.
@@ -211,8 +261,20 @@ class GaitProblem:
         p[0:3] = [-length / 2, height, 0.0]
         p[3:7] = -self.speed / leg  # q1..q4 turn backwards as the hip passes over the feet
         p[PARAMETERS.index("period")] = period
-        return self.from_parameters(p)
+        paper = dataclasses.replace(self, knots=1, samples_per_half=None)
+        return self.embedded(paper.from_parameters(p))
+
+    def embedded(self, variables) -> np.ndarray:
+        """The variables of this problem's family for the paper's spline of ``variables``
+        (21): the same gait (``biped.model.gait.embedded``); ``variables`` themselves for the
+        paper's spline."""
+        z = np.asarray(variables, dtype=float)
+        if self.knots == 1:
+            return z
+        paper = dataclasses.replace(self, knots=1, samples_per_half=None)
+        step = build_step(self.model, self.speed, paper.to_parameters(z))
+        return np.concatenate([z[:8], embedded(step, self.knots).ravel(), z[-1:]])
 
     def first_parameters(self) -> np.ndarray:
-        """The paper's 21 parameters of ``first_guess``."""
+        """The parameters of ``first_guess``."""
         return self.to_parameters(self.first_guess())

@@ -33,7 +33,7 @@ from biped.model.criteria import Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import Robot
 from biped.optimization.hessian import lagrangian_hessian
-from biped.optimization.problem import N_VARIABLES, SCALES, GaitProblem, bounds
+from biped.optimization.problem import GaitProblem, bounds, scales, variable_names
 from biped.optimization.symbolic import StepGraph
 from biped.runtime.interrupts import kept_interrupts
 
@@ -132,20 +132,22 @@ class Solver:
         safety: Safety,
         samples_per_half: int,
         radius_bounds=None,
+        knots: int = 1,
     ):
         # CasADi calls back into Python for every operand's shape while it builds the graph;
         # an interrupt whose handler raises there is swallowed: raised again after the build.
         with kept_interrupts():
-            self._build(model, criterion, safety, samples_per_half, radius_bounds)
+            self._build(model, criterion, safety, samples_per_half, radius_bounds, knots)
 
-    def _build(self, model, criterion, safety, samples_per_half, radius_bounds):
+    def _build(self, model, criterion, safety, samples_per_half, radius_bounds, knots):
         one_blas_thread()
         design = radius_bounds is not None
-        self.graph = graph = StepGraph(model, samples_per_half, safety, design=design)
+        self.graph = graph = StepGraph(model, samples_per_half, safety, design, knots)
         self.criterion = criterion
         self.design = design
-        y = ca.SX.sym("y", N_VARIABLES)
-        unknowns, scaled = [graph.z], [ca.DM(SCALES) * y]
+        self.scales, self.size = scales(knots), len(variable_names(knots))
+        y = ca.SX.sym("y", self.size)
+        unknowns, scaled = [graph.z], [ca.DM(self.scales) * y]
         if design:
             rho = ca.SX.sym("rho", 2)
             y = ca.vertcat(y, rho)
@@ -162,8 +164,8 @@ class Solver:
         self.evaluate = ca.Function(
             "evaluate", graph.inputs, [graph.sthenic, graph.energy, graph.power]
         )
-        self.lower, self.upper = bounds()
-        lower, upper = self.lower / SCALES, self.upper / SCALES
+        self.lower, self.upper = bounds(knots)
+        lower, upper = self.lower / self.scales, self.upper / self.scales
         if design:
             self.radius_bounds = tuple(tuple(map(float, side)) for side in radius_bounds)
             lower = np.concatenate([lower, np.array(self.radius_bounds[0]) / RADIUS_SCALE])
@@ -228,7 +230,7 @@ class Solver:
         began = time.perf_counter()
         nlp = self._nlp(barrier)
         z0 = np.clip(np.asarray(start, dtype=float), self.lower, self.upper)
-        x0 = z0 / SCALES
+        x0 = z0 / self.scales
         inputs = [z0, problem.speed]
         if self.design:
             if radii is None:
@@ -244,7 +246,7 @@ class Solver:
             x0 = np.concatenate([x0, np.abs(power) if np.all(np.isfinite(power)) else 0.0])
         lbx, ubx = self.lbx, self.ubx
         if self.design and hold_radii:
-            held = slice(N_VARIABLES, N_VARIABLES + 2)
+            held = slice(self.size, self.size + 2)
             lbx, ubx = lbx.copy(), ubx.copy()
             lbx[held] = ubx[held] = r0 / RADIUS_SCALE
         result = nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
@@ -258,10 +260,10 @@ class Solver:
         )
         iterations = stats.get("iterations") or {}
         dual = iterations.get("inf_du") or [float("nan")]
-        end = N_VARIABLES + 2 * self.design
+        end = self.size + 2 * self.design
         return Solution(
-            variables=x[:N_VARIABLES] * SCALES,
-            radii=tuple(map(float, x[N_VARIABLES:end] * RADIUS_SCALE)) if self.design else None,
+            variables=x[: self.size] * self.scales,
+            radii=tuple(map(float, x[self.size : end] * RADIUS_SCALE)) if self.design else None,
             value=float(result["f"]),
             status=str(stats["return_status"]),
             iterations=int(stats["iter_count"]),
@@ -272,8 +274,8 @@ class Solver:
 
 
 @functools.lru_cache(maxsize=8)
-def _solver(robot: Robot, knee: str, criterion: str, safety: Safety, samples: int) -> Solver:
-    return Solver(Biped(robot, knee), criterion, safety, samples)
+def _solver(robot: Robot, knee: str, criterion: str, safety: Safety, samples: int, knots) -> Solver:
+    return Solver(Biped(robot, knee), criterion, safety, samples, knots=knots)
 
 
 def solver_for(problem: GaitProblem) -> Solver:
@@ -286,4 +288,5 @@ def solver_for(problem: GaitProblem) -> Solver:
         problem.criterion,
         problem.safety,
         problem.samples_per_half,
+        problem.knots,
     )

@@ -34,7 +34,7 @@ from biped.model.criteria import (
     simpson_weights,
 )
 from biped.model.dynamics import JOINT_MATRIX, Biped
-from biped.model.gait import FREE_SWAP, spline_basis
+from biped.model.gait import FREE_SWAP, hermite, spline_basis
 from biped.model.kinematics import (
     BODY_DIRECTIONS,
     LEG_SWAP,
@@ -51,7 +51,7 @@ from biped.model.kinematics import (
     ZH,
     point_table,
 )
-from biped.optimization.problem import MIN_HIP_HEIGHT, N_VARIABLES, index
+from biped.optimization.problem import MIN_HIP_HEIGHT, index, variable_names
 
 # Constraints are divided by these in the solvers so that all are of order one
 # [N, m, m, rad, rad, m, m].
@@ -322,13 +322,16 @@ class StepGraph:
         method each.
     """
 
-    def __init__(self, model: Biped, samples_per_half: int, safety, design: bool = False):
+    def __init__(
+        self, model: Biped, samples_per_half: int, safety, design: bool = False, knots: int = 1
+    ):
         self.model, self.samples_per_half = model, samples_per_half
-        self.safety, self.design = safety, design
+        self.safety, self.design, self.knots = safety, design, knots
         self.radii = ca.SX.sym("radii", 2) if design else None
         c = _Constants(model, self.radii)
-        self.z, self.speed = ca.SX.sym("z", N_VARIABLES), ca.SX.sym("speed")
-        self.period = self.z[index("period")]  # T [s]
+        self.z = ca.SX.sym("z", len(variable_names(knots)))
+        self.speed = ca.SX.sym("speed")
+        self.period = self.z[-1]  # T [s]
         self.length = self.speed * self.period  # S [m]
         start_angles = self._start_posture(c)
         end_angles, end_rates, start_rates = self._impact(c, start_angles)
@@ -373,9 +376,22 @@ class StepGraph:
         return end_angles, end_rates, start_rates
 
     def _splines(self, start_angles, start_rates, end_angles, end_rates):
-        """3. The spline coefficients (25)-(26) [a0..a3, b0..b3] (8, 6) of the free angles in
-        normalised time, as in ``biped.model.gait.build_step``."""
+        """3. The spline coefficients (``biped.model.gait.Step.coefficients``, 4 (K + 1) x 6)
+        of the free angles in normalised time, as in ``biped.model.gait.build_step``: eqs.
+        (25)-(26) [a0..a3, b0..b3] for the paper's spline, the Hermite pieces of a richer
+        family's."""
         z, period = self.z, self.period
+        if self.knots != 1:
+            knots = [z[8 + 12 * k : 8 + 12 * (k + 1)] for k in range(self.knots)]
+            values = [start_angles, *(knot[:6] for knot in knots), end_angles]
+            slopes = [period * start_rates, *(period * knot[6:] for knot in knots)]
+            slopes.append(period * end_rates)
+            h = 1.0 / (self.knots + 1)
+            pieces = [
+                ca.horzcat(*hermite(h, values[j], slopes[j], values[j + 1], slopes[j + 1])).T
+                for j in range(self.knots + 1)
+            ]
+            return ca.vertcat(*pieces)
         acc0 = z[index("start_accel_qp2") : index("start_accel_q5") + 1]
         acc1 = z[index("end_accel_qp2") : index("end_accel_q5") + 1]
         a0, a1, a2 = start_angles, period * start_rates, 0.5 * period**2 * acc0
@@ -392,10 +408,12 @@ class StepGraph:
         ``QUANTITIES`` as a symbol (``quantities``) and as expressions (``flat``)."""
         radii = [self.radii] if self.design else []
         self.head = ca.vertcat(ca.vec(coefficients), self.period, *radii, self.hip_height)
-        self.period_index = _PERIOD
+        self.period_index = coefficients.numel()
         self.head_symbol = ca.SX.sym("head", self.head.shape[0])
         self.sample = sample_function(c, self.model.robot, self.safety, self.radii)
-        self.basis = _sample_basis(self.samples_per_half, self.head.shape[0], self.design)
+        self.basis = _sample_basis(
+            self.samples_per_half, self.knots, self.head.shape[0], self.design
+        )
         n = self.basis.shape[0] // self.sample.size1_in(0)
         self.quantities = ca.SX.sym("quantities", N_QUANTITIES, n)
         inputs = ca.reshape(ca.DM(self.basis) @ self.head, self.sample.size1_in(0), n)
@@ -419,17 +437,18 @@ class StepGraph:
         penalty) and the constraints Ψ_i − δ_i (``psi``: Ψ_i with the safety margins,
         without δ_i), scaled by ``CONSTRAINT_SCALES``, at the checked samples in
         constraint-major order; the samples' quantities by name."""
-        samples, period = self.samples_per_half, self.head_symbol[_PERIOD]
-        self.weights = ca.DM(simpson_weights(samples)).T  # (1, N)
+        samples, knots = self.samples_per_half, self.knots
+        period = self.head_symbol[self.period_index]
+        self.weights = ca.DM(simpson_weights(samples, knots)).T  # (1, N)
         power = self.rows("power")
         psi = self.rows("psi")
         if self.safety.clearance:
-            required = ca.DM(clearance_profile(samples, self.safety.clearance)).T
+            required = ca.DM(clearance_profile(samples, self.safety.clearance, knots)).T
             psi = ca.vertcat(psi[:5, :], psi[5:, :] - ca.repmat(required, 2, 1))
         n = psi.shape[1]
-        margins = ca.DM(margin_profile(samples)).T
+        margins = ca.DM(margin_profile(samples, knots)).T
         scaled = (psi - margins) / ca.repmat(ca.DM(CONSTRAINT_SCALES), 1, n)
-        rows, cols = np.nonzero(checked_mask(samples).T)  # constraint-major order
+        rows, cols = np.nonzero(checked_mask(samples, knots).T)  # constraint-major order
         self.constraint_names = [CONSTRAINTS[i] for i in rows]
         named = {name: self.rows(name) for name in ("q", "qd", "torques", "wrench")}
         return {
@@ -459,20 +478,17 @@ class StepGraph:
         )
 
 
-_PERIOD = 48  # T's place in the head, after the 8 x 6 spline coefficients
-
-
-def _sample_basis(samples_per_half: int, head_size: int, design: bool) -> np.ndarray:
+def _sample_basis(samples_per_half: int, knots: int, head_size: int, design: bool) -> np.ndarray:
     """The constant matrix (N · inputs, head) that maps the head to the stacked inputs of
     the samples (``sample_function``): the spline bases (``biped.model.gait.spline_basis``)
     on each angle's coefficients, then T and the radii passed on."""
-    _, bases = spline_basis(samples_per_half)
-    n = bases[0].shape[0]
+    _, bases = spline_basis(samples_per_half, knots)
+    n, rows = bases[0].shape  # rows: the coefficients of one angle, 4 per piece
     width = SAMPLE_MOTION + 1 + 2 * design
     matrix = np.zeros((n, width, head_size))
     for k, basis in enumerate(bases):  # values, rates, accels
         for angle in range(6):
-            matrix[:, 6 * k + angle, 8 * angle : 8 * angle + 8] = basis
+            matrix[:, 6 * k + angle, rows * angle : rows * (angle + 1)] = basis
     for extra in range(width - SAMPLE_MOTION):  # T (, r1, r2)
-        matrix[:, SAMPLE_MOTION + extra, _PERIOD + extra] = 1.0
+        matrix[:, SAMPLE_MOTION + extra, 6 * rows + extra] = 1.0
     return matrix.reshape(n * width, head_size)
