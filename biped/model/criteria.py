@@ -77,6 +77,8 @@ CLEARANCE_DELAY = 0.03
 # Largest safety margins accepted [m].
 MAX_CLEARANCE = 0.2
 MAX_ZMP_MARGIN = 0.05
+# Largest least bend of the stance knee asked [rad].
+MAX_KNEE_BEND = 1.0
 
 
 @dataclass(frozen=True)
@@ -88,18 +90,27 @@ class Safety:
         clearance: [m] height the swing foot keeps off the ground away from the ends of the
             step (``clearance_profile``); Ψ6, Ψ7 become the heights above it.
         zmp_margin: [m] distance the ZMP keeps inside the sole's heel and toe (Ψ2, Ψ3).
+        knee_bend: [rad] least flexion of the stance knee over the step (Ψ4 becomes the
+            flexion beyond it): the two knee kinematics differ only where the knee bends.
     """
 
     clearance: float = field(default=0.0, metadata={"unit": "m"})
     zmp_margin: float = field(default=0.0, metadata={"unit": "m"})
+    knee_bend: float = field(default=0.0, metadata={"unit": "rad"})
 
     def __post_init__(self):
-        for name, high in (("clearance", MAX_CLEARANCE), ("zmp_margin", MAX_ZMP_MARGIN)):
+        limits = (
+            ("clearance", MAX_CLEARANCE, "m"),
+            ("zmp_margin", MAX_ZMP_MARGIN, "m"),
+            ("knee_bend", MAX_KNEE_BEND, "rad"),
+        )
+        for name, high, unit in limits:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise BipedError(f"{name} = {value!r}: allowed a number of metres")
+                what = "metres" if unit == "m" else "radians"
+                raise BipedError(f"{name} = {value!r}: allowed a number of {what}")
             if not (math.isfinite(value) and 0.0 <= value <= high):
-                raise BipedError(f"{name} = {value!r} m: allowed 0 to {high} m")
+                raise BipedError(f"{name} = {value!r} {unit}: allowed 0 to {high} {unit}")
             object.__setattr__(self, name, float(value))
 
 
@@ -229,6 +240,8 @@ def evaluate_step(
         feet_z = feet_z - clearance_profile(samples_per_half, safety.clearance, knots)[:, None]
     psi = constraints(robot, q, torques, wrench, feet_z)
     psi[:, 1:3] -= safety.zmp_margin
+    if safety.knee_bend:
+        psi[:, 3] -= safety.knee_bend
     checked = checked_mask(samples_per_half, knots)
     seen = psi - margin_profile(samples_per_half, knots) if margins else psi
     power = np.abs(model.joint_angles(qd) * torques).sum(-1)

@@ -199,6 +199,8 @@ class GaitProblem:
             margins = (
                 f", clearance {self.safety.clearance:g} m, ZMP margin {self.safety.zmp_margin:g} m"
             )
+            if self.safety.knee_bend:
+                margins += f", stance knee bent {self.safety.knee_bend:g} rad at least"
         family = f", {self.knots} knots" if self.knots != 1 else ""
         return (
             f"{self.knee} knee, {self.criterion} criterion, {self.speed:.3f} m/s{margins}{family}"

@@ -282,7 +282,7 @@ def sample_function(c: _Constants, robot, safety, radii=None) -> ca.Function:
         wrench[1],
         zmp + robot.foot_heel - safety.zmp_margin,
         robot.foot_length - robot.foot_heel - zmp - safety.zmp_margin,
-        q[Q2] - q[Q1],
+        q[Q2] - q[Q1] - safety.knee_bend,
         q[Q3] - q[Q4],
         q[ZH] - ca.dot(co, heel_a) + ca.dot(s, heel_b),
         q[ZH] - ca.dot(co, toe_a) + ca.dot(s, toe_b),
