@@ -40,9 +40,15 @@ CONSTRAINTS = (
     "swing_heel",
     "swing_toe",
 )
-CRITERIA = ("sthenic", "energy")
-# Unit of each criterion's value: C_Γ per metre walked, C_E per step.
-CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J"}
+# The paper's criteria (its comparison, a sweep's by default), and ours: the energy per metre
+# walked, C_E / S, which ranks gaits of different step lengths (at a given speed C_E per step
+# rewards short fast steps).
+PAPER_CRITERIA = ("sthenic", "energy")
+CRITERIA = (*PAPER_CRITERIA, "energy-per-metre")
+# The criteria counting the joints' work |Γ_i θ̇_i| (exact through slack variables).
+WORK_CRITERIA = ("energy", "energy-per-metre")
+# Unit of each criterion's value: C_Γ per metre walked, C_E per step, C_E / S per metre.
+CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J", "energy-per-metre": "J/m"}
 PENALTY_WEIGHT = 1e6  # k of eqs. (30)-(31)
 # Err of eqs. (30)-(31) when the parameters give no posture: a large cost growing with the
 # distance [m] by which the hip is out of reach, so that the simplex is led back.
@@ -158,9 +164,11 @@ class StepEvaluation:
     penalty: float  # ∫ k Σ (e^(|Ψ|-Ψ) - 1) dt [s]; inf if any value is not finite
 
     def cost(self, criterion: str, step_length: float) -> float:
-        """C_Γ or C_E with the penalty (Err = 0: the step was built)."""
+        """C_Γ, C_E or C_E / S with the penalty (Err = 0: the step was built)."""
         if criterion == "sthenic":
             return self.sthenic + self.penalty / step_length
+        if criterion == "energy-per-metre":
+            return (self.energy + self.penalty) / step_length
         return self.energy + self.penalty
 
     @property

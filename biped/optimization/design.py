@@ -52,7 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import PAPER_SAFETY, Safety
+from biped.model.criteria import PAPER_SAFETY, WORK_CRITERIA, Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import LENGTH_MIN, Robot
 from biped.optimization.optimize import (
@@ -303,7 +303,7 @@ def optimize_design(
     for z, radii in given:
         start = (np.asarray(z, dtype=float), check_radii(problem.robot, radii))
         candidates.append(("given", start))
-    if problem.criterion == "energy" and starts > 0:  # as for gaits: least torque first
+    if problem.criterion in WORK_CRITERIA and starts > 0:  # as for gaits: least torque first
         sthenic = optimize_design(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
         candidates += sthenic_starts(sthenic.report, (sthenic.optimum.variables, sthenic.radii))
 

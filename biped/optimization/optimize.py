@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import StepEvaluation, evaluate_step
+from biped.model.criteria import WORK_CRITERIA, StepEvaluation, evaluate_step
 from biped.model.gait import Step, build_step
 from biped.optimization import table
 from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
@@ -242,7 +242,7 @@ def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[st
     choice, and the basins of the optima follow it), then perturbations of the default. For
     the energy criterion, the family of short steps ``ENERGY_GUESS_LENGTHS`` under the
     monotone barrier instead (``energy_first_guesses``)."""
-    if problem.criterion == "energy":
+    if problem.criterion in WORK_CRITERIA:
         return energy_first_guesses(problem, starts, seed)
     schedule = start_schedule(starts, seed, GUESS_PERIODS)
     guess, rng = problem.first_guess(), np.random.default_rng(seed)
@@ -338,7 +338,9 @@ def prepare(problem: GaitProblem) -> float:
     seconds it took (0 when they were built already)."""
     began = time.perf_counter()
     criteria = (
-        {problem.criterion, "sthenic"} if problem.criterion == "energy" else {problem.criterion}
+        {problem.criterion, "sthenic"}
+        if problem.criterion in WORK_CRITERIA
+        else {problem.criterion}
     )
     for criterion in sorted(criteria):
         for knots in sorted({problem.knots, 1}):
@@ -403,7 +405,7 @@ def optimize(
     candidates += [("given", np.asarray(z, dtype=float)) for z in given]
     if problem.knots != 1 and starts > 0:
         candidates += _paper_start(problem, seed, starts, solvers, jobs)
-    if problem.criterion == "energy" and starts > 0:
+    if problem.criterion in WORK_CRITERIA and starts > 0:
         candidates += _sthenic_start(problem, seed, starts, solvers, sthenic, jobs)
     for k in range(nelder_mead_starts):
         parameters, *_ = nelder_mead(
@@ -436,7 +438,7 @@ def table_starts(problem: GaitProblem, starts: int) -> list:
         (OTHER_KNEE_START, _embedded(problem, table.other_knee_start(problem))),
     ]
     found = [(kind, start) for kind, start in found if start is not None]
-    if problem.criterion == "energy" and found and found[0][0] == TABLE_START:
+    if problem.criterion in WORK_CRITERIA and found and found[0][0] == TABLE_START:
         found.insert(1, (TABLE_START + MONOTONE, found[0][1]))
     return found
 

@@ -145,7 +145,8 @@ def check_speed(model: Biped, speed: float) -> float:
 
 def check_criterion(criterion: str) -> str:
     if criterion not in CRITERIA:
-        raise BipedError(f"criterion = {criterion!r}: allowed 'sthenic', 'energy'")
+        allowed = ", ".join(map(repr, CRITERIA))
+        raise BipedError(f"criterion = {criterion!r}: allowed {allowed}")
     return criterion
 
 
@@ -156,7 +157,8 @@ class GaitProblem:
     Attributes:
         model: the robot and its knee.
         speed: walking speed V [m/s]; the step length is V T.
-        criterion: ``"sthenic"`` (eq. 30) or ``"energy"`` (eq. 31).
+        criterion: ``"sthenic"`` (eq. 30), ``"energy"`` (eq. 31) or ``"energy-per-metre"``
+            (eq. 31 divided by the step length).
         safety: margins of ours beyond the paper's constraints (``Safety()``: the paper's).
         samples_per_half: samples per spline piece where the solvers impose the constraints.
     """

@@ -4,7 +4,8 @@
                              hip height at the start >= ``MIN_HIP_HEIGHT``,
                              bounds on z (``biped.optimization.problem.bounds``)
 
-C is the sthenic criterion (30) or the energy criterion (31) without penalty. The energy
+C is the sthenic criterion (30), the energy criterion (31) or the energy per metre (31) / S,
+without penalty. The energy
 criterion's |Γ_i θ̇_i| is written exactly with slack variables s_ij (no smoothing):
 
     ∫ Σ_i |Γ_i θ̇_i| dt  =  min T Σ_j w_j Σ_i s_ij   s.t.  s_ij >= Γ_i θ̇_i,  s_ij >= −Γ_i θ̇_i
@@ -186,7 +187,9 @@ class Solver:
         slack = ca.SX.sym("s", power.shape[0])
         self.slacks = power.shape[0]
         weights = ca.vec(ca.repmat(graph.weights, graph.on_symbols["power"].shape[0], 1))
-        objective = period * ca.dot(weights, slack)
+        objective = period * ca.dot(weights, slack)  # C_E, per step
+        if criterion == "energy-per-metre":  # C_E / S = T Σ w s / (V T)
+            objective = ca.dot(weights, slack) / graph.speed
         constraints = ca.vertcat(constraints, slack - power, slack + power)
         return ca.vertcat(y, slack), objective, constraints
 
