@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CRITERIA, PAPER_SAFETY, Safety
+from biped.model.criteria import ALL_CRITERIA, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
 from biped.model.gait import (
     N_PARAMETERS,
@@ -144,8 +144,8 @@ def check_speed(model: Biped, speed: float) -> float:
 
 
 def check_criterion(criterion: str) -> str:
-    if criterion not in CRITERIA:
-        allowed = ", ".join(map(repr, CRITERIA))
+    if criterion not in ALL_CRITERIA:
+        allowed = ", ".join(map(repr, ALL_CRITERIA))
         raise BipedError(f"criterion = {criterion!r}: allowed {allowed}")
     return criterion
 

@@ -123,7 +123,9 @@ class Gait:
     step_length: float = unit_field("m")
     safety: Safety = unit_field(Safety)
     feasible: bool = unit_field(None)
-    costs: dict = unit_field({**CRITERION_UNITS, "energy_per_metre": "J/m"})
+    costs: dict = unit_field(
+        {**{c: CRITERION_UNITS[c] for c in CRITERIA}, "energy_per_metre": "J/m"}
+    )
     robot: Robot = unit_field({f.name: robot_unit(f.name) for f in dataclasses.fields(Robot)})
     parameters: dict = unit_field({name: parameter_unit(name) for name in PARAMETERS})
     constraints: dict = unit_field(CONSTRAINT_UNITS)
