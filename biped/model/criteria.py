@@ -40,9 +40,9 @@ CONSTRAINTS = (
     "swing_heel",
     "swing_toe",
 )
-# The paper's criteria (its comparison, a sweep's by default), and all, with ours: the energy per metre
-# walked, C_E / S, which ranks gaits of different step lengths (at a given speed C_E per step
-# rewards short fast steps).
+# The paper's criteria (its comparison, a sweep's by default), and all, with ours: the energy
+# per metre walked, C_E / S, which ranks gaits of different step lengths (at a given speed C_E
+# per step rewards short fast steps).
 CRITERIA = ("sthenic", "energy")
 ALL_CRITERIA = (*CRITERIA, "energy-per-metre")
 # The criteria counting the joints' work |Γ_i θ̇_i| (exact through slack variables).
