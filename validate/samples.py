@@ -2,8 +2,8 @@
 
 What MuJoCo plays is the file, not the parameters it came from: the torques Γ(t), the motion
 q(t) and the start state are read from ``samples`` (``biped.records.gait_file``), interpolated
-on each spline piece separately (the accelerations and torques jump at the knot t = T/2,
-where the file holds both limits):
+on each spline piece separately (the accelerations and torques jump at the knots, t = T/2 for
+the paper's spline, where the file holds both limits):
 
     q(t), q̇(t)     cubic Hermite through (q, q̇), resp. (q̇, q̈), at the samples: the file holds
                   the derivatives, so the interpolation is exact to O(h⁴) between samples
@@ -55,12 +55,16 @@ class GaitSamples:
         arrays["zmp"] = arrays["zmp"].reshape(-1, 1)
         return cls(period=float(gait.period), step_length=float(gait.step_length), **arrays)
 
-    def pieces(self) -> tuple[slice, slice]:
-        """Rows of the left piece [0, T/2] and of the right piece [T/2, T]."""
-        knot = np.flatnonzero(np.isclose(self.t, 0.5 * self.period, rtol=0.0, atol=1e-12))
-        if len(knot) == 0:
-            raise BipedError("samples.t has no sample at T/2: allowed the knot at T/2 twice")
-        return slice(0, knot[0] + 1), slice(knot[-1], None)
+    def pieces(self) -> list[tuple[slice, float, float]]:
+        """(rows, start [s], end [s]) of each spline piece: the samples between two knots,
+        where the file holds a time twice (the left and right limits at the knot; the
+        paper's spline has one, at T/2)."""
+        knots = np.flatnonzero(np.diff(self.t) == 0.0)
+        if len(knots) == 0:
+            raise BipedError("samples.t has no knot: allowed each knot's time twice (T/2 once)")
+        firsts = [0, *(k + 1 for k in knots)]
+        lasts = [*(k + 1 for k in knots), len(self.t)]
+        return [(slice(a, b), self.t[a], self.t[b - 1]) for a, b in zip(firsts, lasts, strict=True)]
 
     def at(self, name: str, t) -> np.ndarray:
         """One field (``FIELDS``) at times ``t`` (M,): (M, width)."""
@@ -69,9 +73,10 @@ class GaitSamples:
         t = np.where(outside, np.mod(t, self.period), t)
         values = getattr(self, name)
         out = np.empty((len(t), values.shape[1]))
-        left, right = self.pieces()
-        on_left = t < 0.5 * self.period
-        for rows, mask in ((left, on_left), (right, ~on_left)):
+        pieces = self.pieces()
+        ends = [begin for _, begin, _ in pieces[1:]] + [np.inf]
+        for (rows, begin, _), end in zip(pieces, ends, strict=True):
+            mask = (t >= begin) & (t < end)
             if not mask.any():
                 continue
             times = self.t[rows]
