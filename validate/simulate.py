@@ -519,9 +519,7 @@ class PhaseController:
     (``PhaseTable.interpolants``) gathered into one buffer, scaled through its named views
     and written into the log in the actuators' order."""
 
-    def __init__(
-        self, table: PhaseTable, layout: Layout, chunk: int, dt: float, speed_gain: float
-    ):
+    def __init__(self, table: PhaseTable, layout: Layout, chunk: int, dt: float, speed_gain: float):
         self.interpolants, self.layout, self.speed_gain = table.interpolants, layout, speed_gain
         self.x0, self.x_end, self.last = table.advance[0], table.advance[-1], len(table.tau) - 1
         self.per_metre = self.last / (self.x_end - self.x0)  # table rows per metre of advance

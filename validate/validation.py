@@ -1,10 +1,11 @@
 """The validation of a gait file: every check against MuJoCo on one model, and its report.
 
 ``validate`` runs the checks of ``validate.checks`` (the walk's contact read by
-``validate.contact``) and the orbit check of ``validate.orbit``, and returns them, with the gait and what the recording and the video
-draw, as one ``Validation`` (``validate.record.record`` and ``validate.video.write_video``
-take it whole); ``as_json`` gives the report: one object per check with its ``passed`` and
-``notes`` (``Check.line`` prints one line per check).
+``validate.contact``) and the orbit check of ``validate.orbit``, and returns them, with the
+gait and what the recording and the video draw, as one ``Validation``
+(``validate.record.record`` and ``validate.video.write_video`` take it whole); ``as_json``
+gives the report: one object per check with its ``passed`` and ``notes`` (``Check.line``
+prints one line per check).
 """
 
 from __future__ import annotations
