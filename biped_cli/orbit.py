@@ -129,11 +129,15 @@ def orbit_line(knob: str | None, orbit: dict) -> str:
 
 def boundary_lines(content: dict) -> list[str]:
     """Where the orbit stops being stable over the knob's values."""
-    knob, out = content["knob"], []
+    knob, out = content["knob"], []  # a knob given (--vary)
     for boundary in content["boundaries"]:
         (a, b), (left, right) = boundary["between"], boundary["verdicts"]
         at = boundary["radius_crosses_1_at"]
         crossing = "" if at is None else f"; ρ crosses 1 at {knob} x {at:.3g}"
+        if "spectral_radius" not in content["orbits"][content["values"].index(a)]:
+            crossing = f"; the walk falls at {knob} x {a:g}"
+        elif "spectral_radius" not in content["orbits"][content["values"].index(b)]:
+            crossing = f"; the walk falls at {knob} x {b:g}"
         out.append(f"  boundary: {left} at {knob} x {a:g}, {right} at {knob} x {b:g}{crossing}")
     if not content["boundaries"]:
         verdicts = sorted({o["verdict"] for o in content["orbits"]})

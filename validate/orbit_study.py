@@ -5,8 +5,7 @@ the servos' stiffness ``KP``, ``kv`` their damping ``KV``, ``speed`` the speed l
 ``SPEED_GAIN`` (0: the speed loop off). At each value the orbit is found and its multipliers
 computed (``validate.orbit.orbit``); a walk that falls has no orbit and counts as unstable.
 The boundaries are where the verdict changes between two neighbouring values, and where ρ
-crosses 1 between them (linear between the two radii; at the value that walks when the
-other falls).
+crosses 1 between them (linear between the two radii; none where a walk falls).
 
 The orbits of a gait (or of several, one task each) are independent: they run on ``jobs``
 processes (``biped.runtime.runner.run_tasks``); each is deterministic, so the content is the
@@ -85,8 +84,8 @@ def boundaries(values, orbits: list[dict]) -> list[dict]:
         if np.isfinite(ra) and np.isfinite(rb):
             crosses = (ra - 1.0) * (rb - 1.0) <= 0.0 and ra != rb
             crossing = a + (1.0 - ra) * (b - a) / (rb - ra) if crosses else None
-        else:  # one walk falls: the boundary is at the one that walks
-            crossing = a if np.isfinite(ra) else b
+        else:  # a walk falls (no orbit): no radius to cross 1
+            crossing = None
         found.append(
             {
                 "between": [float(a), float(b)],
@@ -126,8 +125,8 @@ def content(path: str | Path, gait: Gait, knob: str | None, values, orbits: list
         "knee": gait.knee,
         "criterion": gait.criterion,
         "speed": gait.speed,
-        "knob": knob,
-        "scales": None if knob is None else KNOBS[knob][1],
+        "knob": "none" if knob is None else knob,
+        "scales": "the validation's controller" if knob is None else KNOBS[knob][1],
         "values": [None if v is None else float(v) for v in values],
         "orbits": orbits,
         "boundaries": [] if knob is None else boundaries(values, orbits),
