@@ -18,11 +18,12 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"  # one core, set before numpy loads its BLAS
 
+from timing import median_time  # noqa: E402
+
 import biped  # noqa: E402
 from biped.optimization.optimize import optimize  # noqa: E402
 from biped.optimization.problem import GaitProblem  # noqa: E402
 from biped.records.gait_file import Gait  # noqa: E402
-from timing import median_time  # noqa: E402
 from validate import orbit  # noqa: E402
 from validate.simulate import Walker, WalkSettings, quiet_mujoco  # noqa: E402
 
@@ -36,7 +37,7 @@ def one_jacobian(returns: orbit.ReturnMap, x, basis, steps: orbit.Steps):
 
 
 def main() -> None:
-    print("orbit of the optimal gaits at 0.3 m/s, one core (median of %d runs)" % REPEATS)
+    print(f"orbit of the optimal gaits at 0.3 m/s, one core (median of {REPEATS} runs)")
     for knee in biped.KNEES:
         gait = Gait.from_optimum(
             optimize(GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3)),

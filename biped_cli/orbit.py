@@ -146,14 +146,15 @@ def boundary_lines(content: dict) -> list[str]:
 
 
 def knee_lines(contents: list[dict]) -> list[str]:
-    """The knees side by side at each criterion and speed both were given at."""
+    """The knees side by side at each criterion and speed both were given at, and per
+    criterion the mean difference over the speeds with its spread."""
     from biped.pages.orbit_figures import SPREADS, rho_difference
 
     rows = {}
     for content in contents:
         rows[content["criterion"], content["speed"], content["knee"]] = content["orbits"][0]
     out = ["knees compared: ρ ± spread; (rolling − revolute) / revolute ± 2 spreads"]
-    differences = []
+    differences: dict = {}
     for criterion, speed in sorted({(c, v) for c, v, _ in rows}):
         pair = [rows.get((criterion, speed, knee)) for knee in ("revolute", "rolling")]
         if None in pair:
@@ -164,16 +165,18 @@ def knee_lines(contents: list[dict]) -> list[str]:
         if "spectral_radius" in revolute and "spectral_radius" in rolling:
             difference, spread = rho_difference(rolling, revolute)
             distinct = abs(difference) > SPREADS * spread
-            differences.append(difference)
+            differences.setdefault(criterion, []).append((difference, spread, distinct))
             line += (
                 f": {difference:+.0f} ± {SPREADS * spread:.0f} % "
                 f"({'distinct' if distinct else 'not distinguishable'})"
             )
         out.append(line)
-    if differences:
+    for criterion, found in differences.items():
+        values, spreads, distinct = (np.array(column) for column in zip(*found, strict=True))
+        mean_spread = float(np.sqrt(np.sum(spreads**2))) / len(values)
         out.append(
-            f"  mean difference over {len(differences)} pairs: {np.mean(differences):+.1f} % "
-            f"(from {min(differences):+.0f} to {max(differences):+.0f} %)"
+            f"  {criterion}: mean difference over {len(values)} speeds {values.mean():+.1f} ± "
+            f"{SPREADS * mean_spread:.1f} %, {int(distinct.sum())} of {len(values)} distinct"
         )
     return out
 

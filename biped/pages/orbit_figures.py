@@ -115,9 +115,9 @@ def knob_figure(content: dict, title: str) -> Figure:
 def speeds_figure(rows: list[dict], title: str) -> Figure:
     """ρ of each knee against speed, one panel per criterion, and rolling - revolute below;
     ``rows``: one per gait, its ``knee``, ``criterion``, ``speed`` and orbit figures."""
-    criteria = sorted({row["criterion"] for row in rows})
+    criteria = sorted({row["criterion"] for row in rows}, key=lambda c: c != "sthenic")
     figure = Figure(figsize=(5.2 * len(criteria), 6.4), layout="constrained")
-    axes = figure.subplots(2, len(criteria), squeeze=False, height_ratios=(2.0, 1.0))
+    axes = figure.subplots(2, len(criteria), squeeze=False, height_ratios=(2.0, 1.0), sharex="col")
     for column, criterion in enumerate(criteria):
         top, bottom = axes[0, column], axes[1, column]
         by_knee = {}
