@@ -20,6 +20,8 @@ DPI = 120
 # How many spreads of ρ the uncertainty bands span (the orbit check's margin).
 SPREADS = 2.0
 FALLS = dict(linestyle="none", marker="x", markersize=9, markeredgewidth=2)
+# Where the speeds figure marks each knee's walks that fall (ρ axis).
+FALL_ROWS = {"revolute": 1.52, "rolling": 1.42}
 VERDICT_COLOURS = {
     "stable": "#2a9d8f",
     "undecided": "#e9c46a",
@@ -137,8 +139,9 @@ def speeds_figure(rows: list[dict], title: str) -> Figure:
                 **style,
             )
             fell = [r["speed"] for r in chosen if "spectral_radius" not in r]
-            if fell:
-                top.plot(fell, [1.55] * len(fell), color=style["color"], clip_on=False, **FALLS)
+            if fell:  # at the top, one row per knee
+                row = FALL_ROWS[knee]
+                top.plot(fell, [row] * len(fell), color=style["color"], clip_on=False, **FALLS)
         top.axhline(1.0, color="k", linewidth=1.2)
         top.plot([], [], color="0.4", label="falls: no orbit", **FALLS)
         top.set_ylim(0.0, 1.6)
