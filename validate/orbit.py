@@ -193,10 +193,6 @@ class ReturnMap:
         sim = self.walk(np.asarray(x, float) - phase * self.dt * self.flow)
         return self.sections(sim, [1])[0]
 
-    def mean(self, x, phases: int = PHASES) -> np.ndarray:
-        """F̄(x) (12,): F averaged over ``phases`` positions of the physics-step grid."""
-        return np.mean(self.at_phases(x, phases), axis=0)
-
     def at_phases(self, x, phases: int) -> np.ndarray:
         """(phases, 12): F(x) at each position (j + 1/2) / phases of the grid."""
         return np.array([self(x, (j + 0.5) / phases) for j in range(phases)])
