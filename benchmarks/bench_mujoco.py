@@ -1,7 +1,7 @@
 """MuJoCo beside the analytical model: inverse dynamics per sample, the forward walk's speed
 (simulated seconds per wall second) on the committed models and on the previous model
 settings in the same process, with MuJoCo's part of it (its rollout calls, per physics step)
-and the controller's (the rest), and the time of a whole validation.
+and the controller's (the rest), and the time of a whole validation and of its orbit check.
 
     python benchmarks/bench_mujoco.py
 
@@ -24,12 +24,13 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 from bench_dynamics import random_states  # noqa: E402
 from mujoco import rollout  # noqa: E402
+from timing import median_time  # noqa: E402
 
 import biped  # noqa: E402
 from biped.optimization.optimize import optimize  # noqa: E402
 from biped.optimization.problem import GaitProblem  # noqa: E402
 from biped.records.gait_file import Gait  # noqa: E402
-from validate import mjcf, simulate  # noqa: E402
+from validate import mjcf, orbit, simulate  # noqa: E402
 from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
 from validate.model import model_spec  # noqa: E402
 from validate.simulate import Walker  # noqa: E402
@@ -148,13 +149,19 @@ def main():
             "the walk's speed"
         )
     print("target: 200 x real time for the committed walk on one core")
-    print("\nvalidation (every check: replay of both stances, walks at kp x 0.5, 1, 2)")
+    print(
+        "\nvalidation (every check: replay of both stances, walks at kp x 0.5, 1, 2, the orbit's "
+        "walks), and the orbit check alone"
+    )
     for knee, gait in gaits.items():
         began = time.perf_counter()
         result = validate(gait, steps=STEPS)
         wall = time.perf_counter() - began
         verdict = "PASS" if result.passed else "FAIL"
-        print(f"{knee:10}{wall:8.2f} s  {verdict}")
+        walker = Walker(gait)
+        with simulate.quiet_mujoco():
+            orbit_wall, _ = median_time(orbit.orbit, walker, repeats=1)
+        print(f"{knee:10}{wall:8.2f} s  {verdict}; the orbit {orbit_wall:.2f} s of it")
 
 
 if __name__ == "__main__":

@@ -365,7 +365,9 @@ def cmd_validate(args) -> int:
     dynamics; each step replayed with the file's torques (the share of every joint's torque
     its servo had to add); a forward walk with contact over --steps steps (every step lands
     and advances, no fall, no slip, the stance foot flat, no scuff of the swing foot); the
-    same walk at half and twice the servo stiffness. Prints a table per gait (or JSON with
+    same walk at half and twice the servo stiffness; the walk's orbit stable (the spectral
+    radius of its return map from step to step, plus two of its spreads, below 1: biped
+    orbit, validate/orbit.py). Prints a table per gait (or JSON with
     --json) and writes a rerun recording per gait (--spawn, --connect: also to a viewer) and,
     with --video, the video of the walk; exits 0 only when every check of every gait passes,
     1 otherwise. A gait file whose samples, costs, constraints or feasibility are not those

@@ -55,13 +55,14 @@ def _stand_in(*args, **kwargs):
 
 @pytest.fixture
 def no_work(monkeypatch):
-    """The optimiser, the sweep, the design map, the figures, the MuJoCo validation and the
-    robustness map stop the command."""
+    """The optimiser, the sweep, the design map, the figures, the MuJoCo validation, the
+    robustness map and the orbit study stop the command."""
     import biped.optimization.design
     import biped.optimization.optimize
     import biped.pages.figures
     import biped.studies.design_map
     import biped.studies.sweep
+    import validate.orbit_study
     import validate.robustness
     import validate.validation
 
@@ -73,6 +74,7 @@ def no_work(monkeypatch):
         (biped.pages.figures, "make_figures"),
         (validate.validation, "validate"),
         (validate.robustness, "robustness_map"),
+        (validate.orbit_study, "study"),
     ]:
         monkeypatch.setattr(module, name, _stand_in)
 

@@ -177,6 +177,7 @@ def test_figures_refuse_an_edited_sweep_file(content, tmp_path, capsys):
 GAIT_READERS = {
     "validate": lambda gait, tmp: ["validate", gait, "--rrd", f"{tmp}/walk.rrd", "--steps", "1"],
     "robustness": lambda gait, tmp: ["robustness", gait, "--out", f"{tmp}/out"],
+    "orbit": lambda gait, tmp: ["orbit", gait, "--out", f"{tmp}/out"],
     "report": lambda gait, tmp: ["report", gait, "--out", f"{tmp}/out"],
     "figures": lambda sweep, tmp: ["figures", "--sweep", sweep, "--out", f"{tmp}/out"],
     "validate.video": lambda gait, tmp: [gait, "--out", f"{tmp}/walk.mp4", "--steps", "1"],

@@ -40,6 +40,16 @@ def written(tmp_path_factory):
             "passed": False,
             "notes": ["the swing foot scuffed the floor", "kp × 2: decided by scuffing"],
         },
+        "orbit": {
+            "verdict": "stable",
+            "spectral_radius": 0.7,
+            "spectral_radius_spread": 0.1,
+            "multipliers_real": [-0.7, 0.2, 0.1],
+            "multipliers_imag": [0.0, 0.1, -0.1],
+            "flow_multiplier": 0.05,
+            "passed": True,
+            "notes": ["slowest multiplier -0.700 (a flip: errors alternate from step to step)"],
+        },
         "passed": False,
         "units": {"forward.steps": "1", "forward.max_slip": "m"},
         "recording": str(recording),
@@ -103,6 +113,18 @@ def test_page_figures_are_drawn_and_labelled(written):
     texts = {t.get_text() for t in figure.findobj(Text)}
     assert set(CONSTRAINT_MEANING.values()) <= texts
     assert sum(t.startswith("smallest ") for t in texts) == len(CONSTRAINTS)
+
+
+def test_page_draws_the_orbit_checks_multipliers(written):
+    """A report with an orbit check: its multipliers listed and drawn in the complex plane
+    (the page's orbit.png, with ink)."""
+    from PIL import Image
+
+    _, out, text = written
+    assert "### orbit: PASS" in text and "| multipliers_real | -0.7, 0.2, 0.1 |" in text
+    assert f"(pipeline-{NAME}/orbit.png)" in text
+    pixels = np.asarray(Image.open(out / f"pipeline-{NAME}" / "orbit.png").convert("RGB"))
+    assert pixels.std() > 20
 
 
 def test_page_links_no_recording_of_another_gait(written, tmp_path):

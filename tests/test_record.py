@@ -256,3 +256,20 @@ def test_time_plots_open_on_the_last_steps_legends_clear_of_the_curves(recorded)
     assert "torque_key" in views
     for series in ("the gait", "feedforward", "MuJoCo (ff + fb)", "feedback", "landings"):
         assert series in key, series
+
+
+def test_recording_draws_the_orbit_checks_multipliers(recorded):
+    """The orbit check's multipliers in the complex plane beside the unit circle: at
+    (Re μ, -Im μ) (rerun's 2D y points down), or a point saying there is no orbit."""
+    result, chunks, _ = recorded
+    orbit = next(check.figures for check in result.checks if check.name == "orbit")
+    paths = {chunk.entity_path for chunk in chunks}
+    assert {"/orbit/unit_circle", "/orbit/axes", "/orbit/multipliers"} <= paths
+    points, _ = column(chunks, "/orbit/multipliers", "Points2D:positions")
+    if "spectral_radius" in orbit:
+        expected = np.column_stack(
+            [orbit["multipliers_real"], -np.array(orbit["multipliers_imag"])]
+        )
+        assert np.allclose(np.array(points[0]), expected, atol=1e-6)
+    else:
+        assert np.allclose(np.array(points[0]), [[0.0, 0.0]])

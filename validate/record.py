@@ -22,14 +22,18 @@ Entity paths, on the timeline ``time`` (seconds of simulation):
                                           stance ankle [m]
     phase                                 the gait's time the controller follows, over T
     summary                               the gait's parameters, criteria and every check
+    orbit/{unit_circle,radius,band,axes}  the complex plane of the orbit check's multipliers:
+    orbit/multipliers                     the unit circle, ρ and ρ ± 2 spreads, the
+                                          multipliers μ (y up: Im μ; ``validate.orbit``)
     torque_key                            the torque plots' series in words (their legend)
 
 ``blueprint()`` lays them out: the 3D view following the robot, one plot per joint with its
 y range fixed to the bulk of the gait's torques (the landings' spikes run off it rather than
 flatten it), Fx and Fz in plots of their own (ranged the same way), the ZMP, the phase and
-the summary. The time plots open on the last ``SHOWN_STEPS`` steps (zoom out for the whole
-walk); every series of a plot has a colour of its own, and where two run together the gait's
-(widest) shows around MuJoCo's feedforward and MuJoCo's torque (narrowest) drawn over them.
+the summary, and the multipliers in the complex plane. The time plots open on the last
+``SHOWN_STEPS`` steps (zoom out for the whole walk); every series of a plot has a colour of
+its own, and where two run together the gait's (widest) shows around MuJoCo's feedforward
+and MuJoCo's torque (narrowest) drawn over them.
 A legend in a plot has room of its own above the curves; the torques' legend would be taller
 than their plots and is a key in words beside them (``torque_key``).
 """
@@ -72,6 +76,11 @@ FEEDFORWARD_WIDTH = 3.0
 MUJOCO_WIDTH = 1.5
 FEEDBACK_WIDTH = 1.5
 EDGE_WIDTH = 1.0
+# Range of the multipliers' view, both axes, and its colours (RGB): axes, unit circle, ρ,
+# ρ ± 2 spreads, the multipliers (light on the viewer's dark background).
+ORBIT_BOUNDS = (-1.25, 1.25)
+ORBIT_AXES, ORBIT_UNIT, ORBIT_RADIUS = (120, 120, 120), (235, 235, 235), (244, 162, 97)
+ORBIT_BAND, ORBIT_POINTS = (42, 157, 143), (233, 196, 106)
 # The time plots open on the last SHOWN_STEPS steps of the walk.
 SHOWN_STEPS = 2
 # Room above the curves of a plot with a legend (ground reaction, ZMP), a fraction of their
@@ -180,9 +189,16 @@ def blueprint(ranges: dict | None = None, window: tuple | None = None) -> rrb.Bl
                 rrb.Horizontal(
                     key,
                     rrb.TextDocumentView(origin="summary", name="gait and checks"),
-                    column_shares=[1, 1],
+                    rrb.Spatial2DView(
+                        origin="orbit",
+                        name="Floquet multipliers μ (Re, Im) [1]",
+                        visual_bounds=rrb.VisualBounds2D(
+                            x_range=ORBIT_BOUNDS, y_range=ORBIT_BOUNDS
+                        ),
+                    ),
+                    column_shares=[1, 1, 1.4],
                 ),
-                row_shares=[3, 1],
+                row_shares=[2.4, 1],
             ),
             column_shares=[3, 2],
         ),
@@ -323,10 +339,12 @@ def summary(biped: Biped, step: GaitSamples, sim: Simulation, checks, gait: Gait
 def _value(value) -> str:
     if isinstance(value, bool):
         return "yes" if value else "no"
-    if isinstance(value, (list, tuple)):
-        return " - ".join(f"{v:.4g}" for v in value)
+    if isinstance(value, (list, tuple)):  # a [low, high] range, or a list of figures
+        return (" - " if len(value) == 2 else ", ").join(_value(v) for v in value)
     if isinstance(value, (float, np.floating)):
         return "n/a" if np.isnan(value) else f"{value:.4g}"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
     return str(value)
 
 
@@ -367,6 +385,9 @@ def record(path: str | Path, validation, spawn: bool = False, connect: str | Non
         rec.log("summary", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
         key = rr.TextDocument(TORQUE_KEY, media_type=rr.MediaType.MARKDOWN)
         rec.log("torque_key", key, static=True)
+        orbit = next((check.figures for check in checks if check.name == "orbit"), None)
+        if orbit is not None:
+            _log_orbit(rec, orbit)
 
     with atomic_path(path) as tmp:
         rec = rr.RecordingStream(APPLICATION, recording_id=recording_id)
@@ -399,6 +420,43 @@ def record(path: str | Path, validation, spawn: bool = False, connect: str | Non
             live.disconnect()
             del live
     return path
+
+
+def _circle(radius: float, points: int = 181) -> np.ndarray:
+    angle = np.linspace(0.0, 2.0 * np.pi, points)
+    return radius * np.column_stack([np.cos(angle), np.sin(angle)])
+
+
+def _log_orbit(rec, orbit: dict) -> None:
+    """The orbit check's multipliers in the complex plane (rerun's 2D y points down: drawn
+    at (Re μ, -Im μ)), the unit circle, ρ and ρ ± 2 spreads, the axes."""
+
+    def strips(path, lines, colour, width, label=None):
+        labels = None if label is None else [label]
+        strip = rr.LineStrips2D(lines, colors=[colour], radii=width, labels=labels)
+        rec.log(f"orbit/{path}", strip, static=True)
+
+    strips("axes", [[(-1.2, 0.0), (1.2, 0.0)], [(0.0, -1.2), (0.0, 1.2)]], ORBIT_AXES, 0.004)
+    strips("unit_circle", [_circle(1.0)], ORBIT_UNIT, 0.008)
+    if "spectral_radius" not in orbit:
+        label = f"no orbit: {orbit.get('verdict', '')}"
+        rec.log("orbit/multipliers", rr.Points2D([(0.0, 0.0)], labels=[label]), static=True)
+        return
+    rho, spread = orbit["spectral_radius"], orbit["spectral_radius_spread"]
+    strips("radius", [_circle(rho)], ORBIT_RADIUS, 0.006)
+    strips(
+        "band",
+        [_circle(max(rho - 2.0 * spread, 0.0)), _circle(rho + 2.0 * spread)],
+        ORBIT_BAND,
+        0.003,
+    )
+    real, imag = np.array(orbit["multipliers_real"]), np.array(orbit["multipliers_imag"])
+    slowest = f"{real[0]:.3f}" + (f"{imag[0]:+.3f}i" if abs(imag[0]) > 1e-9 else "")
+    labels = [f"μ {slowest}, ρ {rho:.3f} ± {spread:.3f}"] + [""] * (len(real) - 1)
+    points = rr.Points2D(
+        np.column_stack([real, -imag]), radii=0.045, colors=[ORBIT_POINTS], labels=labels
+    )
+    rec.log("orbit/multipliers", points, static=True)
 
 
 def _log_torques(rec, biped: Biped, sim: Simulation, torques, ranges: dict, steady) -> None:

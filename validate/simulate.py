@@ -30,7 +30,8 @@ robot. It carries the file's Γ1 and the ankle strategy of a walker, a torque on
 and slows down). The gait's orbit is not stable on its own: played with the phase alone, the
 optimal gaits lose speed step after step in MuJoCo (1.3 T a step after 10 steps) and their
 swing foot, clearing the ground by a millimetre, ends up scuffing it. The five other joints
-track their reference with ``KP``, ``KV`` (times ``WalkSettings.kp_scale``, ``kv_scale``).
+track their reference with ``KP``, ``KV`` (times ``WalkSettings.kp_scale``, ``kv_scale``; K
+times ``WalkSettings.speed_scale``).
 
 A step ends when the swing foot, after leaving the ground, touches it in the landing window
 (the last ``1 - LANDING_WINDOW`` of the step, by phase); the legs then swap roles. A foot
@@ -41,7 +42,11 @@ foot has not landed after ``STEP_TIMEOUT`` periods, or the hip has dropped below
 of its height, the walk ends.
 
 ``Walker`` prepares a gait on a model once; ``Walker.walk`` runs it under ``WalkSettings``
-(gains, friction, a push): the robustness of a gait is many walks of one walker.
+(gains, friction, a push): the robustness of a gait is many walks of one walker. A walk starts
+from the file's start state, or from another state of the left leg in stance (``start``), and
+may end its last step when the hip has advanced by a given distance over the stance ankle
+(``stop_advance``): the return map of ``validate.orbit`` is walks from one section of the
+orbit to the next.
 """
 
 from __future__ import annotations
@@ -126,6 +131,8 @@ class WalkSettings:
     Attributes:
         kp_scale: the servos' stiffness is ``KP`` times this.
         kv_scale: the servos' damping is ``KV`` times this.
+        speed_scale: the stance ankle's gain on the hip's speed is ``SPEED_GAIN`` times this
+            (0: the speed loop off).
         friction: sliding friction coefficient of the soles and the floor (None: the
             model's, ``biped.model.robot.FOOT_FRICTION``).
         push: a shove on the trunk (None: none).
@@ -133,6 +140,7 @@ class WalkSettings:
 
     kp_scale: float = 1.0
     kv_scale: float = 1.0
+    speed_scale: float = 1.0
     friction: float | None = None
     push: Push | None = None
 
@@ -143,6 +151,11 @@ class WalkSettings:
     @property
     def kv(self) -> float:
         return KV * self.kv_scale
+
+    @property
+    def speed_gain(self) -> float:
+        """[N·s] the stance ankle's torque per m/s of the hip's excess speed."""
+        return SPEED_GAIN * self.speed_scale
 
 
 def joint_matrix(model: mujoco.MjModel) -> np.ndarray:
@@ -367,10 +380,22 @@ class Walker:
         return self.samples.period
 
     def walk(
-        self, steps: int = DEFAULT_STEPS, settings: WalkSettings = WalkSettings()
+        self,
+        steps: int = DEFAULT_STEPS,
+        settings: WalkSettings = WalkSettings(),
+        start: tuple[np.ndarray, np.ndarray] | None = None,
+        stop_advance: float | None = None,
     ) -> Simulation:
-        """Play ``steps`` steps of the gait from its start state, left leg in stance first."""
-        return _walk(self, steps, settings)
+        """Play ``steps`` steps of the gait, left leg in stance first.
+
+        Args:
+            start: (q, q̇) (9,) each, the paper's coordinates of the left leg in stance, its
+                ankle at x = 0 (None: the file's start state).
+            stop_advance: [m] the last step ends at the end of the reading period in which
+                the hip's advance over the stance ankle passes this (None: at its landing);
+                that step is not ``landed``.
+        """
+        return _walk(self, steps, settings, start, stop_advance)
 
 
 def simulate(
@@ -408,7 +433,7 @@ def quiet_mujoco() -> Iterator[None]:
                 mujoco.set_mju_user_warning(_QUIET[1])
 
 
-def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
+def _walk(walker: Walker, steps: int, settings: WalkSettings, start, stop_advance) -> Simulation:
     model = copy.deepcopy(walker.model)  # gains and friction change in it
     if settings.friction is not None:
         collides = (model.geom_contype != 0) | (model.geom_conaffinity != 0)
@@ -422,7 +447,7 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings) -> Simulation:
     mujoco.mj_resetData(model, data)
     try:
         with quiet_mujoco():  # counted in the result
-            return _walk_on(walker, steps, settings, model, data)
+            return _walk_on(walker, steps, settings, model, data, start, stop_advance)
     finally:
         spare.append(data)
 
@@ -494,8 +519,8 @@ class PhaseController:
     (``PhaseTable.interpolants``) gathered into one buffer, scaled through its named views
     and written into the log in the actuators' order."""
 
-    def __init__(self, table: PhaseTable, layout: Layout, chunk: int, dt: float):
-        self.interpolants, self.layout = table.interpolants, layout
+    def __init__(self, table: PhaseTable, layout: Layout, chunk: int, dt: float, speed_gain: float):
+        self.interpolants, self.layout, self.speed_gain = table.interpolants, layout, speed_gain
         self.x0, self.x_end, self.last = table.advance[0], table.advance[-1], len(table.tau) - 1
         self.per_metre = self.last / (self.x_end - self.x0)  # table rows per metre of advance
         self.speeds = table.speed.tolist()
@@ -544,11 +569,15 @@ class PhaseController:
         self.torques += np.multiply(self.rotors, rate * rate, out=self.rotor_torques)
         # The ankle strategy: the stance ankle's torque grows with the hip's excess speed
         # (its centre of pressure moves forward and slows the robot down).
-        speed_torque = log.speed_torque[period] = SPEED_GAIN * (hip_speed - planned)
+        speed_torque = log.speed_torque[period] = self.speed_gain * (hip_speed - planned)
         self.ankle_torque -= speed_torque / self.ankle_gear
         block = log.ctrl[period]
         block[:, self.columns] = self.commands
         return block
+
+    def advance(self, log: WalkLog, k: int) -> float:
+        """[m] the hip's advance over the stance ankle at row k (the phase's reading)."""
+        return log.state.item(k, self.hip_x_at) - log.sensors.item(k, self.ankle_at)
 
     def _gather(self, where: np.ndarray) -> tuple[int, float]:
         """The table between its points at ``where`` (table rows, clipped to the table) into
@@ -641,21 +670,22 @@ class Shove:
             self.remaining = 0.0 if n == self.chunk else self.remaining - self.force * n * self.dt
 
 
-def _walk_on(walker, steps, settings, model, data) -> Simulation:
+def _walk_on(walker, steps, settings, model, data, start=None, stop_advance=None) -> Simulation:
     layout, samples, period = walker.layout.of(model), walker.samples, walker.period
-    q0, qd0 = samples.start()
-    start = mapping(model, "left", walker.biped.radii)
-    data.qpos[:], data.qvel[:] = start.qpos(q0), start.qpos(qd0)
+    q0, qd0 = samples.start() if start is None else start
+    left = mapping(model, "left", walker.biped.radii)
+    data.qpos[:], data.qvel[:] = left.qpos(q0), left.qpos(qd0)
     mujoco.mj_forward(model, data)
     dt = model.opt.timestep
     chunk = max(1, round(RESYNC / dt))  # physics steps per reading period
     log = WalkLog(model, data, int(np.ceil(steps * STEP_TIMEOUT * period / dt)) + chunk)
-    controller = PhaseController(walker.table, layout, chunk, dt)
-    floor = FALLEN * min(q0[ZH], samples.end()[0][ZH])
+    controller = PhaseController(walker.table, layout, chunk, dt, settings.speed_gain)
+    floor = FALLEN * min(samples.start()[0][ZH], samples.end()[0][ZH])
     events = StepEvents(layout, controller.last, floor, STEP_TIMEOUT * period, len(log.where))
     shove = Shove(settings.push, model, layout, chunk, dt)
     with rollout.Rollout(nthread=0) as runner:
-        for stance in (SIDES * steps)[:steps]:
+        for j, stance in enumerate((SIDES * steps)[:steps]):
+            stop = None if stop_advance is None or j < steps - 1 else stop_advance
             set_gains(model, layout, stance, settings.kp, settings.kv)
             log.step_starts.append(log.rows)
             log.stances.append(stance)
@@ -668,6 +698,9 @@ def _walk_on(walker, steps, settings, model, data) -> Simulation:
                 n = events.after_step(log, k, chunk)
                 shove.after_step(n)
                 log.rows += n
+                if stop is not None and controller.advance(log, log.rows - 1) > stop:
+                    events.landed = False
+                    break
             log.landed.append(events.landed)
             if not events.landed:
                 break

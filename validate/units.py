@@ -57,6 +57,50 @@ class WalkFigures:
         return {name: value for name, value in values.items() if value is not None}
 
 
+# Units of the section's coordinates (``validate.orbit.COORDINATES``): six angles, six rates.
+SECTION_UNITS = ["rad"] * 6 + ["rad/s"] * 6
+
+
+@dataclass(frozen=True)
+class OrbitFigures:
+    """The figures of the orbit check (``validate.orbit``), each with its unit, in the
+    report's order; without an orbit (a walk fell) only the settings and ``verdict``."""
+
+    verdict: str = unit_field(None)
+    spectral_radius: float | None = unit_field(PURE, default=None)
+    spectral_radius_spread: float | None = unit_field(PURE, default=None)
+    spectral_radius_upper: float | None = unit_field(PURE, default=None)
+    multipliers_real: list | None = unit_field(PURE, default=None)
+    multipliers_imag: list | None = unit_field(PURE, default=None)
+    multipliers_modulus: list | None = unit_field(PURE, default=None)
+    flow_multiplier: float | None = unit_field(PURE, default=None)
+    coordinates: list | None = unit_field(None, default=None)
+    slowest_mode_real: list | None = unit_field(SECTION_UNITS, default=None)
+    slowest_mode_imag: list | None = unit_field(SECTION_UNITS, default=None)
+    fixed_point: list | None = unit_field(SECTION_UNITS, default=None)
+    file_state: list | None = unit_field(SECTION_UNITS, default=None)
+    fixed_point_angle_distance: float | None = unit_field("rad", default=None)
+    fixed_point_rate_distance: float | None = unit_field("rad/s", default=None)
+    residual_angle: float | None = unit_field("rad", default=None)
+    residual_rate: float | None = unit_field("rad/s", default=None)
+    noise_rate: float | None = unit_field("rad/s", default=None)
+    period_ratio: float | None = unit_field(PURE, default=None)
+    kp: float = unit_field("N·m/rad", default=0.0)
+    kv: float = unit_field("N·m·s/rad", default=0.0)
+    speed_gain: float = unit_field("N·s", default=0.0)
+    step_angle: float = unit_field("rad", default=0.0)
+    step_rate: float = unit_field("rad/s", default=0.0)
+    phases: int = unit_field(PURE, default=0)
+    section_advance: float = unit_field("m", default=0.0)
+    section_phase: float = unit_field(PERIOD, default=0.0)
+    walks: int = unit_field(PURE, default=0)
+
+    def to_dict(self) -> dict:
+        """The figures by name (those not measured left out)."""
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        return {name: value for name, value in values.items() if value is not None}
+
+
 FIGURE_UNITS = {
     "model": {"mass_difference": "kg", "problems": PURE},
     "inverse_dynamics": {
@@ -86,6 +130,7 @@ FIGURE_UNITS = {
         "kp": "N·m/rad",
         "kp_scale_range": PURE,
     },
+    "orbit": declared_units(OrbitFigures),
 }
 
 

@@ -1,10 +1,11 @@
 """The validation of a gait file: every check against MuJoCo on one model, and its report.
 
 ``validate`` runs the checks of ``validate.checks`` (the walk's contact read by
-``validate.contact``) and returns them, with the gait and what the recording and the video
-draw, as one ``Validation`` (``validate.record.record`` and ``validate.video.write_video``
-take it whole); ``as_json`` gives the report: one object per check with its ``passed`` and
-``notes`` (``Check.line`` prints one line per check).
+``validate.contact``) and the orbit check of ``validate.orbit``, and returns them, with the
+gait and what the recording and the video draw, as one ``Validation``
+(``validate.record.record`` and ``validate.video.write_video`` take it whole); ``as_json``
+gives the report: one object per check with its ``passed`` and ``notes`` (``Check.line``
+prints one line per check).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from validate import DEFAULT_STEPS
 from validate import checks as c
 from validate.checks import EXACT, Check
 from validate.model import compile_spec, model_spec
+from validate.orbit import Orbit, check_orbit
 from validate.samples import GaitSamples
 from validate.simulate import Simulation, Walker
 
@@ -37,6 +39,7 @@ class Validation:
     samples: GaitSamples
     simulation: Simulation
     contact: dict  # the walk's ground reaction (``validate.contact.ground_reaction``)
+    orbit: Orbit | None = None  # the walk's orbit and its multipliers (``validate.orbit``)
 
     @property
     def passed(self) -> bool:
@@ -65,7 +68,8 @@ def validate(
     walker = Walker(gait, spec)
     forward, sim, reaction = c.check_forward(walker, steps, energy)
     results += [forward, c.check_gains(walker, steps, energy, forward)]
-    return Validation(gait, results, biped, samples, sim, reaction)
+    orbit, found = check_orbit(walker)
+    return Validation(gait, results + [orbit], biped, samples, sim, reaction, found)
 
 
 def as_json(checks) -> dict:

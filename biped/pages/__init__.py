@@ -1,5 +1,6 @@
 """What a reader looks at: the paper's figures and comparison table from a sweep
-(``figures``) and a Markdown page per gait file (``page``).
+(``figures``), a Markdown page per gait file (``page``) and the figures of a walk's orbit
+drawn from a validation report's JSON (``orbit_figures``).
 
 May import: every other layer of ``biped``, matplotlib.
 """

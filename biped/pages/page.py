@@ -45,6 +45,7 @@ from biped.pages.figures import (
     note,
     time_figure,
 )
+from biped.pages.orbit_figures import multipliers_figure
 from biped.records.gait_file import Gait
 from biped.records.units import CONSTRAINT_UNITS, parameter_unit
 from biped.runtime.files import atomic_set
@@ -65,6 +66,8 @@ COST_NAMES = {
     "energy_per_metre": ("energy per metre walked", "J/m"),
 }
 FIGURE_NAMES = ("torques.png", "angles.png", "ground.png", "constraints.png")
+# The validation's orbit check drawn: its multipliers in the complex plane.
+ORBIT_FIGURE = "orbit.png"
 # A constraint dips below δ_i where Ψ_i < δ_i (1 − DIP_TOLERANCE): IPOPT holds its
 # constraints to about 1e-9 (the gait file's optimizer.constraint_violation), a millionth of δ.
 DIP_TOLERANCE = 1e-6
@@ -456,8 +459,8 @@ def _number(value) -> str:
         return "n/a"
     if isinstance(value, bool):
         return "yes" if value else "no"
-    if isinstance(value, (list, tuple)):
-        return " to ".join(_number(v) for v in value)
+    if isinstance(value, (list, tuple)):  # a range "low to high", or a list of figures
+        return (" to " if len(value) == 2 else ", ").join(_number(v) for v in value)
     if isinstance(value, float):
         return f"{value:.4g}"
     return str(value)
@@ -567,16 +570,29 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
                 lines += [f"| {name} | {_number(value)} | {units.get(f'{check}.{name}', '')} |"]
         lines += [""]
         notes = figures.get("notes") or []
-        if notes:  # sentences, one a line (a list of figures is a range: "low to high")
+        if notes:  # sentences, one a line (a list of two figures is a range: "low to high")
             lines += [f"- {note}" for note in notes] + [""]
+        if check == "orbit":
+            lines += [f"![Floquet multipliers]({page.name}/{ORBIT_FIGURE})", ""]
     return lines
+
+
+def page_figures(page: Page) -> dict[str, Figure]:
+    """The page's figures: the gait's (``gait_figures``) and, with a validation report that
+    has an orbit check, its multipliers (``ORBIT_FIGURE``)."""
+    figures = gait_figures(page.gait)
+    orbit = (page.validation or {}).get("orbit")
+    if isinstance(orbit, dict):
+        title = f"{page.gait.knee} knee, {page.gait.criterion}, {page.gait.speed:.3f} m/s"
+        figures[ORBIT_FIGURE] = multipliers_figure(orbit, title)
+    return figures
 
 
 def write_pages(pages: list[Page], out: str | Path) -> list[Path]:
     """Write each page and its figures into ``out``, all or none; returns every file written
     (each page, then its figures)."""
     out = Path(out)
-    rendered = [(page, gait_figures(page.gait), markdown(page, out)) for page in pages]
+    rendered = [(page, page_figures(page), markdown(page, out)) for page in pages]
     with atomic_set(out, "report") as staging:
         for page, figures, text in rendered:
             (staging / page.name).mkdir()

@@ -1,0 +1,280 @@
+"""``biped orbit GAIT.json ... [--vary KNOB VALUES] [--out DIR]``: the orbit of each gait's walk
+in MuJoCo, its Floquet multipliers (``validate.orbit``), under the validation's controller or
+over a range of one of its gains (``validate.orbit_study``).
+
+Per gait ``<out>/<folder>-<gait>.json`` and ``.png`` (the multipliers in the complex plane, or
+with ``--vary`` ρ against the gain), written together; given gaits of both knees, also
+``<out>/knees.png`` (ρ of both knees against speed) and the knees side by side.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from biped_cli import args as types
+
+DEFAULT_ORBIT = "logs/orbit"
+MAX_PHASES = 256
+# Bounds of the central differences' step on the angles [rad].
+STEP_RANGE = (1e-4, 0.02)
+KNEES_FIGURE = "knees.png"
+# Most scales of one --vary (each an orbit: a few hundred walks).
+MAX_SCALES = 100
+
+
+class Vary(argparse.Action):
+    """``--vary KNOB VALUES``: a knob of ``validate.orbit_study.KNOBS`` and its scales
+    (START:STOP:COUNT or a list, each 0 to ``MAX_SCALE``, distinct)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from validate.orbit_study import KNOBS, MAX_SCALE
+
+        knob, text = values
+        if knob not in KNOBS:
+            raise argparse.ArgumentError(self, f"knob {knob!r}: allowed one of {', '.join(KNOBS)}")
+        try:
+            scales = types.number_list(text, f"{knob} scales", MAX_SCALES, "")
+        except argparse.ArgumentTypeError as error:
+            raise argparse.ArgumentError(self, str(error)) from None
+        if scales.size == 0 or not np.all(
+            np.isfinite(scales) & (scales >= 0) & (scales <= MAX_SCALE)
+        ):
+            raise argparse.ArgumentError(
+                self, f"{knob} scales = {text!r}: allowed scales from 0 to {MAX_SCALE:g}"
+            )
+        if scales.size > MAX_SCALES:
+            raise argparse.ArgumentError(
+                self, f"{knob} scales = {text!r}: allowed {MAX_SCALES} at most"
+            )
+        rounded = [round(float(v), 9) for v in scales]
+        repeated = sorted({v for v in rounded if rounded.count(v) > 1})
+        if repeated:
+            raise argparse.ArgumentError(
+                self, f"{knob} scale {repeated[0]:g} given twice: allowed each once"
+            )
+        setattr(namespace, self.dest, (knob, rounded))
+
+
+def step(text: str) -> float:
+    """The central differences' step on the angles [rad]."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    low, high = STEP_RANGE
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(f"step = {text!r} rad: allowed {low:g} to {high:g} rad")
+    return value
+
+
+def add_parser(commands) -> None:
+    from validate.orbit import PHASES, RATE_STEP, STEP
+    from validate.orbit_study import KNOBS
+
+    help = "Floquet multipliers of gaits' walks in MuJoCo: is the walk a stable orbit"
+    parser = types.add_command(commands, "orbit", help, cmd_orbit)
+    types.add_gaits(parser)
+    knobs = "; ".join(f"{name}: {scaled}" for name, (_, scaled) in KNOBS.items())
+    parser.add_argument(
+        "--vary",
+        nargs=2,
+        action=Vary,
+        default=None,
+        metavar=("KNOB", "SCALES"),
+        help=f"the orbit over scales of one gain ({knobs}), START:STOP:COUNT or a list "
+        "S1,S2,... [1] (default: the validation's controller alone)",
+    )
+    rates = RATE_STEP / STEP
+    types.add_options(
+        parser,
+        ("--phases", types.bounded(1, MAX_PHASES), PHASES, "N", "positions of MuJoCo's "
+         f"physics-step grid the return map is averaged over, 1 to {MAX_PHASES} (default "
+         f"{PHASES}; 2 x 12 x N one-step walks a Jacobian)"),
+        ("--step", step, STEP, "RAD", "[rad] central-difference step on the angles, the "
+         f"rates' {rates:g} times it in rad/s, {STEP_RANGE[0]:g} to {STEP_RANGE[1]:g} "
+         f"(default {STEP:g})"),
+        ("--jobs", types.jobs, 1, "N", "processes computing orbits side by side (default 1)"),
+    )  # fmt: skip
+    types.add_model(parser)
+    parser.add_argument(
+        "--out",
+        default=DEFAULT_ORBIT,
+        metavar="DIR",
+        help=f"folder of the results, {types.FOLDER_CREATED} (default {DEFAULT_ORBIT}): "
+        f"<folder>-<gait>.json and .png, and {KNEES_FIGURE} given gaits of both knees",
+    )
+
+
+def _value(knob: str | None, value) -> str:
+    return "the validation's controller" if knob is None else f"{knob} x {value:g}"
+
+
+def orbit_line(knob: str | None, orbit: dict) -> str:
+    """One printed line of an orbit (its figures and notes, ``validate.orbit_study``)."""
+    where = _value(knob, orbit["value"])
+    if "spectral_radius" not in orbit:
+        return f"  {where}: {orbit['verdict'].upper()}: {'; '.join(orbit['notes'])}"
+    return (
+        f"  {where}: {orbit['verdict'].upper()}  ρ {orbit['spectral_radius']:.3f} ± "
+        f"{orbit['spectral_radius_spread']:.3f}, steps {orbit['period_ratio']:.3f} T; "
+        f"{'; '.join(orbit['notes'][:1])}"
+    )
+
+
+def boundary_lines(content: dict) -> list[str]:
+    """Where the orbit stops being stable over the knob's values."""
+    knob, out = content["knob"], []  # a knob given (--vary)
+    for boundary in content["boundaries"]:
+        (a, b), (left, right) = boundary["between"], boundary["verdicts"]
+        at = boundary["radius_crosses_1_at"]
+        crossing = "" if at is None else f"; ρ crosses 1 at {knob} x {at:.3g}"
+        if "spectral_radius" not in content["orbits"][content["values"].index(a)]:
+            crossing = f"; the walk falls at {knob} x {a:g}"
+        elif "spectral_radius" not in content["orbits"][content["values"].index(b)]:
+            crossing = f"; the walk falls at {knob} x {b:g}"
+        out.append(f"  boundary: {left} at {knob} x {a:g}, {right} at {knob} x {b:g}{crossing}")
+    if not content["boundaries"]:
+        verdicts = sorted({o["verdict"] for o in content["orbits"]})
+        out.append(f"  no boundary over the values: {', '.join(verdicts)} throughout")
+    return out
+
+
+def knee_lines(contents: list[dict]) -> list[str]:
+    """The knees side by side at each criterion and speed both were given at, and per
+    criterion the mean difference over the speeds with its spread."""
+    from biped.pages.orbit_figures import SPREADS, rho_difference
+
+    rows = {}
+    for content in contents:
+        rows[content["criterion"], content["speed"], content["knee"]] = content["orbits"][0]
+    out = ["knees compared: ρ ± spread; (rolling − revolute) / revolute ± 2 spreads"]
+    differences: dict = {}
+    for criterion, speed in sorted({(c, v) for c, v, _ in rows}):
+        pair = [rows.get((criterion, speed, knee)) for knee in ("revolute", "rolling")]
+        if None in pair:
+            continue
+        revolute, rolling = pair
+        shown = [f"{knee} {_rho(o)}" for knee, o in (("revolute", revolute), ("rolling", rolling))]
+        line = f"  {criterion} {speed:.3f} m/s: {', '.join(shown)}"
+        if "spectral_radius" in revolute and "spectral_radius" in rolling:
+            difference, spread = rho_difference(rolling, revolute)
+            distinct = abs(difference) > SPREADS * spread
+            differences.setdefault(criterion, []).append((difference, spread, distinct))
+            line += (
+                f": {difference:+.0f} ± {SPREADS * spread:.0f} % "
+                f"({'distinct' if distinct else 'not distinguishable'})"
+            )
+        out.append(line)
+    for criterion, found in differences.items():
+        values, spreads, distinct = (np.array(column) for column in zip(*found, strict=True))
+        mean_spread = float(np.sqrt(np.sum(spreads**2))) / len(values)
+        out.append(
+            f"  {criterion}: mean difference over {len(values)} speeds {values.mean():+.1f} ± "
+            f"{SPREADS * mean_spread:.1f} %, {int(distinct.sum())} of {len(values)} distinct"
+        )
+    return out
+
+
+def _rho(orbit: dict) -> str:
+    if "spectral_radius" not in orbit:
+        return f"no orbit ({orbit['verdict']})"
+    return f"{orbit['spectral_radius']:.3f} ± {orbit['spectral_radius_spread']:.3f}"
+
+
+def _write(out: Path, name: str, content: dict, figure) -> None:
+    """<out>/<name>.json and .png, both or neither."""
+    from biped.pages.orbit_figures import DPI
+    from biped.records.provenance import provenance
+    from biped.runtime.files import atomic_set
+
+    content = {**content, "provenance": provenance()}
+    with atomic_set(out, f"orbit-{name}") as staging:
+        text = json.dumps(content, indent=1, allow_nan=False)
+        (staging / f"{name}.json").write_text(text, encoding="utf-8")
+        figure.savefig(staging / f"{name}.png", dpi=DPI)
+
+
+def cmd_orbit(args) -> int:
+    """Is each gait's walk in MuJoCo a stable orbit? The walk's return map from one section
+    of its steps to the next (just after each landing settles, in the stance leg's
+    coordinates: six free angles and their rates), its fixed point, and its Jacobian by
+    central differences of one-step walks, every direction perturbed both ways (--step),
+    averaged over positions of MuJoCo's physics-step grid (--phases); its eigenvalues, the
+    Floquet multipliers, and the spectral radius ρ with its spread over the grid positions.
+    The verdict: stable when ρ + 2 spreads < 1 at the gait's period, unstable when ρ - 2
+    spreads >= 1 or a walk falls (no orbit), undecided between (validate/orbit.py).
+
+    Under the validation's controller, or with --vary over scales of one of its gains: the
+    servos' stiffness (kp), their damping (kv) or the speed loop's gain (speed; 0 turns it
+    off), and where the orbit stops being stable. Writes per gait <out>/<folder>-<gait>.json
+    (the multipliers, the slowest mode, the fixed point beside the gait file's state, a units
+    map, provenance) and .png, together; given gaits of both knees without --vary,
+    <out>/knees.png, ρ against speed with the knees' difference. Exits 1 if an orbit under the
+    validation's controller is not stable (without --vary), 0 otherwise.
+    """
+    from biped.pages.orbit_figures import knob_figure, multipliers_figure, speeds_figure
+    from biped_cli.commands import read_gaits
+    from biped_cli.progress import Progress
+    from validate.orbit import RATE_STEP, STEP, Steps
+    from validate.orbit_study import content, study
+    from validate.outputs import output_name
+
+    types.check_folder(args.out, "--out")
+    gaits = read_gaits(args.gait, args.model)
+    names = [output_name(path) for path in args.gait]
+    types.distinct_outputs(names, "result")
+    knob, values = args.vary if args.vary is not None else (None, [None])
+
+    steps = Steps(angle=args.step, rate=args.step * RATE_STEP / STEP, phases=args.phases)
+    out, contents, unstable = Path(args.out), [], []
+    began = time.perf_counter()
+    with Progress(len(gaits) * len(values), "orbit") as bar:
+        results = study(gaits, knob, values, args.model, steps, args.jobs, progress=bar)
+    wall = time.perf_counter() - began
+    for path, gait, name, orbits in zip(args.gait, gaits, names, results, strict=True):
+        body = content(path, gait, knob, values, orbits)
+        contents.append(body)
+        label = f"{path}: {gait.knee} knee, {gait.criterion}, {gait.speed} m/s"
+        print(label)
+        for orbit in orbits:
+            print(orbit_line(knob, orbit))
+        if knob is None:
+            figure = multipliers_figure(orbits[0], label)
+            if orbits[0]["verdict"] != "stable":
+                unstable.append(path)
+        else:
+            figure = knob_figure(body, label)
+            for line in boundary_lines(body):
+                print(line)
+        _write(out, name, body, figure)
+        print(f"  wrote {out / (name + '.json')}, {out / (name + '.png')}", flush=True)
+    walks = sum(o["walks"] for body in contents for o in body["orbits"])
+    print(f"{walks} walks in {wall:.1f} s on {args.jobs} process{'es' * (args.jobs > 1)}")
+    if knob is None and len({body["knee"] for body in contents}) == 2:
+        for line in knee_lines(contents):
+            print(line)
+        rows = [
+            {**body["orbits"][0], **{k: body[k] for k in ("knee", "criterion", "speed")}}
+            for body in contents
+        ]
+        figure = speeds_figure(rows, "the optimal gaits' walks in MuJoCo")
+        _save_figure(out / KNEES_FIGURE, figure)
+        print(f"wrote {out / KNEES_FIGURE}")
+    if unstable:
+        print(f"biped orbit: not shown stable: {', '.join(unstable)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _save_figure(path: Path, figure) -> None:
+    from biped.pages.orbit_figures import DPI
+    from biped.runtime.files import atomic_path
+
+    with atomic_path(path) as staging:
+        figure.savefig(staging, dpi=DPI, format="png")

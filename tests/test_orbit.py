@@ -1,0 +1,182 @@
+"""The walk's orbit in MuJoCo (``validate.orbit``): its return map is the walk's, its
+multipliers predict how perturbations decay, two step sizes agree, and the check fails the
+controllers that do not walk the gait's orbit."""
+
+import numpy as np
+import pytest
+
+from tests.conftest import gait_of, optimal_gait
+from validate import orbit as o
+from validate.orbit_study import settings_at
+from validate.simulate import Walker, WalkSettings
+
+_WALKERS: dict = {}
+_ORBITS: dict = {}
+# Steps walked by the decay test, and the grid positions its walks are averaged over (more
+# than the Jacobian's: the difference of two walks three steps on is a third of a step, the
+# landing's noise a tenth of one per grid position). Measured from step 1, once the fast
+# modes (|μ| <= 0.21) are gone, to step 3: beyond, the two walks' difference is down to the
+# walk's own alternation (a third of a step, the landing's noise driving the slowest mode)
+# and they lock onto its opposite phases, which no linear map describes.
+DECAY_STEPS = 3
+DECAY_PHASES = 24
+
+
+def _walker(knee: str) -> Walker:
+    if knee not in _WALKERS:
+        _WALKERS[knee] = Walker(gait_of(optimal_gait(knee)))
+    return _WALKERS[knee]
+
+
+def _orbit(knee: str, knob=None, value=None, steps=None) -> o.Orbit:
+    """The orbit of the optimal gait at 0.3 m/s, computed once per session and arguments."""
+    key = (knee, knob, value, steps)
+    if key not in _ORBITS:
+        settings = settings_at(knob, value)
+        _ORBITS[key] = o.orbit(_walker(knee), settings, steps or o.Steps())
+    return _ORBITS[key]
+
+
+@pytest.mark.parametrize("knee", ["revolute", "rolling"])
+def test_the_optimal_gaits_walk_a_stable_orbit(knee):
+    """Under the validation's controller the optimal gaits at 0.3 m/s walk a stable orbit:
+    ρ + 2 spreads < 1, at the gait's period, its fixed point near the file's state on the
+    section, a fixed point to half a central-difference step; the section's direction, the flow, is the structural multiplier 0; the check
+    passes and its JSON names every coordinate and unit."""
+    result = _orbit(knee)
+    m = result.multipliers
+    assert result.failure is None and result.verdict == "stable", o.notes(result)
+    assert m.radius < 1.0 and m.upper < 1.0
+    assert 0.0 < m.spread < 0.2  # the landing's noise, averaged over the grid
+    assert m.flow_gain < 0.1 * m.radius  # the flow is mapped to (nearly) 0: the section
+    assert abs(result.period_ratio - 1.0) < 0.03
+    distance = np.abs(result.fixed_point - result.file_state)
+    assert distance[:6].max() < 0.01 and distance[6:].max() < 0.1  # rad, rad/s
+    # a fixed point of the averaged map within half a central-difference step
+    assert np.linalg.norm(result.residual / result.steps.vector()) < 0.5
+    figures = o.figures(result)
+    assert figures["coordinates"] == list(o.COORDINATES) and len(figures["fixed_point"]) == 12
+    assert len(figures["multipliers_real"]) == 11 and figures["verdict"] == "stable"
+
+
+def test_the_map_restarted_on_the_section_is_the_walk():
+    """The walk's own next state on the section lies within 3 spreads (over MuJoCo's grid) of
+    the return map applied to its state: the lift, the held stance foot and the restarted
+    controller play the walk."""
+    walker = _walker("rolling")
+    settled = o.settle(walker, WalkSettings())
+    returns = o.ReturnMap(walker, WalkSettings(), settled.reference, settled.flow)
+    for k in (3, 12):
+        images = returns.at_phases(settled.states[k], o.PHASES)
+        z = (settled.states[k + 1] - images.mean(axis=0)) / images.std(axis=0)
+        assert np.all(np.abs(z) < 3.0), z
+
+
+def test_two_step_sizes_give_the_same_multipliers():
+    """The slowest multiplier and ρ with steps 2/3 of the default's agree within two of
+    their combined spreads; a step inside one piece of the map (1e-5 rad, one grid position)
+    does not: there the map's derivative is that of a landing pinned to a physics step."""
+    default = _orbit("rolling").multipliers
+    smaller = _orbit("rolling", steps=o.Steps(angle=2e-3, rate=2e-2)).multipliers
+    tolerance = 2.0 * np.hypot(default.spread, smaller.spread)
+    assert abs(default.values[0] - smaller.values[0]) < tolerance
+    assert abs(default.radius - smaller.radius) < tolerance
+    piece = _orbit("rolling", steps=o.Steps(angle=1e-5, rate=1e-4, phases=1))
+    assert piece.multipliers is None or abs(piece.radius - default.radius) > tolerance
+
+
+def _factor(values, k0: int) -> float:
+    """Per-step factor of |values| from step k0 to the last."""
+    return float(abs(values[-1] / values[k0]) ** (1.0 / (len(values) - 1 - k0)))
+
+
+def test_walked_perturbations_decay_as_the_multipliers_say():
+    """A perturbation of one step along the slowest mode, and a random one, walked three steps
+    (both ways, 24 grid positions): the slowest mode's component changes sign every step (a
+    flip) and shrinks by |μ| a step, the random one by ρ once its fast modes are gone (from
+    step 1 to 3), each within two spreads of ρ; the multiplier of a wrong controller
+    (kp x 1.2, a flip beyond 1) is not."""
+    result = _orbit("rolling")
+    m, scale = result.multipliers, result.steps.vector()
+    tolerance = 2.0 * m.spread
+    slow = np.real(m.vectors[:, 0])
+    walked = o.walked_decay(result, slow, DECAY_STEPS, DECAY_PHASES).mean(axis=0) / scale
+    along = walked @ (slow / scale) / np.sum((slow / scale) ** 2)
+    assert np.all(np.sign(along[1:]) == -np.sign(along[:-1]))  # μ < 0: errors alternate
+    measured = _factor(along, 1)
+    assert abs(measured - abs(m.values[0])) < tolerance, (measured, m.values[0])
+    rng = np.random.default_rng(0)
+    direction = rng.standard_normal(12)
+    direction *= scale / np.linalg.norm(direction)
+    walked = o.walked_decay(result, direction, DECAY_STEPS, DECAY_PHASES).mean(axis=0) / scale
+    random = _factor(np.linalg.norm(walked, axis=1), 1)
+    assert abs(random - m.radius) < tolerance, (random, m.radius)
+    wrong = _orbit("rolling", "kp", 1.2)
+    assert abs(measured - wrong.radius) > tolerance and abs(random - wrong.radius) > tolerance
+
+
+def test_a_flip_beyond_the_unit_circle_fails_the_check():
+    """kp x 1.2 (a gain the walk walks at, 20 steps) puts the slowest multiplier, a flip,
+    beyond -1 by more than two spreads: unstable, and the check says so."""
+    result = _orbit("rolling", "kp", 1.2)
+    assert result.multipliers.values[0].real < -1.0 and result.radius >= 1.0
+    assert result.verdict == "unstable"
+    assert "unstable" in o.notes(result)[-1]
+
+
+def test_a_gain_the_robustness_map_says_falls_has_no_orbit():
+    """kp x 0.25, below the robustness map's lowest kp scale (0.47): the walk falls before it
+    settles, there is no orbit, and it is reported unstable with the step it failed at."""
+    result = _orbit("rolling", "kp", 0.25)
+    assert result.multipliers is None and result.radius == np.inf
+    assert result.verdict == "unstable" and "did not land step" in result.failure
+    figures = o.figures(result)
+    assert figures["verdict"] == "unstable" and "spectral_radius" not in figures
+
+
+def test_the_speed_loop_off_walks_another_orbit():
+    """Without the speed loop the gait loses speed (README): the walk settles on another
+    orbit, steps of 1.3 T, which the check does not take for the gait's."""
+    result = _orbit("revolute", "speed", 0.0)
+    assert result.period_ratio > 1.0 + o.PERIOD_TOLERANCE
+    assert result.verdict in ("another orbit", "unstable", "undecided")
+    assert not result.stable
+
+
+def _refusal(capsys, code) -> str:
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, (code, err)
+    return err
+
+
+def test_orbit_command_writes_the_multipliers(tmp_path, capsys):
+    """`biped orbit GAIT` prints the orbit's line and writes its JSON (every number with its
+    unit) and figure; `--vary kp 0.25` reports the fall loudly as unstable, exit 0 (a study);
+    a bad knob, scale or repeated scale is one line naming it, exit 2, nothing written."""
+    import json
+
+    from biped.records.units import missing
+    from biped_cli import main
+
+    path = tmp_path / "gaits" / "rolling.json"
+    path.parent.mkdir()
+    gait_of(optimal_gait("rolling")).write(path)
+    out = tmp_path / "orbit"
+    assert main(["orbit", str(path), "--phases", "2", "--out", str(out)]) in (0, 1)
+    printed = capsys.readouterr().out
+    assert "the validation's controller:" in printed and "ρ" in printed
+    content = json.loads((out / "gaits-rolling.json").read_text())
+    assert not missing(content, content["units"]), missing(content, content["units"])
+    assert (out / "gaits-rolling.png").stat().st_size > 0
+    assert main(["orbit", str(path), "--vary", "kp", "0.25", "--out", str(out)]) == 0
+    assert "kp x 0.25: UNSTABLE: the walk did not land step" in capsys.readouterr().out
+    for argv, named in [
+        (["--vary", "mass", "1"], "knob 'mass'"),
+        (["--vary", "kp", "-1"], "from 0 to 100"),
+        (["--vary", "kp", "1,1"], "kp scale 1 given twice"),
+        (["--step", "0.5"], "step = '0.5' rad"),
+    ]:
+        fresh = tmp_path / "fresh"
+        err = _refusal(capsys, main(["orbit", str(path), *argv, "--out", str(fresh)]))
+        assert named in err and "allowed" in err, err
+        assert not fresh.exists()

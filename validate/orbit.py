@@ -1,0 +1,568 @@
+"""Is the walk a stable orbit? The return map of MuJoCo's closed-loop walk and its multipliers.
+
+A walking gait is a periodic orbit; the walk in MuJoCo (``validate.simulate``: the file's
+torques, the servos, the speed loop on the stance ankle) is stable when a small error in the
+state at one step is smaller at the next. The map from the state at one step to the state at
+the next (a Poincaré return map) says how much smaller: near its fixed point x*,
+x_{k+1} - x* ≈ J (x_k - x*); the eigenvalues of J (the Floquet multipliers) are the factors
+per step of its modes, the orbit is stable when all lie inside the unit circle, and the
+largest modulus (the spectral radius ρ) is the factor of the slowest mode.
+
+The section: just after each touchdown, once the legs are swapped, in the stance leg's
+coordinates, the state the gait file starts from. MuJoCo's landing is soft: the foot lands
+flat on its heel and toe spheres and rocks between them for about 10 ms (the checks leave out
+the first ``LANDING`` of each step for that reason), so the state the gait file starts from,
+right after a rigid impact, exists in MuJoCo once the landing has settled. The section is
+where the hip's advance over the stance ankle reaches the gait's at ``LANDING`` of the period
+(``section_advance``: x_H(0.1 T), 6 cm behind the ankle at 0.3 m/s), the state interpolated
+between the two physics steps around the crossing, so that the section does not move with
+MuJoCo's 2 ms grid.
+
+The coordinates: with the stance foot flat on the floor the hip follows from the stance leg
+(``Chain.stance_state``), and a state on the section has 12 coordinates, the free angles
+[qp2, q1, q2, q3, q4, q5] [rad] and their rates [rad/s] (``COORDINATES``). The stance foot's
+pose and velocity (its tilt and its sink into the soft floor, a few micrometres, which the
+contact holds) and the rolling knee's equality are not coordinates: a perturbed state keeps
+the reference state's (``ReturnMap.lift``: the walk's mean state on the section), so a
+perturbation never lifts the stance foot or pushes it into the floor. The section fixes one
+more direction, the flow along the orbit: a state moved along it reaches the same next state
+(J f = 0, a structural multiplier 0, measured as ``Multipliers.flow_gain``, 0.04-0.07 for the
+optimal gaits). The dynamic multipliers are those of J on the 11 directions across the flow
+(``section_basis``), along which the map is perturbed.
+
+The closed loop carries nothing else across steps: the controller reads the phase from the
+state at each reading (``RESYNC``), its speed loop is proportional (no memory), the gains
+are the walk's, and on the section the swing foot is in the air. So the return map is of
+the whole closed-loop state. A walk restarted on the section is the walk from there but for
+the clock of its readings of the phase (the section's instead of the touchdown's).
+
+MuJoCo's grid makes the map noisy. Which of the landing foot's two spheres touches first,
+and on which physics step, is decided by micrometres (the optimal gaits land flat, heel and
+toe within 10 µm, coming down 0.1 mm per physics step), and each choice sends the next step
+off with rates a few hundredths of a rad/s apart: the map is piecewise smooth, in pieces
+about 1e-3 rad/s wide in the rates, and within one piece its derivative is that of a landing
+pinned to one physics step, not the walk's. So the map is averaged over ``PHASES`` positions
+of the grid (the start moved back along the flow by (j + 1/2) / PHASES of a physics step),
+and the Jacobian is taken by central differences of ``STEP`` [rad] and ``RATE_STEP``
+[rad/s] over the coordinates (a unit step along each of the 12 directions of
+``section_basis`` in the coordinates over those steps, both ways, at each grid position:
+2 x 12 x PHASES one-step walks). The steps span many pieces and are about the walk's own
+spread on the section (0.02-0.03 rad/s in the rates at the default gains): the map is
+linearised over the states the walk visits. Its response is not linear far below or above
+them (the slowest multiplier of the default gains grows in modulus at smaller steps, the map
+being kinked where the landing changes from heel-first to toe-first), so ``tests/test_orbit``
+holds the multipliers of two step sizes together and the decay of walked perturbations to
+the multipliers. The spread of the central differences over the grid positions gives ρ's
+uncertainty (``Multipliers.spread``: the standard deviation of a bootstrap over them).
+
+The fixed point: the walk does not converge to one state, the landing's noise kicks it at
+every step (the default gains' slowest mode is a flip, near -0.8: the alternating step
+durations of the walk, 301 and 305 physics steps). Its states on the section over
+``MEAN_STEPS`` steps after ``SETTLE_STEPS`` have a mean x̄, from which chord-Newton steps on
+the averaged map, x <- x - (J - I)⁻¹ (F̄(x) - x) (``CHORD_STEPS`` at most, while the residual
+falls), give the fixed point x*. It is reported with its residual |F̄(x*) - x*|, the noise of
+F̄ (its standard error over the grid) and its distance from the gait file's state on the
+section (the file's motion at ``LANDING`` of the period). The residual falls to the noise for
+the rolling knee's optimal gait at 0.3 m/s and stays at about 4 times it, a third of a
+central-difference step, for the revolute knee's: the averaged map, kinked, has no fixed
+point closer than that.
+
+The verdict (``Orbit.verdict``): stable when ρ + ``MARGIN_SPREADS`` spreads < 1 (the orbit
+is inside the unit circle by more than the landing's noise moves its estimate; the
+estimate moves by about one spread from one machine to another, with the gait's last bits)
+and the walk's steps last the gait's period within ``PERIOD_TOLERANCE`` (else it walks
+another orbit: without the speed loop, a stable one at 1.3 T); unstable when ρ - as many
+spreads >= 1, or when a walk falls or misses the section (``OrbitFailure``: an orbit that
+cannot be found is unstable, said loudly); undecided between.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from biped.errors import BipedError
+from biped.model.kinematics import QP1, XH, ZH
+from validate.checks import LANDING, Check
+from validate.mapping import mapping
+from validate.simulate import Simulation, Walker, WalkSettings
+from validate.units import OrbitFigures
+
+# The 12 coordinates of a state on the section, in order: the free angles [rad], then their
+# rates [rad/s] (``biped.model.kinematics``: qp2 swing foot, q1 stance shank, q2 stance thigh,
+# q3 swing thigh, q4 swing shank, q5 trunk).
+ANGLES = ("qp2", "q1", "q2", "q3", "q4", "q5")
+COORDINATES = ANGLES + tuple(f"{name}_rate" for name in ANGLES)
+FREE = slice(1, 7)  # the free angles' columns in the paper's q
+HELD = [QP1, XH, ZH]  # what the stance foot's contact holds: not coordinates
+# Central-difference steps: angles [rad] and rates [rad/s] (see the module docstring).
+STEP = 3e-3
+RATE_STEP = 3e-2
+# Positions of MuJoCo's physics-step grid the map is averaged over.
+PHASES = 12
+# Steps walked before the walk's states on the section are averaged, and how many are.
+SETTLE_STEPS = 6
+MEAN_STEPS = 24
+# Chord-Newton steps at most from the walk's mean state to the fixed point.
+CHORD_STEPS = 3
+# The validation's controller (the forward check's walk).
+NOMINAL = WalkSettings()
+# Resamplings of the grid positions that give the spread of ρ.
+BOOTSTRAP = 200
+# The orbit check's margin: ρ plus this many spreads below 1 (see ``Orbit.verdict``).
+MARGIN_SPREADS = 2.0
+# Largest relative difference of the orbit's step duration from the gait's period: the
+# default walks' steps last 1.01-1.03 T; a walk that settles at another period walks another
+# orbit (the speed loop off: 1.3 T).
+PERIOD_TOLERANCE = 0.05
+
+
+class OrbitFailure(BipedError):
+    """A walk of the return map fell or did not reach the section: no orbit there."""
+
+
+@dataclass(frozen=True)
+class Steps:
+    """Central-difference steps of the return map's Jacobian.
+
+    Attributes:
+        angle: [rad] on each free angle.
+        rate: [rad/s] on each rate.
+        phases: positions of the physics-step grid averaged over.
+    """
+
+    angle: float = STEP
+    rate: float = RATE_STEP
+    phases: int = PHASES
+
+    def vector(self) -> np.ndarray:
+        """(12,) the step on each coordinate."""
+        return np.array([self.angle] * 6 + [self.rate] * 6)
+
+
+class ReturnMap:
+    """The walk from one section of the orbit to the next (see the module docstring).
+
+    Args:
+        walker: the gait on its model.
+        settings: gains of the walk (``WalkSettings``; friction and push as in it).
+        reference: (q, q̇) (9,) each, a state on the section whose stance foot's pose and
+            velocity every lifted state keeps (``lift``).
+        flow: (12,) d/dt of the coordinates there [rad/s, rad/s²]: the direction along which
+            a start is moved back to place MuJoCo's grid (``phases``).
+    """
+
+    def __init__(self, walker: Walker, settings: WalkSettings, reference, flow):
+        self.walker, self.settings = walker, settings
+        self.biped = walker.biped
+        self.advance = section_advance(walker)
+        self.dt = float(walker.model.opt.timestep)
+        self.flow = np.asarray(flow, float)
+        q, qd = reference
+        q_free, qd_free, _ = self.biped.stance_state(q[FREE], qd[FREE])
+        self.held_q, self.held_qd = np.zeros(9), np.zeros(9)
+        self.held_q[HELD] = q[HELD] - q_free[HELD]
+        self.held_qd[HELD] = qd[HELD] - qd_free[HELD]
+        self.walks = 0
+
+    def lift(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """(q, q̇) (9,) of the coordinates ``x`` (12,): the hip from the stance leg, the stance
+        foot's pose and velocity those of the reference."""
+        x = np.asarray(x, float)
+        q, qd, _ = self.biped.stance_state(x[:6], x[6:])
+        return q + self.held_q, qd + self.held_qd
+
+    def walk(self, x, steps: int = 1) -> Simulation:
+        """The walk of ``steps`` steps from ``x`` on the section, ended on the next section."""
+        self.walks += 1
+        return self.walker.walk(
+            steps + 1, self.settings, start=self.lift(x), stop_advance=self.advance
+        )
+
+    def sections(self, sim: Simulation, steps) -> np.ndarray:
+        """(len(steps), 12) the coordinates on the section in each of ``steps`` of ``sim``."""
+        radii = self.biped.radii
+        return np.array(
+            [coordinates(*section_state(sim, self.advance, radii, k)[:2]) for k in steps]
+        )
+
+    def __call__(self, x, phase: float = 0.0) -> np.ndarray:
+        """F(x) (12,): the walk of one step from ``x``, its start moved back along the flow
+        by ``phase`` of a physics step."""
+        sim = self.walk(np.asarray(x, float) - phase * self.dt * self.flow)
+        return self.sections(sim, [1])[0]
+
+    def at_phases(self, x, phases: int) -> np.ndarray:
+        """(phases, 12): F(x) at each position (j + 1/2) / phases of the grid."""
+        return np.array([self(x, (j + 0.5) / phases) for j in range(phases)])
+
+
+def section_advance(walker: Walker) -> float:
+    """[m] the hip's advance over the stance ankle on the section: the gait's at ``LANDING``
+    of the period."""
+    return float(walker.samples.at("q", [LANDING * walker.period])[0, XH])
+
+
+def paper_state(sim: Simulation, row: int, stance: str, radii) -> tuple[np.ndarray, np.ndarray]:
+    """(q, q̇) (9,) of MuJoCo's state at ``row`` in the paper's coordinates of ``stance`` in
+    stance, x_H from the stance ankle."""
+    to_paper = np.linalg.pinv(mapping(sim.model, stance, radii).qpos_from_q)
+    q, qd = to_paper @ sim.qpos[row], to_paper @ sim.qvel[row]
+    q[XH] -= sim.ankle_x(stance)[row]
+    return q, qd
+
+
+def section_state(sim: Simulation, advance: float, radii, step: int):
+    """(q, q̇, q̈) (9,) each on the section in ``step`` of ``sim``, interpolated between the two
+    physics steps around the crossing (q̈ their difference over the step); OrbitFailure if the
+    walk did not get there."""
+    if step >= len(sim.step_starts) or not all(sim.landed[:step]):
+        fell = next((j for j, landed in enumerate(sim.landed) if not landed), len(sim.landed))
+        raise OrbitFailure(f"the walk did not land step {fell + 1}: no orbit")
+    rows = sim.step_slices()[step]
+    stance = sim.stances[step]
+    section, advance = advance, sim.hip_x()[rows] - sim.ankle_x(stance)[rows]
+    after = np.flatnonzero(advance >= section)
+    if not len(after) or after[0] == 0:
+        raise OrbitFailure(f"the walk did not reach the section in step {step + 1}: no orbit")
+    row = rows.start + int(after[0]) - 1
+    (qa, qda), (qb, qdb) = (paper_state(sim, r, stance, radii) for r in (row, row + 1))
+    share = (section - qa[XH]) / (qb[XH] - qa[XH])
+    dt = sim.time[row + 1] - sim.time[row]
+    return qa + share * (qb - qa), qda + share * (qdb - qda), (qdb - qda) / dt
+
+
+def coordinates(q, qd) -> np.ndarray:
+    """(12,) the section's coordinates of a state (q, q̇)."""
+    return np.concatenate([np.asarray(q)[FREE], np.asarray(qd)[FREE]])
+
+
+@dataclass(frozen=True)
+class Settled:
+    """The walk from the gait file's start state, on the section of each step.
+
+    Attributes:
+        states: (MEAN_STEPS, 12) its coordinates on the section after ``SETTLE_STEPS``.
+        reference: (q, q̇) (9,) each, their mean in the paper's coordinates.
+        flow: (12,) the mean d/dt of the coordinates there.
+        period: [s] the mean duration of those steps.
+    """
+
+    states: np.ndarray
+    reference: tuple
+    flow: np.ndarray
+    period: float
+
+    @property
+    def mean(self) -> np.ndarray:
+        return self.states.mean(axis=0)
+
+
+def settle(walker: Walker, settings: WalkSettings) -> Settled:
+    """Walk ``SETTLE_STEPS + MEAN_STEPS`` steps from the file's start state and read the
+    section of the last ``MEAN_STEPS``; OrbitFailure if the walk falls first."""
+    advance, radii = section_advance(walker), walker.biped.radii
+    steps = SETTLE_STEPS + MEAN_STEPS
+    sim = walker.walk(steps + 1, settings, stop_advance=advance)
+    found = [section_state(sim, advance, radii, k) for k in range(SETTLE_STEPS, steps)]
+    q, qd, qdd = (np.array([state[i] for state in found]) for i in range(3))
+    states = np.hstack([q[:, FREE], qd[:, FREE]])
+    flow = np.concatenate([qd[:, FREE].mean(axis=0), qdd[:, FREE].mean(axis=0)])
+    starts = sim.time[sim.step_starts[SETTLE_STEPS : steps + 1]]
+    period = float(np.diff(starts).mean())
+    return Settled(states, (q.mean(axis=0), qd.mean(axis=0)), flow, period)
+
+
+def section_basis(flow, steps: Steps = Steps()) -> np.ndarray:
+    """(12, 12) an orthonormal basis of the coordinates over their steps (``Steps.vector``):
+    the flow first, then 11 directions across it, along which the map is perturbed."""
+    direction = np.asarray(flow, float) / steps.vector()
+    direction /= np.linalg.norm(direction)
+    basis = np.linalg.qr(np.column_stack([direction, np.eye(12)]))[0][:, :12]
+    basis[:, 0] = direction  # QR may flip its sign
+    return basis
+
+
+def central_differences(returns: ReturnMap, x, directions, phases: int = PHASES) -> np.ndarray:
+    """(phases, 12, m): (F(x + d) - F(x - d)) / 2 for each column d of ``directions`` (12, m),
+    at each position of the physics-step grid."""
+    directions = np.asarray(directions, float)
+    out = np.empty((phases, 12, directions.shape[1]))
+    for i, d in enumerate(directions.T):
+        out[:, :, i] = 0.5 * (returns.at_phases(x + d, phases) - returns.at_phases(x - d, phases))
+    return out
+
+
+@dataclass(frozen=True)
+class Multipliers:
+    """The eigenvalues of the return map's Jacobian J (the Floquet multipliers).
+
+    The section fixes one direction: a state moved along the flow of the orbit reaches the
+    same next state, so J f = 0 for the flow f, a structural multiplier 0 (``flow_gain``,
+    measured: |J f| / |f|). The dynamic multipliers are those of J on the states modulo the
+    flow: the block of J on the 11 directions across it (``section_basis``).
+
+    Attributes:
+        values: (11,) complex, the dynamic multipliers by decreasing modulus.
+        vectors: (12, 11) complex, the right eigenvector of each (columns), in the
+            coordinates (rad, rad/s), scaled so that its largest component over its step
+            (``Steps``) is 1: a perturbation of about one step.
+        flow_gain: |J f| / |f| in the coordinates over their steps: the structural 0.
+        spread: the standard deviation of ``radius`` over ``BOOTSTRAP`` resamplings of the
+            grid positions.
+    """
+
+    values: np.ndarray
+    vectors: np.ndarray
+    flow_gain: float
+    spread: float
+
+    @property
+    def radius(self) -> float:
+        """ρ: the largest modulus."""
+        return float(np.abs(self.values).max())
+
+    @property
+    def upper(self) -> float:
+        """ρ + ``MARGIN_SPREADS`` spreads: what the orbit check holds below 1."""
+        return self.radius + MARGIN_SPREADS * self.spread
+
+
+def multipliers(responses: np.ndarray, basis: np.ndarray, steps: Steps, seed=0) -> Multipliers:
+    """The multipliers from ``responses`` (phases, 12, 12) of ``central_differences`` along
+    ``basis`` (``section_basis``, the flow first) times the steps; ``seed``: the bootstrap's."""
+    scale = steps.vector()
+    across = basis[:, 1:]
+
+    def block(mean):  # J on the directions across the flow, modulo the flow
+        return across.T @ (mean[:, 1:] / scale[:, None])
+
+    values, vectors = np.linalg.eig(block(responses.mean(axis=0)))
+    order = np.argsort(-np.abs(values), kind="stable")
+    values, vectors = values[order], across @ vectors[:, order]
+    vectors = vectors / vectors[np.abs(vectors).argmax(axis=0), np.arange(11)]
+    flow_gain = float(np.linalg.norm(responses.mean(axis=0)[:, 0] / scale))
+    rng = np.random.default_rng(seed)
+    phases = len(responses)
+    radii = [
+        np.abs(np.linalg.eigvals(block(responses[rng.integers(0, phases, phases)].mean(0)))).max()
+        for _ in range(BOOTSTRAP)
+    ]
+    return Multipliers(values, vectors * scale[:, None], flow_gain, float(np.std(radii)))
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """The orbit of a gait's walk under one controller, its fixed point and multipliers.
+
+    Attributes:
+        settings: the walk's (gains).
+        steps: the central differences'.
+        advance: [m] the hip's advance over the stance ankle on the section.
+        failure: why there is no orbit (None: there is one; then every field below is set).
+        fixed_point: (12,) x* on the section (``COORDINATES``).
+        file_state: (12,) the gait file's state on the section.
+        residual: (12,) F̄(x*) - x*.
+        noise: (12,) the standard error of F̄(x*) over the grid positions.
+        period_ratio: the walk's mean step duration over the gait's period.
+        multipliers: ``Multipliers``.
+        walks: MuJoCo walks run.
+        returns: the return map it was found on (``ReturnMap``).
+    """
+
+    settings: WalkSettings
+    steps: Steps
+    advance: float
+    failure: str | None = None
+    fixed_point: np.ndarray | None = None
+    file_state: np.ndarray | None = None
+    residual: np.ndarray | None = None
+    noise: np.ndarray | None = None
+    period_ratio: float | None = None
+    multipliers: Multipliers | None = field(default=None, repr=False)
+    walks: int = 0
+    returns: ReturnMap | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def radius(self) -> float:
+        """ρ; infinity without an orbit (a walk that falls is unstable)."""
+        return np.inf if self.multipliers is None else self.multipliers.radius
+
+    @property
+    def verdict(self) -> str:
+        """'stable' (ρ + ``MARGIN_SPREADS`` spreads < 1, at the gait's period within
+        ``PERIOD_TOLERANCE``), 'unstable' (ρ - as many spreads >= 1, or no orbit),
+        'another orbit' (stable at another period), else 'undecided'."""
+        if self.multipliers is None:
+            return "unstable"
+        m = self.multipliers
+        if m.radius - MARGIN_SPREADS * m.spread >= 1.0:
+            return "unstable"
+        if m.upper >= 1.0:
+            return "undecided"
+        return "stable" if abs(self.period_ratio - 1.0) <= PERIOD_TOLERANCE else "another orbit"
+
+    @property
+    def stable(self) -> bool:
+        return self.verdict == "stable"
+
+
+def file_state(walker: Walker) -> np.ndarray:
+    """(12,) the gait file's state on the section: its motion at ``LANDING`` of the period."""
+    tau = [LANDING * walker.period]
+    return coordinates(walker.samples.at("q", tau)[0], walker.samples.at("qd", tau)[0])
+
+
+def orbit(walker: Walker, settings: WalkSettings = NOMINAL, steps: Steps = Steps()):
+    """The orbit of ``walker``'s walk under ``settings`` (see the module docstring): the walk
+    settled from the file's start state, the Jacobian at its mean state on the section,
+    chord-Newton steps to the fixed point, the multipliers. An ``Orbit`` whose ``failure``
+    says why when a walk falls or misses the section."""
+    advance = section_advance(walker)
+    try:
+        settled = settle(walker, settings)
+        returns = ReturnMap(walker, settings, settled.reference, settled.flow)
+        basis = section_basis(settled.flow, steps)
+        directions = basis * steps.vector()[:, None]
+        x = settled.mean
+        responses = central_differences(returns, x, directions, steps.phases)
+        found = multipliers(responses, basis, steps)
+        jacobian = responses.mean(axis=0) @ np.linalg.inv(directions)
+        x, images = _chord_steps(returns, x, jacobian, steps)
+    except OrbitFailure as error:
+        return Orbit(settings, steps, advance, failure=str(error))
+    return Orbit(
+        settings,
+        steps,
+        advance,
+        fixed_point=x,
+        file_state=file_state(walker),
+        residual=images.mean(axis=0) - x,
+        noise=images.std(axis=0) / np.sqrt(steps.phases),
+        period_ratio=settled.period / walker.period,
+        multipliers=found,
+        walks=returns.walks + 1,
+        returns=returns,
+    )
+
+
+def _chord_steps(returns: ReturnMap, x, jacobian, steps: Steps):
+    """Up to ``CHORD_STEPS`` steps x <- x - (J - I)⁻¹ (F̄(x) - x) from ``x``; the x of the
+    lowest residual over the steps (``Steps.vector``), and F at it at each grid position
+    (phases, 12)."""
+    scale = steps.vector()
+    best, best_images, best_norm = None, None, np.inf
+    for _ in range(CHORD_STEPS + 1):
+        images = returns.at_phases(x, steps.phases)
+        residual = images.mean(axis=0) - x
+        norm = np.linalg.norm(residual / scale)
+        if norm >= best_norm:
+            break
+        best, best_images, best_norm = x, images, norm
+        x = x - np.linalg.solve(jacobian - np.eye(12), residual)
+    return best, best_images
+
+
+def figures(result: Orbit) -> dict:
+    """The orbit check's figures (``validate.units.OrbitFigures``) of ``result``."""
+    settings, steps = result.settings, result.steps
+    known = {
+        "verdict": result.verdict,
+        "kp": settings.kp,
+        "kv": settings.kv,
+        "speed_gain": settings.speed_gain,
+        "step_angle": steps.angle,
+        "step_rate": steps.rate,
+        "phases": steps.phases,
+        "section_advance": result.advance,
+        "section_phase": LANDING,
+        "walks": result.walks,
+    }
+    m = result.multipliers
+    if m is None:
+        return OrbitFigures(**known).to_dict()
+    mode = m.vectors[:, 0]
+    distance = np.abs(result.fixed_point - result.file_state)
+    return OrbitFigures(
+        **known,
+        spectral_radius=m.radius,
+        spectral_radius_spread=m.spread,
+        spectral_radius_upper=m.upper,
+        multipliers_real=m.values.real.tolist(),
+        multipliers_imag=m.values.imag.tolist(),
+        multipliers_modulus=np.abs(m.values).tolist(),
+        flow_multiplier=m.flow_gain,
+        coordinates=list(COORDINATES),
+        slowest_mode_real=mode.real.tolist(),
+        slowest_mode_imag=mode.imag.tolist(),
+        fixed_point=result.fixed_point.tolist(),
+        file_state=result.file_state.tolist(),
+        fixed_point_angle_distance=float(distance[:6].max()),
+        fixed_point_rate_distance=float(distance[6:].max()),
+        residual_angle=float(np.abs(result.residual[:6]).max()),
+        residual_rate=float(np.abs(result.residual[6:]).max()),
+        noise_rate=float(result.noise[6:].max()),
+        period_ratio=result.period_ratio,
+    ).to_dict()
+
+
+def notes(result: Orbit) -> list[str]:
+    """What the orbit check says of ``result``: its slowest mode and the verdict's reason."""
+    if result.failure is not None:
+        return [f"{result.failure} (an orbit that cannot be found is unstable)"]
+    m = result.multipliers
+    slowest = m.values[0]
+    if abs(slowest.imag) > 1e-12:
+        kind = f"{slowest.real:.3f} ± {abs(slowest.imag):.3f}i (oscillating over steps)"
+    elif slowest.real < 0:
+        kind = f"{slowest.real:.3f} (a flip: errors alternate from step to step)"
+    else:
+        kind = f"{slowest.real:.3f} (errors keep their sign)"
+    said = [
+        f"slowest multiplier {kind}",
+        f"ρ + {MARGIN_SPREADS:g} spreads = {m.upper:.3f}",
+    ]
+    verdict = result.verdict
+    if verdict == "stable":
+        said.append("stable: below 1 by more than the landing's noise")
+    elif verdict == "undecided":
+        said.append("not shown stable: within the landing's noise of 1")
+    elif verdict == "unstable":
+        said.append("unstable: above 1 by more than the landing's noise")
+    else:
+        said.append(
+            f"another orbit: its steps last {result.period_ratio:.2f} T (allowed within "
+            f"{PERIOD_TOLERANCE:.0%} of T)"
+        )
+    return said
+
+
+def check_orbit(walker: Walker, settings: WalkSettings = NOMINAL) -> tuple[Check, Orbit]:
+    """The orbit check: the orbit of the forward check's walk is stable (``Orbit.verdict``)."""
+    result = orbit(walker, settings)
+    shown = (
+        "spectral_radius",
+        "spectral_radius_spread",
+        "period_ratio",
+        "fixed_point_rate_distance",
+        "walks",
+    )
+    check = Check("orbit", result.stable, figures(result), notes(result), shown=shown)
+    return check, result
+
+
+def walked_decay(result: Orbit, direction, steps: int, phases: int) -> np.ndarray:
+    """(phases, steps + 1, 12): a perturbation ``direction`` (12,) of the fixed point walked
+    ``steps`` steps, one walk each way (x* ± direction) at each of ``phases`` grid positions:
+    (x_k(+) - x_k(-)) / 2 after k steps at each (row 0: ``direction``)."""
+    returns, x = result.returns, result.fixed_point
+    direction = np.asarray(direction, float)
+    walked = np.zeros((2, phases, steps, 12))
+    for side, sign in enumerate((1.0, -1.0)):
+        for j in range(phases):
+            start = x + sign * direction - (j + 0.5) / phases * returns.dt * returns.flow
+            sim = returns.walk(start, steps)
+            walked[side, j] = returns.sections(sim, range(1, steps + 1))
+    start = np.broadcast_to(direction, (phases, 1, 12))
+    return np.concatenate([start, 0.5 * (walked[0] - walked[1])], axis=1)
