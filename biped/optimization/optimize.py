@@ -500,10 +500,32 @@ def sthenic_starts(report: Report, start) -> list:
     return [(STHENIC_START, start), (MONOTONE_START, start)] if report.converged else []
 
 
+# A start solved to a tighter tolerance (``biped.optimization.solver.BARRIERS["tight"]``).
+TIGHT = ", tight tolerance"
+
+
 def barrier_of(kind: str) -> str:
     """The barrier strategy (``biped.optimization.solver.BARRIERS``) a start of this kind is solved
     with."""
+    if kind.endswith(TIGHT):
+        return "tight"
     return "monotone" if kind.endswith(MONOTONE) else "adaptive"
+
+
+def refine(problem: GaitProblem, start, kind: str = "given", seed: int = 0) -> Optimum:
+    """``problem`` solved from the one start ``start`` (variables), under the barrier its
+    ``kind`` names (``barrier_of``; ``"given" + TIGHT``: to a tighter tolerance): an optimum
+    re-solved on a finer grid or more tightly, for its error bar."""
+    began = time.perf_counter()
+    solver = solver_for(problem)
+    best, report = multistart(
+        [(kind, np.asarray(start, dtype=float))],
+        lambda z, barrier: solver.solve(problem, z, barrier=barrier),
+        seed,
+        began,
+        jobs=1,
+    )
+    return checked(problem, best.variables, report)
 
 
 def _family(problem: GaitProblem) -> tuple:

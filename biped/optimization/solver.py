@@ -54,9 +54,16 @@ IPOPT_OPTIONS = {
     "nlp_scaling_method": "none",
 }
 # The barrier strategies a start can be solved with: IPOPT's adaptive one (the default) and
-# its monotone one from mu = 0.01. From the same start they follow other paths through the
-# energy criterion's basins and may end in other local minima (``biped.optimization.optimize``).
-BARRIERS = {"adaptive": {}, "monotone": {"mu_strategy": "monotone", "mu_init": 1e-2}}
+# its monotone one from mu = 0.01 (and a tighter tolerance). From the same start the two
+# follow other paths through the energy criterion's basins and may end in other local minima
+# (``biped.optimization.optimize``).
+BARRIERS = {
+    "adaptive": {},
+    "monotone": {"mu_strategy": "monotone", "mu_init": 1e-2},
+    # From a converged point, a hundred times tighter: what ``IPOPT_OPTIONS``' tolerance
+    # leaves of an optimum (the atlas's error bar).
+    "tight": {"tol": 1e-11, "constr_viol_tol": 1e-11},
+}
 # IPOPT's statuses that are a converged local optimum.
 CONVERGED = ("Solve_Succeeded",)
 # One unit of the knee radii in the solver's scaled space [m].
