@@ -1,0 +1,280 @@
+"""What the atlas says (``biped.studies.atlas``): ``atlas.csv``, a figure per criterion and
+``atlas.md``, whose sentences are computed from the numbers.
+
+The figure of a criterion: on the left the map of the difference between the knees over speed
+x clearance (one panel per knee bend), blue where the rolling knee needs less, hatched where
+the difference is not larger than its uncertainty, a cross where a knee has no certified
+optimum; on the right the differences against speed, one curve per clearance, with their
+error bars.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from biped.model.criteria import CRITERION_UNITS
+from biped.runtime.files import atomic_path, atomic_write_text
+from biped.studies.atlas import RICHER_KNOTS, Cell, Difference, Settings, difference, load
+
+CRITERION_NAMES = {
+    "sthenic": "sthenic criterion C_Γ (squared torques per metre walked)",
+    "energy": "energy criterion C_E (per step)",
+    "energy-per-metre": "energy per metre walked C_E / S",
+}
+
+
+@dataclass(frozen=True)
+class Row:
+    """One line of ``atlas.csv``: a cell and criterion, both knees and their difference."""
+
+    criterion: str
+    cell: Cell
+    difference: Difference
+    revolute: dict | None
+    rolling: dict | None
+
+
+def rows(folder, settings: Settings) -> list[Row]:
+    found = []
+    for criterion in settings.criteria:
+        for cell in settings.cells():
+            diff, finals = difference(folder, criterion, cell)
+            found.append(Row(criterion, cell, diff, finals["revolute"], finals["rolling"]))
+    return found
+
+
+COLUMNS = (
+    "speed [m/s]",
+    "clearance [m]",
+    "knee bend [rad]",
+    "knots",
+    "criterion",
+    "unit",
+    "revolute",
+    "rolling",
+    "difference [%]",
+    "uncertainty [%]",
+    "distinguishable",
+    "discretization [%]",
+    "tolerance [%]",
+    "starts spread [%]",
+    "starts at best revolute",
+    "starts at best rolling",
+    f"difference with {RICHER_KNOTS} knots [%]",
+    "why empty",
+)
+
+
+def csv_text(table: list[Row]) -> str:
+    """``atlas.csv``: one line per cell and criterion, in ``COLUMNS``."""
+
+    def number(value, digits):
+        return "" if value is None else f"{value:.{digits}g}"
+
+    lines = [",".join(COLUMNS)]
+    for row in table:
+        d = row.difference
+        costs = [
+            None if r is None or d.value is None else r["costs"][row.criterion]
+            for r in (row.revolute, row.rolling)
+        ]
+        starts = [
+            "" if r is None else str(r["starts_at_best"]) for r in (row.revolute, row.rolling)
+        ]
+        cells = [
+            f"{row.cell.speed:.3f}",
+            f"{row.cell.clearance:.3f}",
+            f"{row.cell.knee_bend:.3f}",
+            "1",
+            row.criterion,
+            CRITERION_UNITS[row.criterion],
+            number(costs[0], 10),
+            number(costs[1], 10),
+            number(d.value, 6),
+            number(None if d.value is None else d.uncertainty, 3),
+            "" if d.value is None else ("yes" if d.distinguishable else "no"),
+            number(d.discretization, 3),
+            number(d.tolerance, 3),
+            number(d.starts, 3),
+            *starts,
+            number(d.richer, 6),
+            f'"{d.why}"' if d.why else "",
+        ]
+        lines.append(",".join(cells))
+    return "\n".join(lines) + "\n"
+
+
+def figure(settings: Settings, table: list[Row], criterion: str):
+    """The figure of one criterion (matplotlib ``Figure``), as the module says."""
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Rectangle
+
+    bends = settings.knee_bends
+    fig = Figure(figsize=(5.2 * len(bends) + 5.6, 4.6), layout="constrained")
+    axes = fig.subplots(1, len(bends) + 1, squeeze=False)[0]
+    mine = [r for r in table if r.criterion == criterion]
+    values = [r.difference.value for r in mine if r.difference.value is not None]
+    top = max([abs(v) for v in values], default=1.0) or 1.0
+    speeds, clearances = np.array(settings.speeds), np.array(settings.clearances)
+    for ax, bend in zip(axes[:-1], bends, strict=True):
+        grid = np.full((len(clearances), len(speeds)), np.nan)
+        for r in mine:
+            if r.cell.knee_bend != bend or r.difference.value is None:
+                continue
+            grid[list(clearances).index(r.cell.clearance), list(speeds).index(r.cell.speed)] = (
+                r.difference.value
+            )
+        image = ax.imshow(
+            grid,
+            origin="lower",
+            cmap="RdBu_r",
+            vmin=-top,
+            vmax=top,
+            aspect="auto",
+            extent=(-0.5, len(speeds) - 0.5, -0.5, len(clearances) - 0.5),
+        )
+        for r in mine:
+            if r.cell.knee_bend != bend:
+                continue
+            x, y = list(speeds).index(r.cell.speed), list(clearances).index(r.cell.clearance)
+            d = r.difference
+            if d.value is None:
+                ax.plot(x, y, "kx", markersize=10)
+            else:
+                ax.text(x, y, f"{d.value:+.1f}", ha="center", va="center", fontsize=7)
+                if not d.distinguishable:
+                    ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, fill=False, hatch="///", lw=0))
+        ax.set_xticks(range(len(speeds)), [f"{s:g}" for s in speeds])
+        ax.set_yticks(range(len(clearances)), [f"{100 * c:g}" for c in clearances])
+        ax.set_xlabel("speed [m/s]")
+        ax.set_ylabel("swing-foot clearance [cm]")
+        ax.set_title(f"stance knee bent {bend:g} rad at least", fontsize=9)
+        fig.colorbar(image, ax=ax, label="(rolling − revolute) / revolute [%]")
+    curves = axes[-1]
+    for k, clearance in enumerate(clearances):
+        picked = [
+            r
+            for r in mine
+            if r.cell.clearance == clearance
+            and r.cell.knee_bend == bends[0]
+            and r.difference.value is not None
+        ]
+        if not picked:
+            continue
+        curves.errorbar(
+            [r.cell.speed for r in picked],
+            [r.difference.value for r in picked],
+            yerr=[r.difference.uncertainty for r in picked],
+            fmt="o-",
+            capsize=3,
+            color=f"C{k}",
+            label=f"clearance {100 * clearance:g} cm",
+        )
+    curves.axhline(0.0, color="k", lw=0.8)
+    curves.set_xlabel("speed [m/s]")
+    curves.set_ylabel("(rolling − revolute) / revolute [%]")
+    curves.set_title(f"knee bent {bends[0]:g} rad at least; bars: uncertainty", fontsize=9)
+    curves.legend(fontsize=7)
+    fig.suptitle(
+        f"{CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: rolling vs revolute "
+        "knee (blue: the rolling knee needs less; hatched: not distinguishable; x: no "
+        "certified optimum)",
+        fontsize=10,
+    )
+    return fig
+
+
+def sentences(settings: Settings, table: list[Row], walks=()) -> str:
+    """``atlas.md``: what the numbers say, criterion by criterion, computed from them."""
+    lines = ["# Where the rolling knee pays off", ""]
+    lines.append(
+        f"Optimal gaits of both knees (Table 1 robot unless the record says otherwise) over "
+        f"{len(settings.speeds)} speeds ({settings.speeds[0]:g}-{settings.speeds[-1]:g} m/s), "
+        f"{len(settings.clearances)} swing-foot clearances "
+        f"({', '.join(f'{100 * c:g}' for c in settings.clearances)} cm) and least stance-knee "
+        f"bends of {', '.join(f'{b:g}' for b in settings.knee_bends)} rad. Each difference is "
+        "(rolling − revolute) / revolute on the check grid, with its uncertainty: the finer "
+        "grid's change, the tighter tolerance's and the spread of the starts; a difference "
+        "no larger than it is not distinguishable."
+    )
+    for criterion in settings.criteria:
+        lines += ["", f"## {CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]", ""]
+        lines += _criterion_sentences([r for r in table if r.criterion == criterion])
+    if walks:
+        lines += ["", "## Do the optima walk?", ""]
+        lines += [f"- {line}" for line in walks]
+    return "\n".join(lines) + "\n"
+
+
+def _where(row: Row) -> str:
+    cell = row.cell
+    bend = f", knee bent {cell.knee_bend:g} rad" if cell.knee_bend else ""
+    return f"{cell.speed:g} m/s, clearance {100 * cell.clearance:g} cm{bend}"
+
+
+def _criterion_sentences(mine: list[Row]) -> list[str]:
+    done = [r for r in mine if r.difference.value is not None]
+    lines = []
+    if not done:
+        return ["No cell has certified optima of both knees."]
+    less = [r for r in done if r.difference.distinguishable and r.difference.value < 0]
+    more = [r for r in done if r.difference.distinguishable and r.difference.value > 0]
+    blind = [r for r in done if not r.difference.distinguishable]
+    if less:
+        best = min(less, key=lambda r: r.difference.value)
+        lines.append(
+            f"- The rolling knee needs less in {len(less)} of {len(done)} cells, by "
+            f"{-best.difference.value:.2f} ± {best.difference.uncertainty:.2f} % at most "
+            f"({_where(best)})."
+        )
+    else:
+        lines.append(f"- The rolling knee needs distinguishably less in none of {len(done)} cells.")
+    if more:
+        worst = max(more, key=lambda r: r.difference.value)
+        lines.append(
+            f"- It needs more in {len(more)} cells, by {worst.difference.value:.2f} ± "
+            f"{worst.difference.uncertainty:.2f} % at most ({_where(worst)})."
+        )
+    if blind:
+        lines.append(
+            f"- The knees cannot be told apart in {len(blind)} cells (the difference no larger "
+            f"than its uncertainty): {', '.join(_where(r) for r in blind[:6])}"
+            + (" ..." if len(blind) > 6 else "")
+            + "."
+        )
+    empty = [r for r in mine if r.difference.value is None]
+    if empty:
+        lines.append(
+            f"- {len(empty)} cells have no certified optimum of both knees: "
+            + "; ".join(f"{_where(r)} ({r.difference.why})" for r in empty[:6])
+            + (" ..." if len(empty) > 6 else "")
+            + "."
+        )
+    richer = [r for r in done if r.difference.richer is not None]
+    if richer:
+        moves = [r.difference.richer - r.difference.value for r in richer]
+        lines.append(
+            f"- With the richer gait ({RICHER_KNOTS} interior knots) at {len(richer)} corner "
+            f"cells the difference moves by {min(moves):+.2f} to {max(moves):+.2f} points."
+        )
+    return lines
+
+
+def write(folder, out=None, walks=()) -> list[Path]:
+    """``atlas.csv``, ``atlas-<criterion>.png`` and ``atlas.md`` of the atlas in ``folder``, in
+    ``out`` (default the folder); ``walks``: lines saying which optima walk in MuJoCo."""
+    settings = load(folder)
+    out = Path(folder if out is None else out)
+    out.mkdir(parents=True, exist_ok=True)
+    table = rows(folder, settings)
+    written = [atomic_write_text(out / "atlas.csv", csv_text(table))]
+    for criterion in settings.criteria:
+        path = out / f"atlas-{criterion}.png"
+        with atomic_path(path) as tmp:
+            figure(settings, table, criterion).savefig(tmp, dpi=110, format="png")
+        written.append(path)
+    written.append(atomic_write_text(out / "atlas.md", sentences(settings, table, walks)))
+    return written

@@ -1,0 +1,469 @@
+"""The atlas: where the rolling knee pays off, over speed x swing-foot clearance (x a least
+stance-knee bend), each difference between the knees with its error bar.
+
+Each cell (speed, clearance, knee bend) holds, for each knee and criterion, a certified
+optimum of the paper's spline, in the campaign's stages (``biped.studies.campaign``):
+
+1. ``own``: the point's own starts (``biped.optimization.optimize.optimize``); the
+   criteria of the joints' work start from the sthenic optimum of the same point;
+2. ``final``: again from the ``own`` optima of the neighbouring cells (speed and clearance)
+   and of the other knee; the best of both is the point's answer, written as a gait file;
+3. ``fine``, ``tight``, ``richer``: the final optimum re-solved with twice the samples per
+   piece (the discretization), to a hundred times tighter tolerance (the solver's), and, at
+   the corner cells, in the family of 3 interior knots (``biped.model.gait``), which holds the
+   paper's spline: how much the difference moves when the gait is richer.
+
+The difference of a cell is (rolling − revolute) / revolute of the criterion on the check
+grid (``biped.optimization.comparison.relative_change``). Its uncertainty (``Difference``) adds
+what moves it: the finer grid's difference less the cell's, the tighter tolerance's less
+the cell's, and the spread of the starts (for a knee whose best value one start alone reached,
+the distance to the next optimum the starts reached). A difference no larger than its
+uncertainty is not distinguishable. A point whose solver did not converge, or whose optimum
+is infeasible, leaves its cell empty, with why.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from biped.errors import BipedError
+from biped.model.criteria import CRITERION_UNITS, WORK_CRITERIA, Safety
+from biped.model.dynamics import Biped
+from biped.model.gait import check_knots
+from biped.model.kinematics import KNEES
+from biped.model.robot import Robot
+from biped.optimization.optimize import (
+    TIGHT,
+    Optimum,
+    Report,
+    best_of,
+    checked,
+    optimize,
+    refine,
+    single_start_note,
+)
+from biped.optimization.problem import GaitProblem, check_criterion, check_speed
+from biped.records import gait_file
+from biped.records.comparison import relative_change
+from biped.runtime.files import atomic_write_text, distinct_values
+from biped.studies import campaign
+from biped.studies.campaign import Task
+
+MANIFEST = "atlas.json"
+ATLAS = campaign.Campaign(
+    "atlas", MANIFEST, "atlas record", "this folder's atlas was", "an atlas's", "atlas files"
+)
+# The defaults: the speeds from 0.2 m/s to 1 m/s, the clearances, the per-metre criteria.
+DEFAULT_SPEEDS = tuple(float(v) for v in np.round(np.arange(0.2, 1.0001, 0.1), 6))
+DEFAULT_CLEARANCES = (0.0, 0.01, 0.02, 0.03, 0.05)
+DEFAULT_CRITERIA = ("sthenic", "energy-per-metre")
+# The richer family of the corner cells, and the factor of the finer grid.
+RICHER_KNOTS = 3
+FINER = 2
+STAGES = ("own", "final", "fine", "tight", "richer")
+
+
+@dataclass(frozen=True)
+class Cell:
+    speed: float  # [m/s]
+    clearance: float  # [m]
+    knee_bend: float  # [rad]
+
+    def name(self) -> str:
+        return f"{self.speed:.3f}-c{1000 * self.clearance:.0f}mm-b{1000 * self.knee_bend:.0f}mrad"
+
+
+@dataclass(frozen=True)
+class Point:
+    """One optimization of the atlas: a ``stage`` (``STAGES``) of a knee and criterion in a
+    cell."""
+
+    stage: str
+    knee: str
+    criterion: str
+    cell: Cell
+
+    def filename(self) -> str:
+        return f"{self.stage}/{self.knee}-{self.criterion}-{self.cell.name()}.json"
+
+    def gait_filename(self) -> str:
+        """The final optimum's gait file, in the atlas's folder."""
+        return f"{self.knee}-{self.criterion}-{self.cell.name()}.json"
+
+    def at(self, stage: str, knee: str | None = None) -> Point:
+        return Point(stage, knee or self.knee, self.criterion, self.cell)
+
+
+@dataclass(frozen=True)
+class Settings(campaign.Settings):
+    """What shapes an atlas's numbers, recorded in its folder."""
+
+    FORMAT = "biped-atlas/1"
+    robot: Robot
+    speeds: tuple
+    clearances: tuple
+    knee_bends: tuple
+    criteria: tuple
+    knots: int
+    seed: int
+    starts: int
+
+    def cells(self) -> list[Cell]:
+        return [
+            Cell(s, c, b) for b in self.knee_bends for c in self.clearances for s in self.speeds
+        ]
+
+    def corners(self) -> list[Cell]:
+        """The cells of the richer family: the corners of speed x clearance, every bend (none
+        unless the atlas is of the paper's spline, which the richer family holds)."""
+        if self.knots != 1:
+            return []
+        return [
+            Cell(s, c, b)
+            for b in self.knee_bends
+            for c in sorted({self.clearances[0], self.clearances[-1]})
+            for s in sorted({self.speeds[0], self.speeds[-1]})
+        ]
+
+    def problem(self, point: Point, knots: int | None = None, samples=None) -> GaitProblem:
+        cell = point.cell
+        safety = Safety(clearance=cell.clearance, knee_bend=cell.knee_bend)
+        model = Biped(self.robot, point.knee)
+        knots = self.knots if knots is None else knots
+        return GaitProblem(model, cell.speed, point.criterion, safety, samples, knots)
+
+
+def check_settings(settings: Settings) -> Settings:
+    """The settings if every value is allowed (each speed walkable, distinct at the files'
+    resolution; clearances and bends margins of ``Safety``), else a clear error."""
+    for speed in settings.speeds:
+        check_speed(Biped(settings.robot, "revolute"), speed)
+    distinct_values(settings.speeds, "speeds", "m/s", 3, "1 mm/s")
+    distinct_values(settings.clearances, "clearances", "m", 3, "1 mm")
+    distinct_values(settings.knee_bends, "knee bends", "rad", 3, "1 mrad")
+    for clearance in settings.clearances:
+        Safety(clearance=clearance)
+    for bend in settings.knee_bends:
+        Safety(knee_bend=bend)
+    for criterion in settings.criteria:
+        check_criterion(criterion)
+    check_knots(settings.knots)
+    return settings
+
+
+def read(folder, point: Point) -> dict | None:
+    """The record of ``point`` in ``folder``, None if missing or unreadable."""
+    try:
+        content = json.loads((Path(folder) / point.filename()).read_text())
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    return content if isinstance(content, dict) and "status" in content else None
+
+
+def _record(optimum: Optimum, seconds: float) -> dict:
+    """What a stage keeps of an optimum: its status, costs, starts and variables."""
+    report, ev = optimum.report, optimum.evaluation
+    single = report.converged and report.starts_at_best < 2
+    return {
+        "status": report.status,
+        "feasible": optimum.feasible,
+        "certified": optimum.certified,
+        "value": _finite(optimum.value),
+        "costs": {
+            "sthenic": ev.sthenic,
+            "energy": ev.energy,
+            "energy-per-metre": ev.energy / optimum.step.step_length,
+        },
+        "starts": report.starts,
+        "starts_at_best": report.starts_at_best,
+        "single_start": single_start_note(report) if single else None,
+        "next_optimum": _next_optimum(report) if single else 0.0,
+        "violations": optimum.evaluation.violations_line(),
+        "period": optimum.step.period,
+        "step_length": optimum.step.step_length,
+        "seconds": seconds,
+        "report": report.to_dict(),
+        "variables": [_finite(v) for v in optimum.variables],
+    }
+
+
+def _finite(value):
+    return float(value) if math.isfinite(value) else None
+
+
+def _next_optimum(report: Report) -> float:
+    """The relative distance to the next optimum the starts reached above the best (0 when
+    none did)."""
+    best = report.value
+    above = [
+        s.value
+        for s in report.history
+        if s.status == "Solve_Succeeded" and np.isfinite(s.value) and s.value > best * (1 + 1e-6)
+    ]
+    return min(above) / best - 1.0 if above else 0.0
+
+
+def _optimum(settings: Settings, point: Point, content: dict) -> Optimum | None:
+    """The optimum a record holds (its numbers again: JSON keeps every bit)."""
+    if content is None or any(v is None for v in content["variables"]):
+        return None
+    problem = settings.problem(point)
+    return checked(problem, np.array(content["variables"]), Report.from_dict(content["report"]))
+
+
+def _write(task: Task, optimum: Optimum, began: float) -> dict:
+    content = _record(optimum, time.perf_counter() - began)
+    atomic_write_text(task.path, json.dumps(content, indent=1, allow_nan=False))
+    return content
+
+
+def _line(point: Point, content: dict) -> str:
+    status = campaign.failure(content["status"], content["feasible"])
+    if status is None:
+        status = "certified" if point.stage == "final" else "converged, feasible"
+    value = content["costs"][point.criterion]
+    return (
+        f"[{point.stage:6}] {point.knee:8} {point.criterion:16} {point.cell.speed:.3f} m/s "
+        f"clearance {100 * point.cell.clearance:4.1f} cm bend {point.cell.knee_bend:.3f} rad  "
+        f"C = {value:12.6f} {CRITERION_UNITS[point.criterion]:6} {status}; "
+        f"{content['starts_at_best']}/{content['starts']} starts at best  "
+        f"{content['seconds']:5.1f} s"
+    )
+
+
+def _solve_own(task: Task) -> str:
+    """A point's own starts; a work criterion's also from the sthenic optimum (``given``)."""
+    settings, point, began = task.settings, task.point, time.perf_counter()
+    sthenic = None
+    for twin in task.given:
+        sthenic = _optimum(settings, twin, read(task.folder, twin))
+    problem = settings.problem(point)
+    optimum = optimize(problem, seed=settings.seed, starts=settings.starts, sthenic=sthenic, jobs=1)
+    return _line(point, _write(task, optimum, began))
+
+
+def _solve_final(task: Task) -> str:
+    """A point's answer: its own optimum, or better from its neighbours' (``given``)."""
+    settings, point, began = task.settings, task.point, time.perf_counter()
+    own = _optimum(settings, point.at("own"), read(task.folder, point.at("own")))
+    problem = settings.problem(point)
+    given = [read(task.folder, p) for p in task.given]
+    starts = [np.array(c["variables"]) for c in given if c and None not in c["variables"]]
+    optimum = own
+    if starts:
+        again = optimize(problem, seed=settings.seed, starts=0, given=starts, jobs=1)
+        optimum = again if own is None else best_of(problem, [own, again])
+    content = _write(task, optimum, began)
+    gait = gait_file.Gait.from_optimum(optimum, settings.robot)
+    gait.write(Path(task.folder) / point.gait_filename())
+    return _line(point, content)
+
+
+def _solve_refined(task: Task) -> str:
+    """The final optimum re-solved: on the finer grid (``fine``), more tightly (``tight``),
+    or in the richer family from it and from the other knee's (``richer``)."""
+    settings, point, began = task.settings, task.point, time.perf_counter()
+    final = read(task.folder, point.at("final"))
+    if final is None or None in final["variables"]:
+        raise BipedError(f"{point.at('final').filename()}: no final optimum to refine")
+    start = np.array(final["variables"])
+    if point.stage == "fine":
+        samples = FINER * settings.problem(point).samples_per_half
+        optimum = refine(settings.problem(point, samples=samples), start)
+    elif point.stage == "tight":
+        optimum = refine(settings.problem(point), start, "given" + TIGHT)
+    else:
+        richer = settings.problem(point, knots=RICHER_KNOTS)
+        others = [read(task.folder, p) for p in task.given]
+        starts = [start] + [
+            np.array(c["variables"]) for c in others if c and None not in c["variables"]
+        ]
+        optimum = optimize(richer, starts=0, given=[richer.embedded(z) for z in starts], jobs=1)
+    return _line(point, _write(task, optimum, began))
+
+
+def stages(folder: Path, settings: Settings) -> list[list[Task]]:
+    """The tasks still to run, in the order their inputs need."""
+    cells = settings.cells()
+    index = {cell: k for k, cell in enumerate(cells)}
+    sthenic = "sthenic" in settings.criteria
+
+    def done(point):
+        return read(folder, point) is not None
+
+    def task(solve, point, given=()):
+        return Task(solve, settings, point, str(folder), tuple(given))
+
+    def points(stage, criteria, cells_=cells):
+        return [Point(stage, k, c, cell) for c in criteria for cell in cells_ for k in KNEES]
+
+    work = [c for c in settings.criteria if c in WORK_CRITERIA]
+    first = [c for c in settings.criteria if c not in work or not sthenic]
+    own = [
+        [task(_solve_own, p) for p in points("own", first) if not done(p)],
+        [
+            task(_solve_own, p, [Point("own", p.knee, "sthenic", p.cell)])
+            for p in points("own", [c for c in work if sthenic])
+            if not done(p)
+        ],
+    ]
+    final = [
+        task(_solve_final, p, _neighbours(p, settings, index))
+        for p in points("final", settings.criteria)
+        if not done(p)
+    ]
+    refined = [
+        task(_solve_refined, p)
+        for stage in ("fine", "tight")
+        for p in points(stage, settings.criteria)
+        if not done(p)
+    ]
+    refined += [
+        task(_solve_refined, p, [p.at("final", other) for other in KNEES if other != p.knee])
+        for p in points("richer", settings.criteria, settings.corners())
+        if not done(p)
+    ]
+    return [*own, final, refined]
+
+
+def _neighbours(point: Point, settings: Settings, index: dict) -> list[Point]:
+    """The ``own`` optima that start a point's final solve: the neighbouring speeds and
+    clearances of its cell, and the other knee."""
+    cell = point.cell
+    found = []
+    for values, field in ((settings.speeds, "speed"), (settings.clearances, "clearance")):
+        at = list(values).index(getattr(cell, field))
+        for j in (at - 1, at + 1):
+            if 0 <= j < len(values):
+                found.append(dataclasses.replace(cell, **{field: values[j]}))
+    own = [Point("own", point.knee, point.criterion, c) for c in found]
+    return own + [Point("own", k, point.criterion, cell) for k in KNEES if k != point.knee]
+
+
+def run_atlas(folder, settings: Settings, **where) -> Settings:
+    """Every optimization of the atlas not yet in ``folder``; returns its settings.
+    ``where``: ``jobs``, ``dask``, ``stream``, ``progress``, as ``campaign.Campaign.run``."""
+    check_settings(settings)
+    folder = ATLAS.claim(folder, settings, *STAGES)
+    tasks = stages(folder, settings)
+    total = len(settings.cells()) * len(settings.criteria) * len(KNEES) * 4
+    total += len(settings.corners()) * len(settings.criteria) * len(KNEES)
+    remaining = sum(map(len, tasks))
+    plan = (
+        f"atlas: {total} optimizations of {len(settings.cells())} cells x "
+        f"{len(settings.criteria)} criteria x 2 knees in {folder} (own starts, final, finer "
+        f"grid, tighter tolerance, {RICHER_KNOTS} knots at the corners): "
+        f"{total - remaining} already done, {remaining} to run"
+    )
+    ATLAS.run(plan, tasks, lambda: summarize(folder, settings), **where)
+    return settings
+
+
+def summarize(folder, settings: Settings) -> str:
+    """How many final optima are certified, which are not and why."""
+    finals = [
+        Point("final", k, c, cell)
+        for c in settings.criteria
+        for cell in settings.cells()
+        for k in KNEES
+    ]
+
+    def why_not(point):
+        content = read(folder, point)
+        if content is None:
+            return "missing"
+        why = campaign.failure(content["status"], content["feasible"])
+        return f"{why} ({content['violations']})" if why == "INFEASIBLE" else why
+
+    counted = "points certified (final optima, solver converged, feasible on the check grid)"
+    return campaign.tally(finals, why_not, counted, most=8)
+
+
+@dataclass(frozen=True)
+class Difference:
+    """The knees compared in one cell for one criterion [%], with what moves the difference.
+
+    Attributes:
+        value: (rolling − revolute) / revolute on the check grid [%], None without both.
+        discretization: the finer grid's difference less ``value`` [%].
+        tolerance: the tighter tolerance's less ``value`` [%].
+        starts: the spread of the starts [%]: √ of the squared distances to the next optimum
+            of each knee whose best one start alone reached.
+        richer: the difference with the richer family (corner cells) [%], else None.
+        why: why there is no difference (a knee not certified), else "".
+    """
+
+    value: float | None
+    discretization: float
+    tolerance: float
+    starts: float
+    richer: float | None
+    why: str
+
+    @property
+    def uncertainty(self) -> float:
+        """[%] The sum of the three."""
+        return abs(self.discretization) + abs(self.tolerance) + self.starts
+
+    @property
+    def distinguishable(self) -> bool:
+        return self.value is not None and abs(self.value) > self.uncertainty
+
+
+def difference(folder, criterion: str, cell: Cell) -> tuple[Difference, dict]:
+    """The cell's ``Difference`` for ``criterion`` and each knee's final record."""
+    records = {
+        stage: {k: read(folder, Point(stage, k, criterion, cell)) for k in KNEES}
+        for stage in STAGES
+    }
+    finals = records["final"]
+    bad = [k for k in KNEES if finals[k] is None or not finals[k]["certified"]]
+    if bad:
+        reasons = []
+        for knee in bad:
+            content = finals[knee]
+            if content is None:
+                reasons.append(f"{knee} missing")
+            else:
+                why = campaign.failure(content["status"], content["feasible"])
+                detail = f": {content['violations']}" if content["violations"] else ""
+                reasons.append(f"{knee} {why}{detail}")
+        return Difference(None, 0.0, 0.0, 0.0, None, "; ".join(reasons)), finals
+
+    def change(stage):
+        contents = records[stage]
+        if any(c is None or not c["certified"] for c in contents.values()):
+            return None
+        return relative_change(
+            contents["rolling"]["costs"][criterion], contents["revolute"]["costs"][criterion]
+        )
+
+    value = change("final")
+    moved = {stage: change(stage) for stage in ("fine", "tight", "richer")}
+    spread = 100 * math.sqrt(sum(finals[k]["next_optimum"] ** 2 for k in KNEES))
+    return (
+        Difference(
+            value=value,
+            discretization=0.0 if moved["fine"] is None else moved["fine"] - value,
+            tolerance=0.0 if moved["tight"] is None else moved["tight"] - value,
+            starts=spread,
+            richer=moved["richer"],
+            why="",
+        ),
+        finals,
+    )
+
+
+def load(folder) -> Settings:
+    """The settings of the atlas in ``folder``."""
+    found = ATLAS.read(folder)
+    if found is None:
+        raise BipedError(f"{Path(folder) / MANIFEST}: no atlas there: run 'biped atlas'")
+    return Settings.from_dict(found)
