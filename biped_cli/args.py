@@ -13,8 +13,8 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.criteria import CRITERIA, MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
 from biped.model.kinematics import KNEES
+from biped.optimization.comparison import CERTIFIED
 from biped.optimization.problem import MIN_SPEED
-from biped.records.comparison import CERTIFIED
 from validate import DEFAULT_STEPS
 
 # What an option naming an output says of its missing folders (the path written is printed).

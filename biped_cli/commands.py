@@ -99,7 +99,7 @@ def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
     its gait file, what the comparisons use); its criterion on the solver's samples
     (``optimizer.value``, what ranked the starts; left out for a result without it)."""
     from biped.model.criteria import CRITERION_UNITS
-    from biped.records.comparison import (
+    from biped.optimization.comparison import (
         CHECK_SAMPLES_PER_STEP,
         NELDER_MEAD_SAMPLES_PER_STEP,
         SOLVER_SAMPLES_PER_STEP,

@@ -172,7 +172,7 @@ def cmd_design_map(args) -> int:
     when an optimization is not certified (converged and feasible).
     """
     from biped.model.criteria import CRITERION_UNITS
-    from biped.records.comparison import DIFFERENCE_VS_REVOLUTE
+    from biped.optimization.comparison import DIFFERENCE_VS_REVOLUTE
     from biped.runtime.runner import check_dask
     from biped.studies.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
     from validate.workflows import bound_notes

@@ -1,4 +1,4 @@
-"""The words and the sign of comparisons (``biped.records.comparison``): one sign for a difference
+"""The words and the sign of comparisons (``biped.optimization.comparison``): one sign for a difference
 between knees, the two values of a gait file's criterion named for what they are, and
 "certified" said of a sweep's final optima only."""
 
@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from biped.records.comparison import (
+from biped.optimization.comparison import (
     CHECK_SAMPLES_PER_STEP,
     CHECKED_VALUE,
     SOLVER_SAMPLES_PER_STEP,

@@ -15,15 +15,44 @@ ROOT = Path(__file__).resolve().parents[1]
 FORBIDDEN = ("validate", "mujoco", "rerun", "biped_cli")
 
 
-def imported_modules(path: Path) -> set[str]:
-    """Top-level names of the modules a Python file imports, anywhere in it."""
+# The layers of ``biped``, lowest first: each subpackage imports only those below it.
+LAYERS = ("runtime", "model", "optimization", "records", "studies", "pages")
+
+
+def imported_modules(path: Path, depth: int = 1) -> set[str]:
+    """Names of the modules a Python file imports, anywhere in it, to ``depth`` parts."""
     names = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
         if isinstance(node, ast.Import):
-            names.update(alias.name.split(".")[0] for alias in node.names)
+            found = [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            names.add(node.module.split(".")[0])
+            found = [node.module]
+        else:
+            continue
+        names.update(".".join(name.split(".")[:depth]) for name in found)
     return names
+
+
+def upward_imports(root: Path) -> dict:
+    """{module: the biped layers above its own that it imports} of the tree at ``root``."""
+    found = {}
+    for layer in LAYERS:
+        above = {f"biped.{other}" for other in LAYERS[LAYERS.index(layer) + 1 :]}
+        for path in sorted((root / "biped" / layer).glob("*.py")):
+            offending = sorted(imported_modules(path, depth=2) & above)
+            if offending:
+                found[str(path.relative_to(root))] = offending
+    return found
+
+
+def test_each_layer_imports_only_the_layers_below_it(tmp_path):
+    """No module of a biped subpackage imports a layer above its own (``LAYERS``); a module
+    of the optimization layer importing the records layer is named."""
+    assert upward_imports(ROOT) == {}
+    wrong = tmp_path / "biped" / "optimization"
+    wrong.mkdir(parents=True)
+    (wrong / "design.py").write_text("from biped.records.gait_file import Gait\n")
+    assert upward_imports(tmp_path) == {"biped/optimization/design.py": ["biped.records"]}
 
 
 def test_imported_modules_sees_nested_imports(tmp_path):

@@ -202,8 +202,7 @@ def test_page_says_where_constraints_dip_below_the_solver_margin(optimal_page):
     from biped.model.criteria import evaluate_step, margin_profile
     from biped.model.dynamics import Biped
     from biped.model.gait import build_step
-    from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
-    from biped.optimization.problem import SOLVER_SAMPLES_PER_HALF
+    from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PER_HALF
     from biped.pages.page import CONSTRAINT_MEANING
 
     gait, text, figures = optimal_page

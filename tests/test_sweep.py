@@ -421,8 +421,8 @@ def test_a_sweep_lacking_a_criterion_gives_the_other_and_says_what_it_leaves_out
 def test_every_difference_between_the_knees_has_one_sign(sweep, tmp_path):
     """(rolling − revolute) / revolute in %, negative where the rolling knee needs less:
     in comparison.md (the paper's numbers too) and in the figures' difference panels."""
+    from biped.optimization.comparison import DIFFERENCE, relative_change
     from biped.pages.figures import PAPER, read_sweep, sweep_figures
-    from biped.records.comparison import DIFFERENCE, relative_change
 
     assert relative_change(0.9, 1.0) == pytest.approx(-10.0)
     assert PAPER["sthenic_difference"] < 0 and PAPER["energy_difference"] < 0  # less: rolling
@@ -456,8 +456,8 @@ def test_criterion_figures_say_their_units_and_sign_and_why_fig8_middle_scatters
     set as mathtext (no literal underscore), the knees are named in words, a third panel
     holds the difference in %, and Fig. 8 says why the sthenic criterion of the energy
     optima is not a smooth curve."""
+    from biped.optimization.comparison import DIFFERENCE
     from biped.pages.figures import OTHER_NOTES, criterion_figure
-    from biped.records.comparison import DIFFERENCE
 
     series = _synthetic_series()
     for criterion, other in (("sthenic", "energy"), ("energy", "sthenic")):

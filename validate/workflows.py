@@ -126,7 +126,7 @@ def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool
     """Run the pipeline (``Pipeline``), printing with ``say``; whether every gait is feasible
     and passes every check."""
     from biped.model.criteria import CRITERIA
-    from biped.records.comparison import DIFFERENCE, relative_change
+    from biped.optimization.comparison import DIFFERENCE, relative_change
 
     passed, optima, written = True, {}, {}
     for knee in pipeline.knees:

@@ -55,6 +55,7 @@ from biped.errors import BipedError
 from biped.model.criteria import PAPER_SAFETY, WORK_CRITERIA, Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import LENGTH_MIN, Robot
+from biped.optimization.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
 from biped.optimization.optimize import (
     DEFAULT_STARTS,
     GUESS_PERIODS,
@@ -70,7 +71,6 @@ from biped.optimization.optimize import (
 )
 from biped.optimization.problem import GaitProblem, check_criterion, check_speed
 from biped.optimization.solver import Solver
-from biped.records.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
 
 RADII = ("r1", "r2")
 # [m] Lower bound of a designed knee radius: the smallest length of a robot
@@ -388,9 +388,9 @@ class Comparison:
         return all(optimum.certified for _, _, optimum in self.rows())
 
     def gains(self) -> dict:
-        """[%] Change of the criterion (``biped.records.comparison.relative_change``: negative, the
-        first needs less): the design against the revolute knee and against the Table 1
-        radii, the Table 1 radii against the revolute knee."""
+        """[%] Change of the criterion (``comparison.relative_change``: negative, the first
+        needs less): the design against the revolute knee and against the Table 1 radii, the
+        Table 1 radii against the revolute knee."""
         design, revolute, reference = self.design.value, self.revolute.value, self.reference.value
         return {
             "design_vs_revolute": relative_change(design, revolute),

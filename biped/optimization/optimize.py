@@ -38,6 +38,8 @@ from biped.model.gait import Step, build_step
 from biped.optimization import table
 from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
 from biped.optimization.problem import (  # noqa: F401 (re-exported)
+    CHECK_SAMPLES,
+    CHECK_SAMPLES_PER_HALF,
     FIRST_GUESS_PERIOD,
     SCALES,
     GaitProblem,
@@ -60,10 +62,6 @@ GUESS_PERIODS = (FIRST_GUESS_PERIOD, 0.8, 0.45)
 PERTURBATION = 1.0
 # Two starts reach the same optimum when their values agree to this, relative.
 AGREEMENT = 1e-6
-# Samples per spline piece of the feasibility check of an optimum (202 per step), and the same
-# per piece of each family (``biped.model.gait.KNOTS``), about as many per step.
-CHECK_SAMPLES_PER_HALF = 100
-CHECK_SAMPLES = {1: CHECK_SAMPLES_PER_HALF, 3: 50, 5: 34}
 
 
 @dataclass(frozen=True)

@@ -69,12 +69,13 @@ SCALES = np.array([0.03, 0.03, 0.03] + [0.3] * 5 + [2.0] * 12 + [0.05])
 # Duration of a step in the first guess [s].
 FIRST_GUESS_PERIOD = 0.6
 # Samples per spline piece where the solver imposes the constraints Ψ_i >= δ_i (each piece
-# closed: 26 samples); feasibility is then checked on a finer grid
-# (``biped.optimization.optimize.CHECK_SAMPLES_PER_HALF``), where Ψ_i may dip below δ_i
-# between them.
+# closed: 26 samples); feasibility is then checked on a finer grid (``CHECK_SAMPLES_PER_HALF``,
+# 202 samples per step), where Ψ_i may dip below δ_i between them.
 SOLVER_SAMPLES_PER_HALF = 25
+CHECK_SAMPLES_PER_HALF = 100
 # The same per piece of each family (``biped.model.gait.KNOTS``), about as many per step.
 SOLVER_SAMPLES = {1: SOLVER_SAMPLES_PER_HALF, 3: 13, 5: 9}
+CHECK_SAMPLES = {1: CHECK_SAMPLES_PER_HALF, 3: 50, 5: 34}
 # Scales and bounds of a richer family's knot angles [rad] and rates [rad/s].
 KNOT_SCALES = {"": 0.03, "rate_": 0.3}
 KNOT_ANGLE_BOUND = np.pi

@@ -2,5 +2,5 @@
 (``figures``), a Markdown page per gait file (``page``) and the figures of a walk's orbit
 drawn from a validation report's JSON (``orbit_figures``).
 
-May import: every other layer of ``biped``, matplotlib.
+May import: every other layer of ``biped``, numpy, matplotlib.
 """

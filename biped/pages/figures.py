@@ -7,7 +7,7 @@ Fig. 8: optimal energy criterion vs speed (left), sthenic criterion of the same 
 (middle), the difference in % (right).
 comparison.md: our headline numbers beside the paper's.
 
-Every difference between the knees is ``biped.records.comparison.relative_change``: (rolling −
+Every difference between the knees is ``biped.optimization.comparison.relative_change``: (rolling −
 revolute) / revolute in %, negative where the rolling knee needs less; every value is the
 criterion on the check grid (the gait files' ``costs``). The sthenic criterion is per metre
 walked, the energy criterion per step.
@@ -43,7 +43,13 @@ from biped.model.dynamics import JOINTS
 from biped.model.gait import FREE_ANGLES
 from biped.model.kinematics import ANGLES, BODY_DIRECTIONS, COORDINATES, KNEES
 from biped.model.robot import FOOT_FRICTION
-from biped.records.comparison import CERTIFIED, CHECK_GRID, DIFFERENCE, SOLVER_GRID, relative_change
+from biped.optimization.comparison import (
+    CERTIFIED,
+    CHECK_GRID,
+    DIFFERENCE,
+    SOLVER_GRID,
+    relative_change,
+)
 from biped.records.gait_file import Gait
 from biped.runtime.files import atomic_set
 from biped.studies.paper_method import spread_lines
@@ -97,7 +103,7 @@ TIME_AXIS = "normalised time t/T"
 
 
 def certified(gait: Gait) -> bool:
-    """Whether a gait file holds a certified optimum (``biped.records.comparison.CERTIFIED``; a
+    """Whether a gait file holds a certified optimum (``biped.optimization.comparison.CERTIFIED``; a
     sweep's files are its final optima): its solver converged and it is feasible on the
     check grid."""
     return gait.feasible and gait.optimizer.get("status") == "converged"
@@ -537,7 +543,7 @@ def comparison_table(series, flagged=()) -> str:
         "",
         *(_explanations(flexion, series, criteria) if flexion is not None else []),
         "Conventions behind our numbers (see `biped/model/gait.py`, `biped/model/criteria.py`,",
-        "`biped/records/comparison.py`):",
+        "`biped/optimization/comparison.py`):",
         "",
         "- d of eq. (30) is read as the swing foot's travel in one step, twice the step length,",
         "  so C_Γ is per metre walked; C_E of eq. (31) is per step, as printed.",

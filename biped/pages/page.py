@@ -31,8 +31,7 @@ from matplotlib.ticker import FuncFormatter
 from biped.model.criteria import CONSTRAINTS, CRITERION_UNITS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
 from biped.model.gait import PARAMETERS, build_step, half_grid
-from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
-from biped.optimization.problem import SOLVER_SAMPLES_PER_HALF
+from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PER_HALF
 from biped.pages.figures import (
     ANGLE_PANELS,
     DPI,

@@ -1,6 +1,5 @@
-"""What results are written as and compared with: the gait file (``gait_file``), the unit of
-every number in it (``units``), what produced a file (``provenance``) and the words and sign
-of every comparison between knees (``comparison``).
+"""What results are written as: the gait file (``gait_file``), the unit of every number in it
+(``units``) and what produced a file (``provenance``).
 
-May import: ``biped.model``, ``biped.optimization``, ``biped.runtime``, ``biped.errors``.
+May import: ``biped.model``, ``biped.optimization``, ``biped.runtime``, ``biped.errors``, numpy.
 """

@@ -36,9 +36,9 @@ from biped.model.gait import PARAMETERS, build_step
 from biped.model.impact import trailing_foot_lift
 from biped.model.kinematics import COORDINATES, KNEES
 from biped.model.robot import Robot
-from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF, Optimum, check_speed
-from biped.optimization.problem import VARIABLES, GaitProblem
-from biped.records.comparison import CHECKED_VALUE, SOLVER_VALUE
+from biped.optimization.comparison import CHECKED_VALUE, SOLVER_VALUE
+from biped.optimization.optimize import Optimum
+from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, VARIABLES, GaitProblem, check_speed
 from biped.records.provenance import provenance as make_provenance
 from biped.records.units import (
     CONSTRAINT_UNITS,

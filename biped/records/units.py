@@ -14,7 +14,7 @@ number (a count, a ratio) and ``"T"`` for a fraction of the gait's period; a lis
 unit per column of an array whose columns differ. A unit may be followed by what the number is,
 in parentheses, where the key alone would mislead: ``optimizer.value`` is the criterion on the
 solver's samples, which ranks the starts, where ``costs`` hold it on the check grid, which the
-comparisons use (``biped.records.comparison``). Only numbers (and null, a figure that could
+comparisons use (``biped.optimization.comparison``). Only numbers (and null, a figure that could
 not be measured) have units; texts, booleans and ``provenance`` have none.
 """
 

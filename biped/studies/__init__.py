@@ -4,5 +4,5 @@
 stages on a pool or Dask, shows progress and summarizes (``campaign``).
 
 May import: ``biped.model``, ``biped.optimization``, ``biped.records``, ``biped.runtime``,
-``biped.errors``.
+``biped.errors``, numpy, and matplotlib (the design map's figures).
 """

@@ -40,6 +40,7 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.criteria import CRITERION_UNITS, PAPER_SAFETY, Safety
 from biped.model.robot import Robot
+from biped.optimization.comparison import relative_change
 from biped.optimization.design import (
     RADII,
     DesignProblem,
@@ -49,7 +50,6 @@ from biped.optimization.design import (
 )
 from biped.optimization.optimize import DEFAULT_STARTS, optimize
 from biped.optimization.problem import VARIABLES
-from biped.records.comparison import relative_change
 from biped.runtime.files import atomic_path, atomic_write_text, distinct_values
 from biped.runtime.runner import ProgressBar
 from biped.studies import campaign
@@ -320,7 +320,7 @@ class SpeedSummary:
 
     def gain(self, value: float | None) -> float | None:
         """[%] Change of ``value`` against the revolute knee
-        (``biped.records.comparison.relative_change``: negative, ``value`` is the smaller)."""
+        (``biped.optimization.comparison.relative_change``: negative, ``value`` is the smaller)."""
         if value is None or self.revolute is None:
             return None
         return relative_change(value, self.revolute)

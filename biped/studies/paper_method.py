@@ -27,11 +27,11 @@ from biped.model.criteria import CRITERIA, CRITERION_UNITS, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
+from biped.optimization.comparison import DIFFERENCE, relative_change
 from biped.optimization.optimize import optimize
 from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
 from biped.optimization.problem import GaitProblem, check_speed
 from biped.records import gait_file
-from biped.records.comparison import DIFFERENCE, relative_change
 from biped.records.provenance import version
 from biped.runtime.runner import ProgressBar
 from biped.studies import campaign

@@ -36,6 +36,7 @@ from biped.model.dynamics import Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization import table
+from biped.optimization.comparison import SINGLE_START
 from biped.optimization.optimize import (
     DEFAULT_STARTS,
     Optimum,
@@ -47,7 +48,6 @@ from biped.optimization.optimize import (
 )
 from biped.optimization.problem import VARIABLES, GaitProblem, check_speed
 from biped.records import gait_file
-from biped.records.comparison import SINGLE_START
 from biped.runtime.runner import ProgressBar
 from biped.studies import campaign
 from biped.studies.campaign import Task
@@ -144,7 +144,7 @@ def _solve_with_neighbours(task: Task) -> str:
 
 
 # What each stage's line calls its result: only the final stage's optimum is a point's
-# answer, so only it may be called certified (``biped.records.comparison.CERTIFIED``).
+# answer, so only it may be called certified (``biped.optimization.comparison.CERTIFIED``).
 STAGES = {"independent": "own starts, stage 1/2", "final": "final, stage 2/2"}
 
 

@@ -17,9 +17,8 @@ from __future__ import annotations
 
 import math
 
-from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF
 from biped.optimization.penalty import OPTIMIZE_SAMPLES_PER_HALF
-from biped.optimization.problem import SOLVER_SAMPLES_PER_HALF
+from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PER_HALF
 
 # Convention of every difference between knees, in words (pages, figures, command lines).
 DIFFERENCE = "(rolling − revolute) / revolute; negative: the rolling knee needs less"
