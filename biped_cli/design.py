@@ -120,8 +120,8 @@ def cmd_design(args) -> int:
     the design's solver did not converge or its gait is infeasible (no file), or when a
     knee it is compared with is not certified.
     """
-    from biped.optimization.design import compare
-    from validate.workflows import bound_notes, designed_gait, radii_line, uncertified
+    from biped.optimization.design import bound_notes, compare
+    from biped.records.gait_file import Gait
 
     robot = types.robot_of(args)
     problem = design_problem(args, robot, args.speed)
@@ -132,7 +132,7 @@ def cmd_design(args) -> int:
     print(comparison.table())
     for note in bound_notes(problem, design):
         print(note)
-    print(radii_line(comparison))
+    print(comparison.radii_line())
     print(f"design: {design.report.summary()}")
     if design.report.converged and not design.report.confirmed:
         print(
@@ -148,9 +148,9 @@ def cmd_design(args) -> int:
         )
         print(f"biped design: {reason}; no file written", file=sys.stderr)
         return 1
-    path = designed_gait(comparison).write(args.out)
+    path = Gait.from_design(comparison).write(args.out)
     print(f"wrote {path}")
-    bad = uncertified(comparison)
+    bad = comparison.uncertified()
     if bad:
         print(
             "biped design: compared with knees that are not certified optima ("
@@ -173,9 +173,9 @@ def cmd_design_map(args) -> int:
     """
     from biped.model.criteria import CRITERION_UNITS
     from biped.optimization.comparison import DIFFERENCE_VS_REVOLUTE
+    from biped.optimization.design import bound_notes
     from biped.runtime.runner import check_dask
     from biped.studies.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
-    from validate.workflows import bound_notes
 
     robot = types.robot_of(args)
     problem = design_problem(args, robot, float(args.speeds[0]))

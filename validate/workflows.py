@@ -10,7 +10,6 @@ here parses options. May import ``biped`` and ``validate``, never ``biped_cli``.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -194,7 +193,7 @@ def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
     Table 1 radii and the optimal radii (the pipeline's own optima where certified), and the
     designed gait written and validated in MuJoCo as the knees' are. Returns whether every
     step passed."""
-    from biped.optimization.design import compare
+    from biped.optimization.design import bound_notes, compare
     from validate.outputs import check_owner
 
     problem, name = pipeline.design, pipeline.name("design")
@@ -210,64 +209,14 @@ def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
     design = comparison.design
     for line in comparison.table().splitlines() + bound_notes(problem, design):
         say(f"[design] {line}")
-    say(f"[design] {radii_line(comparison)}")
+    say(f"[design] {comparison.radii_line()}")
     say(f"[design] {design.report.summary()}")
     if not design.certified:
         say(f"[design] FAIL  the design is not certified: {design.report.status}")
         return False
-    gait = designed_gait(comparison)
+    gait = Gait.from_design(comparison)
     gait.write(gait_path)
     passed, lines = pipeline.validated("design", gait_path, gait, say)  # in memory, as the knees
     for line in lines:  # every file written, once
         say(f"[design] {line}")
-    return passed and not uncertified(comparison)
-
-
-def radii_line(comparison) -> str:
-    """The optimal radii and criterion of a design, and its gains over the revolute knee and
-    the Table 1 radii."""
-    from biped.model.criteria import CRITERION_UNITS
-
-    design = comparison.design
-    unit = CRITERION_UNITS[comparison.problem.criterion]
-    gains = comparison.gains()
-    bounds = design.at_bounds()
-    return (
-        f"optimal radii: r1 = {design.radii[0]:.4f} m, r2 = {design.radii[1]:.4f} m"
-        f"{' (' + ', '.join(bounds) + ')' if bounds else ''}; "
-        f"{comparison.problem.criterion} {design.value:.6g} {unit}: "
-        f"{gains['design_vs_revolute']:+.2f} % vs revolute, "
-        f"{gains['design_vs_table1']:+.2f} % vs Table 1 radii"
-    )
-
-
-def bound_notes(problem, design=None) -> list[str]:
-    """What the design's bounds did: the robot's own radii moved into them (the reference
-    design of the table), and a designed radius at its lower bound (``MIN_RADIUS``)."""
-    from biped.optimization.design import MIN_RADIUS
-
-    notes = [f"note: {sentence}" for sentence in problem.moved_reference()]
-    for bound in [] if design is None else design.at_bounds():
-        if bound.endswith("lower bound"):
-            notes.append(
-                f"note: {bound} {MIN_RADIUS:g} m: the radii are bounded away from 0, where "
-                "the rolling knee is the revolute knee (the first row); the design gains "
-                "nothing by rolling on that side"
-            )
-    return notes
-
-
-def uncertified(comparison) -> list[str]:
-    """The knees of a comparison that are not certified optima, each with why."""
-    return [
-        f"{label}: {optimum.report.status if not optimum.report.converged else 'infeasible'}"
-        for label, _, optimum in comparison.rows()
-        if not optimum.certified
-    ]
-
-
-def designed_gait(comparison) -> Gait:
-    """The gait of a design: the designed robot's gait and the comparison."""
-    design = comparison.design
-    gait = Gait.from_optimum(design.optimum, design.robot)
-    return dataclasses.replace(gait, design=comparison.to_dict())
+    return passed and not comparison.uncertified()

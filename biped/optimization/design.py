@@ -52,7 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import PAPER_SAFETY, WORK_CRITERIA, Safety
+from biped.model.criteria import CRITERION_UNITS, PAPER_SAFETY, WORK_CRITERIA, Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import LENGTH_MIN, Robot
 from biped.optimization.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
@@ -323,28 +323,17 @@ def optimize_design(
 
 @dataclass(frozen=True)
 class _HeldRadii:
-    """The design graph with the knee radii held: a gait solver for every radius without a
-    new graph (``biped.optimization.optimize.optimize``'s ``solvers``, which it is for each
-    gait problem)."""
+    """The design graph of one criterion with the knee radii held: a gait solver for every
+    radius without a new graph."""
 
-    problem: DesignProblem
+    design: Solver
     radii: tuple
 
-    def __call__(self, gait: GaitProblem):
-        """The held solver of ``gait``'s criterion (one graph serves every radius)."""
-        return dataclasses.replace(
-            self, problem=dataclasses.replace(self.problem, criterion=gait.criterion)
-        )
-
-    def _design(self, criterion: str) -> Solver:
-        return solver_for(dataclasses.replace(self.problem, criterion=criterion))
-
     def prepare(self, barriers) -> None:
-        self._design(self.problem.criterion).prepare(barriers)
+        self.design.prepare(barriers)
 
     def solve(self, gait: GaitProblem, start, barrier: str = "adaptive"):
-        design = self._design(gait.criterion)
-        return design.solve(gait, start, self.radii, hold_radii=True, barrier=barrier)
+        return self.design.solve(gait, start, self.radii, hold_radii=True, barrier=barrier)
 
 
 def optimize_at(
@@ -354,8 +343,13 @@ def optimize_at(
     ``biped.optimization.optimize.optimize`` (same starts, same report) on the design graph,
     so that a map of many radii builds one graph per process."""
     radii = check_radii(problem.robot, radii)
+
+    def held(gait: GaitProblem) -> _HeldRadii:  # once per criterion, not per start
+        design = solver_for(dataclasses.replace(problem, criterion=gait.criterion))
+        return _HeldRadii(design, radii)
+
     gait = problem.gait_problem(radii)
-    return optimize(gait, seed=seed, starts=starts, given=given, solvers=_HeldRadii(problem, radii))
+    return optimize(gait, seed=seed, starts=starts, given=given, solvers=held)
 
 
 @dataclass
@@ -420,6 +414,27 @@ class Comparison:
         lines.append(f"{criterion} vs revolute: {DIFFERENCE_VS_REVOLUTE}")
         return "\n".join(lines)
 
+    def radii_line(self) -> str:
+        """The optimal radii and criterion of the design, and its gains over the revolute
+        knee and the Table 1 radii."""
+        design, gains, bounds = self.design, self.gains(), self.design.at_bounds()
+        criterion = self.problem.criterion
+        return (
+            f"optimal radii: r1 = {design.radii[0]:.4f} m, r2 = {design.radii[1]:.4f} m"
+            f"{' (' + ', '.join(bounds) + ')' if bounds else ''}; "
+            f"{criterion} {design.value:.6g} {CRITERION_UNITS[criterion]}: "
+            f"{gains['design_vs_revolute']:+.2f} % vs revolute, "
+            f"{gains['design_vs_table1']:+.2f} % vs Table 1 radii"
+        )
+
+    def uncertified(self) -> list[str]:
+        """The knees compared that are not certified optima, each with why."""
+        return [
+            f"{label}: {optimum.report.status if not optimum.report.converged else 'infeasible'}"
+            for label, _, optimum in self.rows()
+            if not optimum.certified
+        ]
+
     def to_dict(self) -> dict:
         """The comparison as JSON (``design`` block of a gait file)."""
         knees = []
@@ -440,6 +455,20 @@ class Comparison:
             "gains_percent": self.gains(),
             "reference_moved": self.problem.moved_reference(),
         }
+
+
+def bound_notes(problem: DesignProblem, design: Design | None = None) -> list[str]:
+    """What the design's bounds did: the robot's own radii moved into them (the reference
+    design of the table), and a designed radius at its lower bound (``MIN_RADIUS``)."""
+    notes = [f"note: {sentence}" for sentence in problem.moved_reference()]
+    for bound in [] if design is None else design.at_bounds():
+        if bound.endswith("lower bound"):
+            notes.append(
+                f"note: {bound} {MIN_RADIUS:g} m: the radii are bounded away from 0, where "
+                "the rolling knee is the revolute knee (the first row); the design gains "
+                "nothing by rolling on that side"
+            )
+    return notes
 
 
 def compare(

@@ -165,6 +165,14 @@ class Gait:
         )
 
     @classmethod
+    def from_design(cls, comparison) -> Gait:
+        """The gait of a knee design (``biped.optimization.design.Comparison``): the designed
+        robot's gait, the comparison as its ``design``."""
+        design = comparison.design
+        gait = cls.from_optimum(design.optimum, design.robot)
+        return dataclasses.replace(gait, design=comparison.to_dict())
+
+    @classmethod
     def read(cls, path: str | Path, allowed: str = GAIT_FILE, consistent: bool = False) -> Gait:
         """Read a gait file. Raises BipedError if it is not one, saying what it is if it is
         another of this project's files and what is ``allowed`` (default a gait file: what
