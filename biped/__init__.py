@@ -1,10 +1,11 @@
 """Quasi-optimal gaits of planar bipeds with revolute or rolling knees, in layers, each a
 subpackage that imports only those below it:
 
-    biped.model         robot, kinematics, dynamics, impact, gait, criteria (the paper's model)
+    biped.model         robot, kinematics, dynamics, impact, gait, criteria (the paper's model),
+                        units
     biped.optimization  the step's NLP, its CasADi graph, IPOPT, multistarts, knee design,
                         the words of a comparison
-    biped.records       gait files, units, provenance
+    biped.records       gait files, provenance
     biped.studies       campaigns of optimizations: sweep, design map, the paper's method
     biped.pages         figures and Markdown pages
     biped.runtime       atomic files, interrupts, local or Dask task runner (used by all)

@@ -70,10 +70,8 @@ def test_optimize_writes_a_complete_gait_file(tmp_path, capsys):
     ):
         assert key in content
     assert gait.knee == "rolling" and gait.feasible is True and gait.speed == 0.3
-    assert (
-        isinstance(gait.impact["consistent"], bool) and len(gait.impact["trailing_foot_lift"]) == 2
-    )
-    assert set(gait.costs) >= {"sthenic", "energy"}
+    assert isinstance(gait.impact.consistent, bool) and len(gait.impact.trailing_foot_lift) == 2
+    assert set(gait.costs.to_dict()) >= {"sthenic", "energy"}
     assert gait.robot.r1 == 0.05 and len(gait.parameters) == 21
     t = gait.samples.t
     assert len(t) >= 200 and t[0] == 0.0 and t[-1] == pytest.approx(gait.period)

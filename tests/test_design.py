@@ -237,7 +237,7 @@ def test_design_command_writes_the_designed_robot_and_compares(designed):
     gait = gait_file.read(path)
     radii = gait.design["radii"]
     assert (gait.robot.r1, gait.robot.r2) == (radii["r1"], radii["r2"])
-    assert gait.knee == "rolling" and gait.optimizer["status"] == "converged"
+    assert gait.knee == "rolling" and gait.optimizer.status == "converged"
     rows = {line[:24].strip(): line.split() for line in out.splitlines()[1:4]}
     assert set(rows) == {"revolute", "rolling, Table 1 radii", "rolling, optimal radii"}
     revolute = float(rows["revolute"][3])
@@ -245,7 +245,7 @@ def test_design_command_writes_the_designed_robot_and_compares(designed):
         sthenic, change = float(rows[label][-4]), float(rows[label][-2])
         assert change == pytest.approx(100 * (sthenic / revolute - 1), abs=0.01)
     design = float(rows["rolling, optimal radii"][-4])
-    assert design == pytest.approx(gait.costs["sthenic"], rel=1e-4)
+    assert design == pytest.approx(gait.costs.sthenic, rel=1e-4)
     assert design <= float(rows["rolling, Table 1 radii"][-4]) <= revolute
     assert revolute == pytest.approx(optimal_gait("revolute").evaluation.sthenic, rel=1e-6)
     assert f"r1 = {radii['r1']:.4f} m" in out and "vs Table 1 radii" in out
@@ -336,7 +336,7 @@ def test_pipeline_with_design_compares_three_knees_in_one_table(tmp_path, capsys
     assert (gait.robot.r1, gait.robot.r2) == (radii["r1"], radii["r2"])
     revolute = gait_file.read(out / "revolute-sthenic-0.300.json")
     compared = {knee["knee"]: knee for knee in gait.design["compared"]}
-    assert compared["revolute"]["sthenic"] == revolute.costs["sthenic"]
+    assert compared["revolute"]["sthenic"] == revolute.costs.sthenic
     report = json.loads((out / "design-sthenic-0.300.report.json").read_text())
     assert report["inverse_dynamics"]["passed"] and report["impact"]["passed"]
     knee_report = json.loads((out / "revolute-sthenic-0.300.report.json").read_text())

@@ -57,7 +57,7 @@ def test_validating_a_sweep_gait_keeps_the_pipelines_recording(gaits, capsys):
     assert len(err.strip().splitlines()) == 1
     assert _stamp(pipeline) == before
     # Every figure of the report has its unit; the figures keep their names.
-    from biped.records.units import missing
+    from biped.model.units import missing
 
     assert missing(report, report["units"]) == []
     assert report["units"]["forward.max_slip"] == "m"

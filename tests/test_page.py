@@ -71,11 +71,11 @@ def test_page_states_the_gait_by_name_with_units(written):
     for name in PARAMETERS:
         unit = "s" if name == "period" else "m" if name.endswith("_hip") else "rad"
         assert f"| {name} | {gait.parameters[name]:.6g} | {unit}" in text
-    assert f"| {gait.costs['sthenic']:.5g} | N²·m·s |" in text
-    assert f"| {gait.costs['energy']:.5g} | J |" in text
+    assert f"| {gait.costs.sthenic:.5g} | N²·m·s |" in text
+    assert f"| {gait.costs.energy:.5g} | J |" in text
     t_n, psi, _ = constraint_profile(gait)
     for i, name in enumerate(CONSTRAINTS):
-        worst = gait.constraints[name]
+        worst = getattr(gait.constraints, name)
         assert np.nanmin(psi[:, i]) == pytest.approx(worst, rel=1e-9, abs=1e-12)
         at = t_n[int(np.nanargmin(psi[:, i]))]
         assert f"| {worst:.4g} |" in text and f"| {at:.3f} |" in text

@@ -2,6 +2,7 @@
 interrupt at any point, folders of other settings refused; figures and the comparison table
 come from them."""
 
+import dataclasses
 import io
 import json
 from types import SimpleNamespace
@@ -12,6 +13,7 @@ import pytest
 import biped
 from biped.pages.figures import LABELS, make_figures
 from biped.records import gait_file
+from biped.records.gait_file import Costs
 from biped.studies import sweep as sweep_module
 from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep
 
@@ -37,11 +39,11 @@ def test_sweep_saves_every_point_certified(sweep):
     for path in files:
         gait = gait_file.read(path)
         assert path.name == f"{gait.knee}-{gait.criterion}-{gait.speed:.3f}.json"
-        assert gait.optimizer["status"] == "converged" and gait.feasible
+        assert gait.optimizer.status == "converged" and gait.feasible
         # its own start, the table's (the neighbouring speeds', the other knee's), its one
         # neighbouring speed's and the other knee's optima, and for the energy criterion the
         # table's neighbours and the sthenic optimum of its own problem under both barriers
-        assert gait.optimizer["starts"] == 5 + 3 * (gait.criterion == "energy")
+        assert gait.optimizer.starts == 5 + 3 * (gait.criterion == "energy")
     assert "16 optimizations for 8 points" in log
     assert "0 already done (0 of stage 1, 0 of stage 2), 16 to run" in log
     assert "8 of 8 points certified" in log
@@ -171,12 +173,12 @@ def test_figures_and_table(sweep, tmp_path):
     best = {}
     for knee in biped.KNEES:
         gaits = [gait_file.read(p) for p in folder.glob(f"{knee}-sthenic-*.json")]
-        best[knee] = min(gaits, key=lambda g: g.costs["sthenic"])
-    difference = 100 * (best["rolling"].costs["sthenic"] / best["revolute"].costs["sthenic"] - 1)
+        best[knee] = min(gaits, key=lambda g: g.costs.sthenic)
+    difference = 100 * (best["rolling"].costs.sthenic / best["revolute"].costs.sthenic - 1)
     assert f"| -17.0 % | {difference:+.1f} % |" in table
     assert f"| 0.27 | {best['revolute'].speed:.3f} |" in table
     gaits = [gait_file.read(p) for p in folder.glob("*-*.json")]
-    confirmed = sum(g.optimizer["starts_at_best"] >= 2 for g in gaits)
+    confirmed = sum(g.optimizer.starts_at_best >= 2 for g in gaits)
     assert f"{confirmed} of 8 optima were reached by at least two starts" in table
 
 
@@ -278,17 +280,19 @@ def _synthetic_series(outlier=None):
                     criterion=criterion,
                     speed=float(v),
                     feasible=True,
-                    optimizer={"status": "converged"},
-                    costs={
-                        "sthenic": 30.0 + 40.0 * (v - 0.3) ** 2 + (knee == "rolling"),
-                        "energy": 10.0 + 5.0 * v + 0.2 * (knee == "rolling"),
-                    },
+                    optimizer=SimpleNamespace(status="converged"),
+                    costs=Costs(
+                        sthenic=30.0 + 40.0 * (v - 0.3) ** 2 + (knee == "rolling"),
+                        energy=10.0 + 5.0 * v + 0.2 * (knee == "rolling"),
+                        energy_per_metre=None,
+                    ),
                 )
                 for v in speeds
             ]
     if outlier is not None:
         knee, index, factor = outlier
-        series[(knee, "sthenic")][index].costs["energy"] *= factor
+        gait = series[(knee, "sthenic")][index]
+        gait.costs = dataclasses.replace(gait.costs, energy=gait.costs.energy * factor)
     return series
 
 
@@ -299,10 +303,10 @@ def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
     from biped.pages.figures import criterion_figure
 
     series = _synthetic_series(("rolling", 12, 30.0))
-    value = series[("rolling", "sthenic")][12].costs["energy"]
+    value = series[("rolling", "sthenic")][12].costs.energy
     figure = criterion_figure(series, "sthenic", "energy", "Fig. 4")
     energy = _panel(figure, "energy criterion of the same gaits")
-    others = [g.costs["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]][:-1]
+    others = [g.costs.energy for k in biped.KNEES for g in series[(k, "sthenic")]][:-1]
     low, high = energy.get_ylim()
     assert high < value and low <= min(others) and max(others) <= high
     assert max(others) - min(others) > 0.5 * (high - low)  # the bulk fills the axis
@@ -310,7 +314,7 @@ def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
     plain = criterion_figure(_synthetic_series(), "sthenic", "energy", "Fig. 4")
     assert not [t for t in _texts(plain) if "off scale" in t]
     low, high = _panel(plain, "energy criterion of the same gaits").get_ylim()
-    everything = [g.costs["energy"] for k in biped.KNEES for g in series[(k, "sthenic")]]
+    everything = [g.costs.energy for k in biped.KNEES for g in series[(k, "sthenic")]]
     assert low <= min(everything) and sorted(everything)[-2] <= high
 
 
@@ -320,7 +324,7 @@ def test_a_gait_not_certified_is_marked_apart_from_the_curves():
 
     series = _synthetic_series()
     gait = series[("revolute", "sthenic")].pop(4)
-    gait.optimizer = {"status": "Maximum_Iterations_Exceeded"}
+    gait.optimizer = SimpleNamespace(status="Maximum_Iterations_Exceeded")
     figure = criterion_figure(series, "sthenic", "energy", "Fig. 4", flagged=[gait])
     texts = _texts(figure)
     assert "revolute: not certified\n(solver: Maximum_Iterations_Exceeded)" in texts
@@ -433,7 +437,8 @@ def test_every_difference_between_the_knees_has_one_sign(sweep, tmp_path):
     figures = sweep_figures(series, flagged)
     for criterion, name in (("sthenic", "fig4.png"), ("energy", "fig8.png")):
         best = {
-            knee: min(g.costs[criterion] for g in series[(knee, criterion)]) for knee in biped.KNEES
+            knee: min(g.costs.criterion(criterion) for g in series[(knee, criterion)])
+            for knee in biped.KNEES
         }
         change = relative_change(best["rolling"], best["revolute"])
         assert f"| {change:+.1f} % |" in table
@@ -442,7 +447,9 @@ def test_every_difference_between_the_knees_has_one_sign(sweep, tmp_path):
         expected = [
             relative_change(
                 *(
-                    next(g for g in series[(k, criterion)] if g.speed == v).costs[criterion]
+                    next(g for g in series[(k, criterion)] if g.speed == v).costs.criterion(
+                        criterion
+                    )
                     for k in ("rolling", "revolute")
                 )
             )

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from biped import Robot
+from biped.model.units import PURE, missing, numeric_paths
 from biped.records.gait_file import Gait
-from biped.records.units import PURE, missing, numeric_paths
 from tests.conftest import small_optimum
 
 

@@ -225,7 +225,7 @@ def test_model_errors_are_fail_lines(gait_path, tmp_path, capsys):
 
 def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
     """Each check is an object with ``passed`` and ``notes``; every number has its unit."""
-    from biped.records.units import missing
+    from biped.model.units import missing
 
     code, content, _ = report
     for name in ("model", "inverse_dynamics", "impact", "feedforward", "forward", "gains"):

@@ -34,8 +34,8 @@ import numpy as np
 
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import ZH
+from biped.model.units import PURE
 from biped.records.gait_file import Gait
-from biped.records.units import PURE
 from validate import contact
 from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
 from validate.mapping import mapping, other
@@ -174,7 +174,7 @@ def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait
         "normal_impulse": float(mj_impulse[1]),
         "landing_speed": float(np.linalg.norm(biped.point_jacobian(q, "swing_ankle") @ qd_minus)),
     }
-    impulse = (gait.impact or {}).get("impulse")
+    impulse = None if gait.impact is None else gait.impact.impulse
     notes = []
     if impulse is not None:
         figures["max_impulse_error"] = float(np.abs(mj_impulse - np.asarray(impulse)).max())

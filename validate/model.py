@@ -29,7 +29,7 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.dynamics import Biped
 from biped.model.robot import SOLE_EDGES, Robot
-from biped.records.units import robot_unit
+from biped.model.units import robot_unit
 from validate.mjcf import FOLDER, FOOT_FRICTION, SIDES, robot_xml, scene_xml
 
 # Names of the six actuated joints, in the order of every (N, 6) array of the validation.

@@ -321,10 +321,9 @@ def summary(biped: Biped, step: GaitSamples, sim: Simulation, checks, gait: Gait
         ("step length [m]", f"{step.step_length:.4f}"),
         ("steps simulated", str(len(sim.stances))),
     ]
-    rows += [(f"criterion {name}", f"{value:.4g}") for name, value in gait.costs.items()]
-    rows += [
-        (f"constraint {name}", f"{value:.4g}") for name, value in (gait.constraints or {}).items()
-    ]
+    rows += [(f"criterion {name}", f"{value:.4g}") for name, value in gait.costs.to_dict().items()]
+    constraints = {} if gait.constraints is None else gait.constraints.to_dict()
+    rows += [(f"constraint {name}", f"{value:.4g}") for name, value in constraints.items()]
     lines += [f"| {name} | {value} |" for name, value in rows]
     if checks:
         lines += ["", "## Checks", ""]

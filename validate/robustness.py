@@ -49,8 +49,8 @@ import mujoco
 
 from biped.errors import BipedError
 from biped.model.dynamics import Biped
+from biped.model.units import PURE
 from biped.records.gait_file import Gait
-from biped.records.units import PURE
 from biped.runtime.runner import ProgressBar, run_tasks
 from validate.checks import walk_verdict
 from validate.model import compile_spec, model_spec

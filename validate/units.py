@@ -1,6 +1,6 @@
 """Units of the validation report's figures (``validate.validation``), for its ``units`` map.
 
-Paths and notation as in ``biped.records.units``: ``"forward.max_slip": "m"``. "weight" is a
+Paths and notation as in ``biped.model.units``: ``"forward.max_slip": "m"``. "weight" is a
 fraction of the robot's weight, "S" of the gait's step length; a figure that is the largest of
 several quantities of different units names them all ("N, N·m": the largest of the errors
 of Fx, Fz [N] and Cy [N·m]).
@@ -12,7 +12,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from biped.model.dynamics import JOINTS
-from biped.records.units import PERIOD, PURE, declared_units, unit_field
+from biped.model.units import PERIOD, PURE, declared_units, unit_field
 
 GAIN_KEYS = ("0_5", "1", "2")  # validate.checks.GAIN_SCALES and the default, as keys
 

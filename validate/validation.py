@@ -58,7 +58,7 @@ def validate(
     biped, samples = gait.biped, GaitSamples.from_gait(gait)
     spec = model if isinstance(model, mujoco.MjSpec) else model_spec(biped, model)
     robot_model = compile_spec(spec)
-    energy = gait.costs["energy"]
+    energy = gait.costs.energy
     results = [
         c.check_model(robot_model, biped),
         c.check_inverse_dynamics(robot_model, biped, samples),

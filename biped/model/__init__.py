@@ -1,7 +1,8 @@
 """The analytical model of the bipeds (the paper's section 2 and appendices A, B): the robot's
 parameters and conventions (``robot``), geometry (``kinematics``), Lagrangian dynamics, ground
 wrench and ZMP (``dynamics``), the flat-foot impact (``impact``), the spline gait of one step
-(``gait``, section 3) and its criteria and constraints (``criteria``, section 4).
+(``gait``, section 3), its criteria and constraints (``criteria``, section 4), and the unit of
+every number, declared beside the fields of the records that hold them (``units``).
 
 May import: ``biped.errors``, numpy, scipy. Nothing here knows of solvers, files or MuJoCo.
 """

@@ -28,14 +28,16 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import WORK_CRITERIA, StepEvaluation, evaluate_step
+from biped.model.criteria import CRITERION_UNITS, WORK_CRITERIA, StepEvaluation, evaluate_step
 from biped.model.gait import Step, build_step
+from biped.model.units import PURE, unit_field
 from biped.optimization import table
+from biped.optimization.comparison import CHECKED_VALUE, SOLVER_VALUE
 from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
 from biped.optimization.problem import (  # noqa: F401 (re-exported)
     CHECK_SAMPLES,
@@ -64,14 +66,22 @@ PERTURBATION = 1.0
 AGREEMENT = 1e-6
 
 
+def _solver_value(criterion: str) -> str:
+    return f"{CRITERION_UNITS[criterion]} ({SOLVER_VALUE})"
+
+
+def _best_value(criterion: str) -> str:
+    return f"{CRITERION_UNITS[criterion]} ({SOLVER_VALUE}; costs.{criterion} is {CHECKED_VALUE})"
+
+
 @dataclass(frozen=True)
 class Start:
     """One start of the solver and where it ended."""
 
-    kind: str  # "first guess", "perturbed", "nelder-mead", "given"
-    value: float  # criterion reached (solver's samples)
-    status: str  # solver status
-    iterations: int
+    kind: str = unit_field(None)  # "first guess", "perturbed", "nelder-mead", "given"
+    value: float = unit_field(_solver_value)  # criterion reached (solver's samples)
+    status: str = unit_field(None)  # solver status
+    iterations: int = unit_field(PURE)
 
 
 @dataclass(frozen=True)
@@ -94,17 +104,18 @@ class Report:
         history: every start with its kind, value, status and iterations.
     """
 
-    method: str
-    status: str
-    starts: int
-    starts_at_best: int
-    iterations: int
-    constraint_violation: float
-    dual_infeasibility: float
-    seconds: float
-    seed: int
-    value: float = float("nan")  # the best start's criterion on the solver's samples
-    history: tuple = field(default_factory=tuple)
+    method: str = unit_field(None)
+    status: str = unit_field(None)
+    starts: int = unit_field(PURE)
+    starts_at_best: int = unit_field(PURE)
+    iterations: int = unit_field(PURE)
+    constraint_violation: float = unit_field("1 (the solver's scaled constraints)")
+    dual_infeasibility: float = unit_field("1 (IPOPT's measure)")
+    seconds: float = unit_field("s")
+    seed: int = unit_field(PURE)
+    # the best start's criterion on the solver's samples
+    value: float = unit_field(_best_value, default=float("nan"))
+    history: tuple = unit_field([Start], default_factory=tuple)
 
     @property
     def converged(self) -> bool:
@@ -162,6 +173,7 @@ def _from_json(cls, content: dict):
         "int": int,
         "float": lambda v: float("nan") if v is None else float(v),
         "tuple": lambda v: tuple(_from_json(Start, start) for start in v),
+        "dict": dict,
     }
     fields = dataclasses.fields(cls)
     given = [f for f in fields if f.name in content or f.default is dataclasses.MISSING]

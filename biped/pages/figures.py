@@ -106,7 +106,7 @@ def certified(gait: Gait) -> bool:
     """Whether a gait file holds a certified optimum (``biped.optimization.comparison.CERTIFIED``; a
     sweep's files are its final optima): its solver converged and it is feasible on the
     check grid."""
-    return gait.feasible and gait.optimizer.get("status") == "converged"
+    return gait.feasible and gait.optimizer.status == "converged"
 
 
 def read_sweep(folder: str | Path) -> tuple[dict, list]:
@@ -131,7 +131,7 @@ def read_sweep(folder: str | Path) -> tuple[dict, list]:
 
 def _curve(series, knee, criterion, cost):
     gaits = series.get((knee, criterion), [])
-    return np.array([g.speed for g in gaits]), np.array([g.costs[cost] for g in gaits])
+    return np.array([g.speed for g in gaits]), np.array([g.costs.criterion(cost) for g in gaits])
 
 
 def off_bulk(values) -> np.ndarray:
@@ -177,7 +177,9 @@ def difference_curve(series, criterion, cost) -> tuple[np.ndarray, np.ndarray]:
     """Speeds [m/s] where both knees have a certified ``criterion`` optimum, and the
     difference of their ``cost`` there [%] (``relative_change``, rolling vs revolute)."""
     values = {
-        knee: {round(g.speed, 6): g.costs[cost] for g in series.get((knee, criterion), [])}
+        knee: {
+            round(g.speed, 6): g.costs.criterion(cost) for g in series.get((knee, criterion), ())
+        }
         for knee in KNEES
     }
     speeds = sorted(set(values["revolute"]) & set(values["rolling"]))
@@ -219,8 +221,9 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
     crosses = [g for g in flagged if g.criterion == criterion]
     for ax, cost in zip(axes, (criterion, other), strict=False):
         unit = CRITERION_UNITS[cost]
-        everything = [g.costs[cost] for k in KNEES for g in series.get((k, criterion), [])]
-        limits = bulk_limits(everything or [g.costs[cost] for g in crosses])
+        gaits = [g for k in KNEES for g in series.get((k, criterion), [])]
+        everything = [g.costs.criterion(cost) for g in gaits]
+        limits = bulk_limits(everything or [g.costs.criterion(cost) for g in crosses])
         for knee in KNEES:
             v, c = _curve(series, knee, criterion, cost)
             outside = (c < limits[0]) | (c > limits[1])
@@ -229,8 +232,8 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
                 text = f"{knee} {x:.3f} m/s:\n{value:.4g} {unit}, off scale"
                 _mark_off_scale(ax, x, value, limits, STYLE[knee]["color"], text)
         for i, gait in enumerate(crosses):
-            x, value = gait.speed, gait.costs[cost]
-            status = gait.optimizer.get("status")
+            x, value = gait.speed, gait.costs.criterion(cost)
+            status = gait.optimizer.status
             why = "infeasible" if not gait.feasible else f"solver: {status}"
             label = "not certified" if i == 0 else None
             if limits[0] <= value <= limits[1]:
@@ -517,7 +520,7 @@ def comparison_table(series, flagged=()) -> str:
     safeties = sorted({g.safety for gaits in series.values() for g in gaits}, key=str)
     everything = [g for c in criteria for k in KNEES for g in series[(k, c)]]
     total = len(everything)
-    confirmed = sum(g.optimizer["starts_at_best"] >= 2 for g in everything)
+    confirmed = sum(g.optimizer.starts_at_best >= 2 for g in everything)
     safety = "; ".join(
         f"swing-foot clearance {s.clearance:g} m, ZMP margin {s.zmp_margin:g} m" for s in safeties
     )
@@ -595,7 +598,7 @@ def _explanations(flexion, series, criteria) -> list[str]:
 
 def _minimum_per_step(series, knee) -> float:
     """[m/s] Speed of the knee's least sthenic criterion per step (certified optima)."""
-    best = min(series[(knee, "sthenic")], key=lambda g: g.costs["sthenic"] * g.step_length)
+    best = min(series[(knee, "sthenic")], key=lambda g: g.costs.sthenic * g.step_length)
     return float(best.speed)
 
 
@@ -619,7 +622,8 @@ def make_figures(sweep_folder: str | Path, out_folder: str | Path, stream=None) 
         )
     figures = sweep_figures(series, flagged, criteria)
     certified_values = {
-        key: {round(g.speed, 6): g.costs[key[1]] for g in gaits} for key, gaits in series.items()
+        key: {round(g.speed, 6): g.costs.criterion(key[1]) for g in gaits}
+        for key, gaits in series.items()
     }
     table = "\n".join(
         [comparison_table(series, flagged), *spread_lines(sweep_folder, certified_values)]

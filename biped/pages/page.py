@@ -28,9 +28,10 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
-from biped.model.criteria import CONSTRAINTS, CRITERION_UNITS, evaluate_step, margin_profile
+from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
 from biped.model.gait import PARAMETERS, build_step, half_grid
+from biped.model.units import CONSTRAINT_UNITS, parameter_unit
 from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PER_HALF
 from biped.pages.figures import (
     ANGLE_PANELS,
@@ -46,7 +47,6 @@ from biped.pages.figures import (
 )
 from biped.pages.orbit_figures import multipliers_figure
 from biped.records.gait_file import Gait
-from biped.records.units import CONSTRAINT_UNITS, parameter_unit
 from biped.runtime.files import atomic_set
 
 # What each constraint of eq. (28) keeps.
@@ -58,11 +58,6 @@ CONSTRAINT_MEANING = {
     "swing_knee": "Ψ5 swing knee flexion q3 − q4",
     "swing_heel": "Ψ6 swing heel height",
     "swing_toe": "Ψ7 swing toe height",
-}
-COST_NAMES = {
-    "sthenic": ("sthenic criterion C_Γ (per metre walked)", CRITERION_UNITS["sthenic"]),
-    "energy": ("energy criterion C_E (per step)", CRITERION_UNITS["energy"]),
-    "energy_per_metre": ("energy per metre walked", "J/m"),
 }
 FIGURE_NAMES = ("torques.png", "angles.png", "ground.png", "constraints.png")
 # The validation's orbit check drawn: its multipliers in the complex plane.
@@ -166,7 +161,7 @@ def dip_sentence(gait: Gait, dips: list[Dip]) -> str:
         f"{d.at:.3f} (δ = {_milli(d.margin, d.unit)})"
         for d in dips
     )
-    if gait.optimizer.get("method") != "ipopt":
+    if gait.optimizer.method != "ipopt":
         why = (
             "the paper's method keeps the margins through its penalty only, not as bounds "
             "at samples"
@@ -363,7 +358,7 @@ def _constraint_panels(gait: Gait) -> tuple:
     t_n, psi, delta = constraint_profile(gait)
     t_s, psi_solver, _ = constraint_profile(gait, SOLVER_SAMPLES_PER_HALF)
     dips = {dip.name: dip for dip in margin_dips(gait)}
-    solver_samples = gait.optimizer.get("method") == "ipopt"
+    solver_samples = gait.optimizer.method == "ipopt"
 
     def panel(i, name):
         def mark(ax, gaits):
@@ -404,7 +399,7 @@ def _constraints_title(gait: Gait, dips: list[Dip]) -> str:
     title = "constraints Ψ (the solver's margin δ dotted"
     if not dips:
         return f"{title})"
-    between = gait.optimizer.get("method") == "ipopt" and all(dip.kept for dip in dips)
+    between = gait.optimizer.method == "ipopt" and all(dip.kept for dip in dips)
     where = " between the solver's samples, dots" if between else ""
     return f"{title}; insets: Ψ below δ{where})"
 
@@ -477,7 +472,7 @@ def markdown(page: Page, folder: Path) -> str:
     optimum = (
         "certified optimum"
         if certified(gait)
-        else f"not a certified optimum (solver: {report.get('status')}, "
+        else f"not a certified optimum (solver: {report.status}, "
         f"feasible: {_number(gait.feasible)})"
     )
     lines = [f"# {title}", ""]
@@ -501,18 +496,19 @@ def markdown(page: Page, folder: Path) -> str:
         f"| step length | {gait.step_length:.4f} | m |",
         f"| swing-foot clearance asked (beyond the paper's) | {safety.clearance:g} | m |",
         f"| ZMP margin asked (beyond the paper's) | {safety.zmp_margin:g} | m |",
-        f"| optimiser | {report.get('method')}: {report.get('status')}, "
-        f"{report.get('starts_at_best')} of {report.get('starts')} starts at the best | |",
+        f"| optimiser | {report.method}: {report.status}, "
+        f"{report.starts_at_best} of {report.starts} starts at the best | |",
         "",
         "## Criteria",
         "",
         "| criterion | value | unit |",
         "|---|---|---|",
     ]
-    for name, (label, unit) in COST_NAMES.items():
-        if name in gait.costs:
-            optimised = " (optimised)" if name == gait.criterion else ""
-            lines += [f"| {label}{optimised} | {gait.costs[name]:.5g} | {unit} |"]
+    for f in dataclasses.fields(gait.costs):
+        value, label, unit = getattr(gait.costs, f.name), f.metadata["label"], f.metadata["unit"]
+        if value is not None:
+            optimised = " (optimised)" if f.name == gait.criterion else ""
+            lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
     lines += [
         "",
         "## Constraints: tightest margins",

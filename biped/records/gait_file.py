@@ -1,16 +1,17 @@
 """Gait files: one optimal gait as a ``Gait`` record, written as JSON atomically (SI units,
 the paper's coordinate order; ground at z = 0, stance ankle at x = 0), read back with checks.
 
-``Gait`` is declared once, each field with its unit as metadata: the file holds its fields in
-their order, ``format`` first and ``units`` (``Gait.units``: the unit of every number, see
-``biped.records.units``) before ``samples``. ``costs`` are on the check grid of 202 samples
-per step (what the comparisons, tables and figures use); ``optimizer.value`` is the criterion
-on the solver's 52 samples per step, which ranked the starts. ``constraints`` hold the worst
-Ψ_i on the samples less the safety margins (>= 0 when met); ``impact.consistent``: Iz > 0 and
-the trailing foot lifts (the flat-foot impact model holds); ``provenance``: what produced the
-file (``biped.records.provenance``). The samples run from t = 0 to t = T inclusive on both
-spline pieces; t = T/2 appears twice, left and right limits, because the accelerations (and
-torques) jump at the knot.
+``Gait`` and its inner records (``Costs``, ``Constraints``, ``Impact``, ``Optimizer``,
+``Samples``) are declared once, each field with its unit as metadata: the file holds their
+fields in their order, ``format`` first and ``units`` (``Gait.units``: the unit of every
+number, see ``biped.model.units``) before ``samples``. ``costs`` are on the check grid of 202
+samples per step (what the comparisons, tables and figures use); ``optimizer.value`` is the
+criterion on the solver's 52 samples per step, which ranked the starts. ``constraints`` hold
+the worst Ψ_i on the samples less the safety margins (>= 0 when met); ``impact.consistent``:
+Iz > 0 and the trailing foot lifts (the flat-foot impact model holds); ``provenance``: what
+produced the file (``biped.records.provenance``). The samples run from t = 0 to t = T
+inclusive on both spline pieces; t = T/2 appears twice, left and right limits, because the
+accelerations (and torques) jump at the knot.
 
 ``Gait.read`` checks the format and names the bad field; with ``consistent=True`` it also
 recomputes what the parameters determine (``Gait.check_consistency``) and refuses a file
@@ -36,11 +37,7 @@ from biped.model.gait import PARAMETERS, build_step
 from biped.model.impact import trailing_foot_lift
 from biped.model.kinematics import COORDINATES, KNEES
 from biped.model.robot import Robot
-from biped.optimization.comparison import CHECKED_VALUE, SOLVER_VALUE
-from biped.optimization.optimize import Optimum
-from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, VARIABLES, GaitProblem, check_speed
-from biped.records.provenance import provenance as make_provenance
-from biped.records.units import (
+from biped.model.units import (
     CONSTRAINT_UNITS,
     PURE,
     declared_units,
@@ -49,6 +46,9 @@ from biped.records.units import (
     robot_unit,
     unit_field,
 )
+from biped.optimization.optimize import Optimum, Report
+from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, VARIABLES, GaitProblem, check_speed
+from biped.records.provenance import provenance as make_provenance
 from biped.runtime.files import atomic_write_text
 
 FORMAT = "biped-gait/2"  # 2: safety margins recorded
@@ -95,20 +95,116 @@ class Samples:
         return {f.name: getattr(self, f.name).tolist() for f in dataclasses.fields(self)}
 
 
-def _optimizer_units(criterion: str) -> dict:
-    """Units of the ``optimizer`` record (``biped.optimization.optimize.Report``)."""
-    value = CRITERION_UNITS[criterion]
-    return {
-        **dict.fromkeys(("starts", "starts_at_best", "iterations"), PURE),
-        "constraint_violation": "1 (the solver's scaled constraints)",
-        "dual_infeasibility": "1 (IPOPT's measure)",
-        "seconds": "s",
-        "seed": PURE,
-        "value": f"{value} ({SOLVER_VALUE}; costs.{criterion} is {CHECKED_VALUE})",
-        "history[].value": f"{value} ({SOLVER_VALUE})",
-        "history[].iterations": PURE,
-        **{f"variables.{name}": parameter_unit(name) for name in VARIABLES},
-    }
+class _Record:
+    """A gait's object of named values (costs, constraints, impact), declared with units."""
+
+    def to_dict(self) -> dict:
+        """The fields in order (one the file lacked left out, as it was)."""
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        return {name: value for name, value in values.items() if value is not None}
+
+    @classmethod
+    def from_content(cls, content, name: str, bad):
+        """The record of a file's object ``name`` as it holds it (None for none; a field it
+        lacks None, named by ``Gait.check_consistency``); ``bad`` if it is not an object."""
+        if content is None:
+            return None
+        if not isinstance(content, dict):
+            raise bad(f"{name} = {content!r}, allowed an object")
+        return cls(**{f.name: content.get(f.name) for f in dataclasses.fields(cls)})
+
+
+def _cost(unit: str, label: str, of):
+    """A field of ``Costs``: its unit, its label on a page, and ``of(model, step, evaluation)``,
+    its value for the gait's model, step and evaluation on the check grid."""
+    return unit_field(unit, metadata={"label": label, "of": of})
+
+
+@dataclass(frozen=True, eq=False)
+class Costs(_Record):
+    """The gait's criteria on the check grid (no penalty), which the comparisons use; each
+    field says how it follows from the gait, so that a new cost is one line."""
+
+    sthenic: float = _cost(
+        CRITERION_UNITS["sthenic"],
+        "sthenic criterion C_Γ (per metre walked)",
+        lambda model, step, ev: ev.sthenic,
+    )
+    energy: float = _cost(
+        CRITERION_UNITS["energy"],
+        "energy criterion C_E (per step)",
+        lambda model, step, ev: ev.energy,
+    )
+    energy_per_metre: float = _cost(
+        "J/m", "energy per metre walked", lambda model, step, ev: ev.energy / step.step_length
+    )
+
+    @classmethod
+    def of(cls, model: Biped, step, evaluation) -> Costs:
+        """The costs of a gait's step and its evaluation on the check grid."""
+        fields = dataclasses.fields(cls)
+        return cls(**{f.name: f.metadata["of"](model, step, evaluation) for f in fields})
+
+    def criterion(self, name: str) -> float:
+        """The value of the criterion ``name`` (``biped.model.criteria.ALL_CRITERIA``)."""
+        return getattr(self, name.replace("-", "_"))
+
+
+# The worst Ψ_i of each constraint on the check grid less its safety margin (>= 0 when met),
+# by name (``biped.model.criteria.CONSTRAINTS``).
+Constraints = dataclasses.make_dataclass(
+    "Constraints",
+    [(name, float, unit_field(unit)) for name, unit in CONSTRAINT_UNITS.items()],
+    bases=(_Record,),
+    frozen=True,
+    eq=False,
+    namespace={"__module__": __name__, "__doc__": "Ψ_i − margin, worst on the check grid."},
+)
+
+
+@dataclass(frozen=True, eq=False)
+class Impact(_Record):
+    """The flat-foot impact that ends the step (eqs. 21-24): the impulse on the landing foot
+    [Fx, Fz, Cy], the trailing foot's lift velocities (heel, toe), whether the flat-foot model
+    holds (Iz > 0 and the trailing foot lifts), the velocities just before and after it."""
+
+    impulse: list = unit_field(["N·s", "N·s", "N·m·s"])
+    trailing_foot_lift: list = unit_field("m/s")
+    consistent: bool = unit_field(None)
+    qd_minus: list = unit_field(RATES)
+    qd_plus: list = unit_field(RATES)
+
+    @classmethod
+    def of(cls, model: Biped, step) -> Impact:
+        """The impact at the end of a gait's step."""
+        qd_plus, _ = model.impact(*step.end)
+        lift = trailing_foot_lift(model, step.end[0], qd_plus)
+        return cls(
+            impulse=step.impulse.tolist(),
+            trailing_foot_lift=lift.tolist(),
+            consistent=bool(step.impulse[1] > 0 and np.all(lift >= 0)),
+            qd_minus=step.end[1].tolist(),
+            qd_plus=step.start[1].tolist(),
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Optimizer(Report):
+    """How the gait was found (``biped.optimization.optimize.Report``) and the solver's
+    variables at its optimum (None where not finite: a Nelder-Mead point beyond their reach)."""
+
+    variables: dict = unit_field({name: parameter_unit(name) for name in VARIABLES}, kw_only=True)
+
+    @classmethod
+    def of(cls, report: Report, variables) -> Optimizer:
+        """The record of ``report`` and ``variables`` (21,)."""
+        fields = {f.name: getattr(report, f.name) for f in dataclasses.fields(Report)}
+        named = dict(zip(VARIABLES, map(_finite_or_none, variables), strict=True))
+        return cls(**fields, variables=named)
+
+    def report(self) -> Report:
+        """The optimizer's ``Report`` alone."""
+        return Report(**{f.name: getattr(self, f.name) for f in dataclasses.fields(Report)})
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,21 +219,12 @@ class Gait:
     step_length: float = unit_field("m")
     safety: Safety = unit_field(Safety)
     feasible: bool = unit_field(None)
-    costs: dict = unit_field(
-        {**{c: CRITERION_UNITS[c] for c in CRITERIA}, "energy_per_metre": "J/m"}
-    )
+    costs: Costs = unit_field(Costs)
     robot: Robot = unit_field({f.name: robot_unit(f.name) for f in dataclasses.fields(Robot)})
     parameters: dict = unit_field({name: parameter_unit(name) for name in PARAMETERS})
-    constraints: dict = unit_field(CONSTRAINT_UNITS)
-    impact: dict | None = unit_field(
-        {
-            "impulse": ["N·s", "N·s", "N·m·s"],
-            "trailing_foot_lift": "m/s",
-            "qd_minus": RATES,
-            "qd_plus": RATES,
-        }
-    )
-    optimizer: dict = unit_field(_optimizer_units)
+    constraints: Constraints | None = unit_field(Constraints)
+    impact: Impact | None = unit_field(Impact)
+    optimizer: Optimizer = unit_field(Optimizer)
     provenance: dict = unit_field(None)
     samples: Samples = unit_field(Samples)
     design: dict | None = unit_field(None, default=None)  # a designed knee's (``biped design``)
@@ -147,7 +234,6 @@ class Gait:
         """The gait of an optimum of ``robot``; ``provenance``: what produced it (default:
         ``biped.records.provenance.provenance()`` now)."""
         ev, step = optimum.evaluation, optimum.step
-        variables = map(_finite_or_none, optimum.variables)
         return cls(
             knee=optimum.knee,
             criterion=optimum.criterion,
@@ -156,10 +242,7 @@ class Gait:
             feasible=optimum.feasible,
             robot=robot,
             parameters=dict(zip(PARAMETERS, map(float, optimum.parameters), strict=True)),
-            optimizer={
-                **optimum.report.to_dict(),
-                "variables": dict(zip(VARIABLES, variables, strict=True)),
-            },
+            optimizer=Optimizer.of(optimum.report, optimum.variables),
             provenance=dict(provenance) if provenance is not None else make_provenance(),
             **_derived(Biped(robot, optimum.knee), step, ev),
         )
@@ -235,10 +318,17 @@ class Gait:
         except BipedError as error:
             raise bad(str(error)) from None
         _check_step(content, bad)
+        try:
+            optimizer = Optimizer.from_dict(content["optimizer"])
+        except (KeyError, TypeError, ValueError, AttributeError) as error:
+            raise bad(f"optimizer {content.get('optimizer')!r} ({error!r})") from None
         fields = {f.name: content.get(f.name) for f in dataclasses.fields(cls)}
-        return cls(
-            **{**fields, "safety": safety, "robot": robot, "samples": _samples(content, bad)}
-        )
+        records = {
+            name: record.from_content(content.get(name), name, bad)
+            for name, record in (("costs", Costs), ("constraints", Constraints), ("impact", Impact))
+        }
+        read = {"safety": safety, "robot": robot, "optimizer": optimizer}
+        return cls(**{**fields, **records, **read, "samples": _samples(content, bad)})
 
     @staticmethod
     def units(criterion: str) -> dict:
@@ -255,9 +345,9 @@ class Gait:
             value = getattr(self, f.name)
             if value is None and f.name == "design":
                 continue
-            if isinstance(value, Samples):
+            if hasattr(value, "to_dict"):  # the samples, records, robot
                 value = value.to_dict()
-            elif dataclasses.is_dataclass(value):  # the safety margins, the robot
+            elif dataclasses.is_dataclass(value):  # the safety margins
                 value = dataclasses.asdict(value)
             content[f.name] = value
         return content
@@ -320,24 +410,14 @@ class Gait:
 def _derived(model: Biped, step, evaluation) -> dict:
     """The fields of a gait that its parameters determine, from its step and its evaluation
     on the check grid."""
-    qd_plus, _ = model.impact(*step.end)
-    lift = trailing_foot_lift(model, step.end[0], qd_plus)
     return {
         "period": step.period,
         "step_length": step.step_length,
-        "costs": {
-            "sthenic": evaluation.sthenic,
-            "energy": evaluation.energy,
-            "energy_per_metre": evaluation.energy / step.step_length,
-        },
-        "constraints": dict(zip(CONSTRAINTS, map(float, evaluation.worst), strict=True)),
-        "impact": {
-            "impulse": step.impulse.tolist(),
-            "trailing_foot_lift": lift.tolist(),
-            "consistent": bool(step.impulse[1] > 0 and np.all(lift >= 0)),
-            "qd_minus": step.end[1].tolist(),
-            "qd_plus": step.start[1].tolist(),
-        },
+        "costs": Costs.of(model, step, evaluation),
+        "constraints": Constraints(
+            **dict(zip(CONSTRAINTS, map(float, evaluation.worst), strict=True))
+        ),
+        "impact": Impact.of(model, step),
         "samples": Samples(
             **{f.name: getattr(evaluation, f.name) for f in dataclasses.fields(Samples)}
         ),
@@ -517,13 +597,13 @@ def _check_samples(samples: Samples, expected: Samples, units: dict, bad) -> Non
             )
 
 
-def _check_group(stored, group: str, expected: dict, units: dict, bad) -> None:
-    """The costs or the constraints against the parameters'."""
-    if not isinstance(stored, dict):
+def _check_group(stored, group: str, expected, units: dict, bad) -> None:
+    """The costs or the constraints (records) against the parameters'."""
+    if stored is None:
         raise bad(f"{group} missing")
-    for name, wanted in expected.items():
+    for name, wanted in expected.to_dict().items():
         path = f"{group}.{name}"
-        value = stored.get(name)
+        value = getattr(stored, name)
         if not _finite_number(value) or _mismatch(value, wanted):
             raise bad(
                 f"{path} = {value!r}{_shown(units, path)}, its parameters give "
@@ -531,20 +611,20 @@ def _check_group(stored, group: str, expected: dict, units: dict, bad) -> None:
             )
 
 
-def _check_impact(impact, expected: dict, bad) -> None:
+def _check_impact(impact: Impact, expected: Impact, bad) -> None:
     """The impact record against the parameters' (its ``consistent`` flag last)."""
     for name in ("impulse", "qd_minus", "qd_plus", "trailing_foot_lift"):
-        path = f"impact.{name}"
+        path, value, wanted = f"impact.{name}", getattr(impact, name), getattr(expected, name)
         try:
-            found = _mismatch(impact[name], expected[name])
-        except (KeyError, TypeError, ValueError):
-            raise bad(
-                f"{path} is not the {np.shape(expected[name])} numbers it should be"
-            ) from None
+            if value is None:
+                raise TypeError(name)
+            found = _mismatch(value, wanted)
+        except (TypeError, ValueError):
+            raise bad(f"{path} is not the {np.shape(wanted)} numbers it should be") from None
         if found:
             raise bad(f"{path} does not belong to the parameters (off by {found[1]:.3g})")
-    if impact.get("consistent") is not expected["consistent"]:
+    if impact.consistent is not expected.consistent:
         raise bad(
-            f"impact.consistent = {impact.get('consistent')!r}, its parameters give "
-            f"{str(expected['consistent']).lower()}"
+            f"impact.consistent = {impact.consistent!r}, its parameters give "
+            f"{str(expected.consistent).lower()}"
         )

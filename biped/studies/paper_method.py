@@ -168,7 +168,7 @@ def read_runs(sweep_folder: str | Path) -> dict:
                 if not file.exists():
                     break
                 gait = gait_file.read(file)
-                values.append(float(gait.costs[criterion]))
+                values.append(float(gait.costs.criterion(criterion)))
             if len(values) == seeds:
                 runs[(knee, criterion)] = values
     return runs, speed

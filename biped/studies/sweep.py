@@ -40,7 +40,6 @@ from biped.optimization.comparison import SINGLE_START
 from biped.optimization.optimize import (
     DEFAULT_STARTS,
     Optimum,
-    Report,
     best_of,
     checked,
     optimize,
@@ -105,9 +104,8 @@ def _read_gait(path: Path, point: Point, settings: Settings):
 
 def _optimum_of(gait: gait_file.Gait, settings: Settings, point: Point) -> Optimum:
     """The ``Optimum`` stored in a gait file (same numbers: JSON keeps every bit)."""
-    variables = np.array([gait.optimizer["variables"][name] for name in VARIABLES], float)
-    report = Report.from_dict(gait.optimizer)
-    return checked(_problem(settings, point), variables, report)
+    variables = np.array([gait.optimizer.variables[name] for name in VARIABLES], float)
+    return checked(_problem(settings, point), variables, gait.optimizer.report())
 
 
 def _solve_independent(task: Task) -> str:
@@ -117,7 +115,7 @@ def _solve_independent(task: Task) -> str:
     sthenic = None
     for twin in task.given:
         gait = gait_file.read(Path(task.folder) / twin.filename())
-        if campaign.variables(gait.optimizer["variables"]) is not None:  # else computed again
+        if campaign.variables(gait.optimizer.variables) is not None:  # else computed again
             sthenic = _optimum_of(gait, settings, twin)
     problem = _problem(settings, point)
     optimum = optimize(problem, seed=settings.seed, starts=settings.starts, sthenic=sthenic)
@@ -130,7 +128,7 @@ def _solve_with_neighbours(task: Task) -> str:
     settings, point, stage = task.settings, task.point, Path(task.folder) / INDEPENDENT
     own = _optimum_of(gait_file.read(stage / point.filename()), settings, point)
     given = [
-        campaign.variables(gait_file.read(stage / p.filename()).optimizer["variables"])
+        campaign.variables(gait_file.read(stage / p.filename()).optimizer.variables)
         for p in task.given
     ]
     given = [variables for variables in given if variables is not None]
@@ -309,9 +307,9 @@ def optima_table(folder) -> dict:
             for speed in settings.speeds:
                 point = Point(knee, criterion, speed)
                 gait = _read_gait(folder / point.filename(), point, settings)
-                if gait is None or campaign.failure(gait.optimizer["status"], gait.feasible):
+                if gait is None or campaign.failure(gait.optimizer.status, gait.feasible):
                     continue
-                optimum = campaign.variables(gait.optimizer["variables"])
+                optimum = campaign.variables(gait.optimizer.variables)
                 series.setdefault((knee, criterion), []).append((speed, optimum))
     source = f"the certified final optima of the sweep in {folder.name}/ ({MANIFEST})"
     return table.content(series, settings.robot, settings.safety, source)
@@ -325,12 +323,12 @@ def summarize(folder: Path, points, settings: Settings) -> str:
         gait = gaits[p]
         if gait is None:
             return "missing"
-        return campaign.failure(str(gait.optimizer.get("status")), gait.feasible)
+        return campaign.failure(gait.optimizer.status, gait.feasible)
 
     single = [
-        f"{p.filename()} ({single_start_note(Report.from_dict(gaits[p].optimizer))})"
+        f"{p.filename()} ({single_start_note(gaits[p].optimizer.report())})"
         for p in points
-        if why_not(p) is None and gaits[p].optimizer["starts_at_best"] < 2
+        if why_not(p) is None and gaits[p].optimizer.starts_at_best < 2
     ]
     note = f"; {len(single)} of them {SINGLE_START}: " + ", ".join(single) if single else ""
     counted = "points certified (final optima, solver converged, feasible on the check grid)"

@@ -16,6 +16,10 @@ in parentheses, where the key alone would mislead: ``optimizer.value`` is the cr
 solver's samples, which ranks the starts, where ``costs`` hold it on the check grid, which the
 comparisons use (``biped.optimization.comparison``). Only numbers (and null, a figure that could
 not be measured) have units; texts, booleans and ``provenance`` have none.
+
+A record declares the unit of each of its fields beside it (``unit_field``), and its map
+follows from the declarations (``declared_units``): the gait file's ``Gait`` and its inner
+records, the optimizer's ``Report``, a walk's figures (``validate.units``).
 """
 
 from __future__ import annotations
@@ -103,12 +107,13 @@ def per_coordinate(angle: str, length: str) -> list[str]:
     return [angle if name in ANGLES else length for name in COORDINATES]
 
 
-def unit_field(unit, columns: tuple | None = None, **kwargs):
+def unit_field(unit, columns: tuple | None = None, metadata: dict | None = None, **kwargs):
     """A record's field with its unit (a string, one per column, a map of sub-fields to
-    units, a record type whose fields carry theirs, a function of the gait's criterion, or
-    None: no number) and, for an array of samples, the names of its columns (None: one
-    number a sample)."""
-    return dataclasses.field(metadata={"unit": unit, "columns": columns}, **kwargs)
+    units, a record type whose fields carry theirs, ``[type]`` for a list of such records, a
+    function of the gait's criterion, or None: no number), for an array of samples the names
+    of its columns (None: one number a sample), and any further ``metadata``."""
+    metadata = {"unit": unit, "columns": columns, **(metadata or {})}
+    return dataclasses.field(metadata=metadata, **kwargs)
 
 
 def declared_units(record, prefix: str = "", criterion: str | None = None) -> dict:
@@ -119,7 +124,9 @@ def declared_units(record, prefix: str = "", criterion: str | None = None) -> di
         unit = f.metadata.get("unit")
         unit = unit(criterion) if callable(unit) and not isinstance(unit, type) else unit
         path = f"{prefix}{f.name}"
-        if isinstance(unit, type):
+        if isinstance(unit, list) and len(unit) == 1 and isinstance(unit[0], type):
+            units.update(declared_units(unit[0], f"{path}[].", criterion))
+        elif isinstance(unit, type):
             units.update(declared_units(unit, f"{path}.", criterion))
         elif isinstance(unit, dict):
             units.update({f"{path}.{key}": value for key, value in unit.items()})
