@@ -202,18 +202,21 @@ def cmd_sweep(args) -> int:
     terminal, else a line at most every 10 s.
     """
     from biped.runtime.runner import check_dask
-    from biped.studies.paper_method import FOLDER, SETTINGS, check_paper_method, run_paper_method
-    from biped.studies.paper_method import SPEED as PAPER_METHOD_SPEED
-    from biped.studies.sweep import INDEPENDENT, MANIFEST, check_sweep, run_sweep
+    from biped.studies import paper_method
+    from biped.studies.sweep import INDEPENDENT, MANIFEST, check_sweep, run_sweep, sweep_settings
 
     robot = robot_of(args)
     check_folder(args.out, "--out")
     # at the sweep's speed nearest the paper's optima
-    paper_speed = float(min(args.speeds, key=lambda v: abs(v - PAPER_METHOD_SPEED)))
+    paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
-    check_sweep(args.out, robot, args.speeds, args.knees, args.seed, args.starts, safety(args))
+    sweep = sweep_settings(robot, args.speeds, args.knees, args.seed, args.starts, safety(args))
+    check_sweep(args.out, sweep)
     if args.paper_seeds:  # refused before the sweep runs, not after
-        check_paper_method(args.out, robot, paper_speed, args.paper_seeds, args.knees, safety(args))
+        planned = paper_method.paper_settings(
+            robot, paper_speed, args.paper_seeds, args.knees, safety(args)
+        )
+        paper_method.check_paper_method(args.out, planned)
     if args.dask is not None:
         check_dask(args.dask)
     points = run_sweep(
@@ -229,7 +232,7 @@ def cmd_sweep(args) -> int:
     )
     runs = []
     if args.paper_seeds:
-        runs = run_paper_method(
+        runs = paper_method.run_paper_method(
             args.out,
             robot,
             speed=paper_speed,
@@ -243,7 +246,9 @@ def cmd_sweep(args) -> int:
     def files(n: int) -> str:
         return f"{n} gait file{'' if n == 1 else 's'}"
 
-    paper = f", {FOLDER}/ ({SETTINGS} and {files(len(runs))})" if runs else ""
+    paper = (
+        f", {paper_method.FOLDER}/ ({paper_method.SETTINGS} and {files(len(runs))})" if runs else ""
+    )
     print(  # the folder's files, once: a file per optimization is too many to name
         f"sweep results in {args.out}: {MANIFEST}, {files(len(points))} "
         f"<knee>-<criterion>-<speed>.json, {INDEPENDENT}/ (each point's first solve){paper}"

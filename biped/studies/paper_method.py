@@ -94,8 +94,15 @@ def _solve(task: Task) -> str:
     )
 
 
-def _settings(robot: Robot, speed: float, seeds: int, knees, safety: Safety) -> PaperMethod:
-    """The settings of the runs, each checked (BipedError naming a bad one)."""
+def paper_settings(
+    robot: Robot,
+    speed: float = SPEED,
+    seeds: int = DEFAULT_SEEDS,
+    knees=KNEES,
+    safety: Safety = PAPER_SAFETY,
+) -> PaperMethod:
+    """The settings of ``run_paper_method`` with these arguments, each checked (BipedError
+    naming a bad one)."""
     if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
         raise BipedError(f"seeds = {seeds!r}: allowed an integer >= 1")
     for knee in knees:
@@ -103,19 +110,10 @@ def _settings(robot: Robot, speed: float, seeds: int, knees, safety: Safety) -> 
     return PaperMethod(robot, safety, float(speed), seeds)
 
 
-def check_paper_method(
-    sweep_folder: str | Path,
-    robot: Robot,
-    speed: float = SPEED,
-    seeds: int = DEFAULT_SEEDS,
-    knees=KNEES,
-    safety: Safety = PAPER_SAFETY,
-) -> None:
-    """Raise the BipedError ``run_paper_method`` would raise before running, writing nothing
-    (so that a sweep is refused before it starts, not after)."""
-    PAPER.check(
-        Path(sweep_folder) / FOLDER, _settings(robot, speed, seeds, knees, safety).to_dict()
-    )
+def check_paper_method(sweep_folder: str | Path, settings: PaperMethod) -> None:
+    """Raise the BipedError ``run_paper_method`` would raise on the folder's record before
+    running, writing nothing (so that a sweep is refused before it starts, not after)."""
+    PAPER.check(Path(sweep_folder) / FOLDER, settings.to_dict())
 
 
 def run_paper_method(
@@ -134,7 +132,7 @@ def run_paper_method(
     """The paper's Nelder-Mead from seeds 0 .. ``seeds`` − 1 for every knee and criterion at
     ``speed``, into ``sweep_folder``/paper-method/ (runs already there are kept); returns
     the gait files. ``progress(total)``, if given, makes a bar advanced after each run."""
-    settings = _settings(robot, speed, seeds, knees, safety)
+    settings = paper_settings(robot, speed, seeds, knees, safety)
     folder = PAPER.claim(Path(sweep_folder) / FOLDER, settings)  # checked before it is made
     runs = [Run(k, c, settings.speed, s) for c in criteria for k in knees for s in range(seeds)]
     todo = [Task(_solve, settings, r, str(folder)) for r in runs]

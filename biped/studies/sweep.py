@@ -164,29 +164,29 @@ def _line(stage: str, point: Point, optimum: Optimum) -> str:
     )
 
 
-def check_speeds(robot: Robot, speeds, knees) -> list[float]:
-    """Sorted speeds, each walkable and with its own file name; raise a clear error if not."""
+def sweep_settings(
+    robot: Robot,
+    speeds=DEFAULT_SPEEDS,
+    knees=KNEES,
+    seed: int = 0,
+    starts: int = DEFAULT_STARTS,
+    safety: Safety = PAPER_SAFETY,
+) -> Settings:
+    """The settings of ``run_sweep`` with these arguments, its speeds sorted, each walkable by
+    every knee and with its own file name; a clear error if not."""
     speeds = sorted(float(s) for s in speeds)
     for knee in knees:
         model = Biped(robot, knee)
         for speed in speeds:
             check_speed(model, speed)
-    return campaign.distinct_speeds(speeds)
+    speeds = campaign.distinct_speeds(speeds)
+    return Settings(robot, safety, tuple(speeds), int(seed), int(starts))
 
 
-def check_sweep(
-    folder,
-    robot: Robot,
-    speeds,
-    knees=KNEES,
-    seed=0,
-    starts=DEFAULT_STARTS,
-    safety: Safety = PAPER_SAFETY,
-) -> None:
-    """Raise the BipedError ``run_sweep`` would raise on its settings (speeds, the folder's
-    record), writing nothing: a command checks the sweep before what follows from it."""
-    speeds = check_speeds(robot, speeds, knees)
-    SWEEP.check(folder, Settings(robot, safety, tuple(speeds), int(seed), int(starts)).to_dict())
+def check_sweep(folder, settings: Settings) -> None:
+    """Raise the BipedError ``run_sweep`` would raise on the folder's record, writing
+    nothing: a command checks the sweep before what follows from it."""
+    SWEEP.check(folder, settings.to_dict())
 
 
 def run_sweep(
@@ -209,27 +209,24 @@ def run_sweep(
     and ``progress`` (a bar over the optimizations of all stages) to ``campaign.Campaign.run``."""
     if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
         raise BipedError(f"knees {list(knees)}, criteria {list(criteria)}: allowed each once")
-    speeds = check_speeds(robot, speeds, knees)
-    settings = Settings(robot, safety, tuple(speeds), int(seed), int(starts))
+    settings = sweep_settings(robot, speeds, knees, seed, starts, safety)
     folder = SWEEP.claim(folder, settings, INDEPENDENT)  # checked before anything is written
-    points = [Point(k, c, s) for c in criteria for k in knees for s in speeds]
+    points = [Point(k, c, s) for c in criteria for k in knees for s in settings.speeds]
     final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
-    stages = _stages(folder, settings, points, final, knees)
-    plan = _plan(folder, settings, points, final, stages)
+    saved = {p for p in points if _read_gait(folder / INDEPENDENT / p.filename(), p, settings)}
+    stages = _stages(folder, settings, points, final, knees, saved)
+    plan = _plan(folder, points, final, stages, saved)
     where = dict(jobs=jobs, dask=dask, stream=stream, progress=progress)
     SWEEP.run(plan, stages, lambda: summarize(folder, points, settings), **where)
     return points
 
 
-def _plan(folder: Path, settings: Settings, points, final, stages) -> str:
+def _plan(folder: Path, points, final, stages, saved: set) -> str:
     """What the sweep will do, counted in optimizations as its progress bar counts them: two
     per point, in the stages of its lines (``STAGES``: own starts, then final), those of
-    each stage already in the folder, and those to run (the bar's total)."""
-
-    def saved(p):
-        return _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is not None
-
-    done = {"independent": sum(map(saved, points)), "final": len(points) - len(final)}
+    each stage already in the folder (``saved``: the points with an independent optimum),
+    and those to run (the bar's total)."""
+    done = {"independent": len(saved), "final": len(points) - len(final)}
     to_run = sum(len(tasks) for tasks in stages)
     unneeded = 2 * len(points) - sum(done.values()) - to_run  # stage 1 of finished points
     text = (
@@ -242,23 +239,21 @@ def _plan(folder: Path, settings: Settings, points, final, stages) -> str:
     return text
 
 
-def _stages(folder: Path, settings: Settings, points, final, knees) -> list:
+def _stages(folder: Path, settings: Settings, points, final, knees, saved: set) -> list:
     """The tasks still to run, in stages whose tasks are independent of each other and
     depend only on the files of the stages before: the sthenic independent optima; the
     energy ones (each started from the sthenic optimum of its problem, when the sweep has
-    that criterion) with the sthenic finals; the energy finals."""
+    that criterion) with the sthenic finals; the energy finals. ``saved``: the points whose
+    independent optimum is in the folder."""
     speeds = settings.speeds
     needed = {n for p in final for n in [p, *_neighbours(p, speeds, knees)]}
     twins = {p: Point(p.knee, "sthenic", p.speed) for p in points if p.criterion == "energy"}
     if not any(p.criterion == "sthenic" for p in points):
         twins = {}
 
-    def missing(p):
-        return _read_gait(folder / INDEPENDENT / p.filename(), p, settings) is None
+    needed |= {twins[p] for p in needed if p in twins and p not in saved}
 
-    needed |= {twins[p] for p in needed if p in twins and missing(p)}
-
-    independent = [p for p in points if p in needed and missing(p)]
+    independent = [p for p in points if p in needed and p not in saved]
     first = [p for p in independent if p not in twins]
     second = [p for p in independent if p in twins]
 
