@@ -54,7 +54,7 @@ from biped.records.gait_file import Gait
 from biped.runtime.runner import ProgressBar, run_tasks
 from validate.checks import walk_verdict
 from validate.model import compile_spec, model_spec
-from validate.simulate import KP, KV, Push, Walker, WalkSettings, quiet_mujoco
+from validate.simulate import KP, KV, Push, Walker, WalkSettings
 
 # Far ends of the brackets: impulse [N·s] (a 70 kg robot's speed changes by 0.29 m/s), trunk
 # mass error (fraction), gain scale (each way).
@@ -406,8 +406,7 @@ def map_limit(
     walk."""
     if name not in LIMITS:
         raise BipedError(f"limit {name!r}: allowed one of {', '.join(LIMITS)}")
-    with quiet_mujoco():
-        return _Mapper(gait, model, settings).limit(name)
+    return _Mapper(gait, model, settings).limit(name)
 
 
 # The mapper of the gait being mapped, in this process: (key, _Mapper).
@@ -420,8 +419,7 @@ def _limit_task(task: tuple) -> Limit:
     key, gait, model, settings, name = task
     if not _PREPARED or _PREPARED[0][0] != key:
         _PREPARED[:] = [(key, _Mapper(gait, model, settings))]
-    with quiet_mujoco():
-        return _PREPARED[0][1].limit(name)
+    return _PREPARED[0][1].limit(name)
 
 
 def robustness_map(
@@ -447,8 +445,7 @@ def robustness_map(
     mapper = _Mapper(gait, model, settings)
     _PREPARED[:] = [(key, mapper)]
     try:
-        with quiet_mujoco():
-            nominal = mapper.verdict(mapper.walker)
+        nominal = mapper.verdict(mapper.walker)
         if progress is not None:
             progress.advance(1 if not nominal else 1 + len(LIMITS))
         limits = {}

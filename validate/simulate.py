@@ -54,7 +54,6 @@ from __future__ import annotations
 import contextlib
 import copy
 import functools
-import threading
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
@@ -408,29 +407,18 @@ def simulate(
     return Walker(gait, model).walk(steps, settings)
 
 
-# MuJoCo's warning handler while walks silence it: (walks under way, the handler before).
-_QUIET = [0, None]
-_QUIET_LOCK = threading.Lock()
-
-
 @contextlib.contextmanager
 def quiet_mujoco() -> Iterator[None]:
     """Within the block, MuJoCo's warnings are neither printed nor written to its log file
     (MuJoCo's own handler writes ``MUJOCO_LOG.TXT`` into the working directory): a walk counts
-    them itself (``Simulation.warnings``) and a walk that raises one fails. Nests, and holds
-    across threads: the handler comes back when the last block ends."""
-    with _QUIET_LOCK:
-        if _QUIET[0] == 0:
-            _QUIET[1] = mujoco.get_mju_user_warning()
-            mujoco.set_mju_user_warning(lambda message: None)
-        _QUIET[0] += 1
+    them itself (``Simulation.warnings``) and a walk that raises one fails. The handler before
+    comes back when the block ends (walks run one at a time in a process)."""
+    before = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)
     try:
         yield
     finally:
-        with _QUIET_LOCK:
-            _QUIET[0] -= 1
-            if _QUIET[0] == 0:
-                mujoco.set_mju_user_warning(_QUIET[1])
+        mujoco.set_mju_user_warning(before)
 
 
 def _walk(walker: Walker, steps: int, settings: WalkSettings, start, stop_advance) -> Simulation:
