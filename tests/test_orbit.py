@@ -156,6 +156,7 @@ def test_orbit_command_writes_the_multipliers(tmp_path, capsys):
     import json
 
     from biped.records.units import missing
+
     from biped_cli import main
 
     path = tmp_path / "gaits" / "rolling.json"

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from biped.records.units import PURE
 
 from biped.errors import BipedError
 from biped.records.gait_file import Gait
-from biped.records.units import PURE
 from biped.runtime.runner import ProgressBar, run_tasks
 from validate.model import model_spec
 from validate.orbit import NOMINAL, Orbit, Steps, figures, notes, orbit

@@ -217,6 +217,28 @@ def _rgba(model: mujoco.MjModel, geom: int) -> np.ndarray:
     return np.round(255 * np.asarray(rgba)).astype(np.uint8)
 
 
+# The rerun archetype of each kind of visual geom (MuJoCo's geom type), with its options.
+ARCHETYPES = {
+    int(mujoco.mjtGeom.mjGEOM_CAPSULE): (rr.Capsules3D, {}),
+    int(mujoco.mjtGeom.mjGEOM_BOX): (rr.Boxes3D, {"fill_mode": "solid"}),
+    int(mujoco.mjtGeom.mjGEOM_CYLINDER): (rr.Cylinders3D, {"fill_mode": "solid"}),
+}
+
+
+def _shape(model: mujoco.MjModel, g: int) -> dict:
+    """A capsule, box or cylinder geom's fields of its archetype, in its body's frame (a
+    capsule from the end of its axis, as rerun draws it)."""
+    kind, size, pos = model.geom_type[g], model.geom_size[g], model.geom_pos[g]
+    if kind == mujoco.mjtGeom.mjGEOM_BOX:
+        return {"centers": pos, "half_sizes": size[:3]}
+    if kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+        return {"centers": pos, "radii": size[0], "lengths": 2 * size[1]}
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, model.geom_quat[g])
+    base = pos - rotation.reshape(3, 3) @ [0.0, 0.0, size[1]]
+    return {"translations": base, "radii": size[0], "lengths": 2 * size[1]}
+
+
 def visual_geoms(model: mujoco.MjModel, color=None) -> dict:
     """Body name -> its visual geoms (group 2) as rerun archetypes in the body's frame, in
     the model's colours or all in ``color`` (RGBA)."""
@@ -225,57 +247,20 @@ def visual_geoms(model: mujoco.MjModel, color=None) -> dict:
         body = model.geom_bodyid[g]
         if model.geom_group[g] != 2 or body == 0:
             continue
-        kind, size = model.geom_type[g], model.geom_size[g]
-        pos, quat = model.geom_pos[g], model.geom_quat[g]
-        entry = shapes.setdefault(model.body(body).name, {"capsule": [], "box": [], "cylinder": []})
+        entry = shapes.setdefault(model.body(body).name, {kind: [] for kind in ARCHETYPES})
         rgba = _rgba(model, g) if color is None else np.array(color, dtype=np.uint8)
-        if kind == mujoco.mjtGeom.mjGEOM_CAPSULE:
-            rotation = np.zeros(9)
-            mujoco.mju_quat2Mat(rotation, quat)
-            base = pos - rotation.reshape(3, 3) @ [0.0, 0.0, size[1]]
-            entry["capsule"].append((base, quat, size[0], 2 * size[1], rgba))
-        elif kind == mujoco.mjtGeom.mjGEOM_BOX:
-            entry["box"].append((pos, quat, size[:3], rgba))
-        elif kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
-            entry["cylinder"].append((pos, quat, size[0], 2 * size[1], rgba))
+        kind = int(model.geom_type[g])
+        if kind in ARCHETYPES:
+            entry[kind].append({**_shape(model, g), "q": model.geom_quat[g], "colors": rgba})
     archetypes = {}
     for body, entry in shapes.items():
-        parts = []
-        if entry["capsule"]:
-            base, quat, radius, length, rgba = zip(*entry["capsule"], strict=True)
-            parts.append(
-                rr.Capsules3D(
-                    translations=base,
-                    quaternions=_xyzw(np.array(quat)),
-                    radii=radius,
-                    lengths=length,
-                    colors=rgba,
-                )
-            )
-        if entry["box"]:
-            pos, quat, half, rgba = zip(*entry["box"], strict=True)
-            parts.append(
-                rr.Boxes3D(
-                    centers=pos,
-                    quaternions=_xyzw(np.array(quat)),
-                    half_sizes=half,
-                    colors=rgba,
-                    fill_mode="solid",
-                )
-            )
-        if entry["cylinder"]:
-            pos, quat, radius, length, rgba = zip(*entry["cylinder"], strict=True)
-            parts.append(
-                rr.Cylinders3D(
-                    centers=pos,
-                    quaternions=_xyzw(np.array(quat)),
-                    radii=radius,
-                    lengths=length,
-                    colors=rgba,
-                    fill_mode="solid",
-                )
-            )
-        archetypes[body] = parts
+        archetypes[body] = []
+        for kind, found in entry.items():
+            if found:
+                archetype, options = ARCHETYPES[kind]
+                fields = {key: [f[key] for f in found] for key in found[0] if key != "q"}
+                quaternions = _xyzw(np.array([f["q"] for f in found]))
+                archetypes[body].append(archetype(**fields, quaternions=quaternions, **options))
     return archetypes
 
 
@@ -458,10 +443,20 @@ def _log_orbit(rec, orbit: dict) -> None:
     rec.log("orbit/multipliers", points, static=True)
 
 
+def _line(rec, path: str, name: str, color, width: float) -> None:
+    """The style of the time series at ``path``: its name in the legend, colour and width."""
+    rec.log(path, rr.SeriesLines(colors=color, names=name, widths=width), static=True)
+
+
+def _scalars(rec, path: str, time: np.ndarray, values: np.ndarray) -> None:
+    """The values of the time series at ``path`` at the simulation times ``time`` [s]."""
+    indexes = [rr.TimeColumn("time", duration=time)]
+    rec.send_columns(path, indexes=indexes, columns=rr.Scalars.columns(scalars=values))
+
+
 def _log_torques(rec, biped: Biped, sim: Simulation, torques, ranges: dict, steady) -> None:
     """Per joint: the gait's torque, MuJoCo's, its feedforward and feedback, the landings."""
     model = sim.model
-    time_column = [rr.TimeColumn("time", duration=sim.time)]
     stance_of = sim.stance_of()
     feedforward, feedback = sim.feedforward(), sim.feedback()  # JOINT_ORDER
     parts = {"feedforward": np.zeros_like(torques), "feedback": np.zeros_like(torques)}
@@ -486,87 +481,35 @@ def _log_torques(rec, biped: Biped, sim: Simulation, torques, ranges: dict, stea
             "feedback": parts["feedback"][:, i],
         }
         for source, series in values.items():
-            name, color, width = styles[source]
-            rec.log(
-                f"{base}/{source}",
-                rr.SeriesLines(colors=color, names=name, widths=width),
-                static=True,
-            )
-            rec.send_columns(
-                f"{base}/{source}", indexes=time_column, columns=rr.Scalars.columns(scalars=series)
-            )
+            _line(rec, f"{base}/{source}", *styles[source])
+            _scalars(rec, f"{base}/{source}", sim.time, series)
+        marks = rr.SeriesPoints(
+            colors=LANDING_COLOR, names="landing", markers="square", marker_sizes=2.0
+        )
+        rec.log(f"{base}/landing", marks, static=True)
         low = ranges[base][0]
-        rec.log(
-            f"{base}/landing",
-            rr.SeriesPoints(
-                colors=LANDING_COLOR, names="landing", markers="square", marker_sizes=2.0
-            ),
-            static=True,
-        )
-        rec.send_columns(
-            f"{base}/landing",
-            indexes=[rr.TimeColumn("time", duration=sim.time[landing])],
-            columns=rr.Scalars.columns(scalars=np.full(len(landing), low)),
-        )
+        _scalars(rec, f"{base}/landing", sim.time[landing], np.full(len(landing), low))
 
 
 def _log_series(rec, biped: Biped, step, sim: Simulation, contact, wrench, zmp) -> None:
     """Ground reaction, ZMP and phase plots, the gait's and MuJoCo's."""
-    time_column = [rr.TimeColumn("time", duration=sim.time)]
     for name in ("Fx", "Fz"):
-        rec.log(
-            f"ground/{name}/analytic",
-            rr.SeriesLines(colors=ANALYTIC_COLOR, names=f"{name} gait", widths=ANALYTIC_WIDTH),
-            static=True,
-        )
-        rec.log(
-            f"ground/{name}/mujoco",
-            rr.SeriesLines(colors=MUJOCO_COLOR, names=f"{name} MuJoCo", widths=MUJOCO_WIDTH),
-            static=True,
-        )
-    rec.log(
-        "zmp/analytic",
-        rr.SeriesLines(colors=ANALYTIC_COLOR, names="ZMP gait", widths=ANALYTIC_WIDTH),
-        static=True,
-    )
-    rec.log(
-        "zmp/mujoco",
-        rr.SeriesLines(colors=MUJOCO_COLOR, names="CoP MuJoCo", widths=MUJOCO_WIDTH),
-        static=True,
-    )
+        _line(rec, f"ground/{name}/analytic", f"{name} gait", ANALYTIC_COLOR, ANALYTIC_WIDTH)
+        _line(rec, f"ground/{name}/mujoco", f"{name} MuJoCo", MUJOCO_COLOR, MUJOCO_WIDTH)
+    _line(rec, "zmp/analytic", "ZMP gait", ANALYTIC_COLOR, ANALYTIC_WIDTH)
+    _line(rec, "zmp/mujoco", "CoP MuJoCo", MUJOCO_COLOR, MUJOCO_WIDTH)
     for name in SOLE_EDGES:
-        color = SOLE_COLORS[name]
-        edge = rr.SeriesLines(colors=color, names=f"{name} edge", widths=EDGE_WIDTH)
-        rec.log(f"zmp/{name}", edge, static=True)
+        _line(rec, f"zmp/{name}", f"{name} edge", SOLE_COLORS[name], EDGE_WIDTH)
     for i, name in enumerate(("Fx", "Fz")):
-        rec.send_columns(
-            f"ground/{name}/analytic",
-            indexes=time_column,
-            columns=rr.Scalars.columns(scalars=wrench[:, i]),
-        )
+        _scalars(rec, f"ground/{name}/analytic", sim.time, wrench[:, i])
         sampled = ~np.isnan(contact["force"][:, i])
-        rec.send_columns(
-            f"ground/{name}/mujoco",
-            indexes=[rr.TimeColumn("time", duration=sim.time[sampled])],
-            columns=rr.Scalars.columns(scalars=contact["force"][sampled, i]),
-        )
-    rec.send_columns("zmp/analytic", indexes=time_column, columns=rr.Scalars.columns(scalars=zmp))
-    rec.send_columns(
-        "phase", indexes=time_column, columns=rr.Scalars.columns(scalars=sim.phase / step.period)
-    )
+        _scalars(rec, f"ground/{name}/mujoco", sim.time[sampled], contact["force"][sampled, i])
+    _scalars(rec, "zmp/analytic", sim.time, zmp)
+    _scalars(rec, "phase", sim.time, sim.phase / step.period)
     sampled = ~np.isnan(contact["cop"])
-    rec.send_columns(
-        "zmp/mujoco",
-        indexes=[rr.TimeColumn("time", duration=sim.time[sampled])],
-        columns=rr.Scalars.columns(scalars=contact["cop"][sampled]),
-    )
-    robot = biped.robot
-    for name, value in robot.sole_edges().items():
-        rec.send_columns(
-            f"zmp/{name}",
-            indexes=time_column,
-            columns=rr.Scalars.columns(scalars=np.full(len(sim.time), value)),
-        )
+    _scalars(rec, "zmp/mujoco", sim.time[sampled], contact["cop"][sampled])
+    for name, value in biped.robot.sole_edges().items():
+        _scalars(rec, f"zmp/{name}", sim.time, np.full(len(sim.time), value))
 
 
 def _log_world(rec, biped: Biped, sim: Simulation, contact, q_ref, zmp) -> None:

@@ -102,11 +102,6 @@ class Biped(Chain):
         self._stance_leg = self.directions[:, [Q1, Q2]]
 
     # ------------------------------------------------------------------ matrices of eq. (19)
-    @property
-    def control_matrix(self):
-        """B (9, 6) = (∂θ/∂q)ᵀ: Γ_i acts +Γ_i on the body whose angle enters θ_i with +."""
-        return JOINT_MATRIX.T
-
     def joint_angles(self, q):
         """θ (..., 6) of eq. (32) from q (..., 9); also maps q̇ to θ̇."""
         return np.asarray(q) @ JOINT_MATRIX.T

@@ -348,13 +348,3 @@ def check_embedding(knots: int, richer: int) -> None:
             f"knots = {richer}: its knots do not include those of {knots} knot(s), so its "
             "family does not hold the other's"
         )
-
-
-def angles_at(step: Step, t_n):
-    """Angles, rates, accelerations (..., 6) at normalised times t_n in [0, 1], the left
-    piece up to t_n = 0.5 inclusive, the right piece after."""
-    t_n = np.asarray(t_n, dtype=float)
-    left = evaluate(step, np.minimum(t_n, 0.5), "left")
-    right = evaluate(step, np.maximum(t_n, 0.5), "right")
-    first = (t_n <= 0.5)[..., None]
-    return tuple(np.where(first, a, b) for a, b in zip(left, right, strict=True))

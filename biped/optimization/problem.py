@@ -192,10 +192,6 @@ class GaitProblem:
         """The names of the solvers' variables (``variable_names``)."""
         return variable_names(self.knots)
 
-    def at_speed(self, speed: float) -> GaitProblem:
-        """The same problem at another speed."""
-        return dataclasses.replace(self, speed=speed)
-
     def describe(self) -> str:
         margins = ""
         if self.safety != PAPER_SAFETY:
