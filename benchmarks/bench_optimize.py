@@ -36,7 +36,7 @@ from biped.optimization.optimize import (  # noqa: E402
 )
 from biped.optimization.problem import GaitProblem  # noqa: E402
 from biped.runtime.runner import free_cores  # noqa: E402
-from biped.studies.sweep import run_sweep  # noqa: E402
+from biped.studies.sweep import run_sweep, sweep_settings  # noqa: E402
 
 SPEED = 0.3
 TARGETS = {"sthenic": 0.5, "energy": 1.5}  # [s] of a solve once set up
@@ -165,11 +165,11 @@ def sweep() -> None:
     with tempfile.TemporaryDirectory() as folder:
         began = time.perf_counter()
         with open(os.devnull, "w") as null:
-            run_sweep(f"{folder}/now", biped.Robot.paper(), stream=null)
+            run_sweep(f"{folder}/now", sweep_settings(biped.Robot.paper()), stream=null)
         now = time.perf_counter() - began
         began = time.perf_counter()
         with solvers_before(), open(os.devnull, "w") as null:
-            run_sweep(f"{folder}/before", biped.Robot.paper(), stream=null, jobs=1)
+            run_sweep(f"{folder}/before", sweep_settings(biped.Robot.paper()), stream=null, jobs=1)
         before = time.perf_counter() - began
     cores = free_cores()
     print(

@@ -21,7 +21,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import biped  # noqa: E402
-from biped.studies.sweep import run_sweep  # noqa: E402
+from biped.studies.sweep import run_sweep, sweep_settings  # noqa: E402
 
 
 def _gaits(folder: Path) -> dict:
@@ -41,18 +41,18 @@ def main():
     parser.add_argument("--speeds", default="0.25,0.275,0.3,0.325")
     args = parser.parse_args()
     speeds = [float(v) for v in args.speeds.split(",")]
-    sweep = dict(knees=("revolute",), criteria=("sthenic",), starts=1, stream=io.StringIO())
-    robot = biped.Robot.paper()
+    sweep = dict(knees=("revolute",), criteria=("sthenic",), stream=io.StringIO())
+    settings = sweep_settings(biped.Robot.paper(), speeds, starts=1)
     points = len(speeds)
     print(f"sweep: revolute knee, sthenic, {points} speeds, 1 start: {2 * points} optimizations")
     with tempfile.TemporaryDirectory() as root:
         root = Path(root)
         began = time.perf_counter()
-        run_sweep(root / "in-process", robot, speeds, jobs=1, **sweep)
+        run_sweep(root / "in-process", settings, jobs=1, **sweep)
         reference = time.perf_counter() - began
         print(f"in this process           {reference:7.1f} s   1.00 x")
         began = time.perf_counter()
-        run_sweep(root / "pool", robot, speeds, jobs=args.workers, **sweep)
+        run_sweep(root / "pool", settings, jobs=args.workers, **sweep)
         pool = time.perf_counter() - began
         print(f"pool of {args.workers} processes        {pool:7.1f} s   {reference / pool:.2f} x")
 
@@ -64,7 +64,7 @@ def main():
         ) as cluster:
             start = time.perf_counter() - began
             began = time.perf_counter()
-            run_sweep(root / "dask", robot, speeds, dask=cluster.scheduler_address, **sweep)
+            run_sweep(root / "dask", settings, dask=cluster.scheduler_address, **sweep)
             dask = time.perf_counter() - began
         print(
             f"Dask, {args.workers} workers          {dask:7.1f} s   {reference / dask:.2f} x"

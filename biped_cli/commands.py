@@ -210,48 +210,28 @@ def cmd_sweep(args) -> int:
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
-    sweep = sweep_settings(robot, args.speeds, args.knees, args.seed, args.starts, safety(args))
+    sweep = sweep_settings(robot, args.speeds, args.seed, args.starts, safety(args))
     check_sweep(args.out, sweep)
     if args.paper_seeds:  # refused before the sweep runs, not after
-        planned = paper_method.paper_settings(
-            robot, paper_speed, args.paper_seeds, args.knees, safety(args)
-        )
-        paper_method.check_paper_method(args.out, planned)
+        paper = paper_method.paper_settings(robot, paper_speed, args.paper_seeds, safety(args))
+        paper_method.check_paper_method(args.out, paper)
     if args.dask is not None:
         check_dask(args.dask)
-    points = run_sweep(
-        args.out,
-        robot,
-        args.speeds,
-        args.knees,
-        args.criteria,
-        seed=args.seed,
-        starts=args.starts,
-        safety=safety(args),
-        **types.campaign(args, "sweep"),
-    )
+    which = (args.knees, args.criteria)
+    points = run_sweep(args.out, sweep, *which, **types.campaign(args, "sweep"))
     runs = []
     if args.paper_seeds:
-        runs = paper_method.run_paper_method(
-            args.out,
-            robot,
-            speed=paper_speed,
-            seeds=args.paper_seeds,
-            knees=args.knees,
-            criteria=args.criteria,
-            safety=safety(args),
-            **types.campaign(args, "paper's method"),
-        )
+        where = types.campaign(args, "paper's method")
+        runs = paper_method.run_paper_method(args.out, paper, *which, **where)
 
     def files(n: int) -> str:
         return f"{n} gait file{'' if n == 1 else 's'}"
 
-    paper = (
-        f", {paper_method.FOLDER}/ ({paper_method.SETTINGS} and {files(len(runs))})" if runs else ""
-    )
+    folder = f", {paper_method.FOLDER}/ ({paper_method.SETTINGS} and {files(len(runs))})"
     print(  # the folder's files, once: a file per optimization is too many to name
         f"sweep results in {args.out}: {MANIFEST}, {files(len(points))} "
-        f"<knee>-<criterion>-<speed>.json, {INDEPENDENT}/ (each point's first solve){paper}"
+        f"<knee>-<criterion>-<speed>.json, {INDEPENDENT}/ (each point's first solve)"
+        f"{folder if runs else ''}"
     )
     return 0
 

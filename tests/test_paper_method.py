@@ -8,7 +8,13 @@ import pytest
 
 import biped
 from biped.errors import BipedError
-from biped.studies.paper_method import FOLDER, read_runs, run_paper_method, spread_lines
+from biped.studies.paper_method import (
+    FOLDER,
+    paper_settings,
+    read_runs,
+    run_paper_method,
+    spread_lines,
+)
 from tests.conftest import optimal_gait
 
 SEEDS = 2
@@ -18,9 +24,8 @@ SEEDS = 2
 def runs(tmp_path_factory):
     folder = tmp_path_factory.mktemp("sweep")
     with open(folder.parent / "log.txt", "w") as stream:
-        files = run_paper_method(
-            folder, biped.Robot.paper(), seeds=SEEDS, criteria=("sthenic",), jobs=1, stream=stream
-        )
+        settings = paper_settings(biped.Robot.paper(), seeds=SEEDS)
+        files = run_paper_method(folder, settings, criteria=("sthenic",), jobs=1, stream=stream)
     return folder, files
 
 
@@ -56,12 +61,12 @@ def test_no_seed_of_the_paper_method_goes_below_the_certified_optimum(runs):
 def test_a_rerun_keeps_the_runs_and_other_settings_are_refused(runs):
     folder, files = runs
     before = {f: os.stat(f).st_mtime_ns for f in files}
-    run_paper_method(
-        folder, biped.Robot.paper(), seeds=SEEDS, criteria=("sthenic",), jobs=1, stream=None
-    )
+    settings = paper_settings(biped.Robot.paper(), seeds=SEEDS)
+    run_paper_method(folder, settings, criteria=("sthenic",), jobs=1, stream=None)
     assert {f: os.stat(f).st_mtime_ns for f in files} == before
     with pytest.raises(BipedError, match="seeds = 2"):
-        run_paper_method(folder, biped.Robot.paper(), seeds=SEEDS + 1, jobs=1, stream=None)
+        more = paper_settings(biped.Robot.paper(), seeds=SEEDS + 1)
+        run_paper_method(folder, more, jobs=1, stream=None)
     assert not list((folder / FOLDER).glob("*.tmp"))
 
 
@@ -96,4 +101,4 @@ def test_the_table_sets_each_seed_beside_the_certified_difference(runs):
 
 def test_bad_seed_count_is_refused(tmp_path):
     with pytest.raises(BipedError, match="seeds = 0"):
-        run_paper_method(tmp_path, biped.Robot.paper(), seeds=0)
+        paper_settings(biped.Robot.paper(), seeds=0)

@@ -23,12 +23,13 @@ import pytest
 import biped
 from biped.runtime import interrupts, runner
 from biped.runtime.files import atomic_write_text
-from biped.studies.sweep import INDEPENDENT, run_sweep
+from biped.studies.sweep import INDEPENDENT, run_sweep, sweep_settings
 from biped_cli import main, progress
 
 SPEEDS = (0.275, 0.3)
 # A small sweep: one knee, one criterion, two speeds, one start (4 optimizations).
-SMALL = dict(knees=("revolute",), criteria=("sthenic",), starts=1)
+SMALL = dict(knees=("revolute",), criteria=("sthenic",))
+SETTINGS = sweep_settings(biped.Robot.paper(), SPEEDS, starts=1)
 
 
 def overflowing_task(task):
@@ -196,7 +197,7 @@ def test_dask_missing_is_one_line_naming_the_extra(tmp_path, capsys, monkeypatch
 def local_sweep(tmp_path_factory):
     """The small sweep on one process of this machine."""
     folder = tmp_path_factory.mktemp("local")
-    run_sweep(folder, biped.Robot.paper(), SPEEDS, jobs=1, stream=io.StringIO(), **SMALL)
+    run_sweep(folder, SETTINGS, jobs=1, stream=io.StringIO(), **SMALL)
     return folder
 
 
@@ -219,7 +220,7 @@ def every_file(folder) -> dict:
 def test_a_sweep_on_dask_writes_the_files_of_a_local_sweep(local_sweep, cluster, tmp_path):
     """The same files, every number identical (JSON keeps every bit), both stages."""
     log = io.StringIO()
-    run_sweep(tmp_path, biped.Robot.paper(), SPEEDS, dask=cluster, stream=log, **SMALL)
+    run_sweep(tmp_path, SETTINGS, dask=cluster, stream=log, **SMALL)
     expected = every_file(local_sweep)
     assert sorted(expected) == sorted(every_file(tmp_path))
     assert len([n for n in expected if n.startswith(INDEPENDENT)]) == 2

@@ -15,10 +15,15 @@ from biped.pages.figures import LABELS, make_figures
 from biped.records import gait_file
 from biped.records.gait_file import Costs
 from biped.studies import sweep as sweep_module
-from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep
+from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep, sweep_settings
 
 SPEEDS = (0.275, 0.3)
-FAST = dict(starts=1, jobs=1)
+FAST = dict(jobs=1)
+
+
+def _settings(robot=None, speeds=SPEEDS, seed=0, starts=1):
+    """A small sweep's settings (one start a point)."""
+    return sweep_settings(robot or biped.Robot.paper(), speeds, seed=seed, starts=starts)
 
 
 @pytest.fixture(scope="module")
@@ -26,7 +31,7 @@ def sweep(tmp_path_factory):
     """A small sweep, both knees and both criteria, two speeds, one process."""
     folder = tmp_path_factory.mktemp("sweep")
     log = io.StringIO()
-    run_sweep(folder, biped.Robot.paper(), SPEEDS, stream=log, **FAST)
+    run_sweep(folder, _settings(), stream=log, **FAST)
     return folder, log.getvalue()
 
 
@@ -88,11 +93,11 @@ def test_interrupted_sweep_resumes_to_the_same_files(sweep, tmp_path, monkeypatc
     robot = biped.Robot.paper()
     monkeypatch.setattr(gait_file, "write_json", stop_after)
     with pytest.raises(Interrupt):
-        run_sweep(tmp_path, robot, SPEEDS, criteria=criteria, stream=io.StringIO(), **FAST)
+        run_sweep(tmp_path, _settings(robot), criteria=criteria, stream=io.StringIO(), **FAST)
     assert count[0] == after
     monkeypatch.setattr(gait_file, "write_json", write)
     (tmp_path / INDEPENDENT / ".rolling-sthenic-0.300.json.abc123.tmp").write_text('{"cut')
-    run_sweep(tmp_path, robot, SPEEDS, criteria=criteria, stream=io.StringIO(), **FAST)
+    run_sweep(tmp_path, _settings(robot), criteria=criteria, stream=io.StringIO(), **FAST)
     expected = {k: v for k, v in _content(folder).items() if k.split("-")[1] in criteria}
     assert _content(tmp_path) == expected
     assert not list(tmp_path.rglob("*.tmp"))
@@ -126,7 +131,7 @@ def test_a_resumed_sweep_counts_optimizations_as_its_bar_does(tmp_path, monkeypa
     robot = biped.Robot.paper()
     monkeypatch.setattr(gait_file, "write_json", stop_after_independent)
     with pytest.raises(Interrupt):
-        run_sweep(tmp_path, robot, SPEEDS, stream=io.StringIO(), **tiny)
+        run_sweep(tmp_path, _settings(robot), stream=io.StringIO(), **tiny)
     monkeypatch.setattr(gait_file, "write_json", write)
     log, bars = io.StringIO(), []
 
@@ -134,7 +139,7 @@ def test_a_resumed_sweep_counts_optimizations_as_its_bar_does(tmp_path, monkeypa
         bars.append(CountingBar(total))
         return bars[-1]
 
-    run_sweep(tmp_path, robot, SPEEDS, stream=log, progress=counting_bar, **tiny)
+    run_sweep(tmp_path, _settings(robot), stream=log, progress=counting_bar, **tiny)
     plan = log.getvalue().splitlines()[0]
     assert "4 optimizations for 2 points" in plan and "in 2 stages (own starts, final)" in plan
     assert plan.endswith("2 already done (2 of stage 1, 0 of stage 2), 2 to run")
@@ -145,19 +150,19 @@ def test_sweep_refuses_other_settings(sweep):
     """Resuming into a folder made with another robot, seed or start count is refused."""
     folder, _ = sweep
     with pytest.raises(biped.BipedError, match="robot"):
-        run_sweep(folder, biped.Robot.from_mapping({"r1": 0.08}), SPEEDS, **FAST)
+        run_sweep(folder, _settings(biped.Robot.from_mapping({"r1": 0.08})), **FAST)
     with pytest.raises(biped.BipedError, match="seed = 0"):
-        run_sweep(folder, biped.Robot.paper(), SPEEDS, seed=1, **FAST)
+        run_sweep(folder, _settings(seed=1), **FAST)
     with pytest.raises(biped.BipedError, match="starts = 1"):
-        run_sweep(folder, biped.Robot.paper(), SPEEDS, starts=2, jobs=1)
+        run_sweep(folder, _settings(starts=2), jobs=1)
 
 
 def test_sweep_checks_its_input_before_any_work(tmp_path):
     """An unwalkable speed or a knee named twice fails at once, writing nothing."""
     with pytest.raises(biped.BipedError, match="speed = 3.5"):
-        run_sweep(tmp_path, biped.Robot.paper(), (0.2, 3.5), **FAST)
+        run_sweep(tmp_path, _settings(speeds=(0.2, 3.5)), **FAST)
     with pytest.raises(biped.BipedError, match="each once"):
-        run_sweep(tmp_path, biped.Robot.paper(), SPEEDS, knees=("rolling", "rolling"), **FAST)
+        run_sweep(tmp_path, _settings(), knees=("rolling", "rolling"), **FAST)
     assert not list(tmp_path.rglob("*.json"))
 
 

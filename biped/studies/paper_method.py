@@ -95,17 +95,13 @@ def _solve(task: Task) -> str:
 
 
 def paper_settings(
-    robot: Robot,
-    speed: float = SPEED,
-    seeds: int = DEFAULT_SEEDS,
-    knees=KNEES,
-    safety: Safety = PAPER_SAFETY,
+    robot: Robot, speed: float = SPEED, seeds: int = DEFAULT_SEEDS, safety: Safety = PAPER_SAFETY
 ) -> PaperMethod:
-    """The settings of ``run_paper_method`` with these arguments, each checked (BipedError
-    naming a bad one)."""
+    """The settings of runs of the paper's method, each checked (BipedError naming a bad
+    one): ``seeds`` (0 .. seeds − 1) at ``speed`` [m/s], walkable by either knee."""
     if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
         raise BipedError(f"seeds = {seeds!r}: allowed an integer >= 1")
-    for knee in knees:
+    for knee in KNEES:
         check_speed(Biped(robot, knee), speed)
     return PaperMethod(robot, safety, float(speed), seeds)
 
@@ -118,23 +114,22 @@ def check_paper_method(sweep_folder: str | Path, settings: PaperMethod) -> None:
 
 def run_paper_method(
     sweep_folder: str | Path,
-    robot: Robot,
-    speed: float = SPEED,
-    seeds: int = DEFAULT_SEEDS,
+    settings: PaperMethod,
     knees=KNEES,
     criteria=CRITERIA,
-    safety: Safety = PAPER_SAFETY,
+    *,
     jobs: int | None = None,
     dask: str | None = None,
     stream=None,
     progress: Callable[[int], ProgressBar] | None = None,
 ) -> list[Path]:
-    """The paper's Nelder-Mead from seeds 0 .. ``seeds`` − 1 for every knee and criterion at
-    ``speed``, into ``sweep_folder``/paper-method/ (runs already there are kept); returns
-    the gait files. ``progress(total)``, if given, makes a bar advanced after each run."""
-    settings = paper_settings(robot, speed, seeds, knees, safety)
+    """The paper's Nelder-Mead from the seeds of ``settings`` (``paper_settings``) for every
+    knee and criterion, into ``sweep_folder``/paper-method/ (runs already there are kept);
+    returns the gait files. ``progress(total)``, if given, makes a bar advanced after each
+    run."""
     folder = PAPER.claim(Path(sweep_folder) / FOLDER, settings)  # checked before it is made
-    runs = [Run(k, c, settings.speed, s) for c in criteria for k in knees for s in range(seeds)]
+    speed, seeds = settings.speed, settings.seeds
+    runs = [Run(k, c, speed, s) for c in criteria for k in knees for s in range(seeds)]
     todo = [Task(_solve, settings, r, str(folder)) for r in runs]
     todo = [task for task in todo if not task.path.exists()]
     plan = (

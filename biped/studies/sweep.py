@@ -167,15 +167,15 @@ def _line(stage: str, point: Point, optimum: Optimum) -> str:
 def sweep_settings(
     robot: Robot,
     speeds=DEFAULT_SPEEDS,
-    knees=KNEES,
     seed: int = 0,
     starts: int = DEFAULT_STARTS,
     safety: Safety = PAPER_SAFETY,
 ) -> Settings:
-    """The settings of ``run_sweep`` with these arguments, its speeds sorted, each walkable by
-    every knee and with its own file name; a clear error if not."""
+    """The settings of a sweep (``run_sweep``), its speeds sorted, each walkable by either knee
+    and with its own file name; a clear error if not. ``seed`` and ``starts`` go to
+    ``biped.optimization.optimize.optimize``."""
     speeds = sorted(float(s) for s in speeds)
-    for knee in knees:
+    for knee in KNEES:
         model = Biped(robot, knee)
         for speed in speeds:
             check_speed(model, speed)
@@ -191,25 +191,21 @@ def check_sweep(folder, settings: Settings) -> None:
 
 def run_sweep(
     folder: Path,
-    robot: Robot,
-    speeds=DEFAULT_SPEEDS,
+    settings: Settings,
     knees=KNEES,
     criteria=CRITERIA,
-    seed: int = 0,
-    starts: int = DEFAULT_STARTS,
-    safety: Safety = PAPER_SAFETY,
+    *,
     jobs: int | None = None,
     stream=None,
     dask: str | None = None,
     progress: Callable[[int], ProgressBar] | None = None,
 ) -> list[Point]:
-    """Certified optima of every (knee, criterion, speed) not yet in ``folder``; returns all
-    points. ``seed`` and ``starts`` go to ``biped.optimization.optimize.optimize``; ``jobs``
-    (default: all cores), ``dask`` (``tcp://HOST:PORT``), ``stream`` (a line per optimization)
-    and ``progress`` (a bar over the optimizations of all stages) to ``campaign.Campaign.run``."""
+    """Certified optima of every (knee, criterion, speed) of ``settings`` (``sweep_settings``)
+    not yet in ``folder``; returns all points. ``jobs`` (default: all cores), ``dask``
+    (``tcp://HOST:PORT``), ``stream`` (a line per optimization) and ``progress`` (a bar over
+    the optimizations of all stages) go to ``campaign.Campaign.run``."""
     if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
         raise BipedError(f"knees {list(knees)}, criteria {list(criteria)}: allowed each once")
-    settings = sweep_settings(robot, speeds, knees, seed, starts, safety)
     folder = SWEEP.claim(folder, settings, INDEPENDENT)  # checked before anything is written
     points = [Point(k, c, s) for c in criteria for k in knees for s in settings.speeds]
     final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
