@@ -205,13 +205,11 @@ class Design:
 
     Attributes:
         problem: what was solved.
-        radii: (r1, r2) [m].
-        optimum: the gait at these radii, checked on the fine grid as every optimum
+        optimum: the gait of the designed robot, checked on the fine grid as every optimum
             (``biped.optimization.optimize.checked``); its report is the design's (starts, status).
     """
 
     problem: DesignProblem
-    radii: tuple
     optimum: Optimum
 
     report = property(lambda self: self.optimum.report)
@@ -221,6 +219,11 @@ class Design:
     @property
     def robot(self) -> Robot:
         return self.optimum.problem.model.robot
+
+    @property
+    def radii(self) -> tuple[float, float]:
+        """(r1, r2) [m] of the designed robot."""
+        return self.robot.r1, self.robot.r2
 
     def at_bounds(self) -> list[str]:
         """The radii at a bound (within 1e-6 m), e.g. ``["r1 at its upper bound"]``."""
@@ -318,7 +321,7 @@ def optimize_design(
         for r, low, high in zip(best.radii, problem.lower, problem.upper, strict=True)
     )
     optimum = checked(problem.gait_problem(radii), best.variables, report)
-    return Design(problem, radii, optimum)
+    return Design(problem, optimum)
 
 
 @dataclass(frozen=True)
