@@ -22,32 +22,33 @@ class WalkFigures:
     """The figures of a forward walk (``validate.checks.walk_figures``), each with its unit, in
     the report's order; ``max_knee_equality_violation`` for the rolling knee only."""
 
+    # the leading steps that land and advance the hip, the stance foot still and flat
     steps: int = unit_field(PURE)
-    fell: bool = unit_field(None)
-    max_slip: float = unit_field("m")
-    step_duration_range: list = unit_field(PERIOD)
-    step_advance_range: list = unit_field("S")
-    max_landing_slide: float = unit_field("m")
-    max_foot_tilt: float = unit_field("rad")
-    max_heel_lift: float = unit_field("m")
-    max_toe_lift: float = unit_field("m")
-    scuff_steps: int = unit_field(PURE)
-    scuff_duration: float = unit_field("s")
-    scuff_depth: float = unit_field("m")
-    swing_clearance: float = unit_field("m")
-    gait_swing_clearance: float = unit_field("m")
-    zmp_rms_error: float = unit_field("m")
-    zmp_relative_error: float = unit_field(PURE)
-    touchdown_jump_error: float = unit_field(PURE)
-    ground_force_rms_error: float = unit_field("weight")
-    feedforward_rms: float = unit_field("N·m")
-    feedback_rms: float = unit_field("N·m")
-    feedback_share: float = unit_field(PURE)
-    landing_feedback_rms: float = unit_field("N·m")
-    energy_per_step: float = unit_field("J")
-    analytic_energy_per_step: float = unit_field("J")
-    warnings: int = unit_field(PURE)
-    distance: float = unit_field("m")
+    fell: bool  # a step not landed, the hip too low or the trunk tilted, or shuffling
+    max_slip: float = unit_field("m")  # stance foot's travel in its stance, landing settled
+    step_duration_range: list = unit_field(PERIOD)  # of the steps walked
+    step_advance_range: list = unit_field("S")  # the hip's advance in each of them
+    max_landing_slide: float = unit_field("m")  # the stance foot's in the landing windows
+    max_foot_tilt: float = unit_field("rad")  # of the stance foot
+    max_heel_lift: float = unit_field("m")  # of the stance sole's heel
+    max_toe_lift: float = unit_field("m")  # and toe
+    scuff_steps: int = unit_field(PURE)  # the swing foot on the floor before its landing
+    scuff_duration: float = unit_field("s")  # in all
+    scuff_depth: float = unit_field("m")  # deepest
+    swing_clearance: float = unit_field("m")  # the swing foot's least height, steps walked
+    gait_swing_clearance: float = unit_field("m")  # the gait's own
+    zmp_rms_error: float = unit_field("m")  # centre of pressure − the gait's ZMP, steady
+    zmp_relative_error: float = unit_field(PURE)  # that over the rms of Γ1 / Fz
+    touchdown_jump_error: float = unit_field(PURE)  # velocity jump − the impact map's, median
+    ground_force_rms_error: float = unit_field("weight")  # (Fx, Fz) − the gait's, steady
+    feedforward_rms: float = unit_field("N·m")  # the motors' torques (the gait's), steady
+    feedback_rms: float = unit_field("N·m")  # the servos', steady
+    feedback_share: float = unit_field(PURE)  # the servos' share of the torques
+    landing_feedback_rms: float = unit_field("N·m")  # the servos' in the landing windows
+    energy_per_step: float = unit_field("J")  # ∫ Σ |Γ θ̇| dt of MuJoCo's torques a step
+    analytic_energy_per_step: float = unit_field("J")  # the gait's
+    warnings: int = unit_field(PURE)  # MuJoCo's
+    distance: float = unit_field("m")  # the hip's travel
     seconds_simulated: float = unit_field("s")
     max_knee_equality_violation: float | None = unit_field("rad", default=None)
 

@@ -78,44 +78,32 @@ def _best_value(criterion: str) -> str:
 class Start:
     """One start of the solver and where it ended."""
 
-    kind: str = unit_field(None)  # "first guess", "perturbed", "nelder-mead", "given"
+    kind: str  # "first guess", "perturbed", "nelder-mead", "given"
     value: float = unit_field(_solver_value)  # criterion reached (solver's samples)
-    status: str = unit_field(None)  # solver status
+    status: str  # solver status
     iterations: int = unit_field(PURE)
 
 
 @dataclass(frozen=True)
 class Report:
-    """How an optimum was found, as recorded in gait files (``optimizer``).
+    """How an optimum was found, as recorded in gait files (``optimizer``): ``status`` is
+    ``"converged"`` when the best start's solver converged, else the solver's own status
+    (IPOPT's return status, or ``"budget exhausted"`` for Nelder-Mead); the numbers at the
+    best start, ``starts_at_best`` the converged starts within ``AGREEMENT`` of its value (the
+    sthenic optimum under both barriers counts once)."""
 
-    Attributes:
-        method: ``"ipopt"`` or ``"nelder-mead"``.
-        status: ``"converged"`` when the best start's solver converged, else the solver's
-            own status (IPOPT's return status, or ``"budget exhausted"`` for Nelder-Mead).
-        starts: number of starts.
-        starts_at_best: converged starts within ``AGREEMENT`` of the best value (the
-            sthenic optimum under both barriers counts once).
-        iterations: solver iterations of the best start.
-        constraint_violation: largest violation of a constraint or bound at the best point,
-            in the solver's scaled units.
-        dual_infeasibility: at the best point (IPOPT's measure; NaN for Nelder-Mead).
-        seconds: wall time of all starts.
-        seed: seed of the perturbed starts and of Nelder-Mead's restarts.
-        history: every start with its kind, value, status and iterations.
-    """
-
-    method: str = unit_field(None)
-    status: str = unit_field(None)
+    method: str  # "ipopt" or "nelder-mead"
+    status: str
     starts: int = unit_field(PURE)
     starts_at_best: int = unit_field(PURE)
-    iterations: int = unit_field(PURE)
+    iterations: int = unit_field(PURE)  # the best start's
+    # the largest violation of a constraint or bound at the best point
     constraint_violation: float = unit_field("1 (the solver's scaled constraints)")
-    dual_infeasibility: float = unit_field("1 (IPOPT's measure)")
-    seconds: float = unit_field("s")
-    seed: int = unit_field(PURE)
-    # the best start's criterion on the solver's samples
-    value: float = unit_field(_best_value, default=float("nan"))
-    history: tuple = unit_field([Start], default_factory=tuple)
+    dual_infeasibility: float = unit_field("1 (IPOPT's measure)")  # NaN for Nelder-Mead
+    seconds: float = unit_field("s")  # wall time of all starts
+    seed: int = unit_field(PURE)  # of the perturbed starts and of Nelder-Mead's restarts
+    value: float = unit_field(_best_value, default=float("nan"))  # on the solver's samples
+    history: tuple = unit_field([Start], default_factory=tuple)  # every start
 
     @property
     def converged(self) -> bool:

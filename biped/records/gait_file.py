@@ -212,22 +212,22 @@ class Gait:
     """One optimal gait, as its file holds it (see the module); built by ``from_optimum`` or
     ``read``. Its ``biped``, ``problem`` and ``parameter_vector`` follow from it."""
 
-    knee: str = unit_field(None)
-    criterion: str = unit_field(None)
+    knee: str
+    criterion: str
     speed: float = unit_field("m/s")
     period: float = unit_field("s")
     step_length: float = unit_field("m")
-    safety: Safety = unit_field(Safety)
-    feasible: bool = unit_field(None)
+    safety: Safety = unit_field(Safety)  # margins beyond the paper's constraints
+    feasible: bool  # every constraint holds on the check grid
     costs: Costs = unit_field(Costs)
     robot: Robot = unit_field({f.name: robot_unit(f.name) for f in dataclasses.fields(Robot)})
     parameters: dict = unit_field({name: parameter_unit(name) for name in PARAMETERS})
-    constraints: Constraints | None = unit_field(Constraints)
-    impact: Impact | None = unit_field(Impact)
+    constraints: Constraints | None = unit_field(Constraints)  # None: a file without them
+    impact: Impact | None = unit_field(Impact)  # None: a file without it
     optimizer: Optimizer = unit_field(Optimizer)
-    provenance: dict = unit_field(None)
+    provenance: dict
     samples: Samples = unit_field(Samples)
-    design: dict | None = unit_field(None, default=None)  # a designed knee's (``biped design``)
+    design: dict | None = None  # a designed knee's (``biped design``)
 
     @classmethod
     def from_optimum(cls, optimum: Optimum, robot: Robot, provenance: dict | None = None) -> Gait:
