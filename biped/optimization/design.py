@@ -1,44 +1,32 @@
 """Knee co-design: the rolling knee's radii optimised together with the gait.
 
-The paper fixes the radii of the rolling knee at r1 = r2 = 5 cm and ends on "integrate the
-radii r1 and r2 in the parameter vector". A ``DesignProblem`` does that: minimise the
-criterion over the gait's variables z (``biped.optimization.problem.VARIABLES``) and the
-radii (r1, r2) together, under the gait's constraints, with IPOPT on the graph of the step
-whose radii are symbols (``biped.optimization.symbolic.StepGraph(..., design=True)``,
-``biped.optimization.solver.Solver`` with ``radius_bounds``). Every other parameter of the
-robot (masses, inertias, segment lengths, centres of mass) stays as given.
+The paper fixes r1 = r2 = 5 cm and ends on "integrate the radii r1 and r2 in the parameter
+vector". A ``DesignProblem`` minimises the criterion over the gait's variables and (r1, r2)
+together, under the gait's constraints, with IPOPT on the graph of the step whose radii are
+symbols (``StepGraph(..., design=True)``, ``Solver`` with ``radius_bounds``); every other
+parameter of the robot stays as given.
 
-Design bounds. The segment lengths l1, l2 include the radii (``biped.model.robot``: both knees
-have the same height), so a radius moves length from the shank or the thigh into the knee:
-l'1 = l1 − r1 from the ankle to the shank circle's centre C1, l'2 = l2 − r2 from the hip to
-the thigh circle's centre C2. The centres of mass are measured from the knee for the shank
-(s1, so s1 − r1 from C1) and from the hip for the thigh (s2). They stay on their segments
-(between C1 and the ankle, between the hip and C2) when
+Design bounds. The segment lengths l1, l2 include the radii (``biped.model.robot``), so a
+radius moves length into the knee: l'1 = l1 − r1 from the ankle to the shank circle's centre
+C1, l'2 = l2 − r2 from the hip to the thigh circle's centre C2. The centres of mass (s1 from
+the knee, s2 from the hip) stay on their segments when
 
     0 <= r1 <= s1            (shank: s1 − r1 >= 0; then l'1 >= l1 − s1 > 0)
     0 <= r2 <= l2 − s2       (thigh: s2 <= l'2; then l'2 >= s2 > 0)
 
-which are the bounds by default (``radius_limits``: 0.181 m and 0.236 m for Table 1, 43 %
-and 57 % of the segments); narrower upper bounds may be given. Beyond them the robot's
-fixed masses and inertias would describe a segment whose centre of mass lies off it.
-At r1 = r2 = 0 the rolling knee is the revolute knee exactly (``biped.model.kinematics``), and so
-it is at r1 = 0 or r2 = 0 alone: a circle rolling on a point turns about it, the link
-between the centres stays on the other segment. Such a "rolling knee" is no design of one:
-it is the revolute knee, beside which every design is compared, and the MJCF of a rolling
-knee (a link between the two centres, hinges turning in the ratio r2 / r1) cannot hold it.
-The radii are therefore bounded below by ``MIN_RADIUS`` (1 mm; MuJoCo plays a knee of 1 mm
-and 20 cm, its hinges in the ratio 200); a design at that bound says that the knee gains
-nothing by rolling there. The robot's own radii, the reference design, are moved into the
-bounds where they lie beyond them, and ``DesignProblem.moved_reference`` says so.
+the bounds by default (``radius_limits``: 0.181 m and 0.236 m for Table 1); narrower upper
+bounds may be given. At r1 = 0 or r2 = 0 the rolling knee is the revolute knee (a circle
+rolling on a point turns about it), beside which every design is compared and which no
+rolling knee's MJCF can hold: the radii are bounded below by ``MIN_RADIUS`` (1 mm), and a
+design at that bound gains nothing by rolling there. The robot's own radii, the reference
+design, are moved into the bounds where they lie beyond them (``moved_reference``).
 
 Starts, solved by the gaits' multistart (``biped.optimization.optimize.multistart``): the
-gait's first guesses at the robot's own radii (Table 1's) and starts with radii drawn
-uniformly in the bounds and the gait's first guess there perturbed, from
-``numpy.random.default_rng(seed)`` (``DESIGN_STARTS``), and any given (gait, radii) pairs; for
-the energy criterion also the sthenic design (under both barriers,
-``biped.optimization.optimize.sthenic_starts``). The best converged start wins; its report
-counts the starts that reached the same value. When no start converged the report carries
-IPOPT's status (and the command line exits 1): never a silent fallback.
+gait's first guesses at the robot's own radii, starts with radii drawn uniformly in the
+bounds from ``numpy.random.default_rng(seed)`` (``DESIGN_STARTS``), given (gait, radii)
+pairs, and for the energy criterion the sthenic design under both barriers. The best
+converged start wins; when none converged the report carries IPOPT's status (and the
+command line exits 1): never a silent fallback.
 """
 
 from __future__ import annotations
