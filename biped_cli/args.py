@@ -306,12 +306,18 @@ def add_jobs(parser) -> None:
     parser.add_argument("--jobs", type=jobs, default=None, metavar="N", help=JOBS_HELP)
 
 
+def _read(text: str, kind, otherwise):
+    """``kind(text)``, or ``otherwise`` where ``text`` is not one (a value every check
+    refuses)."""
+    try:
+        return kind(text)
+    except ValueError:
+        return otherwise
+
+
 def margin(name: str, high: float):
     def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = float("nan")
+        value = _read(text, float, float("nan"))
         if not (0.0 <= value <= high):
             raise argparse.ArgumentTypeError(f"{name} = {text!r} m: allowed 0 to {high}")
         return value
@@ -328,10 +334,7 @@ def bounded(low: int, high: int | None = None):
     allowed = f"an integer >= {low}" if high is None else f"an integer from {low} to {high}"
 
     def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            value = low - 1
+        value = _read(text, int, low - 1)
         if value < low or (high is not None and value > high):
             raise argparse.ArgumentTypeError(f"{text!r}: allowed {allowed}")
         return value
@@ -347,10 +350,7 @@ jobs = bounded(1, MAX_JOBS)
 
 def metres(text: str) -> float:
     """A finite length or position [m]."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
+    value = _read(text, float, float("nan"))
     if not np.isfinite(value):
         raise argparse.ArgumentTypeError(f"{text!r} m: allowed a finite number")
     return value

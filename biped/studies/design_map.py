@@ -31,7 +31,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,7 +50,6 @@ from biped.optimization.design import (
 from biped.optimization.optimize import DEFAULT_STARTS, optimize
 from biped.optimization.problem import VARIABLES
 from biped.runtime.files import atomic_path, atomic_write_text, distinct_values
-from biped.runtime.runner import ProgressBar
 from biped.studies import campaign
 from biped.studies.campaign import Task
 
@@ -242,10 +240,7 @@ def run_design_map(
     upper=None,
     seed: int = 0,
     starts: int = DEFAULT_STARTS,
-    jobs: int | None = None,
-    dask: str | None = None,
-    stream=None,
-    progress: Callable[[int], ProgressBar] | None = None,
+    **where,
 ) -> MapSettings:
     """Every optimization of the map not yet in ``folder``; returns its settings.
 
@@ -253,7 +248,8 @@ def run_design_map(
         speeds: walking speeds [m/s].
         r1, r2: the grid's radii [m] (default ``DEFAULT_GRID`` from 0 to the upper bound).
         upper: the design's upper bounds of (r1, r2) [m] (default ``radius_limits``).
-        jobs, dask, stream, progress: as ``campaign.Campaign.run``.
+        where: where the map runs (``jobs``, ``dask``, ``stream``, ``progress``), as
+            ``campaign.Campaign.run`` says.
     """
     speeds = campaign.distinct_speeds(speeds)
     problem = DesignProblem(robot, speeds[0], criterion, safety, upper=upper)
@@ -273,7 +269,6 @@ def run_design_map(
         f"design map: {total} optimizations in {folder}, {total - remaining} already done, "
         f"{remaining} to run"
     )
-    where = dict(jobs=jobs, dask=dask, stream=stream, progress=progress)
     MAP.run(plan, stages, lambda: summarize(folder, settings), **where)
     return settings
 

@@ -16,7 +16,6 @@ would have reported.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +32,6 @@ from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
 from biped.optimization.problem import GaitProblem, check_speed
 from biped.records import gait_file
 from biped.records.provenance import version
-from biped.runtime.runner import ProgressBar
 from biped.studies import campaign
 from biped.studies.campaign import Task
 
@@ -113,20 +111,11 @@ def check_paper_method(sweep_folder: str | Path, settings: PaperMethod) -> None:
 
 
 def run_paper_method(
-    sweep_folder: str | Path,
-    settings: PaperMethod,
-    knees=KNEES,
-    criteria=CRITERIA,
-    *,
-    jobs: int | None = None,
-    dask: str | None = None,
-    stream=None,
-    progress: Callable[[int], ProgressBar] | None = None,
+    sweep_folder: str | Path, settings: PaperMethod, knees=KNEES, criteria=CRITERIA, **where
 ) -> list[Path]:
     """The paper's Nelder-Mead from the seeds of ``settings`` (``paper_settings``) for every
     knee and criterion, into ``sweep_folder``/paper-method/ (runs already there are kept);
-    returns the gait files. ``progress(total)``, if given, makes a bar advanced after each
-    run."""
+    returns the gait files. ``where`` they run: as ``campaign.Campaign.run`` says."""
     folder = PAPER.claim(Path(sweep_folder) / FOLDER, settings)  # checked before it is made
     speed, seeds = settings.speed, settings.seeds
     runs = [Run(k, c, speed, s) for c in criteria for k in knees for s in range(seeds)]
@@ -136,7 +125,6 @@ def run_paper_method(
         f"paper's method: {len(runs)} Nelder-Mead runs at {speed:.3f} m/s in {folder}: "
         f"{len(runs) - len(todo)} already done, {len(todo)} to run"
     )
-    where = dict(jobs=jobs, dask=dask, stream=stream, progress=progress)
     PAPER.run(plan if todo else None, [todo], **where)
     return [folder / r.filename() for r in runs]
 

@@ -24,7 +24,6 @@ the summary; they are not optimised again.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -47,7 +46,6 @@ from biped.optimization.optimize import (
 )
 from biped.optimization.problem import VARIABLES, GaitProblem, check_speed
 from biped.records import gait_file
-from biped.runtime.runner import ProgressBar
 from biped.studies import campaign
 from biped.studies.campaign import Task
 
@@ -189,21 +187,11 @@ def check_sweep(folder, settings: Settings) -> None:
     SWEEP.check(folder, settings.to_dict())
 
 
-def run_sweep(
-    folder: Path,
-    settings: Settings,
-    knees=KNEES,
-    criteria=CRITERIA,
-    *,
-    jobs: int | None = None,
-    stream=None,
-    dask: str | None = None,
-    progress: Callable[[int], ProgressBar] | None = None,
-) -> list[Point]:
+def run_sweep(folder: Path, settings: Settings, knees=KNEES, criteria=CRITERIA, **where):
     """Certified optima of every (knee, criterion, speed) of ``settings`` (``sweep_settings``)
-    not yet in ``folder``; returns all points. ``jobs`` (default: all cores), ``dask``
-    (``tcp://HOST:PORT``), ``stream`` (a line per optimization) and ``progress`` (a bar over
-    the optimizations of all stages) go to ``campaign.Campaign.run``."""
+    not yet in ``folder``; returns all points. ``where`` the sweep runs (``jobs``, ``dask``,
+    ``stream`` of a line per optimization, ``progress`` over the optimizations of all stages)
+    as ``campaign.Campaign.run`` says."""
     if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
         raise BipedError(f"knees {list(knees)}, criteria {list(criteria)}: allowed each once")
     folder = SWEEP.claim(folder, settings, INDEPENDENT)  # checked before anything is written
@@ -212,7 +200,6 @@ def run_sweep(
     saved = {p for p in points if _read_gait(folder / INDEPENDENT / p.filename(), p, settings)}
     stages = _stages(folder, settings, points, final, knees, saved)
     plan = _plan(folder, points, final, stages, saved)
-    where = dict(jobs=jobs, dask=dask, stream=stream, progress=progress)
     SWEEP.run(plan, stages, lambda: summarize(folder, points, settings), **where)
     return points
 
