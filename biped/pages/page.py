@@ -504,11 +504,9 @@ def markdown(page: Page, folder: Path) -> str:
         "| criterion | value | unit |",
         "|---|---|---|",
     ]
-    for f in dataclasses.fields(gait.costs):
-        value, label, unit = getattr(gait.costs, f.name), f.metadata["label"], f.metadata["unit"]
-        if value is not None:
-            optimised = " (optimised)" if f.name == gait.criterion else ""
-            lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
+    for name, label, value, unit in gait.costs.labelled():
+        optimised = " (optimised)" if name == gait.criterion else ""
+        lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
     lines += [
         "",
         "## Constraints: tightest margins",

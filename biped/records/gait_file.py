@@ -149,6 +149,15 @@ class Costs(_Record):
         """The value of the criterion ``name`` (``biped.model.criteria.ALL_CRITERIA``)."""
         return getattr(self, name.replace("-", "_"))
 
+    def labelled(self) -> list[tuple]:
+        """(name, label, value, unit) of each cost the gait has, in order."""
+        fields = [(f, getattr(self, f.name)) for f in dataclasses.fields(self)]
+        return [
+            (f.name, f.metadata["label"], value, f.metadata["unit"])
+            for f, value in fields
+            if value is not None
+        ]
+
 
 # The worst Ψ_i of each constraint on the check grid less its safety margin (>= 0 when met),
 # by name (``biped.model.criteria.CONSTRAINTS``).
