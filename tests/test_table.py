@@ -10,8 +10,8 @@ import biped
 from biped.model.criteria import PAPER_SAFETY, evaluate_step
 from biped.model.gait import build_step
 from biped.optimization import table
-from biped.optimization.optimize import CHECK_SAMPLES_PER_HALF, optimize
-from biped.optimization.problem import VARIABLES, GaitProblem
+from biped.optimization.optimize import optimize
+from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, VARIABLES, GaitProblem
 
 ROBOT = biped.Robot.paper()
 

@@ -35,6 +35,7 @@ in a command's own process, none in a campaign's worker, whose siblings use them
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import sys
@@ -161,28 +162,31 @@ def _in_process(function: Callable, tasks: list) -> Iterator:
         yield result
 
 
-def _start_pool(jobs: int, pools: list) -> None:
-    """Append to ``pools`` a pool of ``jobs`` spawned workers deaf to Ctrl-C from their first
-    instruction; a Ctrl-C or SIGTERM received meanwhile takes effect once the pool is started
-    and in ``pools`` (``biped.runtime.interrupts.starting_workers``)."""
-    context = multiprocessing.get_context("spawn")
-    with starting_workers():
-        pools.append(context.Pool(jobs, initializer=_worker_init))
-
-
-def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
+@contextlib.contextmanager
+def _pool(method: str, jobs: int) -> Iterator:
+    """A pool of ``jobs`` workers started by ``method`` ("spawn", "fork"), deaf to Ctrl-C from
+    their first instruction (a Ctrl-C or SIGTERM received meanwhile takes effect once the pool
+    is started: ``biped.runtime.interrupts.starting_workers``); on any exception in the block
+    (Ctrl-C, SIGTERM, an error of a task, the caller stopping early) the workers are
+    terminated, else the pool is closed; joined either way."""
     pools: list = []  # the pool, once started
     try:
-        _start_pool(jobs, pools)
-        yield from pools[0].imap_unordered(function, tasks)
+        with starting_workers():
+            pools.append(multiprocessing.get_context(method).Pool(jobs, _worker_init))
+        yield pools[0]
         pools[0].close()
-    except BaseException:  # Ctrl-C, SIGTERM, an error of a task, the caller stopping early
+    except BaseException:
         for pool in pools:
             pool.terminate()
         raise
     finally:
         for pool in pools:
             pool.join()
+
+
+def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
+    with _pool("spawn", jobs) as pool:
+        yield from pool.imap_unordered(function, tasks)
 
 
 # What the forked workers of ``run_forked`` call: (function, arguments), set before the fork.
@@ -200,20 +204,10 @@ def run_forked(function: Callable, arguments: list, jobs: int) -> list:
         return [function(a) for a in arguments]
     global _FORKED
     _FORKED = (function, arguments)
-    pools: list = []
     try:
-        with starting_workers():
-            pools.append(multiprocessing.get_context("fork").Pool(jobs, _worker_init))
-        results = pools[0].map(_call_forked, range(len(arguments)), chunksize=1)
-        pools[0].close()
-        return results
-    except BaseException:
-        for pool in pools:
-            pool.terminate()
-        raise
+        with _pool("fork", jobs) as pool:
+            return pool.map(_call_forked, range(len(arguments)), chunksize=1)
     finally:
-        for pool in pools:
-            pool.join()
         _FORKED = (None, ())
 
 
