@@ -123,7 +123,8 @@ def _cost(unit: str, label: str, of):
 @dataclass(frozen=True, eq=False)
 class Costs(_Record):
     """The gait's criteria on the check grid (no penalty), which the comparisons use; each
-    field says how it follows from the gait, so that a new cost is one line."""
+    field says its unit, its label and how it follows from the gait, so that a new cost is
+    one declaration here (its file entry, unit, consistency check and page row follow)."""
 
     sthenic: float = _cost(
         CRITERION_UNITS["sthenic"],
@@ -179,7 +180,7 @@ class Impact(_Record):
 
     impulse: list = unit_field(["N·s", "N·s", "N·m·s"])
     trailing_foot_lift: list = unit_field("m/s")
-    consistent: bool = unit_field(None)
+    consistent: bool
     qd_minus: list = unit_field(RATES)
     qd_plus: list = unit_field(RATES)
 
@@ -327,17 +328,14 @@ class Gait:
         except BipedError as error:
             raise bad(str(error)) from None
         _check_step(content, bad)
-        try:
-            optimizer = Optimizer.from_dict(content["optimizer"])
-        except (KeyError, TypeError, ValueError, AttributeError) as error:
-            raise bad(f"optimizer {content.get('optimizer')!r} ({error!r})") from None
+        optimizer = _optimizer(content.get("optimizer"), bad)
         fields = {f.name: content.get(f.name) for f in dataclasses.fields(cls)}
         records = {
             name: record.from_content(content.get(name), name, bad)
             for name, record in (("costs", Costs), ("constraints", Constraints), ("impact", Impact))
         }
-        read = {"safety": safety, "robot": robot, "optimizer": optimizer}
-        return cls(**{**fields, **records, **read, "samples": _samples(content, bad)})
+        parsed = {"safety": safety, "robot": robot, "optimizer": optimizer}
+        return cls(**{**fields, **records, **parsed, "samples": _samples(content, bad)})
 
     @staticmethod
     def units(criterion: str) -> dict:
@@ -523,6 +521,18 @@ def _check_step(content: dict, bad) -> None:
             f"step_length = {length!r} m, allowed speed × period = {speed * period!r} m "
             f"(speed {speed!r} m/s, period {period!r} s)"
         )
+
+
+def _optimizer(content, bad) -> Optimizer:
+    """The optimizer record of a file's content, or ``bad`` naming the field it lacks."""
+    if not isinstance(content, dict):
+        raise bad("missing 'optimizer'" if content is None else "optimizer is not an object")
+    try:
+        return Optimizer.from_dict(content)
+    except KeyError as error:
+        raise bad(f"optimizer.{error.args[0]} missing") from None
+    except (TypeError, ValueError, AttributeError) as error:
+        raise bad(f"optimizer is not a solver's report ({error})") from None
 
 
 def _samples(content: dict, bad) -> Samples:
