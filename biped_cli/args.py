@@ -259,9 +259,10 @@ def add_steps(parser) -> None:
     parser.add_argument("--steps", type=steps, default=DEFAULT_STEPS, metavar="N", help=STEPS_HELP)
 
 
-def add_folder(parser, option: str, default: str, what: str) -> None:
-    """An output folder, ``--out DIR`` or ``--recordings DIR``: ``what`` it holds."""
-    help = f"{what}, {FOLDER_CREATED} (default {default})"
+def add_folder(parser, option: str, default: str, what: str, files: str = "") -> None:
+    """An output folder, ``--out DIR`` or ``--recordings DIR``: ``what`` it holds, and the
+    ``files`` written there (``": <folder>-<gait>.json"``)."""
+    help = f"{what}, {FOLDER_CREATED} (default {default}){files}"
     parser.add_argument(option, default=default, metavar="DIR", help=help)
 
 

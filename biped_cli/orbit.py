@@ -102,13 +102,8 @@ def add_parser(commands) -> None:
         ("--jobs", types.jobs, 1, "N", "processes computing orbits side by side (default 1)"),
     )  # fmt: skip
     types.add_model(parser)
-    parser.add_argument(
-        "--out",
-        default=DEFAULT_ORBIT,
-        metavar="DIR",
-        help=f"folder of the results, {types.FOLDER_CREATED} (default {DEFAULT_ORBIT}): "
-        f"<folder>-<gait>.json and .png, and {KNEES_FIGURE} given gaits of both knees",
-    )
+    files = f": <folder>-<gait>.json and .png, and {KNEES_FIGURE} given gaits of both knees"
+    types.add_folder(parser, "--out", DEFAULT_ORBIT, "folder of the results", files)
 
 
 def _value(knob: str | None, value) -> str:

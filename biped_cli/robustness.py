@@ -49,13 +49,8 @@ def add_parser(commands) -> None:
          f"processes walking the limits side by side (default {default.jobs})"),
     )  # fmt: skip
     types.add_model(parser)
-    parser.add_argument(
-        "--out",
-        default=DEFAULT_ROBUSTNESS,
-        metavar="DIR",
-        help=f"folder of the maps, {types.FOLDER_CREATED} (default {DEFAULT_ROBUSTNESS}): "
-        "<folder>-<gait>.json and .png",
-    )
+    files = ": <folder>-<gait>.json and .png"
+    types.add_folder(parser, "--out", DEFAULT_ROBUSTNESS, "folder of the maps", files)
 
 
 def _settings(args):

@@ -155,8 +155,7 @@ def test_orbit_command_writes_the_multipliers(tmp_path, capsys):
     a bad knob, scale or repeated scale is one line naming it, exit 2, nothing written."""
     import json
 
-    from biped.records.units import missing
-
+    from biped.model.units import missing
     from biped_cli import main
 
     path = tmp_path / "gaits" / "rolling.json"

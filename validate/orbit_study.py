@@ -18,9 +18,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from biped.records.units import PURE
 
 from biped.errors import BipedError
+from biped.model.units import PURE
 from biped.records.gait_file import Gait
 from biped.runtime.runner import ProgressBar, run_tasks
 from validate.model import model_spec

@@ -67,7 +67,7 @@ class OrbitFigures:
     """The figures of the orbit check (``validate.orbit``), each with its unit, in the
     report's order; without an orbit (a walk fell) only the settings and ``verdict``."""
 
-    verdict: str = unit_field(None)
+    verdict: str
     spectral_radius: float | None = unit_field(PURE, default=None)
     spectral_radius_spread: float | None = unit_field(PURE, default=None)
     spectral_radius_upper: float | None = unit_field(PURE, default=None)
@@ -75,7 +75,7 @@ class OrbitFigures:
     multipliers_imag: list | None = unit_field(PURE, default=None)
     multipliers_modulus: list | None = unit_field(PURE, default=None)
     flow_multiplier: float | None = unit_field(PURE, default=None)
-    coordinates: list | None = unit_field(None, default=None)
+    coordinates: list | None = None
     slowest_mode_real: list | None = unit_field(SECTION_UNITS, default=None)
     slowest_mode_imag: list | None = unit_field(SECTION_UNITS, default=None)
     fixed_point: list | None = unit_field(SECTION_UNITS, default=None)

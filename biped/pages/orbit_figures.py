@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from biped.optimization.comparison import relative_change
 from biped.pages.figures import DIFFERENCE_AXIS, STYLE
-from biped.records.comparison import relative_change
 
 DPI = 120
 # How many spreads of ρ the uncertainty bands span (the orbit check's margin).
