@@ -39,6 +39,7 @@ from biped.model.dynamics import Biped
 from biped.model.gait import check_knots
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
+from biped.optimization.comparison import relative_change
 from biped.optimization.optimize import (
     TIGHT,
     Optimum,
@@ -51,7 +52,6 @@ from biped.optimization.optimize import (
 )
 from biped.optimization.problem import GaitProblem, check_criterion, check_speed
 from biped.records import gait_file
-from biped.records.comparison import relative_change
 from biped.runtime.files import atomic_write_text, distinct_values
 from biped.studies import campaign
 from biped.studies.campaign import Task
