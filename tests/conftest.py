@@ -1,5 +1,7 @@
 """Shared fixtures: both robots and seeded random motions with the stance foot fixed."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -84,3 +86,22 @@ def with_torques(gait, torques):
 
     samples = dataclasses.replace(gait.samples, torques=np.asarray(torques, dtype=float))
     return dataclasses.replace(gait, samples=samples)
+
+
+def edited_gait_file(content: dict, folder, change=None, name: str = "gait.json"):
+    """A gait file of a copy of ``content`` edited by ``change(copy)``, in ``folder``."""
+    edited = json.loads(json.dumps(content))
+    if change is not None:
+        change(edited)
+    path = folder / name
+    path.write_text(json.dumps(edited))
+    return path
+
+
+def refusal(read, path) -> str:
+    """The BipedError of ``read(path)``: one line, naming the file."""
+    with pytest.raises(biped.BipedError) as error:
+        read(path)
+    message = str(error.value)
+    assert str(path) in message and "\n" not in message
+    return message

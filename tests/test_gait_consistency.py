@@ -10,11 +10,10 @@ import sys
 import pytest
 
 from biped import Robot
-from biped.errors import BipedError
 from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped_cli import main
-from tests.conftest import small_optimum
+from tests.conftest import edited_gait_file, refusal, small_optimum
 
 
 @pytest.fixture(scope="module")
@@ -24,23 +23,13 @@ def content():
     return json.loads(json.dumps(Gait.from_optimum(optimum, Robot.paper()).to_dict()))
 
 
-def _write(content, tmp_path, change=None, name="gait.json"):
-    edited = json.loads(json.dumps(content))
-    if change is not None:
-        change(edited)
-    path = tmp_path / name
-    path.write_text(json.dumps(edited))
-    return path
+_write = edited_gait_file
 
 
 def _refusal(path) -> str:
     """The one-line refusal of ``read_consistent`` (the file reads as a gait file)."""
     gait_file.read(path)  # the format is right: only the consistency is wrong
-    with pytest.raises(BipedError) as error:
-        gait_file.read_consistent(path)
-    message = str(error.value)
-    assert str(path) in message and "\n" not in message
-    return message
+    return refusal(gait_file.read_consistent, path)
 
 
 def test_an_untouched_file_is_consistent(content, tmp_path):

@@ -9,7 +9,7 @@ from biped.errors import BipedError
 from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped.records.provenance import PACKAGE
-from tests.conftest import small_optimum
+from tests.conftest import edited_gait_file, refusal, small_optimum
 
 
 @pytest.fixture(scope="module")
@@ -31,15 +31,7 @@ def test_gait_file_round_trip_with_provenance(content, tmp_path):
 
 
 def _corrupt(content, tmp_path, change):
-    edited = json.loads(json.dumps(content))
-    change(edited)
-    path = tmp_path / "edited.json"
-    path.write_text(json.dumps(edited))
-    with pytest.raises(BipedError) as error:
-        gait_file.read(path)
-    message = str(error.value)
-    assert str(path) in message and "\n" not in message
-    return message
+    return refusal(gait_file.read, edited_gait_file(content, tmp_path, change, "edited.json"))
 
 
 def test_nan_in_samples_is_named_not_finite(content, tmp_path):

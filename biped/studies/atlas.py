@@ -107,11 +107,11 @@ class Settings(campaign.Settings):
 
     FORMAT = "biped-atlas/1"
     robot: Robot
-    speeds: tuple
-    clearances: tuple
-    knee_bends: tuple
+    speeds: tuple  # [m/s]
+    clearances: tuple  # [m] of the swing foot (Safety.clearance)
+    knee_bends: tuple  # [rad] least flexion of the stance knee (Safety.knee_bend)
     criteria: tuple
-    knots: int
+    knots: int  # interior knots of the spline family
     seed: int
     starts: int
 

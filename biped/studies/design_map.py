@@ -91,10 +91,10 @@ class MapSettings(campaign.Settings):
     robot: Robot
     criterion: str
     safety: Safety
-    speeds: tuple
-    r1: tuple
-    r2: tuple
-    upper: tuple
+    speeds: tuple  # [m/s]
+    r1: tuple  # [m] the grid's radii
+    r2: tuple  # [m]
+    upper: tuple  # [m] the design's upper bounds of (r1, r2)
     seed: int
     starts: int
 

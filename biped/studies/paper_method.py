@@ -55,8 +55,8 @@ class PaperMethod(campaign.Settings):
     FORMAT = "biped-paper-method/1"
     robot: Robot
     safety: Safety
-    speed: float
-    seeds: int
+    speed: float  # [m/s]
+    seeds: int  # runs from seeds 0 .. seeds − 1
 
     def stamp(self) -> dict:
         """The method's budget and the version (not an IPOPT campaign's)."""
@@ -71,8 +71,8 @@ class PaperMethod(campaign.Settings):
 class Run:
     knee: str
     criterion: str
-    speed: float
-    seed: int
+    speed: float  # [m/s]
+    seed: int  # 0: from the first guess, k: from its perturbation number k
 
     def filename(self) -> str:
         return f"{self.knee}-{self.criterion}-{self.speed:.3f}-seed{self.seed}.json"

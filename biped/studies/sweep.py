@@ -74,9 +74,9 @@ class Settings(campaign.Settings):
     FORMAT = "biped-sweep/2"
     robot: Robot
     safety: Safety
-    speeds: tuple
-    seed: int
-    starts: int
+    speeds: tuple  # [m/s], sorted
+    seed: int  # of every optimization's perturbed starts
+    starts: int  # every point's own starts
 
 
 def _problem(settings: Settings, point: Point) -> GaitProblem:
