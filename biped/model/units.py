@@ -91,7 +91,7 @@ def parameter_unit(name: str) -> str:
         return "m"
     if name == "period":
         return "s"
-    if name.startswith("end_rate_"):
+    if name.startswith("end_rate_") or "_rate_" in name:  # the ends' and the knots' rates
         return "rad/s"
     if "_accel_" in name:
         return "rad/s²"

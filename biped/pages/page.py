@@ -13,7 +13,7 @@ jumps of the torques and ground reaction at the mid-step knot (marked on their p
 the verdict and figures of its validation in MuJoCo when a report is given, and links to the
 recording and the video. ``write_pages`` writes pages as a set, all or none
 (``biped.runtime.files.atomic_set``). The constraints are computed again from the gait's parameters
-on the grid the optimiser checks feasibility on (``CHECK_SAMPLES_PER_HALF``).
+on the grid the optimiser checks feasibility on (``CHECK_SAMPLES``).
 """
 
 from __future__ import annotations
@@ -30,9 +30,9 @@ from matplotlib.ticker import FuncFormatter
 
 from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
-from biped.model.gait import PARAMETERS, build_step, half_grid
+from biped.model.gait import build_step, parameter_names, piece_grid
 from biped.model.units import CONSTRAINT_UNITS, parameter_unit
-from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PER_HALF
+from biped.optimization.problem import CHECK_SAMPLES, SOLVER_SAMPLES
 from biped.pages.figures import (
     ANGLE_PANELS,
     DPI,
@@ -93,19 +93,18 @@ class Tightest:
 
 
 @functools.lru_cache(maxsize=8)  # a page's table, captions and figures all read it
-def constraint_profile(
-    gait: Gait, samples_per_half: int = CHECK_SAMPLES_PER_HALF
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def constraint_profile(gait: Gait, samples_per_half: int | None = None) -> tuple:
     """On the optimiser's check grid (or ``samples_per_half`` samples per spline piece): the
     step's normalised times t/T (N,), Ψ1..Ψ7 (N, 7) less the gait's safety margins (NaN
     where a constraint is not checked: the swing foot at the ends) and the solver's margins
     δ (N, 7); read-only, computed once per gait record and grid."""
-    step = build_step(gait.biped, gait.speed, gait.parameter_vector)
-    evaluation = evaluate_step(gait.biped, step, samples_per_half, safety=gait.safety)
+    samples = CHECK_SAMPLES[gait.knots] if samples_per_half is None else samples_per_half
+    step = build_step(gait.biped, gait.speed, gait.parameter_vector, gait.knots)
+    evaluation = evaluate_step(gait.biped, step, samples, safety=gait.safety)
     arrays = (
-        np.concatenate(half_grid(samples_per_half)),
+        np.concatenate(piece_grid(samples, gait.knots)),
         evaluation.constraints,
-        margin_profile(samples_per_half),
+        margin_profile(samples, gait.knots),
     )
     for array in arrays:
         array.setflags(write=False)
@@ -132,7 +131,7 @@ def margin_dips(gait: Gait) -> list[Dip]:
     """The constraints that dip below the solver's margin δ on the check grid, each at its
     deepest sample (smallest Ψ_i − δ_i), in ``CONSTRAINTS`` order."""
     t_n, psi, delta = constraint_profile(gait)
-    _, psi_solver, delta_solver = constraint_profile(gait, SOLVER_SAMPLES_PER_HALF)
+    _, psi_solver, delta_solver = constraint_profile(gait, SOLVER_SAMPLES[gait.knots])
     dips = []
     for i, name in enumerate(CONSTRAINTS):
         below = _below(psi[:, i], delta[:, i])
@@ -169,7 +168,7 @@ def dip_sentence(gait: Gait, dips: list[Dip]) -> str:
     elif all(d.kept for d in dips):
         why = (
             f"each between the solver's samples: the solver holds Ψ ≥ δ at its "
-            f"{SOLVER_SAMPLES_PER_HALF + 1} samples per spline piece only (dots in the insets)"
+            f"{SOLVER_SAMPLES[gait.knots] + 1} samples per spline piece only (dots in the insets)"
         )
     else:
         kept = [CONSTRAINT_MEANING[d.name].split()[0] for d in dips if not d.kept]
@@ -180,7 +179,7 @@ def dip_sentence(gait: Gait, dips: list[Dip]) -> str:
         else "the gait is not feasible on the check grid"
     )
     return (
-        f"Below the solver's margin δ on the check grid ({CHECK_SAMPLES_PER_HALF + 1} samples "
+        f"Below the solver's margin δ on the check grid ({CHECK_SAMPLES[gait.knots] + 1} samples "
         f"per spline piece): {each}; {why}. {verdict}."
     )
 
@@ -335,7 +334,7 @@ def _dip_inset(
     ``_inset_place``): the curve on the check grid, δ dotted and, with ``solver_samples``,
     the solver's samples (dots) on either side of it."""
     (t_n, psi, delta), (t_s, psi_s) = profile, solver_profile
-    spacing = KNOT / SOLVER_SAMPLES_PER_HALF
+    spacing = KNOT / SOLVER_SAMPLES[1]
     x0, x1 = dip.at - 1.5 * spacing, dip.at + 1.5 * spacing
     depth = dip.margin - dip.value
     y0, y1 = dip.value - 0.4 * depth, dip.margin + 1.2 * depth
@@ -356,7 +355,7 @@ def _dip_inset(
 
 def _constraint_panels(gait: Gait) -> tuple:
     t_n, psi, delta = constraint_profile(gait)
-    t_s, psi_solver, _ = constraint_profile(gait, SOLVER_SAMPLES_PER_HALF)
+    t_s, psi_solver, _ = constraint_profile(gait, SOLVER_SAMPLES[gait.knots])
     dips = {dip.name: dip for dip in margin_dips(gait)}
     solver_samples = gait.optimizer.method == "ipopt"
 
@@ -532,7 +531,8 @@ def markdown(page: Page, folder: Path) -> str:
         lines += ["", dips]
     lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [
-        f"| {name} | {gait.parameters[name]:.6g} | {parameter_unit(name)} |" for name in PARAMETERS
+        f"| {name} | {gait.parameters[name]:.6g} | {parameter_unit(name)} |"
+        for name in parameter_names(gait.knots)
     ]
     lines += ["", "## Figures", ""]
     captions = figure_captions(gait)

@@ -31,9 +31,16 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CONSTRAINTS, CRITERIA, CRITERION_UNITS, Safety, evaluate_step
+from biped.model.criteria import (
+    ALL_CRITERIA,
+    CONSTRAINTS,
+    CRITERIA,
+    CRITERION_UNITS,
+    Safety,
+    evaluate_step,
+)
 from biped.model.dynamics import JOINTS, Biped
-from biped.model.gait import PARAMETERS, build_step
+from biped.model.gait import PARAMETERS, build_step, check_knots, parameter_names
 from biped.model.impact import trailing_foot_lift
 from biped.model.kinematics import COORDINATES, KNEES
 from biped.model.robot import Robot
@@ -47,7 +54,13 @@ from biped.model.units import (
     unit_field,
 )
 from biped.optimization.optimize import Optimum, Report
-from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, VARIABLES, GaitProblem, check_speed
+from biped.optimization.problem import (
+    CHECK_SAMPLES,
+    VARIABLES,
+    GaitProblem,
+    check_speed,
+    variable_names,
+)
 from biped.records.provenance import provenance as make_provenance
 from biped.runtime.files import atomic_write_text
 
@@ -206,10 +219,11 @@ class Optimizer(Report):
     variables: dict = unit_field({name: parameter_unit(name) for name in VARIABLES}, kw_only=True)
 
     @classmethod
-    def of(cls, report: Report, variables) -> Optimizer:
-        """The record of ``report`` and ``variables`` (21,)."""
+    def of(cls, report: Report, variables, names=VARIABLES) -> Optimizer:
+        """The record of ``report`` and ``variables`` named ``names`` (the paper's spline's
+        21 by default)."""
         fields = {f.name: getattr(report, f.name) for f in dataclasses.fields(Report)}
-        named = dict(zip(VARIABLES, map(_finite_or_none, variables), strict=True))
+        named = dict(zip(names, map(_finite_or_none, variables), strict=True))
         return cls(**fields, variables=named)
 
     def report(self) -> Report:
@@ -238,12 +252,14 @@ class Gait:
     provenance: dict
     samples: Samples = unit_field(Samples)
     design: dict | None = None  # a designed knee's (``biped design``)
+    knots: int = 1  # interior knots of the gait's spline family (1: the paper's; written if not)
 
     @classmethod
     def from_optimum(cls, optimum: Optimum, robot: Robot, provenance: dict | None = None) -> Gait:
         """The gait of an optimum of ``robot``; ``provenance``: what produced it (default:
         ``biped.records.provenance.provenance()`` now)."""
-        ev, step = optimum.evaluation, optimum.step
+        ev, step, knots = optimum.evaluation, optimum.step, optimum.problem.knots
+        names = parameter_names(knots)
         return cls(
             knee=optimum.knee,
             criterion=optimum.criterion,
@@ -251,9 +267,10 @@ class Gait:
             safety=optimum.safety,
             feasible=optimum.feasible,
             robot=robot,
-            parameters=dict(zip(PARAMETERS, map(float, optimum.parameters), strict=True)),
-            optimizer=Optimizer.of(optimum.report, optimum.variables),
+            parameters=dict(zip(names, map(float, optimum.parameters), strict=True)),
+            optimizer=Optimizer.of(optimum.report, optimum.variables, variable_names(knots)),
             provenance=dict(provenance) if provenance is not None else make_provenance(),
+            knots=knots,
             **_derived(Biped(robot, optimum.knee), step, ev),
         )
 
@@ -311,18 +328,20 @@ class Gait:
             raise bad(f"safety {content.get('safety')!r}: {error}") from None
         _check_kinds(content, bad)
         try:
+            knots = check_knots(content.get("knots", 1))
             robot = Robot.from_mapping(content["robot"], source="robot")
             names = set(content["parameters"])
         except (KeyError, TypeError) as error:
             raise bad(f"robot or parameters missing ({error})") from None
         except BipedError as error:
             raise bad(str(error)) from None
+        expected = parameter_names(knots)
         if (
             not isinstance(content["parameters"], dict)
-            or names != set(PARAMETERS)
+            or names != set(expected)
             or not all(map(_finite_number, content["parameters"].values()))
         ):
-            raise bad(f"parameters are not the {len(PARAMETERS)} finite numbers of the gait")
+            raise bad(f"parameters are not the {len(expected)} finite numbers of the gait")
         try:
             check_speed(Biped(robot, content["knee"]), content["speed"])
         except BipedError as error:
@@ -334,28 +353,46 @@ class Gait:
             name: record.from_content(content.get(name), name, bad)
             for name, record in (("costs", Costs), ("constraints", Constraints), ("impact", Impact))
         }
-        parsed = {"safety": safety, "robot": robot, "optimizer": optimizer}
+        parsed = {"safety": safety, "robot": robot, "optimizer": optimizer, "knots": knots}
         return cls(**{**fields, **records, **parsed, "samples": _samples(content, bad)})
 
     @staticmethod
-    def units(criterion: str) -> dict:
-        """The ``units`` map of a gait file optimised for ``criterion``, from the fields'
+    def units(criterion: str, knots: int = 1, knee_bend: bool = False) -> dict:
+        """The ``units`` map of a gait file optimised for ``criterion`` in the family of
+        ``knots`` interior knots, with a least knee bend if ``knee_bend``, from the fields'
         declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
-        return declared_units(Gait, "", criterion)
+        units = declared_units(Gait, "", criterion)
+        if not knee_bend:  # the paper's knees: the file does not write it
+            del units["safety.knee_bend"]
+        if knots == 1:
+            return units
+        units["knots"] = PURE
+        for prefix, names in (
+            ("parameters.", parameter_names(knots)),
+            ("optimizer.variables.", variable_names(knots)),
+        ):
+            units = {key: value for key, value in units.items() if not key.startswith(prefix)}
+            units.update({prefix + name: parameter_unit(name) for name in names})
+        return units
+
+    def _units(self) -> dict:
+        return self.units(self.criterion, self.knots, bool(self.safety.knee_bend))
 
     def to_dict(self) -> dict:
         """The JSON-ready content of the gait's file."""
         content = {"format": FORMAT}
         for f in dataclasses.fields(self):
             if f.name == "samples":
-                content["units"] = self.units(self.criterion)
+                content["units"] = self._units()
             value = getattr(self, f.name)
-            if value is None and f.name == "design":
+            if (f.name, value) in (("design", None), ("knots", 1)):  # the paper's: unwritten
                 continue
             if hasattr(value, "to_dict"):  # the samples, records, robot
                 value = value.to_dict()
-            elif dataclasses.is_dataclass(value):  # the safety margins
+            elif dataclasses.is_dataclass(value):  # the safety margins, a knee bend if asked
                 value = dataclasses.asdict(value)
+                if not value["knee_bend"]:
+                    del value["knee_bend"]
             content[f.name] = value
         return content
 
@@ -371,12 +408,13 @@ class Gait:
     @property
     def problem(self) -> GaitProblem:
         """The problem the gait solves."""
-        return GaitProblem(self.biped, self.speed, self.criterion, self.safety)
+        return GaitProblem(self.biped, self.speed, self.criterion, self.safety, knots=self.knots)
 
     @property
     def parameter_vector(self) -> np.ndarray:
-        """The 21 parameters in ``PARAMETERS`` order."""
-        return np.array([self.parameters[name] for name in PARAMETERS])
+        """The parameters in ``biped.model.gait.parameter_names(knots)`` order (the paper's
+        21 for its spline)."""
+        return np.array([self.parameters[name] for name in parameter_names(self.knots)])
 
     def check_consistency(self, source: str = "gait") -> None:
         """Raise a ``BipedError`` naming the first field that does not belong to the gait's
@@ -388,12 +426,13 @@ class Gait:
             return BipedError(f"{source} is inconsistent: {what}")
 
         try:
-            step = build_step(self.biped, self.speed, self.parameter_vector)
+            step = build_step(self.biped, self.speed, self.parameter_vector, self.knots)
         except BipedError as error:
             raise bad(f"its parameters build no step ({error})") from None
-        evaluation = evaluate_step(self.biped, step, CHECK_SAMPLES_PER_HALF, safety=self.safety)
+        samples = CHECK_SAMPLES[self.knots]
+        evaluation = evaluate_step(self.biped, step, samples, safety=self.safety)
         expected = _derived(self.biped, step, evaluation)
-        units = self.units(self.criterion)
+        units = self._units()
         for key in ("period", "step_length"):
             if _mismatch(getattr(self, key), expected[key]):
                 raise bad(
@@ -502,8 +541,8 @@ def _check_kinds(content: dict, bad) -> None:
     """The knee, the criterion, ``feasible`` and the costs of their kinds."""
     if content["knee"] not in KNEES:
         raise bad(f"knee = {content['knee']!r}, allowed {', '.join(KNEES)}")
-    if content["criterion"] not in CRITERIA:
-        raise bad(f"criterion = {content['criterion']!r}, allowed {', '.join(CRITERIA)}")
+    if content["criterion"] not in ALL_CRITERIA:
+        raise bad(f"criterion = {content['criterion']!r}, allowed {', '.join(ALL_CRITERIA)}")
     if not isinstance(content["feasible"], bool):
         raise bad(f"feasible = {content['feasible']!r}, allowed true or false")
     costs = content["costs"]

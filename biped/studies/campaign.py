@@ -25,9 +25,10 @@ import numpy as np
 
 from biped.errors import BipedError
 from biped.model.criteria import Safety
+from biped.model.gait import KNOTS
 from biped.model.robot import Robot
 from biped.optimization import table
-from biped.optimization.problem import VARIABLES
+from biped.optimization.problem import variable_names
 from biped.records.provenance import version
 from biped.runtime.files import atomic_write_text, clean_stale_temporaries, distinct_values
 from biped.runtime.runner import ProgressBar, run_tasks
@@ -105,8 +106,12 @@ def failure(status: str, feasible: bool) -> str | None:
 
 
 def variables(named: dict) -> np.ndarray | None:
-    """The solver's variables (21,) from {name: value}, None if it ended without them."""
-    values = [named[name] for name in VARIABLES]
+    """The solver's variables from {name: value} in the order of its family
+    (``biped.optimization.problem.variable_names``), None if it ended without them."""
+    names = tuple(named)
+    if not any(names == variable_names(knots) for knots in KNOTS):
+        raise BipedError(f"variables {', '.join(names[:3])}, ...: allowed a gait family's")
+    values = list(named.values())
     return None if any(v is None for v in values) else np.array(values, float)
 
 

@@ -30,8 +30,16 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CRITERIA, CRITERION_UNITS, PAPER_SAFETY, Safety
+from biped.model.criteria import (
+    ALL_CRITERIA,
+    CRITERIA,
+    CRITERION_UNITS,
+    PAPER_SAFETY,
+    WORK_CRITERIA,
+    Safety,
+)
 from biped.model.dynamics import Biped
+from biped.model.gait import check_knots
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization import table
@@ -44,7 +52,7 @@ from biped.optimization.optimize import (
     optimize,
     single_start_note,
 )
-from biped.optimization.problem import VARIABLES, GaitProblem, check_speed
+from biped.optimization.problem import GaitProblem, check_speed
 from biped.records import gait_file
 from biped.studies import campaign
 from biped.studies.campaign import Task
@@ -77,11 +85,12 @@ class Settings(campaign.Settings):
     speeds: tuple  # [m/s], sorted
     seed: int  # of every optimization's perturbed starts
     starts: int  # every point's own starts
+    knots: int = 1  # interior knots of the gaits' spline family (``biped.model.gait``)
 
 
 def _problem(settings: Settings, point: Point) -> GaitProblem:
     model = Biped(settings.robot, point.knee)
-    return GaitProblem(model, point.speed, point.criterion, settings.safety)
+    return GaitProblem(model, point.speed, point.criterion, settings.safety, knots=settings.knots)
 
 
 def _read_gait(path: Path, point: Point, settings: Settings):
@@ -92,6 +101,7 @@ def _read_gait(path: Path, point: Point, settings: Settings):
         return None
     found = (gait.knee, gait.criterion, gait.speed)
     same = gait.robot == settings.robot and gait.safety == settings.safety
+    same = same and gait.knots == settings.knots
     if found != (point.knee, point.criterion, point.speed) or not same:
         raise BipedError(
             f"{path} holds a gait of another robot, safety or point ({found[0]}, "
@@ -102,7 +112,7 @@ def _read_gait(path: Path, point: Point, settings: Settings):
 
 def _optimum_of(gait: gait_file.Gait, settings: Settings, point: Point) -> Optimum:
     """The ``Optimum`` stored in a gait file (same numbers: JSON keeps every bit)."""
-    variables = np.array([gait.optimizer.variables[name] for name in VARIABLES], float)
+    variables = campaign.variables(gait.optimizer.variables)
     return checked(_problem(settings, point), variables, gait.optimizer.report())
 
 
@@ -168,6 +178,7 @@ def sweep_settings(
     seed: int = 0,
     starts: int = DEFAULT_STARTS,
     safety: Safety = PAPER_SAFETY,
+    knots: int = 1,
 ) -> Settings:
     """The settings of a sweep (``run_sweep``), its speeds sorted, each walkable by either knee
     and with its own file name; a clear error if not. ``seed`` and ``starts`` go to
@@ -178,7 +189,7 @@ def sweep_settings(
         for speed in speeds:
             check_speed(model, speed)
     speeds = campaign.distinct_speeds(speeds)
-    return Settings(robot, safety, tuple(speeds), int(seed), int(starts))
+    return Settings(robot, safety, tuple(speeds), int(seed), int(starts), check_knots(knots))
 
 
 def check_sweep(folder, settings: Settings) -> None:
@@ -230,7 +241,7 @@ def _stages(folder: Path, settings: Settings, points, final, knees, saved: set) 
     independent optimum is in the folder."""
     speeds = settings.speeds
     needed = {n for p in final for n in [p, *_neighbours(p, speeds, knees)]}
-    twins = {p: Point(p.knee, "sthenic", p.speed) for p in points if p.criterion == "energy"}
+    twins = {p: Point(p.knee, "sthenic", p.speed) for p in points if p.criterion in WORK_CRITERIA}
     if not any(p.criterion == "sthenic" for p in points):
         twins = {}
 
@@ -279,8 +290,13 @@ def optima_table(folder) -> dict:
     if found is None:
         raise BipedError(f"{folder} has no {MANIFEST}: allowed a folder biped sweep wrote")
     settings = Settings.from_dict(found)
+    if settings.knots != 1:
+        raise BipedError(
+            f"{folder / MANIFEST}: a sweep of {settings.knots} knots: allowed a sweep of the "
+            "paper's spline (knots 1), whose variables the table holds"
+        )
     series: dict = {}
-    for criterion in CRITERIA:
+    for criterion in ALL_CRITERIA:
         for knee in KNEES:
             for speed in settings.speeds:
                 point = Point(knee, criterion, speed)
