@@ -11,7 +11,15 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CRITERIA, MAX_CLEARANCE, MAX_ZMP_MARGIN, Safety
+from biped.model.criteria import (
+    ALL_CRITERIA,
+    CRITERIA,
+    MAX_CLEARANCE,
+    MAX_KNEE_BEND,
+    MAX_ZMP_MARGIN,
+    Safety,
+)
+from biped.model.gait import KNOTS
 from biped.model.kinematics import KNEES
 from biped.optimization.comparison import CERTIFIED
 from biped.optimization.problem import MIN_SPEED
@@ -40,7 +48,12 @@ KNEE_HELP = (
 CRITERION_HELP = (
     "sthenic (the paper's eq. 30): the squared joint torques integrated over a step and divided "
     "by the step length S, (1/S) ∫ ΓᵀΓ dt, so per metre walked [N²·m·s]; energy (eq. 31): the "
-    "absolute work of the joints over a step, ∫ Σ |Γ_i θ̇_i| dt [J per step]"
+    "absolute work of the joints over a step, ∫ Σ |Γ_i θ̇_i| dt [J per step]; "
+    "energy-per-metre: the energy criterion divided by the step length, per metre walked [J/m]"
+)
+KNOTS_HELP = (
+    "interior knots of each angle's cubic spline: 1, the paper's (21 parameters); 3 or 5, "
+    "richer gaits that hold the paper's (45, 69 parameters)"
 )
 CERTIFIED_HELP = f"certified: {CERTIFIED}"
 
@@ -84,22 +97,35 @@ def add_knee(parser, several: bool = False, **kwargs) -> None:
         parser.add_argument("--knee", choices=KNEES, help=f"knee kinematic; {KNEE_HELP}", **kwargs)
 
 
-def add_criterion(parser, several: bool = False) -> None:
-    """``--criterion`` (default sthenic) or ``--criteria`` (one or both, default both), each
-    criterion defined with its unit in the help."""
+def add_criterion(parser, several: bool = False, default=CRITERIA) -> None:
+    """``--criterion`` (default sthenic) or ``--criteria`` (one or more, default ``default``:
+    the paper's two), each criterion defined with its unit in the help."""
     if several:
-        help = f"criteria to minimise, one or both; {CRITERION_HELP}"
-        _add_several(parser, "--criteria", CRITERIA, help)
+        help = f"criteria to minimise, one or more; {CRITERION_HELP}"
+        _add_several(parser, "--criteria", ALL_CRITERIA, help, default)
     else:
         help = f"criterion to minimise; {CRITERION_HELP} (default %(default)s)"
-        parser.add_argument("--criterion", choices=CRITERIA, default="sthenic", help=help)
+        parser.add_argument("--criterion", choices=ALL_CRITERIA, default="sthenic", help=help)
 
 
-def _add_several(parser, option: str, choices: tuple, help: str) -> None:
-    """``option``: distinct ``choices``, one or more (default: all)."""
-    help += " (default: both)"
+def _add_several(parser, option: str, choices: tuple, help: str, default=None) -> None:
+    """``option``: distinct ``choices``, one or more (default: ``default``, else all)."""
+    default = list(choices if default is None else default)
+    help += f" (default: {' '.join(default)})"
     parser.add_argument(
-        option, nargs="+", choices=choices, default=list(choices), action=Distinct, help=help
+        option, nargs="+", choices=choices, default=default, action=Distinct, help=help
+    )
+
+
+def add_knots(parser) -> None:
+    """``--knots K``: the gait family (``biped.model.gait.KNOTS``)."""
+    parser.add_argument(
+        "--knots",
+        type=int,
+        choices=KNOTS,
+        default=1,
+        metavar="K",
+        help=f"{KNOTS_HELP}; K one of {', '.join(map(str, KNOTS))} (default %(default)s)",
     )
 
 
@@ -189,7 +215,7 @@ def budget(args) -> dict:
 
 def safety(args) -> Safety:
     """The safety margins given on the command line."""
-    return Safety(clearance=args.clearance, zmp_margin=args.zmp_margin)
+    return Safety(clearance=args.clearance, zmp_margin=args.zmp_margin, knee_bend=args.knee_bend)
 
 
 def add_budget(parser, sweep: bool = False):
@@ -239,6 +265,9 @@ def add_safety(parser) -> None:
          "ground away from the ends of the step (default 0, the paper's z >= 0)"),
         ("--zmp-margin", zmp_margin, 0.0, "M",
          "[m] distance the ZMP must keep inside the sole's heel and toe (default 0)"),
+        ("--knee-bend", knee_bend, 0.0, "RAD",
+         f"[rad] least flexion of the stance knee over the step, 0 to {MAX_KNEE_BEND} "
+         "(default 0, the paper's knee not inverted)"),
     )  # fmt: skip
 
 
@@ -316,11 +345,11 @@ def _read(text: str, kind, otherwise):
         return otherwise
 
 
-def margin(name: str, high: float):
+def margin(name: str, high: float, unit: str = "m"):
     def parse(text: str) -> float:
         value = _read(text, float, float("nan"))
         if not (0.0 <= value <= high):
-            raise argparse.ArgumentTypeError(f"{name} = {text!r} m: allowed 0 to {high}")
+            raise argparse.ArgumentTypeError(f"{name} = {text!r} {unit}: allowed 0 to {high}")
         return value
 
     return parse
@@ -328,6 +357,7 @@ def margin(name: str, high: float):
 
 clearance = margin("clearance", MAX_CLEARANCE)
 zmp_margin = margin("zmp margin", MAX_ZMP_MARGIN)
+knee_bend = margin("knee bend", MAX_KNEE_BEND, "rad")
 
 
 def bounded(low: int, high: int | None = None):

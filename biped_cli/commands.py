@@ -140,7 +140,8 @@ def cmd_optimize(args) -> int:
     from biped.runtime.runner import free_cores
 
     robot = robot_of(args)
-    problem = GaitProblem(Biped(robot, args.knee), args.speed, args.criterion, safety(args))
+    model = Biped(robot, args.knee)
+    problem = GaitProblem(model, args.speed, args.criterion, safety(args), knots=args.knots)
     check_output(args.out)
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
     setup = prepare(problem) if args.method == "ipopt" else 0.0
@@ -190,6 +191,7 @@ def add_optimize(commands) -> None:
     types.add_speed(opt)
     types.add_gait_out(opt)
     types.add_budget(opt)
+    types.add_knots(opt)
     types.add_robot(opt)
 
 
@@ -210,7 +212,7 @@ def cmd_sweep(args) -> int:
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
-    sweep = sweep_settings(robot, args.speeds, args.seed, args.starts, safety(args))
+    sweep = sweep_settings(robot, args.speeds, args.seed, args.starts, safety(args), args.knots)
     check_sweep(args.out, sweep)
     if args.paper_seeds:  # refused before the sweep runs, not after
         paper = paper_method.paper_settings(robot, paper_speed, args.paper_seeds, safety(args))
@@ -247,6 +249,7 @@ def add_sweep(commands) -> None:
     types.add_folder(sweep, "--out", DEFAULT_SWEEP, "folder of the sweep")
     types.add_jobs(sweep)
     types.add_budget(sweep, sweep=True)
+    types.add_knots(sweep)
     types.add_robot(sweep)
     types.add_dask(sweep)
     types.add_options(

@@ -11,7 +11,7 @@ import re
 import sys
 
 from biped.records.provenance import command_line, version
-from biped_cli import commands, design, orbit, report, robustness
+from biped_cli import atlas, commands, design, orbit, report, robustness
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
 
 DEBUG_HELP = "on an error, print its traceback before the one-line message"
@@ -57,6 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
         commands.add_pipeline,
         commands.add_figures,
         commands.add_table,
+        atlas.add_parser,
         design.add_parsers,
         report.add_parser,
         robustness.add_parser,

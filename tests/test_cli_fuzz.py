@@ -55,11 +55,12 @@ def _stand_in(*args, **kwargs):
 
 @pytest.fixture
 def no_work(monkeypatch):
-    """The optimiser, the sweep, the design map, the figures, the MuJoCo validation, the
+    """The optimiser, the sweep, the design map, the atlas, the figures, the MuJoCo validation, the
     robustness map and the orbit study stop the command."""
     import biped.optimization.design
     import biped.optimization.optimize
     import biped.pages.figures
+    import biped.studies.atlas
     import biped.studies.design_map
     import biped.studies.sweep
     import validate.orbit_study
@@ -71,6 +72,7 @@ def no_work(monkeypatch):
         (biped.studies.sweep, "run_sweep"),
         (biped.optimization.design, "compare"),
         (biped.studies.design_map, "run_design_map"),
+        (biped.studies.atlas, "run_atlas"),
         (biped.pages.figures, "make_figures"),
         (validate.validation, "validate"),
         (validate.robustness, "robustness_map"),

@@ -112,7 +112,7 @@ def test_criterion_and_certified_are_defined_where_used():
         if "--criterion" in page or "--criteria" in page:
             assert " ".join(CRITERION_HELP.split()) in page, name
             assert "N²·m·s" in page and "per metre walked" in page and "[J" in page, name
-            assert "default sthenic" in page or "default: both" in page, name
+            assert "default sthenic" in page or "default: sthenic" in page, name
         if "certified" in page:
             assert " ".join(CERTIFIED_HELP.split()) in page, name
 

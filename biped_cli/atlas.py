@@ -1,0 +1,165 @@
+"""``biped atlas``: where the rolling knee pays off, over speed x clearance (x a least knee bend),
+each difference with its error bar (``biped.studies.atlas``); then its CSV, figures and
+``atlas.md`` (``biped.pages.atlas``), with the optima at the corners and at the best pay-off
+walked in MuJoCo (``validate.validation``)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from biped.model.criteria import MAX_CLEARANCE, MAX_KNEE_BEND
+from biped_cli import args as types
+
+DEFAULT_ATLAS = "logs/atlas"
+MAX_VALUES = 100
+
+
+def _values(name: str, unit: str, high: float):
+    """A list or range of values from 0 to ``high`` (``types.number_list``)."""
+
+    def parse(text: str) -> np.ndarray:
+        values = types.number_list(text, name, MAX_VALUES, f" [{unit}]")
+        if values.size == 0 or not np.all(np.isfinite(values) & (values >= 0) & (values <= high)):
+            raise argparse.ArgumentTypeError(
+                f"{name} = {text!r}: allowed values from 0 to {high:g} {unit}"
+            )
+        return np.round(values, 6)
+
+    return parse
+
+
+clearances = _values("clearances", "m", MAX_CLEARANCE)
+knee_bends = _values("knee bends", "rad", MAX_KNEE_BEND)
+
+
+def cmd_atlas(args) -> int:
+    """Certified optimal gaits of both knees over a grid of speed x swing-foot clearance (x a
+    least stance-knee bend), for each criterion asked; each difference between the knees,
+    (rolling − revolute) / revolute, with its uncertainty: the change on a grid of twice the
+    samples, at a hundred times tighter tolerance and the spread of the starts; a difference
+    no larger than it is not distinguishable. At the corner cells the gait is also optimized
+    with 3 interior knots: how the difference moves with a richer gait. Writes the optima,
+    atlas.csv, atlas-<criterion>.png and atlas.md in --out; the optima at the corners and at
+    the best pay-off are walked in MuJoCo (unless --no-walks) and atlas.md says which pass.
+    Run again to resume. Exits 0 when every optimum is certified, 1 otherwise."""
+    from biped.pages import atlas as pages
+    from biped.runtime.runner import check_dask
+    from biped.studies import atlas
+
+    settings = atlas.check_settings(
+        atlas.Settings(
+            types.robot_of(args),
+            tuple(float(v) for v in args.speeds),
+            tuple(float(v) for v in args.clearances),
+            tuple(float(v) for v in args.knee_bends),
+            tuple(args.criteria),
+            args.knots,
+            args.seed,
+            args.starts,
+        )
+    )
+    types.check_folder(args.out, "--out")
+    atlas.ATLAS.check(args.out, settings.to_dict())
+    if args.dask is not None:
+        check_dask(args.dask)
+    atlas.run_atlas(args.out, settings, **types.campaign(args, "atlas"))
+    walks = [] if args.no_walks else _walks(args.out, settings)
+    for path in pages.write(args.out, walks=walks):
+        print(f"wrote {path}")
+    certified = all(
+        (content := atlas.read(args.out, atlas.Point("final", k, c, cell))) is not None
+        and content["certified"]
+        for c in settings.criteria
+        for cell in settings.cells()
+        for k in ("revolute", "rolling")
+    )
+    return 0 if certified else 1
+
+
+def _walks(folder, settings) -> list[str]:
+    """The optima at the corners and at the best pay-off of each criterion, walked in MuJoCo
+    (``validate.validation.validate``): a line each, what passes or fails and why."""
+    from pathlib import Path
+
+    from biped.records.gait_file import Gait
+    from biped.studies import atlas
+    from validate.validation import validate
+
+    lines = []
+    for criterion in settings.criteria:
+        chosen = {cell: "corner" for cell in _corners(settings)}
+        best = _best_payoff(folder, settings, criterion)
+        if best is not None:
+            chosen[best] = "corner, best pay-off" if best in chosen else "best pay-off"
+        for cell, why in chosen.items():
+            for knee in ("revolute", "rolling"):
+                path = Path(folder) / atlas.Point("final", knee, criterion, cell).gait_filename()
+                if not path.exists():
+                    continue
+                result = validate(Gait.read(path, consistent=True))
+                failed = [
+                    f"{c.name} ({'; '.join(c.notes) or 'failed'})"
+                    for c in result.checks
+                    if not c.passed
+                ]
+                verdict = "passes every check" if not failed else "fails " + ", ".join(failed)
+                lines.append(f"{path.name} ({why}): {verdict}")
+                print(f"walked {lines[-1]}", file=sys.stderr)
+    return lines
+
+
+def _corners(settings):
+    from biped.studies.atlas import Cell
+
+    bend = settings.knee_bends[0]
+    return [
+        Cell(s, c, bend)
+        for c in sorted({settings.clearances[0], settings.clearances[-1]})
+        for s in sorted({settings.speeds[0], settings.speeds[-1]})
+    ]
+
+
+def _best_payoff(folder, settings, criterion):
+    """The cell where the rolling knee needs distinguishably the least, else None."""
+    from biped.studies.atlas import difference
+
+    found = []
+    for cell in settings.cells():
+        diff, _ = difference(folder, criterion, cell)
+        if diff.distinguishable and diff.value < 0:
+            found.append((diff.value, cell))
+    return min(found, key=lambda pair: pair[0])[1] if found else None
+
+
+def add_parser(commands) -> None:
+    from biped.optimization.optimize import DEFAULT_STARTS
+    from biped.studies.atlas import DEFAULT_CLEARANCES, DEFAULT_CRITERIA, DEFAULT_SPEEDS
+
+    help = "where the rolling knee pays off: speed x clearance, with error bars"
+    parser = types.add_command(commands, "atlas", help, cmd_atlas)
+    shown = f"{DEFAULT_SPEEDS[0]:g}:{DEFAULT_SPEEDS[-1]:g}:{len(DEFAULT_SPEEDS)}"
+    types.add_speeds(parser, np.array(DEFAULT_SPEEDS), shown)
+    types.add_options(
+        parser,
+        ("--clearances", clearances, np.array(DEFAULT_CLEARANCES), "C",
+         f"[m] swing-foot clearances, START:STOP:COUNT or a list C1,C2,..., 0 to "
+         f"{MAX_CLEARANCE:g} m (default {','.join(f'{c:g}' for c in DEFAULT_CLEARANCES)})"),
+        ("--knee-bends", knee_bends, np.array([0.0]), "B",
+         f"[rad] least stance-knee bends, a list or START:STOP:COUNT, 0 to {MAX_KNEE_BEND:g} "
+         "rad (default 0: the paper's knee, not inverted)"),
+        ("--starts", types.positive, DEFAULT_STARTS, "N",
+         f"IPOPT's own starts per point (default {DEFAULT_STARTS}); {types.CERTIFIED_HELP}"),
+        ("--seed", types.non_negative, 0, "N", "seed of the perturbed starts (default 0)"),
+    )  # fmt: skip
+    types.add_criterion(parser, several=True, default=DEFAULT_CRITERIA)
+    types.add_knots(parser)
+    types.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
+    parser.add_argument(
+        "--no-walks", action="store_true", help="skip walking the chosen optima in MuJoCo"
+    )
+    types.add_robot(parser)
+    types.add_jobs(parser)
+    types.add_dask(parser)
