@@ -144,15 +144,26 @@ def figure(settings: Settings, table: list[Row], criterion: str):
             if d.value is None:
                 ax.plot(x, y, "kx", markersize=10)
             else:
-                ax.text(x, y, f"{d.value:+.1f}", ha="center", va="center", fontsize=7)
+                dark = abs(d.value) > 0.6 * top  # white on the darkest cells
+                ax.text(
+                    x,
+                    y,
+                    f"{d.value:+.1f}\n±{d.uncertainty:.1f}",
+                    ha="center",
+                    va="center",
+                    fontsize=6.5,
+                    color="white" if dark else "black",
+                )
                 if not d.distinguishable:
-                    ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, fill=False, hatch="///", lw=0))
+                    ax.add_patch(
+                        Rectangle((x - 0.5, y - 0.5), 1, 1, fill=False, hatch="//", lw=0, ec="0.55")
+                    )
         ax.set_xticks(range(len(speeds)), [f"{s:g}" for s in speeds])
         ax.set_yticks(range(len(clearances)), [f"{100 * c:g}" for c in clearances])
         ax.set_xlabel("speed [m/s]")
         ax.set_ylabel("swing-foot clearance [cm]")
-        ax.set_title(f"stance knee bent {bend:g} rad at least", fontsize=9)
-        fig.colorbar(image, ax=ax, label="(rolling − revolute) / revolute [%]")
+        ax.set_title(f"{_bend_words(bend)}; cells: difference ± uncertainty [%]", fontsize=9)
+        fig.colorbar(image, ax=ax, label="rolling vs revolute [%]")
     curves = axes[-1]
     for k, clearance in enumerate(clearances):
         picked = [
@@ -176,15 +187,23 @@ def figure(settings: Settings, table: list[Row], criterion: str):
     curves.axhline(0.0, color="k", lw=0.8)
     curves.set_xlabel("speed [m/s]")
     curves.set_ylabel("(rolling − revolute) / revolute [%]")
-    curves.set_title(f"knee bent {bends[0]:g} rad at least; bars: uncertainty", fontsize=9)
+    curves.set_title(f"{_bend_words(bends[0])}; bars: uncertainty", fontsize=9)
     curves.legend(fontsize=7)
     fig.suptitle(
-        f"{CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: rolling vs revolute "
-        "knee (blue: the rolling knee needs less; hatched: not distinguishable; x: no "
-        "certified optimum)",
+        f"{CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: "
+        "(rolling − revolute) / revolute knee\n"
+        "blue: the rolling knee needs less; hatched: not distinguishable; x: no "
+        "certified optimum of both knees",
         fontsize=10,
     )
     return fig
+
+
+def _bend_words(bend: float) -> str:
+    """A panel's knee bend, in words."""
+    if bend == 0.0:
+        return "stance knee not inverted (the paper's)"
+    return f"stance knee bent {bend:g} rad at least"
 
 
 def sentences(settings: Settings, table: list[Row], walks=()) -> str:

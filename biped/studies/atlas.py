@@ -367,7 +367,8 @@ def run_atlas(folder, settings: Settings, **where) -> Settings:
 
 
 def summarize(folder, settings: Settings) -> str:
-    """How many final optima are certified, which are not and why."""
+    """How many final optima are certified, which are not and why; how many optimizations
+    the stages hold and their median time (each record's own solve, not the walls')."""
     finals = [
         Point("final", k, c, cell)
         for c in settings.criteria
@@ -383,7 +384,15 @@ def summarize(folder, settings: Settings) -> str:
         return f"{why} ({content['violations']})" if why == "INFEASIBLE" else why
 
     counted = "points certified (final optima, solver converged, feasible on the check grid)"
-    return campaign.tally(finals, why_not, counted, most=8)
+    seconds = [
+        json.loads(path.read_text())["seconds"]
+        for stage in STAGES
+        for path in sorted((Path(folder) / stage).glob("*.json"))
+    ]
+    note = (
+        f"; {len(seconds)} optimizations, median {np.median(seconds):.2f} s each" if seconds else ""
+    )
+    return campaign.tally(finals, why_not, counted, note, most=8)
 
 
 @dataclass(frozen=True)
