@@ -162,6 +162,7 @@ def solvers_before():
 def sweep() -> None:
     """The default sweep (both knees, both criteria, 13 speeds) on all cores, both ways; the
     method before runs in this process (``--jobs 1``), so its time is given per core too."""
+    cores = free_cores()  # the processes of the sweep now
     with tempfile.TemporaryDirectory() as folder:
         began = time.perf_counter()
         with open(os.devnull, "w") as null:
@@ -171,7 +172,6 @@ def sweep() -> None:
         with solvers_before(), open(os.devnull, "w") as null:
             run_sweep(f"{folder}/before", sweep_settings(biped.Robot.paper()), stream=null, jobs=1)
         before = time.perf_counter() - began
-    cores = free_cores()
     print(
         f"\ndefault sweep (2 knees x 2 criteria x 13 speeds): now {now:.1f} s on {cores} "
         f"processes; before {before:.1f} s on one process, {before / cores:.1f} s per core of "

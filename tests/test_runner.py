@@ -505,6 +505,10 @@ def test_forked_runs_give_the_results_in_order_and_raise_errors():
     with pytest.raises(ZeroDivisionError):
         runner.run_forked(lambda x: 1 / (x - 3), list(range(5)), 2)
     assert runner.free_cores() >= 1
+    # a campaign run in this process: each task on one core, this process itself afterwards
+    cores = runner.free_cores()
+    seen = list(runner.run_tasks(lambda _: runner.free_cores(), [0, 1], jobs=1, stream=None))
+    assert seen == [1, 1] and runner.free_cores() == cores
     runner._IN_WORKER, before = True, runner._IN_WORKER
     try:
         assert runner.free_cores() == 1

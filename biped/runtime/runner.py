@@ -155,10 +155,17 @@ def _worker_init():
 
 
 def _in_process(function: Callable, tasks: list) -> Iterator:
+    """The tasks one after the other in this process, each as in a worker (one core,
+    ``free_cores``); this process is itself again between tasks and after them."""
+    global _IN_WORKER
     for task in tasks:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            result = _quietly(function, task)
+        was = _IN_WORKER
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                result = _quietly(function, task)
+        finally:
+            _IN_WORKER = was
         yield result
 
 
