@@ -46,7 +46,7 @@ from typing import Protocol, TextIO
 import numpy as np
 
 from biped.errors import BipedError
-from biped.runtime.interrupts import starting_workers, worker_signals
+from biped.runtime.interrupts import deferred_signals, starting_workers, worker_signals
 
 # How long to wait for a Dask scheduler to answer [s].
 CONNECT_TIMEOUT = 10.0
@@ -175,20 +175,22 @@ def _pool(method: str, jobs: int) -> Iterator:
     their first instruction (a Ctrl-C or SIGTERM received meanwhile takes effect once the pool
     is started: ``biped.runtime.interrupts.starting_workers``); on any exception in the block
     (Ctrl-C, SIGTERM, an error of a task, the caller stopping early) the workers are
-    terminated, else the pool is closed; joined either way."""
+    terminated, else the pool is closed; joined either way, a signal received meanwhile (a
+    second Ctrl-C) taking effect once they are."""
     pools: list = []  # the pool, once started
     try:
         with starting_workers():
             pools.append(multiprocessing.get_context(method).Pool(jobs, _worker_init))
         yield pools[0]
-        pools[0].close()
     except BaseException:
-        for pool in pools:
-            pool.terminate()
+        with deferred_signals():  # a second Ctrl-C must not cut the clean-up short
+            for pool in pools:
+                pool.terminate()
+                pool.join()
         raise
-    finally:
-        for pool in pools:
-            pool.join()
+    with deferred_signals():
+        pools[0].close()
+        pools[0].join()
 
 
 def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
@@ -196,6 +198,10 @@ def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
         yield from pool.imap_unordered(function, tasks)
 
 
+# How often the waiting main thread of ``run_forked`` wakes [s]: a signal's C handler may run
+# in another thread (the pool's), and Python runs the signal's handler only when the main
+# thread runs again: a wait that never woke would miss a Ctrl-C or SIGTERM until the end.
+_WAKE = 0.1
 # What the forked workers of ``run_forked`` call: (function, arguments), set before the fork.
 _FORKED: tuple = (None, ())
 
@@ -213,7 +219,10 @@ def run_forked(function: Callable, arguments: list, jobs: int) -> list:
     _FORKED = (function, arguments)
     try:
         with _pool("fork", jobs) as pool:
-            return pool.map(_call_forked, range(len(arguments)), chunksize=1)
+            results = pool.map_async(_call_forked, range(len(arguments)), chunksize=1)
+            while not results.ready():  # wakes to run a signal's handler (see _WAKE)
+                results.wait(_WAKE)
+            return results.get()
     finally:
         _FORKED = (None, ())
 
