@@ -15,6 +15,10 @@ with k = 10⁶ and d = 2 S (see ``biped.model.gait``). Integrals use Simpson's r
 piece separately: the accelerations, hence the torques, jump at the knot t = T/2.
 Ψ6 and Ψ7 vanish by construction at t = 0 and t = T (both feet on the ground); they are
 checked at the interior samples only.
+
+The electrical criterion (ours, ``biped.model.actuators``): the electrical energy the motors
+draw per metre walked without regeneration, E / S = (1/S) ∫₀ᵀ Σ_i max(P_i, 0) dt [J/m], P_i
+= u_i i_i the electrical power of joint i's motor.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ import numpy as np
 from scipy.integrate import simpson
 
 from biped.errors import BipedError
+from biped.model.actuators import Drive, drive
 from biped.model.dynamics import Biped, zmp_from
 from biped.model.gait import Step, breakpoints, piece_grid, sample
 from biped.model.kinematics import Q1, Q2, Q3, Q4
@@ -44,11 +49,19 @@ CONSTRAINTS = (
 # per metre walked, C_E / S, which ranks gaits of different step lengths (at a given speed C_E
 # per step rewards short fast steps).
 CRITERIA = ("sthenic", "energy")
-ALL_CRITERIA = (*CRITERIA, "energy-per-metre")
-# The criteria counting the joints' work |Γ_i θ̇_i| (exact through slack variables).
-WORK_CRITERIA = ("energy", "energy-per-metre")
-# Unit of each criterion's value: C_Γ per metre walked, C_E per step, C_E / S per metre.
-CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J", "energy-per-metre": "J/m"}
+# And ours of the actuators: the electrical energy per metre walked, without regeneration.
+ALL_CRITERIA = (*CRITERIA, "energy-per-metre", "electrical")
+# The criteria counting the joints' work |Γ_i θ̇_i| or the motors' power max(P_i, 0) (exact
+# through slack variables).
+WORK_CRITERIA = ("energy", "energy-per-metre", "electrical")
+# Unit of each criterion's value: C_Γ per metre walked, C_E per step, C_E / S per metre, the
+# electrical energy per metre.
+CRITERION_UNITS = {
+    "sthenic": "N²·m·s",
+    "energy": "J",
+    "energy-per-metre": "J/m",
+    "electrical": "J/m",
+}
 PENALTY_WEIGHT = 1e6  # k of eqs. (30)-(31)
 # Err of eqs. (30)-(31) when the parameters give no posture: a large cost growing with the
 # distance [m] by which the hip is out of reach, so that the simplex is led back.
@@ -162,13 +175,18 @@ class StepEvaluation:
     sthenic: float  # (2/d) ∫ ΓᵀΓ dt [N²·m·s]
     energy: float  # ∫ Σ |Γ θ̇| dt [J]
     penalty: float  # ∫ k Σ (e^(|Ψ|-Ψ) - 1) dt [s]; inf if any value is not finite
+    drive: Drive  # the motors at each sample, arrays (N, 6) (``biped.model.actuators``)
+    electrical: float  # ∫ Σ max(P_i, 0) dt [J]: per step, without regeneration
+    electrical_net: float  # ∫ Σ P_i dt [J]: per step, with regeneration
 
     def cost(self, criterion: str, step_length: float) -> float:
-        """C_Γ, C_E or C_E / S with the penalty (Err = 0: the step was built)."""
+        """C_Γ, C_E, C_E / S or E / S with the penalty (Err = 0: the step was built)."""
         if criterion == "sthenic":
             return self.sthenic + self.penalty / step_length
         if criterion == "energy-per-metre":
             return (self.energy + self.penalty) / step_length
+        if criterion == "electrical":
+            return (self.electrical + self.penalty) / step_length
         return self.energy + self.penalty
 
     @property
@@ -252,9 +270,11 @@ def evaluate_step(
         psi[:, 3] -= safety.knee_bend
     checked = checked_mask(samples_per_half, knots)
     seen = psi - margin_profile(samples_per_half, knots) if margins else psi
-    power = np.abs(model.joint_angles(qd) * torques).sum(-1)
+    rates = model.joint_angles(qd)
+    power = np.abs(rates * torques).sum(-1)
     squared = (torques**2).sum(-1)
     weights = step.period * simpson_weights(samples_per_half, knots)
+    motors = drive(robot.drive_actuators.constants(), torques, rates, model.joint_angles(qdd))
     finite = bool(np.all(np.isfinite(psi[checked])) and np.all(np.isfinite(squared)))
     return StepEvaluation(
         t=t,
@@ -268,4 +288,7 @@ def evaluate_step(
         sthenic=float(weights @ squared) / step.step_length,
         energy=float(weights @ power),
         penalty=float(weights @ penalty_rate(seen, checked)) if finite else float("inf"),
+        drive=motors,
+        electrical=float(weights @ np.maximum(motors.power, 0.0).sum(-1)),
+        electrical_net=float(weights @ motors.power.sum(-1)),
     )

@@ -1,0 +1,113 @@
+"""Actuators: the robot file's motors, the drive's formulas, the electrical figures of a gait."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import biped
+from biped.errors import ParameterError
+from biped.model.actuators import JOINT_KINDS, Actuator, Actuators, drive
+from biped.model.criteria import evaluate_step, simpson_weights
+from biped.model.gait import build_step
+from biped.optimization.problem import GaitProblem
+
+SAMPLES = 40
+
+
+def _evaluation(actuators=None, knee="rolling"):
+    """A walkable step (the first guess at 0.3 m/s) evaluated with ``actuators``."""
+    robot = dataclasses.replace(biped.Robot.paper(), actuators=actuators)
+    model = biped.Biped(robot, knee)
+    problem = GaitProblem(model, 0.3)
+    step = build_step(model, 0.3, problem.first_parameters())
+    return model, step, evaluate_step(model, step, SAMPLES)
+
+
+def test_joint_kinds_follow_the_joints():
+    """Each joint of eq. (32) is driven by the actuator of its kind."""
+    assert JOINT_KINDS == tuple(joint.split("_")[1] for joint in biped.JOINTS)
+
+
+def test_lossless_actuator_gives_the_paper_energy():
+    """R = 0, no friction, no rotor, η = 1: P_i = Γ_i θ̇_i, so E without regeneration is the
+    positive work and 2 E − E_regenerated is the paper's energy criterion C_E."""
+    model, step, ev = _evaluation(Actuators.same(Actuator.lossless()))
+    rates = model.joint_angles(ev.qd)
+    np.testing.assert_allclose(ev.drive.power, ev.torques * rates, rtol=1e-12, atol=1e-12)
+    assert 2 * ev.electrical - ev.electrical_net == pytest.approx(ev.energy, rel=1e-12)
+    weights = step.period * simpson_weights(SAMPLES, 1)
+    positive = weights @ np.maximum(ev.torques * rates, 0.0).sum(-1)
+    assert ev.electrical == pytest.approx(positive, rel=1e-12)
+
+
+def test_copper_losses_are_the_squared_torques_scaled():
+    """Without friction and rotor: copper losses = R / (k_t N η)² ∫ Γ² per joint, so with
+    equal actuators the sthenic criterion ranks gaits like the copper losses."""
+    actuator = Actuator.lossless(resistance=0.3, gear_efficiency=0.8, gear_ratio=50.0)
+    model, step, ev = _evaluation(Actuators.same(actuator))
+    weights = step.period * simpson_weights(SAMPLES, 1)
+    scale = actuator.resistance / (actuator.torque_constant * 50.0 * 0.8) ** 2
+    np.testing.assert_allclose(
+        weights @ ev.drive.copper, scale * (weights @ ev.torques**2), rtol=1e-12
+    )
+    total = weights @ ev.drive.copper.sum(-1)
+    assert total == pytest.approx(scale * ev.sthenic * step.step_length, rel=1e-12)
+
+
+def test_power_balance():
+    """u i = R i² + θ̇ (Γ + Γ_f) / η + J_r N² θ̇ θ̈ with the default actuators."""
+    model, step, ev = _evaluation()
+    k = Actuators.default().constants()
+    rates, accels = model.joint_angles(ev.qd), model.joint_angles(ev.qdd)
+    friction = k["viscous_friction"] * rates + k["coulomb_friction"] * np.tanh(rates / 1e-2)
+    mechanical = rates * (ev.torques + friction) / k["gear_efficiency"]
+    rotor = k["rotor_inertia"] * k["gear_ratio"] ** 2 * rates * accels
+    np.testing.assert_allclose(ev.drive.power, ev.drive.copper + mechanical + rotor, atol=1e-9)
+
+
+def test_drive_is_one_formula_for_numpy_and_casadi():
+    """The CasADi drive of a sample is the numpy drive to 1e-12."""
+    import casadi as ca
+
+    k = Actuators.default().constants()
+    rng = np.random.default_rng(3)
+    torque, speed, accel = rng.normal(0, 5, (3, 6))
+    numeric = drive(k, torque, speed, accel)
+    columns = {name: ca.DM(value) for name, value in k.items()}
+    symbolic = drive(columns, ca.DM(torque), ca.DM(speed), ca.DM(accel), tanh=ca.tanh)
+    for f in dataclasses.fields(numeric):
+        np.testing.assert_allclose(
+            np.asarray(getattr(symbolic, f.name)).ravel(), getattr(numeric, f.name), rtol=1e-12
+        )
+
+
+def test_robot_file_actuators(tmp_path):
+    """A TOML robot file sets every joint's actuator ([actuator]) and one kind's
+    ([actuators.knee]); its JSON form reads back equal."""
+    path = tmp_path / "robot.toml"
+    path.write_text("r1 = 0.06\n[actuator]\ngear_ratio = 100\n[actuators.knee]\nresistance = 0.3\n")
+    robot = biped.Robot.from_file(path)
+    assert robot.actuators.hip.gear_ratio == robot.actuators.knee.gear_ratio == 100.0
+    assert robot.actuators.knee.resistance == 0.3
+    assert robot.actuators.ankle.resistance == Actuator.default().resistance
+    assert biped.Robot.from_mapping(robot.to_dict()) == robot
+    assert "actuators" not in biped.Robot.paper().to_dict()  # the default set is not written
+
+
+@pytest.mark.parametrize(
+    "values, needle",
+    [
+        ({"actuator": {"resistance": -1.0}}, "actuator.resistance = -1.0"),
+        ({"actuators": {"knee": {"gear_efficiency": 1.5}}}, "actuators.knee.gear_efficiency"),
+        ({"actuators": {"elbow": {}}}, "actuators.elbow"),
+        ({"actuator": {"peak_torque": 1.0}}, "actuator.peak_torque = 1.0"),
+        ({"actuator": {"voltage": 48}}, "actuator.voltage"),
+        ({"actuator": {"torque_constant": "big"}}, "actuator.torque_constant = 'big'"),
+    ],
+)
+def test_bad_actuator_names_the_value(values, needle):
+    """A bad actuator field raises an error naming the field and the value."""
+    with pytest.raises(ParameterError) as error:
+        biped.Robot.from_mapping(values)
+    assert needle in str(error.value) and "allowed" in str(error.value)
