@@ -8,7 +8,7 @@ import pytest
 import biped
 from biped.errors import ParameterError
 from biped.model.actuators import JOINT_KINDS, Actuator, Actuators, drive
-from biped.model.criteria import evaluate_step, simpson_weights
+from biped.model.criteria import ACTUATOR_MARGIN, Safety, evaluate_step, simpson_weights
 from biped.model.gait import build_step
 from biped.optimization.problem import GaitProblem
 
@@ -111,3 +111,82 @@ def test_bad_actuator_names_the_value(values, needle):
     with pytest.raises(ParameterError) as error:
         biped.Robot.from_mapping(values)
     assert needle in str(error.value) and "allowed" in str(error.value)
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_electrical_graph_equals_numeric_figures(knee):
+    """The CasADi graph's motor powers, voltages, electrical criterion and actuator-limit
+    margins are the numeric model's to 1e-12 at random variables."""
+    from biped.optimization.problem import SCALES
+    from biped.optimization.symbolic import StepGraph
+
+    safety = Safety(actuator_limits=True)
+    robot = dataclasses.replace(
+        biped.Robot.paper(), actuators=Actuators.from_mapping(None, {"knee": {"gear_ratio": 30}})
+    )
+    problem = GaitProblem(biped.Biped(robot, knee), 0.3, safety=safety)
+    graph = StepGraph(problem.model, 25, safety, motors=True)
+    names = ["electrical_power", "voltage", "electrical", "constraints"]
+    function = ca_function(graph, names)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        z = problem.first_guess() + 0.3 * SCALES * rng.standard_normal(21)
+        z[:2] = rng.uniform(0.05, 0.3, 2)
+        out = dict(zip(names, function(z, problem.speed), strict=True))
+        step = build_step(problem.model, problem.speed, problem.to_parameters(z))
+        ev = evaluate_step(problem.model, step, 25, safety=safety)
+
+        def same(symbolic, value):
+            value = np.asarray(value)
+            np.testing.assert_allclose(
+                np.asarray(symbolic), value, rtol=1e-12, atol=1e-12 * np.max(np.abs(value))
+            )
+
+        same(out["electrical_power"].full().T, ev.drive.power)
+        same(out["voltage"].full().T, ev.drive.voltage)
+        same(float(out["electrical"]), ev.electrical / step.step_length)
+        limits = out["constraints"].full().ravel()[-ev.actuator_margins.size :]
+        # both sample, then limit, then joint; the solver's keep a margin
+        same(limits + ACTUATOR_MARGIN, ev.actuator_margins.ravel())
+
+
+def ca_function(graph, names):
+    import casadi as ca
+
+    return ca.Function("f", graph.inputs, [getattr(graph, name) for name in names])
+
+
+def test_torque_above_peak_is_infeasible_under_actuator_limits():
+    """A motor whose peak torque is below the gait's makes the gait infeasible under the
+    actuator limits, naming the joint and the limit; without them it changes nothing."""
+    _, _, free = _evaluation()
+    peak = float(np.abs(free.torques[:, 2]).max())  # the stance hip's
+    weak = Actuator.default()
+    weak = dataclasses.replace(weak, continuous_torque=0.5 * peak, peak_torque=0.9 * peak)
+    actuators = Actuators(Actuator.default(), Actuator.default(), weak)
+    robot = dataclasses.replace(biped.Robot.paper(), actuators=actuators)
+    model = biped.Biped(robot, "rolling")
+    step = build_step(model, 0.3, GaitProblem(model, 0.3).first_parameters())
+    limited = evaluate_step(model, step, SAMPLES, safety=Safety(actuator_limits=True))
+    assert not limited.feasible
+    assert limited.violations()["stance_hip peak_torque"] == pytest.approx(1 - 1 / 0.9)
+    unlimited = evaluate_step(model, step, SAMPLES)
+    assert not any(" " in name for name in unlimited.violations())
+
+
+def test_optimum_under_actuator_limits_stays_within_them():
+    """An optimum under --actuator-limits keeps every torque within its motor's peak, where
+    the free optimum exceeds it, and is feasible on the check grid."""
+    from biped.optimization.optimize import optimize
+
+    free = optimize(GaitProblem(biped.Biped(biped.Robot.paper(), "rolling"), 0.3), starts=1)
+    peak = float(np.abs(free.evaluation.torques[:, 2]).max())
+    weak = dataclasses.replace(Actuator.default(), continuous_torque=1.0, peak_torque=0.8 * peak)
+    actuators = Actuators(Actuator.default(), Actuator.default(), weak)
+    robot = dataclasses.replace(biped.Robot.paper(), actuators=actuators)
+    safety = Safety(actuator_limits=True)
+    problem = GaitProblem(biped.Biped(robot, "rolling"), 0.3, safety=safety)
+    limited = optimize(problem, starts=1)
+    assert limited.certified
+    assert np.abs(limited.evaluation.torques[:, [2, 3]]).max() <= 0.8 * peak
+    assert limited.value > free.value

@@ -23,6 +23,7 @@ draw per metre walked without regeneration, E / S = (1/S) ∫₀ᵀ Σ_i max(P_i
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -31,8 +32,8 @@ import numpy as np
 from scipy.integrate import simpson
 
 from biped.errors import BipedError
-from biped.model.actuators import Drive, drive
-from biped.model.dynamics import Biped, zmp_from
+from biped.model.actuators import LIMITS, Drive, drive, limit_margins
+from biped.model.dynamics import JOINTS, Biped, zmp_from
 from biped.model.gait import Step, breakpoints, piece_grid, sample
 from biped.model.kinematics import Q1, Q2, Q3, Q4
 
@@ -76,6 +77,9 @@ BUILD_ERROR_SLOPE = 1e13  # per metre out of reach
 # the foot leaves and reaches the ground.
 MARGINS = np.array([1.0, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
 FOOT_MARGIN_RAMP = 0.1  # fraction of the step
+# Margin δ the optimiser keeps from each actuator limit (``Safety.actuator_limits``), a share
+# of the limit: between the solver's samples a torque, speed or voltage may rise above them.
+ACTUATOR_MARGIN = 0.01
 
 
 @functools.cache
@@ -111,13 +115,19 @@ class Safety:
         zmp_margin: [m] distance the ZMP keeps inside the sole's heel and toe (Ψ2, Ψ3).
         knee_bend: [rad] least flexion of the stance knee over the step (Ψ4 becomes the
             flexion beyond it): the two knee kinematics differ only where the knee bends.
+        actuator_limits: every joint's torque, speed and voltage within its motor's
+            (``biped.model.actuators.limit_margins``) at every sample: a gait the motors
+            cannot follow is not feasible.
     """
 
     clearance: float = field(default=0.0, metadata={"unit": "m"})
     zmp_margin: float = field(default=0.0, metadata={"unit": "m"})
     knee_bend: float = field(default=0.0, metadata={"unit": "rad"})
+    actuator_limits: bool = field(default=False, metadata={"unit": None})
 
     def __post_init__(self):
+        if not isinstance(self.actuator_limits, bool):
+            raise BipedError(f"actuator_limits = {self.actuator_limits!r}: allowed true or false")
         limits = (
             ("clearance", MAX_CLEARANCE, "m"),
             ("zmp_margin", MAX_ZMP_MARGIN, "m"),
@@ -134,6 +144,17 @@ class Safety:
 
 
 PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
+
+
+def safety_dict(safety: Safety) -> dict:
+    """The margins as a file writes them: a least knee bend and the actuator limits only
+    when asked (a file of the paper's problem is as it was before they existed)."""
+    values = dataclasses.asdict(safety)
+    if not values["knee_bend"]:
+        del values["knee_bend"]
+    if not values["actuator_limits"]:
+        del values["actuator_limits"]
+    return values
 
 
 @functools.cache
@@ -178,6 +199,9 @@ class StepEvaluation:
     drive: Drive  # the motors at each sample, arrays (N, 6) (``biped.model.actuators``)
     electrical: float  # ∫ Σ max(P_i, 0) dt [J]: per step, without regeneration
     electrical_net: float  # ∫ Σ P_i dt [J]: per step, with regeneration
+    # Under ``Safety.actuator_limits``: the margins of ``limit_margins`` (N, 6, 6): sample,
+    # limit (``LIMITS`` each twice, − then +), joint; else None.
+    actuator_margins: np.ndarray | None = None
 
     def cost(self, criterion: str, step_length: float) -> float:
         """C_Γ, C_E, C_E / S or E / S with the penalty (Err = 0: the step was built)."""
@@ -200,8 +224,17 @@ class StepEvaluation:
         return np.nanmin(self.constraints, axis=0)
 
     def violations(self) -> dict:
-        """Worst value of each violated constraint (Ψ_i < 0), by name."""
-        return {name: float(w) for name, w in zip(CONSTRAINTS, self.worst, strict=True) if w < 0.0}
+        """Worst value of each violated constraint (Ψ_i < 0), by name; under the actuator
+        limits also each joint's limit exceeded ("swing_knee max_speed": its margin, a share
+        of the limit)."""
+        found = {name: float(w) for name, w in zip(CONSTRAINTS, self.worst, strict=True) if w < 0.0}
+        if self.actuator_margins is not None:
+            worst = self.actuator_margins.min(axis=0).reshape(len(LIMITS), 2, -1).min(axis=1)
+            for limit, row in zip(LIMITS, worst, strict=True):
+                for joint, margin in zip(JOINTS, row, strict=True):
+                    if margin < 0.0:
+                        found[f"{joint} {limit}"] = float(margin)
+        return found
 
     def violations_line(self) -> str:
         """The violated constraints and worst values, as printed: 'zmp_toe = -0.0012, ...'."""
@@ -274,7 +307,13 @@ def evaluate_step(
     power = np.abs(rates * torques).sum(-1)
     squared = (torques**2).sum(-1)
     weights = step.period * simpson_weights(samples_per_half, knots)
-    motors = drive(robot.drive_actuators.constants(), torques, rates, model.joint_angles(qdd))
+    constants = robot.drive_actuators.constants()
+    motors = drive(constants, torques, rates, model.joint_angles(qdd))
+    limits = None
+    penalty = penalty_rate(seen, checked)
+    if safety.actuator_limits:
+        limits = np.stack(limit_margins(constants, torques, rates, motors.voltage), axis=1)
+        penalty = penalty + penalty_rate(limits.reshape(len(t), -1), True)
     finite = bool(np.all(np.isfinite(psi[checked])) and np.all(np.isfinite(squared)))
     return StepEvaluation(
         t=t,
@@ -287,8 +326,9 @@ def evaluate_step(
         constraints=np.where(checked, psi, np.nan),
         sthenic=float(weights @ squared) / step.step_length,
         energy=float(weights @ power),
-        penalty=float(weights @ penalty_rate(seen, checked)) if finite else float("inf"),
+        penalty=float(weights @ penalty) if finite else float("inf"),
         drive=motors,
         electrical=float(weights @ np.maximum(motors.power, 0.0).sum(-1)),
         electrical_net=float(weights @ motors.power.sum(-1)),
+        actuator_margins=limits,
     )

@@ -40,6 +40,7 @@ from biped.model.criteria import (
     CRITERION_UNITS,
     Safety,
     evaluate_step,
+    safety_dict,
     simpson_weights,
 )
 from biped.model.dynamics import JOINTS, Biped
@@ -474,9 +475,7 @@ class Gait:
             if hasattr(value, "to_dict"):  # the samples, records, robot
                 value = value.to_dict()
             elif dataclasses.is_dataclass(value):  # the safety margins, a knee bend if asked
-                value = dataclasses.asdict(value)
-                if not value["knee_bend"]:
-                    del value["knee_bend"]
+                value = safety_dict(value)
             content[f.name] = value
         return content
 

@@ -180,6 +180,7 @@ def _record(optimum: Optimum, seconds: float) -> dict:
             "sthenic": ev.sthenic,
             "energy": ev.energy,
             "energy-per-metre": ev.energy / optimum.step.step_length,
+            "electrical": ev.electrical / optimum.step.step_length,
         },
         "starts": report.starts,
         "starts_at_best": report.starts_at_best,

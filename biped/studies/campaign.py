@@ -66,8 +66,10 @@ class Settings:
             value = getattr(self, field.name)
             if isinstance(value, Robot):
                 value = value.to_dict()
-            elif isinstance(value, Safety):
+            elif isinstance(value, Safety):  # the actuator limits only when asked
                 value = dataclasses.asdict(value)
+                if not value["actuator_limits"]:
+                    del value["actuator_limits"]
             content[field.name] = list(value) if isinstance(value, tuple) else value
         return {**content, **self.stamp()}
 
