@@ -199,9 +199,9 @@ class Electrical(_Record):
     Without regeneration a joint's negative power is lost (∫ max(P, 0) dt), with it it is
     recovered (∫ P dt). The cost of transport is the energy per metre over the weight m g."""
 
-    current_peak: list = _per_joint("A", "largest |i|")
+    current_peak: list = _per_joint("A", "largest current")
     current_rms: list = _per_joint("A", "RMS current over the step")
-    voltage_peak: list = _per_joint("V", "largest |u|")
+    voltage_peak: list = _per_joint("V", "largest voltage")
     copper: list = _per_joint("J", "copper losses R i² over the step")
     friction: list = _per_joint("J", "friction losses over the step")
     energy: list = _per_joint("J", "electrical energy over the step, no regeneration")
