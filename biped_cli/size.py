@@ -97,13 +97,53 @@ def cmd_size(args) -> int:
         totals.append((path, gait, total))
         print(f"  total actuator mass: {total:.3f} kg (two ankles, two knees, two hips)")
     if len(totals) > 1:
-        print("total actuator mass, side by side:")
+        print(
+            "side by side: total actuator mass, and the electrical energy per metre with the "
+            "gait's own actuators (costs.electrical, no regeneration):"
+        )
         for path, gait, total in totals:
             shown = "no combination" if total is None else f"{total:.3f} kg"
-            print(f"  {gait.knee:<9} {gait.criterion:<17} {gait.speed:.3f} m/s  {shown}  ({path})")
+            print(
+                f"  {gait.knee:<9} {gait.criterion:<17} {gait.speed:.3f} m/s  {shown}  "
+                f"{_electrical(gait)}  ({path})"
+            )
+        for line in _knee_differences(totals):
+            print(line)
     if status:
         print("biped size: a joint has no combination of the catalog", file=sys.stderr)
     return status
+
+
+def _electrical(gait) -> str:
+    value = gait.costs.electrical
+    return "electrical not recorded" if value is None else f"{value:.4f} J/m"
+
+
+def _knee_differences(totals) -> list[str]:
+    """For each speed and criterion with one gait of each knee: (rolling − revolute) /
+    revolute of the electrical energy per metre and of the total actuator mass."""
+    from biped.optimization.comparison import DIFFERENCE, relative_change
+
+    lines = []
+    groups: dict = {}
+    for _, gait, total in totals:
+        groups.setdefault((gait.criterion, gait.speed), {}).setdefault(gait.knee, []).append(
+            (gait, total)
+        )
+    for (criterion, speed), knees in groups.items():
+        pairs = [knees.get(k, []) for k in ("revolute", "rolling")]
+        if any(len(pair) != 1 for pair in pairs):
+            continue
+        (revolute, mass_v), (rolling, mass_r) = pairs[0][0], pairs[1][0]
+        energy = relative_change(
+            rolling.costs.electrical or float("nan"), revolute.costs.electrical or float("nan")
+        )
+        mass = relative_change(mass_r or float("nan"), mass_v or float("nan"))
+        lines.append(
+            f"  rolling vs revolute, {criterion} optima at {speed:.3f} m/s: electrical energy "
+            f"{energy:+.2f} %, actuator mass {mass:+.2f} % ({DIFFERENCE})"
+        )
+    return lines
 
 
 def add_parser(commands) -> None:
