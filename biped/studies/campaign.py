@@ -39,6 +39,7 @@ _READ = {
     "Safety": lambda value: Safety(**value),
     "tuple": tuple,
     "int": int,
+    "bool": bool,
     "float": float,
     "str": lambda value: value,
 }
