@@ -190,3 +190,71 @@ def test_optimum_under_actuator_limits_stays_within_them():
     assert limited.certified
     assert np.abs(limited.evaluation.torques[:, [2, 3]]).max() <= 0.8 * peak
     assert limited.value > free.value
+
+
+def test_sthenic_optimum_is_bit_identical_with_or_without_actuators():
+    """The actuators do not enter the sthenic problem: a robot file's motors leave its
+    optimum, to the bit, as the default set's (and the paper's figures of its file)."""
+    from biped.optimization.optimize import optimize
+    from biped.records.gait_file import Gait
+
+    paper = biped.Robot.paper()
+    motors = dataclasses.replace(paper, actuators=Actuators.same(Actuator.lossless()))
+    found = [
+        optimize(GaitProblem(biped.Biped(r, "revolute"), 0.3), starts=1) for r in (paper, motors)
+    ]
+    assert np.array_equal(found[0].variables, found[1].variables)
+    files = [
+        Gait.from_optimum(o, r, provenance={}).to_dict()
+        for o, r in zip(found, (paper, motors), strict=True)
+    ]
+    for key in ("parameters", "samples", "constraints", "impact"):
+        assert files[0][key] == files[1][key], key
+    assert files[0]["costs"]["sthenic"] == files[1]["costs"]["sthenic"]
+    assert files[0]["electrical"] != files[1]["electrical"]
+    assert "actuators" not in files[0]["robot"] and "actuators" in files[1]["robot"]
+    assert files[1]["units"]["robot.actuators.hip.supply_voltage"] == "V"
+
+
+def test_gait_file_electrical_figures_are_checked_and_old_files_read(tmp_path):
+    """A gait file's electrical figures are recomputed on reading: an edited one is refused,
+    naming it; a file written before the actuators (no electrical block, no
+    costs.electrical) reads and is consistent."""
+    import json
+
+    from biped.errors import BipedError
+    from biped.records.gait_file import Gait, read_consistent
+    from tests.conftest import optimal_gait
+
+    gait = Gait.from_optimum(optimal_gait("rolling"), biped.Robot.paper())
+    content = gait.to_dict()
+    edited = json.loads(json.dumps(content))
+    edited["electrical"]["copper"][1] *= 1.01
+    path = tmp_path / "edited.json"
+    path.write_text(json.dumps(edited))
+    with pytest.raises(BipedError, match="electrical.copper"):
+        read_consistent(path)
+    old = json.loads(json.dumps(content))
+    del old["electrical"], old["costs"]["electrical"]
+    old["units"] = {
+        k: v for k, v in old["units"].items() if not k.startswith(("electrical", "costs.electr"))
+    }
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(old))
+    read = read_consistent(path)
+    assert read.electrical is None and read.costs.electrical is None
+
+
+def test_report_page_has_the_drive(tmp_path, capsys):
+    """biped report's page gives the motors' figures per joint and the cost of transport."""
+    from biped.records.gait_file import Gait
+    from biped_cli.main import main
+    from tests.conftest import optimal_gait
+
+    path = tmp_path / "rolling.json"
+    Gait.from_optimum(optimal_gait("rolling"), biped.Robot.paper()).write(path)
+    assert main(["report", str(path), "--out", str(tmp_path / "pages")]) == 0
+    page = next((tmp_path / "pages").glob("*.md")).read_text(encoding="utf-8")
+    assert "## Drive (the default set's actuators" in page
+    assert "| swing_knee |" in page and "| cost of transport |" in page
+    assert "electrical energy per metre walked (no regeneration)" in page
