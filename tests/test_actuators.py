@@ -258,3 +258,46 @@ def test_report_page_has_the_drive(tmp_path, capsys):
     assert "## Drive (the default set's actuators" in page
     assert "| swing_knee |" in page and "| cost of transport |" in page
     assert "electrical energy per metre walked (no regeneration)" in page
+
+
+ROBOT_FILE = """r1 = 0.06
+[actuator]
+gear_ratio = 36.0
+gear_efficiency = 0.81
+continuous_torque = 31.8
+peak_torque = 63.7
+max_speed = 6.98
+mass = 0.605
+
+[actuators.knee]
+resistance = 0.25
+"""
+
+
+def test_robot_file_with_actuators_drives_the_commands(tmp_path, capsys):
+    """A robot file with actuators drives optimize (electrical, within the limits),
+    validate, report, atlas and size; its gait file holds the actuators."""
+    import json
+
+    from biped_cli.main import main
+
+    robot = tmp_path / "robot.toml"
+    robot.write_text(ROBOT_FILE)
+    gait = tmp_path / "gait.json"
+    common = ["--robot", str(robot), "--speed", "0.3", "--criterion", "electrical"]
+    optimize = ["optimize", "--knee", "rolling", *common, "--starts", "1", "--actuator-limits"]
+    assert main([*optimize, "--out", str(gait)]) == 0
+    content = json.loads(gait.read_text())
+    assert content["robot"]["actuators"]["knee"]["resistance"] == 0.25
+    assert content["safety"]["actuator_limits"] is True
+    assert content["criterion"] == "electrical" and content["electrical"]["energy_per_metre"] > 0
+    assert main(["validate", str(gait), "--steps", "3", "--rrd", str(tmp_path / "w.rrd")]) in (0, 1)
+    assert main(["report", str(gait), "--out", str(tmp_path / "pages")]) == 0
+    assert main(["size", str(gait)]) == 0
+    atlas = ["atlas", "--robot", str(robot), "--speeds", "0.3", "--clearances", "0"]
+    atlas += ["--criteria", "electrical", "--starts", "1", "--no-walks"]
+    assert main([*atlas, "--out", str(tmp_path / "atlas")]) in (0, 1)
+    assert (tmp_path / "atlas" / "atlas-electrical.png").exists()
+    out = capsys.readouterr().out
+    assert "PASS  model" in out and "PASS  inverse_dynamics" in out
+    assert "total actuator mass" in out
