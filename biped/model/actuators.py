@@ -36,6 +36,7 @@ for the 70 kg robot of Table 1 (its knee holds 72 N·m standing on one leg, ``bi
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
@@ -252,12 +253,20 @@ class Actuators:
         return tuple(getattr(self, kind) for kind in JOINT_KINDS)
 
     def constants(self) -> dict:
-        """Each field as an array (6,) over the joints (``JOINTS``)."""
-        joints = self.per_joint()
-        return {
-            f.name: np.array([getattr(a, f.name) for a in joints])
-            for f in dataclasses.fields(Actuator)
-        }
+        """Each field as an array (6,) over the joints (``JOINTS``), read-only (built once
+        per set: every evaluation of a step asks for them)."""
+        return _constants(self)
+
+
+@functools.cache
+def _constants(actuators: Actuators) -> dict:
+    joints = actuators.per_joint()
+    arrays = {
+        f.name: np.array([getattr(a, f.name) for a in joints]) for f in dataclasses.fields(Actuator)
+    }
+    for array in arrays.values():
+        array.setflags(write=False)
+    return arrays
 
 
 @dataclass(frozen=True)
