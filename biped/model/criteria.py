@@ -32,7 +32,7 @@ import numpy as np
 from scipy.integrate import simpson
 
 from biped.errors import BipedError
-from biped.model.actuators import LIMITS, Drive, drive, limit_margins
+from biped.model.actuators import LIMITS, Actuators, Drive, drive, limit_margins
 from biped.model.dynamics import JOINTS, Biped, zmp_from
 from biped.model.gait import Step, breakpoints, piece_grid, sample
 from biped.model.kinematics import Q1, Q2, Q3, Q4
@@ -196,12 +196,31 @@ class StepEvaluation:
     sthenic: float  # (2/d) ∫ ΓᵀΓ dt [N²·m·s]
     energy: float  # ∫ Σ |Γ θ̇| dt [J]
     penalty: float  # ∫ k Σ (e^(|Ψ|-Ψ) - 1) dt [s]; inf if any value is not finite
-    drive: Drive  # the motors at each sample, arrays (N, 6) (``biped.model.actuators``)
-    electrical: float  # ∫ Σ max(P_i, 0) dt [J]: per step, without regeneration
-    electrical_net: float  # ∫ Σ P_i dt [J]: per step, with regeneration
+    # What the motors' figures (``drive``, ``electrical``, computed when first asked) follow
+    # from: the joints' rates θ̇ and accelerations θ̈ (N, 6), the actuators, the weights
+    # [s] (N,) of Simpson's rule on the grid.
+    joint_rates: np.ndarray
+    joint_accels: np.ndarray
+    actuators: Actuators
+    weights: np.ndarray
     # Under ``Safety.actuator_limits``: the margins of ``limit_margins`` (N, 6, 6): sample,
     # limit (``LIMITS`` each twice, − then +), joint; else None.
     actuator_margins: np.ndarray | None = None
+
+    @functools.cached_property
+    def drive(self) -> Drive:
+        """The motors at each sample, arrays (N, 6) (``biped.model.actuators.drive``)."""
+        return drive(self.actuators.constants(), self.torques, self.joint_rates, self.joint_accels)
+
+    @functools.cached_property
+    def electrical(self) -> float:
+        """[J] ∫ Σ max(P_i, 0) dt: the motors' energy over the step, without regeneration."""
+        return float(self.weights @ np.maximum(self.drive.power, 0.0).sum(-1))
+
+    @functools.cached_property
+    def electrical_net(self) -> float:
+        """[J] ∫ Σ P_i dt: the motors' energy over the step, with regeneration."""
+        return float(self.weights @ self.drive.power.sum(-1))
 
     def cost(self, criterion: str, step_length: float) -> float:
         """C_Γ, C_E, C_E / S or E / S with the penalty (Err = 0: the step was built)."""
@@ -307,12 +326,13 @@ def evaluate_step(
     power = np.abs(rates * torques).sum(-1)
     squared = (torques**2).sum(-1)
     weights = step.period * simpson_weights(samples_per_half, knots)
-    constants = robot.drive_actuators.constants()
-    motors = drive(constants, torques, rates, model.joint_angles(qdd))
+    actuators, accels = robot.drive_actuators, model.joint_angles(qdd)
     limits = None
     penalty = penalty_rate(seen, checked)
     if safety.actuator_limits:
-        limits = np.stack(limit_margins(constants, torques, rates, motors.voltage), axis=1)
+        constants = actuators.constants()
+        voltage = drive(constants, torques, rates, accels).voltage
+        limits = np.stack(limit_margins(constants, torques, rates, voltage), axis=1)
         penalty = penalty + penalty_rate(limits.reshape(len(t), -1), True)
     finite = bool(np.all(np.isfinite(psi[checked])) and np.all(np.isfinite(squared)))
     return StepEvaluation(
@@ -327,8 +347,9 @@ def evaluate_step(
         sthenic=float(weights @ squared) / step.step_length,
         energy=float(weights @ power),
         penalty=float(weights @ penalty) if finite else float("inf"),
-        drive=motors,
-        electrical=float(weights @ np.maximum(motors.power, 0.0).sum(-1)),
-        electrical_net=float(weights @ motors.power.sum(-1)),
+        joint_rates=rates,
+        joint_accels=accels,
+        actuators=actuators,
+        weights=weights,
         actuator_margins=limits,
     )
