@@ -28,7 +28,15 @@ from validate import DEFAULT_STEPS
 # What an option naming an output says of its missing folders (the path written is printed).
 FOLDERS_CREATED = "missing folders are created"
 FOLDER_CREATED = "created if missing"
-ROBOT_HELP = "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1)"
+ROBOT_HELP = (
+    "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1); a "
+    "table [actuator] sets every joint's motor and gear, [actuators.knee] (ankle, hip) one "
+    "kind's (fields left out keep the default AK80 motor behind a 64:1 gear)"
+)
+ACTUATOR_LIMITS_HELP = (
+    "every joint's torque, speed and voltage within its motor's peak torque, top speed and "
+    "supply voltage at every sample: a gait the motors cannot follow is not feasible"
+)
 SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower steps are mm long)"
 # Most speeds of a sweep: each is an optimisation per knee and criterion.
 MAX_SPEEDS = 1000
@@ -49,7 +57,9 @@ CRITERION_HELP = (
     "sthenic (the paper's eq. 30): the squared joint torques integrated over a step and divided "
     "by the step length S, (1/S) ∫ ΓᵀΓ dt, so per metre walked [N²·m·s]; energy (eq. 31): the "
     "absolute work of the joints over a step, ∫ Σ |Γ_i θ̇_i| dt [J per step]; "
-    "energy-per-metre: the energy criterion divided by the step length, per metre walked [J/m]"
+    "energy-per-metre: the energy criterion divided by the step length, per metre walked [J/m]; "
+    "electrical: the electrical energy the motors draw per metre walked, negative power lost "
+    "(no regeneration), from the robot's actuators [J/m]"
 )
 KNOTS_HELP = (
     "interior knots of each angle's cubic spline: 1, the paper's (21 parameters); 3 or 5, "
@@ -215,7 +225,12 @@ def budget(args) -> dict:
 
 def safety(args) -> Safety:
     """The safety margins given on the command line."""
-    return Safety(clearance=args.clearance, zmp_margin=args.zmp_margin, knee_bend=args.knee_bend)
+    return Safety(
+        clearance=args.clearance,
+        zmp_margin=args.zmp_margin,
+        knee_bend=args.knee_bend,
+        actuator_limits=getattr(args, "actuator_limits", False),
+    )
 
 
 def add_budget(parser, sweep: bool = False):
@@ -269,6 +284,7 @@ def add_safety(parser) -> None:
          f"[rad] least flexion of the stance knee over the step, 0 to {MAX_KNEE_BEND} "
          "(default 0, the paper's knee not inverted)"),
     )  # fmt: skip
+    parser.add_argument("--actuator-limits", action="store_true", help=ACTUATOR_LIMITS_HELP)
 
 
 def add_robot(parser) -> None:

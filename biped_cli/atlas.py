@@ -59,6 +59,7 @@ def cmd_atlas(args) -> int:
             args.knots,
             args.seed,
             args.starts,
+            actuator_limits=args.actuator_limits,
         )
     )
     types.check_folder(args.out, "--out")
@@ -160,6 +161,7 @@ def add_parser(commands) -> None:
     parser.add_argument(
         "--no-walks", action="store_true", help="skip walking the chosen optima in MuJoCo"
     )
+    parser.add_argument("--actuator-limits", action="store_true", help=types.ACTUATOR_LIMITS_HELP)
     types.add_robot(parser)
     types.add_jobs(parser)
     types.add_dask(parser)

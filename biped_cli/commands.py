@@ -110,7 +110,8 @@ def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
         f"{knee} knee, {criterion}-optimal gait at {speed} m/s: period "
         f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m",
         f"  costs, on the check grid ({CHECK_SAMPLES_PER_STEP} samples per step; the "
-        f"comparisons use them): sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J",
+        f"comparisons use them): sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J, "
+        f"electrical {ev.electrical / optimum.step.step_length:.6g} J/m (no regeneration)",
     ]
     samples = (
         f"{SOLVER_SAMPLES_PER_STEP} per step; it ranks the starts"

@@ -11,7 +11,7 @@ import re
 import sys
 
 from biped.records.provenance import command_line, version
-from biped_cli import atlas, commands, design, orbit, report, robustness
+from biped_cli import atlas, commands, design, orbit, report, robustness, size
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
 
 DEBUG_HELP = "on an error, print its traceback before the one-line message"
@@ -62,6 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
         report.add_parser,
         robustness.add_parser,
         orbit.add_parser,
+        size.add_parser,
     ):
         add(subcommands)
     for command in subcommands.choices.values():  # after the command too: biped demo --debug

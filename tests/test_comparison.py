@@ -51,7 +51,7 @@ def _optimum(converged=True, feasible=True, value=27.77, solver_value=27.78):
         seconds=1.0,
         value=solver_value,
     )
-    evaluation = SimpleNamespace(sthenic=value, energy=1.25)
+    evaluation = SimpleNamespace(sthenic=value, energy=1.25, electrical=0.9)
     step = SimpleNamespace(period=0.6, step_length=0.18)
     return SimpleNamespace(
         report=report, feasible=feasible, value=value, evaluation=evaluation, step=step
@@ -66,7 +66,7 @@ def test_the_optimize_lines_name_both_values_of_the_criterion():
     text = optimum_line("rolling", "sthenic", 0.3, _optimum())
     costs, solver = text.splitlines()[1:]
     assert "check grid (202 samples per step" in costs and "comparisons use" in costs
-    assert "sthenic 27.77 N²·m·s, energy 1.25 J" in costs
+    assert "sthenic 27.77 N²·m·s, energy 1.25 J, electrical 5 J/m (no regeneration)" in costs
     assert "optimizer.value" in solver and "52 per step" in solver
     assert "ranks the starts" in solver and "sthenic 27.78 N²·m·s" in solver
     assert (

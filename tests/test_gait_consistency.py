@@ -168,6 +168,7 @@ GAIT_READERS = {
     "robustness": lambda gait, tmp: ["robustness", gait, "--out", f"{tmp}/out"],
     "orbit": lambda gait, tmp: ["orbit", gait, "--out", f"{tmp}/out"],
     "report": lambda gait, tmp: ["report", gait, "--out", f"{tmp}/out"],
+    "size": lambda gait, tmp: ["size", gait],
     "figures": lambda sweep, tmp: ["figures", "--sweep", sweep, "--out", f"{tmp}/out"],
     "validate.video": lambda gait, tmp: [gait, "--out", f"{tmp}/walk.mp4", "--steps", "1"],
 }

@@ -1,7 +1,6 @@
 """The units map of gait files: a unit for every number, every column of a mixed array, and
 the robot's fields in the units its own documentation states."""
 
-import dataclasses
 import inspect
 import json
 import re
@@ -67,12 +66,24 @@ def test_robot_units_are_those_its_fields_document():
     """Each Robot field's unit in the map is the one in brackets in its docstring."""
     source = inspect.getsource(Robot)
     stated = dict(re.findall(r"\n    (\w+): float(?: = [^\n]+)?\n    \"\"\"\[([^\]]+)\]", source))
-    fields = [f.name for f in dataclasses.fields(Robot)]
+    fields = [f.name for f in Robot.body_fields()]
     assert sorted(stated) == sorted(fields)
     units = Gait.units("energy")
     for name in fields:
         assert units[f"robot.{name}"] == stated[name], name
     assert units["optimizer.value"].startswith("J (the criterion on the solver's")
+
+
+def test_actuator_units_are_those_its_fields_document():
+    """Each Actuator field's unit in the map is the one in brackets in its docstring."""
+    from biped.model.actuators import UNITS, Actuator
+
+    source = inspect.getsource(Actuator)
+    stated = dict(re.findall(r"\n    (\w+): float(?: = [^\n]+)?\n    \"\"\"\[([^\]]+)\]", source))
+    assert stated == UNITS
+    units = Gait.units("electrical", actuators=True)
+    assert units["robot.actuators.knee.resistance"] == "Ω"
+    assert units["costs.electrical"] == units["electrical.energy_per_metre"] == "J/m"
 
 
 def test_printed_check_lines_carry_the_units_of_their_figures():

@@ -19,7 +19,6 @@ trips on it.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from pathlib import Path
 
@@ -270,7 +269,7 @@ def parameter_differences(model: mujoco.MjModel, biped: Biped) -> list[str]:
     ``biped.Robot``'s fields: the field, the model's value and where it is, the robot's."""
     held = model_parameters(model, biped.knee)
     lines = []
-    for field in dataclasses.fields(Robot):
+    for field in Robot.body_fields():
         wanted = getattr(biped.robot, field.name)
         unit = robot_unit(field.name)
         for where, value in held.get(field.name, []):

@@ -145,7 +145,7 @@ def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool
         revolute, rolling = costs["revolute"], costs["rolling"]
         changes = ", ".join(
             f"{criterion} {relative_change(rolling[criterion], revolute[criterion]):+.1f} %"
-            for criterion in CRITERIA
+            for criterion in (*CRITERIA, "electrical")
         )
         gaits = f"{pipeline.criterion}-optimal gaits"
         say(f"rolling vs revolute knee, {gaits}: {changes} ({DIFFERENCE})")

@@ -2,7 +2,9 @@
 parameters and conventions (``robot``), geometry (``kinematics``), Lagrangian dynamics, ground
 wrench and ZMP (``dynamics``), the flat-foot impact (``impact``), the spline gait of one step
 (``gait``, section 3), its criteria and constraints (``criteria``, section 4), and the unit of
-every number, declared beside the fields of the records that hold them (``units``).
+every number, declared beside the fields of the records that hold them (``units``); ours: the
+joints' motors and gears and what they draw (``actuators``), and their sizing from a catalog
+(``sizing``, ``catalog.json``).
 
 May import: ``biped.errors``, numpy, scipy. Nothing here knows of solvers, files or MuJoCo.
 """

@@ -15,10 +15,15 @@ with k = 10⁶ and d = 2 S (see ``biped.model.gait``). Integrals use Simpson's r
 piece separately: the accelerations, hence the torques, jump at the knot t = T/2.
 Ψ6 and Ψ7 vanish by construction at t = 0 and t = T (both feet on the ground); they are
 checked at the interior samples only.
+
+The electrical criterion (ours, ``biped.model.actuators``): the electrical energy the motors
+draw per metre walked without regeneration, E / S = (1/S) ∫₀ᵀ Σ_i max(P_i, 0) dt [J/m], P_i
+= u_i i_i the electrical power of joint i's motor.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -27,7 +32,8 @@ import numpy as np
 from scipy.integrate import simpson
 
 from biped.errors import BipedError
-from biped.model.dynamics import Biped, zmp_from
+from biped.model.actuators import LIMITS, Actuators, Drive, drive, limit_margins
+from biped.model.dynamics import JOINTS, Biped, zmp_from
 from biped.model.gait import Step, breakpoints, piece_grid, sample
 from biped.model.kinematics import Q1, Q2, Q3, Q4
 
@@ -44,11 +50,19 @@ CONSTRAINTS = (
 # per metre walked, C_E / S, which ranks gaits of different step lengths (at a given speed C_E
 # per step rewards short fast steps).
 CRITERIA = ("sthenic", "energy")
-ALL_CRITERIA = (*CRITERIA, "energy-per-metre")
-# The criteria counting the joints' work |Γ_i θ̇_i| (exact through slack variables).
-WORK_CRITERIA = ("energy", "energy-per-metre")
-# Unit of each criterion's value: C_Γ per metre walked, C_E per step, C_E / S per metre.
-CRITERION_UNITS = {"sthenic": "N²·m·s", "energy": "J", "energy-per-metre": "J/m"}
+# And ours of the actuators: the electrical energy per metre walked, without regeneration.
+ALL_CRITERIA = (*CRITERIA, "energy-per-metre", "electrical")
+# The criteria counting the joints' work |Γ_i θ̇_i| or the motors' power max(P_i, 0) (exact
+# through slack variables).
+WORK_CRITERIA = ("energy", "energy-per-metre", "electrical")
+# Unit of each criterion's value: C_Γ per metre walked, C_E per step, C_E / S per metre, the
+# electrical energy per metre.
+CRITERION_UNITS = {
+    "sthenic": "N²·m·s",
+    "energy": "J",
+    "energy-per-metre": "J/m",
+    "electrical": "J/m",
+}
 PENALTY_WEIGHT = 1e6  # k of eqs. (30)-(31)
 # Err of eqs. (30)-(31) when the parameters give no posture: a large cost growing with the
 # distance [m] by which the hip is out of reach, so that the simplex is led back.
@@ -63,6 +77,9 @@ BUILD_ERROR_SLOPE = 1e13  # per metre out of reach
 # the foot leaves and reaches the ground.
 MARGINS = np.array([1.0, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3])
 FOOT_MARGIN_RAMP = 0.1  # fraction of the step
+# Margin δ the optimiser keeps from each actuator limit (``Safety.actuator_limits``), a share
+# of the limit: between the solver's samples a torque, speed or voltage may rise above them.
+ACTUATOR_MARGIN = 0.01
 
 
 @functools.cache
@@ -98,13 +115,19 @@ class Safety:
         zmp_margin: [m] distance the ZMP keeps inside the sole's heel and toe (Ψ2, Ψ3).
         knee_bend: [rad] least flexion of the stance knee over the step (Ψ4 becomes the
             flexion beyond it): the two knee kinematics differ only where the knee bends.
+        actuator_limits: every joint's torque, speed and voltage within its motor's
+            (``biped.model.actuators.limit_margins``) at every sample: a gait the motors
+            cannot follow is not feasible.
     """
 
     clearance: float = field(default=0.0, metadata={"unit": "m"})
     zmp_margin: float = field(default=0.0, metadata={"unit": "m"})
     knee_bend: float = field(default=0.0, metadata={"unit": "rad"})
+    actuator_limits: bool = field(default=False, metadata={"unit": None})
 
     def __post_init__(self):
+        if not isinstance(self.actuator_limits, bool):
+            raise BipedError(f"actuator_limits = {self.actuator_limits!r}: allowed true or false")
         limits = (
             ("clearance", MAX_CLEARANCE, "m"),
             ("zmp_margin", MAX_ZMP_MARGIN, "m"),
@@ -121,6 +144,17 @@ class Safety:
 
 
 PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
+
+
+def safety_dict(safety: Safety) -> dict:
+    """The margins as a file writes them: a least knee bend and the actuator limits only
+    when asked (a file of the paper's problem is as it was before they existed)."""
+    values = dataclasses.asdict(safety)
+    if not values["knee_bend"]:
+        del values["knee_bend"]
+    if not values["actuator_limits"]:
+        del values["actuator_limits"]
+    return values
 
 
 @functools.cache
@@ -162,13 +196,40 @@ class StepEvaluation:
     sthenic: float  # (2/d) ∫ ΓᵀΓ dt [N²·m·s]
     energy: float  # ∫ Σ |Γ θ̇| dt [J]
     penalty: float  # ∫ k Σ (e^(|Ψ|-Ψ) - 1) dt [s]; inf if any value is not finite
+    # What the motors' figures (``drive``, ``electrical``, computed when first asked) follow
+    # from: the joints' rates θ̇ and accelerations θ̈ (N, 6), the actuators, the weights
+    # [s] (N,) of Simpson's rule on the grid.
+    joint_rates: np.ndarray
+    joint_accels: np.ndarray
+    actuators: Actuators
+    weights: np.ndarray
+    # Under ``Safety.actuator_limits``: the margins of ``limit_margins`` (N, 6, 6): sample,
+    # limit (``LIMITS`` each twice, − then +), joint; else None.
+    actuator_margins: np.ndarray | None = None
+
+    @functools.cached_property
+    def drive(self) -> Drive:
+        """The motors at each sample, arrays (N, 6) (``biped.model.actuators.drive``)."""
+        return drive(self.actuators.constants(), self.torques, self.joint_rates, self.joint_accels)
+
+    @functools.cached_property
+    def electrical(self) -> float:
+        """[J] ∫ Σ max(P_i, 0) dt: the motors' energy over the step, without regeneration."""
+        return float(self.weights @ np.maximum(self.drive.power, 0.0).sum(-1))
+
+    @functools.cached_property
+    def electrical_net(self) -> float:
+        """[J] ∫ Σ P_i dt: the motors' energy over the step, with regeneration."""
+        return float(self.weights @ self.drive.power.sum(-1))
 
     def cost(self, criterion: str, step_length: float) -> float:
-        """C_Γ, C_E or C_E / S with the penalty (Err = 0: the step was built)."""
+        """C_Γ, C_E, C_E / S or E / S with the penalty (Err = 0: the step was built)."""
         if criterion == "sthenic":
             return self.sthenic + self.penalty / step_length
         if criterion == "energy-per-metre":
             return (self.energy + self.penalty) / step_length
+        if criterion == "electrical":
+            return (self.electrical + self.penalty) / step_length
         return self.energy + self.penalty
 
     @property
@@ -182,8 +243,17 @@ class StepEvaluation:
         return np.nanmin(self.constraints, axis=0)
 
     def violations(self) -> dict:
-        """Worst value of each violated constraint (Ψ_i < 0), by name."""
-        return {name: float(w) for name, w in zip(CONSTRAINTS, self.worst, strict=True) if w < 0.0}
+        """Worst value of each violated constraint (Ψ_i < 0), by name; under the actuator
+        limits also each joint's limit exceeded ("swing_knee max_speed": its margin, a share
+        of the limit)."""
+        found = {name: float(w) for name, w in zip(CONSTRAINTS, self.worst, strict=True) if w < 0.0}
+        if self.actuator_margins is not None:
+            worst = self.actuator_margins.min(axis=0).reshape(len(LIMITS), 2, -1).min(axis=1)
+            for limit, row in zip(LIMITS, worst, strict=True):
+                for joint, margin in zip(JOINTS, row, strict=True):
+                    if margin < 0.0:
+                        found[f"{joint} {limit}"] = float(margin)
+        return found
 
     def violations_line(self) -> str:
         """The violated constraints and worst values, as printed: 'zmp_toe = -0.0012, ...'."""
@@ -252,9 +322,18 @@ def evaluate_step(
         psi[:, 3] -= safety.knee_bend
     checked = checked_mask(samples_per_half, knots)
     seen = psi - margin_profile(samples_per_half, knots) if margins else psi
-    power = np.abs(model.joint_angles(qd) * torques).sum(-1)
+    rates = model.joint_angles(qd)
+    power = np.abs(rates * torques).sum(-1)
     squared = (torques**2).sum(-1)
     weights = step.period * simpson_weights(samples_per_half, knots)
+    actuators, accels = robot.drive_actuators, model.joint_angles(qdd)
+    limits = None
+    penalty = penalty_rate(seen, checked)
+    if safety.actuator_limits:
+        constants = actuators.constants()
+        voltage = drive(constants, torques, rates, accels).voltage
+        limits = np.stack(limit_margins(constants, torques, rates, voltage), axis=1)
+        penalty = penalty + penalty_rate(limits.reshape(len(t), -1), True)
     finite = bool(np.all(np.isfinite(psi[checked])) and np.all(np.isfinite(squared)))
     return StepEvaluation(
         t=t,
@@ -267,5 +346,10 @@ def evaluate_step(
         constraints=np.where(checked, psi, np.nan),
         sthenic=float(weights @ squared) / step.step_length,
         energy=float(weights @ power),
-        penalty=float(weights @ penalty_rate(seen, checked)) if finite else float("inf"),
+        penalty=float(weights @ penalty) if finite else float("inf"),
+        joint_rates=rates,
+        joint_accels=accels,
+        actuators=actuators,
+        weights=weights,
+        actuator_margins=limits,
     )

@@ -23,6 +23,7 @@ import tomllib
 from pathlib import Path
 
 from biped.errors import ParameterError
+from biped.model.actuators import Actuators
 
 # Standard gravity [m/s²].
 STANDARD_GRAVITY = 9.81
@@ -110,9 +111,14 @@ class Robot:
     """[m] Radius of the thigh's rolling surface (rolling knee only)."""
     gravity: float = STANDARD_GRAVITY
     """[m/s²] Gravitational acceleration; plausible 0.1 to 100 m/s²."""
+    actuators: Actuators | None = None
+    """The joints' motors and gears (``biped.model.actuators``); None: the default set,
+    ``Actuators.default()`` (what ``drive_actuators`` gives), left out of the file."""
 
     def __post_init__(self):
-        for field in dataclasses.fields(self):
+        if self.actuators is not None and not isinstance(self.actuators, Actuators):
+            raise ParameterError("actuators", self.actuators, "a biped.model.actuators.Actuators")
+        for field in self.body_fields():
             value = getattr(self, field.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ParameterError(field.name, value, "a real number")
@@ -123,7 +129,7 @@ class Robot:
             if not math.isfinite(number):
                 raise ParameterError(field.name, value, "a finite number")
             object.__setattr__(self, field.name, number)
-        positive = [f.name for f in dataclasses.fields(self) if f.name not in ("r1", "r2")]
+        positive = [f.name for f in self.body_fields() if f.name not in ("r1", "r2")]
         for name in positive:
             if getattr(self, name) <= 0.0:
                 raise ParameterError(name, getattr(self, name), "> 0")
@@ -150,6 +156,16 @@ class Robot:
             )
         self._check_below("r1", "shank_length", "0 <= r1 < shank_length")
         self._check_below("r2", "thigh_length", "0 <= r2 < thigh_length")
+
+    @classmethod
+    def body_fields(cls) -> tuple:
+        """The fields of the body parameters (numbers), all but ``actuators``."""
+        return tuple(f for f in dataclasses.fields(cls) if f.name != "actuators")
+
+    @property
+    def drive_actuators(self) -> Actuators:
+        """The actuators that drive the joints: ``actuators``, or the default set."""
+        return self.actuators if self.actuators is not None else Actuators.default()
 
     def _check_below(self, name: str, bound: str, allowed: str, strict: bool = True):
         value, limit = getattr(self, name), getattr(self, bound)
@@ -185,13 +201,22 @@ class Robot:
 
     @classmethod
     def from_mapping(cls, values: dict, source: str = "mapping") -> Robot:
-        """A robot from a mapping of field names; missing fields take Table 1 values."""
+        """A robot from a mapping of field names; missing fields take Table 1 values.
+
+        Actuators (``biped.model.actuators``): a table ``actuator`` for every joint and a
+        table ``actuators`` of the kinds (``ankle``, ``knee``, ``hip``) over it, each of
+        ``Actuator``'s field names (SI units); fields left out take the default actuator's.
+        A mapping with neither has the default set (``actuators`` None)."""
         if not isinstance(values, dict):
             raise ParameterError(source, type(values).__name__, "a table of field = value")
-        known = {f.name for f in dataclasses.fields(cls)}
+        values = dict(values)
+        common, per_kind = values.pop("actuator", None), values.pop("actuators", None)
+        known = {f.name for f in dataclasses.fields(cls)} | {"actuator"}
         unknown = sorted(set(values) - known)
         if unknown:
             raise ParameterError(unknown[0], values[unknown[0]], f"one of {sorted(known)}")
+        if common is not None or per_kind is not None:
+            values["actuators"] = Actuators.from_mapping(common, per_kind)
         return dataclasses.replace(cls.paper(), **values)
 
     @classmethod
@@ -221,8 +246,12 @@ class Robot:
         return cls.from_mapping(values, source=str(path))
 
     def to_dict(self) -> dict:
-        """Field names to values, for JSON output."""
-        return dataclasses.asdict(self)
+        """Field names to values, for JSON output; ``actuators`` (each kind's fields) only
+        when given."""
+        values = {f.name: getattr(self, f.name) for f in self.body_fields()}
+        if self.actuators is not None:
+            values["actuators"] = self.actuators.to_dict()
+        return values
 
     # ------------------------------------------------------------------ derived values
     @property

@@ -388,9 +388,11 @@ class Comparison:
         the problem's criterion, its change against the revolute knee (the convention
         on the last line)."""
         criterion = self.problem.criterion
+        title = f"{criterion} vs revolute"
+        width = max(22, len(title) + 2)  # the longer criteria's names keep their space
         head = (
             f"{'knee':24}{'r1 [m]':>9}{'r2 [m]':>9}{'sthenic [N²·m·s]':>18}{'energy [J]':>12}"
-            f"{f'{criterion} vs revolute':>22}"
+            f"{title:>{width}}"
         )
         lines = [head]
         for label, radii, optimum in self.rows():
@@ -400,7 +402,7 @@ class Comparison:
             lines.append(
                 f"{label:24}{r1:>9}{r2:>9}{optimum.evaluation.sthenic:18.4f}"
                 f"{optimum.evaluation.energy:12.4f}"
-                f"{'' if radii is None else f'{change:+.2f} %':>22}{status}"
+                f"{'' if radii is None else f'{change:+.2f} %':>{width}}{status}"
             )
         lines.append(f"{criterion} vs revolute: {DIFFERENCE_VS_REVOLUTE}")
         return "\n".join(lines)

@@ -210,8 +210,13 @@ class Optimum:
         return (not self.certified, not self.feasible, self.value)
 
     def costs(self) -> dict:
-        """Both criteria of the gait (no penalty)."""
-        return {"sthenic": self.evaluation.sthenic, "energy": self.evaluation.energy}
+        """Both criteria of the paper and the motors' energy per metre (no penalty)."""
+        ev = self.evaluation
+        return {
+            "sthenic": ev.sthenic,
+            "energy": ev.energy,
+            "electrical": ev.electrical / self.step.step_length,
+        }
 
 
 def check_method(method: str) -> str:

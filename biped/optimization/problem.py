@@ -158,8 +158,9 @@ class GaitProblem:
     Attributes:
         model: the robot and its knee.
         speed: walking speed V [m/s]; the step length is V T.
-        criterion: ``"sthenic"`` (eq. 30), ``"energy"`` (eq. 31) or ``"energy-per-metre"``
-            (eq. 31 divided by the step length).
+        criterion: ``"sthenic"`` (eq. 30), ``"energy"`` (eq. 31), ``"energy-per-metre"``
+            (eq. 31 divided by the step length) or ``"electrical"`` (the motors' energy per
+            metre, ``biped.model.actuators``).
         safety: margins of ours beyond the paper's constraints (``Safety()``: the paper's).
         samples_per_half: samples per spline piece where the solvers impose the constraints.
     """
@@ -200,6 +201,8 @@ class GaitProblem:
             )
             if self.safety.knee_bend:
                 margins += f", stance knee bent {self.safety.knee_bend:g} rad at least"
+            if self.safety.actuator_limits:
+                margins += ", within the actuators' limits"
         family = f", {self.knots} knots" if self.knots != 1 else ""
         return (
             f"{self.knee} knee, {self.criterion} criterion, {self.speed:.3f} m/s{margins}{family}"

@@ -10,6 +10,11 @@ criterion's |Γ_i θ̇_i| is written exactly with slack variables s_ij (no smoot
 
     ∫ Σ_i |Γ_i θ̇_i| dt  =  min T Σ_j w_j Σ_i s_ij   s.t.  s_ij >= Γ_i θ̇_i,  s_ij >= −Γ_i θ̇_i
 
+The electrical criterion (the motors' energy per metre without regeneration,
+``biped.model.actuators``) likewise, a joint's negative power lost:
+
+    (1/S) ∫ Σ_i max(P_i, 0) dt  =  min Σ_j w_j Σ_i s_ij / V   s.t.  s_ij >= P_ij,  s_ij >= 0
+
 The solver works on scaled variables y = z / ``SCALES``. One ``Solver`` (graph, derivatives
 and IPOPT instance) is built per robot, knee, criterion, safety and sample count and serves
 every speed and every start (``solver_for``).
@@ -150,7 +155,8 @@ class Solver:
     def _build(self, model, criterion, safety, samples_per_half, radius_bounds, knots):
         one_blas_thread()
         design = radius_bounds is not None
-        self.graph = graph = StepGraph(model, samples_per_half, safety, design, knots)
+        motors = criterion == "electrical"
+        self.graph = graph = StepGraph(model, samples_per_half, safety, design, knots, motors)
         self.criterion = criterion
         self.design = design
         self.scales, self.size = scales(knots), len(variable_names(knots))
@@ -169,8 +175,11 @@ class Solver:
         name = "design" if design else "gait"
         self.nlp = ca.nlpsol(name, "ipopt", nlp, self._options("adaptive"))
         self._nlps = {"adaptive": self.nlp}  # and the other barriers', built when first used
+        # The powers the slacks bound: the motors' P_i for the electrical criterion (s >= P,
+        # s >= 0), the joints' Γ_i θ̇_i for the energy criteria (s >= |Γ θ̇|).
+        slacked = graph.electrical_power if motors else graph.power
         self.evaluate = ca.Function(
-            "evaluate", graph.inputs, [graph.sthenic, graph.energy, graph.power]
+            "evaluate", graph.inputs, [graph.sthenic, graph.energy, slacked]
         )
         self.lower, self.upper = bounds(knots)
         lower, upper = self.lower / self.scales, self.upper / self.scales
@@ -190,6 +199,13 @@ class Solver:
         if criterion == "sthenic":
             self.slacks = 0
             return y, graph.on_symbols["sthenic"], constraints
+        if criterion == "electrical":  # E / S = Σ w s / V, s >= P (here), s >= 0 (bounds)
+            power = ca.vec(graph.on_symbols["electrical_power"])  # P_i, sample-major
+            slack = ca.SX.sym("s", power.shape[0])
+            self.slacks = power.shape[0]
+            weights = ca.vec(ca.repmat(graph.weights, 6, 1))
+            objective = ca.dot(weights, slack) / graph.speed
+            return ca.vertcat(y, slack), objective, ca.vertcat(constraints, slack - power)
         power = ca.vec(graph.on_symbols["power"])  # Γ_i θ̇_i, sample-major
         slack = ca.SX.sym("s", power.shape[0])
         self.slacks = power.shape[0]
@@ -253,7 +269,8 @@ class Solver:
             inputs.append(r0)
         if self.slacks:
             power = np.asarray(self.evaluate(*inputs)[2]).T.ravel()
-            x0 = np.concatenate([x0, np.abs(power) if np.all(np.isfinite(power)) else 0.0])
+            start = np.maximum(power, 0.0) if self.criterion == "electrical" else np.abs(power)
+            x0 = np.concatenate([x0, start if np.all(np.isfinite(power)) else 0.0])
         lbx, ubx = self.lbx, self.ubx
         if self.design and hold_radii:
             held = slice(self.size, self.size + 2)

@@ -26,7 +26,9 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from biped.model.actuators import LIMITS, drive, limit_margins
 from biped.model.criteria import (
+    ACTUATOR_MARGIN,
     CONSTRAINTS,
     checked_mask,
     clearance_profile,
@@ -246,7 +248,9 @@ def _reach_squared(c: _Constants, bend):
 
 # The quantities of one sample (``sample_function``), in order, with their row counts: the
 # stance state, the inverse dynamics, Ψ1-Ψ7 with the ZMP margin (the swing foot's clearance,
-# which varies over the step, is taken off afterwards), ΓᵀΓ and the joints' powers Γ_i θ̇_i.
+# which varies over the step, is taken off afterwards), ΓᵀΓ and the joints' powers Γ_i θ̇_i;
+# with the motors (``biped.model.actuators``), their electrical powers P_i = u_i i_i and
+# voltages u_i.
 QUANTITIES = (
     ("q", 9),
     ("qd", 9),
@@ -256,18 +260,21 @@ QUANTITIES = (
     ("squared", 1),
     ("power", 6),
 )
+MOTOR_QUANTITIES = (("electrical", 6), ("voltage", 6))
 _ROWS, _COUNT = {}, 0
-for _name, _n in QUANTITIES:
+for _name, _n in QUANTITIES + MOTOR_QUANTITIES:
     _ROWS[_name], _COUNT = slice(_COUNT, _COUNT + _n), _COUNT + _n
-N_QUANTITIES = _COUNT  # 41
+N_QUANTITIES = _ROWS["power"].stop  # 41; 53 with the motors'
+N_MOTOR_QUANTITIES = _COUNT
 # A sample's inputs: the free angles and their first and second derivatives in normalised
 # time (6 each), then the period T [s], then (design) the knee radii.
 SAMPLE_MOTION = 18
 
 
-def sample_function(c: _Constants, robot, safety, radii=None) -> ca.Function:
+def sample_function(c: _Constants, robot, safety, radii=None, motors=False) -> ca.Function:
     """One sample of the step as a CasADi function: v = [angles, d/dt_n, d²/dt_n² (6 each),
-    T (, r1, r2)] -> the ``QUANTITIES`` (41,). Every sample of a step is this function of a
+    T (, r1, r2)] -> the ``QUANTITIES`` (41,), with ``motors`` also the ``MOTOR_QUANTITIES``
+    of ``robot.drive_actuators`` (53,). Every sample of a step is this function of a
     linear map of the step's head (``StepGraph.basis``), which lets the solver build the
     Hessian of its Lagrangian sample by sample (``biped.optimization.hessian``)."""
     motion, period = ca.SX.sym("motion", SAMPLE_MOTION), ca.SX.sym("period")
@@ -287,8 +294,13 @@ def sample_function(c: _Constants, robot, safety, radii=None) -> ca.Function:
         q[ZH] - ca.dot(co, heel_a) + ca.dot(s, heel_b),
         q[ZH] - ca.dot(co, toe_a) + ca.dot(s, toe_b),
     )
-    power = torques * (ca.DM(JOINT_MATRIX) @ qd)
+    rates = ca.DM(JOINT_MATRIX) @ qd
+    power = torques * rates
     quantities = ca.vertcat(q, qd, torques, wrench, psi, ca.sumsqr(torques), power)
+    if motors:  # the same formulas as the numeric model's (``biped.model.actuators.drive``)
+        constants = {k: ca.DM(v) for k, v in robot.drive_actuators.constants().items()}
+        state = drive(constants, torques, rates, ca.DM(JOINT_MATRIX) @ qdd, tanh=ca.tanh)
+        quantities = ca.vertcat(quantities, state.power, state.voltage)
     inputs = [motion, period] + ([radii] if radii is not None else [])
     return ca.Function("sample", [ca.vertcat(*inputs)], [quantities], ["v"], ["quantities"])
 
@@ -323,10 +335,18 @@ class StepGraph:
     """
 
     def __init__(
-        self, model: Biped, samples_per_half: int, safety, design: bool = False, knots: int = 1
+        self,
+        model: Biped,
+        samples_per_half: int,
+        safety,
+        design: bool = False,
+        knots: int = 1,
+        motors: bool = False,
     ):
         self.model, self.samples_per_half = model, samples_per_half
         self.safety, self.design, self.knots = safety, design, knots
+        # The motors' quantities, for the electrical criterion or the actuator limits.
+        self.motors = motors or safety.actuator_limits
         self.radii = ca.SX.sym("radii", 2) if design else None
         c = _Constants(model, self.radii)
         self.z = ca.SX.sym("z", len(variable_names(knots)))
@@ -410,12 +430,13 @@ class StepGraph:
         self.head = ca.vertcat(ca.vec(coefficients), self.period, *radii, self.hip_height)
         self.period_index = coefficients.numel()
         self.head_symbol = ca.SX.sym("head", self.head.shape[0])
-        self.sample = sample_function(c, self.model.robot, self.safety, self.radii)
+        self.sample = sample_function(c, self.model.robot, self.safety, self.radii, self.motors)
         self.basis = _sample_basis(
             self.samples_per_half, self.knots, self.head.shape[0], self.design
         )
         n = self.basis.shape[0] // self.sample.size1_in(0)
-        self.quantities = ca.SX.sym("quantities", N_QUANTITIES, n)
+        count = N_MOTOR_QUANTITIES if self.motors else N_QUANTITIES
+        self.quantities = ca.SX.sym("quantities", count, n)
         inputs = ca.reshape(ca.DM(self.basis) @ self.head, self.sample.size1_in(0), n)
         self._flat_quantities = self.sample.map(n)(inputs)
 
@@ -451,14 +472,46 @@ class StepGraph:
         rows, cols = np.nonzero(checked_mask(samples, knots).T)  # constraint-major order
         self.constraint_names = [CONSTRAINTS[i] for i in rows]
         named = {name: self.rows(name) for name in ("q", "qd", "torques", "wrench")}
+        constraints = [scaled[i, j] for i, j in zip(rows, cols, strict=True)]
+        motors = {}
+        if self.motors:
+            electrical = self.rows("electrical")
+            motors = {
+                "electrical_power": electrical,
+                "voltage": self.rows("voltage"),
+                # E / S = T Σ_j w_j Σ_i max(P_ij, 0) / (V T) [J/m]
+                "electrical": (self.weights @ ca.sum1(ca.fmax(electrical, 0.0)).T) / self.speed,
+            }
+        if self.safety.actuator_limits:
+            constraints += self._actuator_limits()
         return {
             **named,
+            **motors,
             "power": power,
             "psi": psi,
             "sthenic": (self.weights @ self.rows("squared").T) / self.speed,
             "energy": period * (self.weights @ ca.sum1(ca.fabs(power)).T),
-            "constraints": ca.vertcat(*[scaled[i, j] for i, j in zip(rows, cols, strict=True)]),
+            "constraints": ca.vertcat(*constraints),
         }
+
+    def _actuator_limits(self) -> list:
+        """The actuator limits (``biped.model.actuators.limit_margins``: shares of each
+        joint's peak torque, top speed and supply voltage, >= 0 when met) less their margin
+        ``ACTUATOR_MARGIN`` at every sample,
+        sample-major, then limit, then joint; their names join ``constraint_names``."""
+        constants = {k: ca.DM(v) for k, v in self.model.robot.drive_actuators.constants().items()}
+        torques, voltage = self.rows("torques"), self.rows("voltage")
+        rates = ca.DM(JOINT_MATRIX) @ self.rows("qd")
+        limits = []
+        for j in range(torques.shape[1]):  # sample j, its six joints
+            margins = limit_margins(constants, torques[:, j], rates[:, j], voltage[:, j])
+            limits.append(ca.vertcat(*margins) - ACTUATOR_MARGIN)
+        names = [f"{limit} {side}" for limit in LIMITS for side in "-+"]
+        per_sample = len(names) * 6
+        self.constraint_names += [
+            f"actuator {names[i // 6]}" for _ in limits for i in range(per_sample)
+        ]
+        return [ca.vertcat(*limits)]
 
     @property
     def inputs(self) -> list:

@@ -23,6 +23,7 @@ CRITERION_NAMES = {
     "sthenic": "sthenic criterion C_Γ (squared torques per metre walked)",
     "energy": "energy criterion C_E (per step)",
     "energy-per-metre": "energy per metre walked C_E / S",
+    "electrical": "electrical energy per metre walked E / S (the motors', no regeneration)",
 }
 
 

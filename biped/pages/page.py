@@ -506,6 +506,7 @@ def markdown(page: Page, folder: Path) -> str:
     for name, label, value, unit in gait.costs.labelled():
         optimised = " (optimised)" if name == gait.criterion else ""
         lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
+    lines += _drive_lines(gait)
     lines += [
         "",
         "## Constraints: tightest margins",
@@ -543,6 +544,35 @@ def markdown(page: Page, folder: Path) -> str:
     if page.validation is not None:
         lines += _validation_lines(page, folder)
     return "\n".join(lines) + "\n"
+
+
+def _drive_lines(gait: Gait) -> list[str]:
+    """The motors' figures (``Electrical``; none for a file written before the actuators):
+    a row per joint, then the energies per step and per metre and the cost of transport,
+    without and with regeneration."""
+    electrical = gait.electrical
+    if electrical is None:
+        return []
+    which = "the robot file's" if gait.robot.actuators is not None else "the default set's"
+    per_joint = [f for f in dataclasses.fields(electrical) if f.metadata.get("columns")]
+    totals = [f for f in dataclasses.fields(electrical) if not f.metadata.get("columns")]
+    lines = [
+        "",
+        f"## Drive ({which} actuators, `biped.model.actuators`)",
+        "",
+        "| joint | "
+        + " | ".join(f"{f.metadata['label']} [{f.metadata['unit']}]" for f in per_joint)
+        + " |",
+        "|---" * (len(per_joint) + 1) + "|",
+    ]
+    for j, joint in enumerate(JOINTS):
+        values = " | ".join(f"{getattr(electrical, f.name)[j]:.4g}" for f in per_joint)
+        lines += [f"| {joint} | {values} |"]
+    lines += ["", "| figure | value | unit |", "|---|---|---|"]
+    for f in totals:
+        unit = f.metadata["unit"]
+        lines += [f"| {f.name.replace('_', ' ')} | {getattr(electrical, f.name):.5g} | {unit} |"]
+    return lines
 
 
 def _validation_lines(page: Page, folder: Path) -> list[str]:

@@ -31,6 +31,8 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model.actuators import KINDS
+from biped.model.actuators import UNITS as ACTUATOR_UNITS
 from biped.model.criteria import (
     ALL_CRITERIA,
     CONSTRAINTS,
@@ -38,6 +40,8 @@ from biped.model.criteria import (
     CRITERION_UNITS,
     Safety,
     evaluate_step,
+    safety_dict,
+    simpson_weights,
 )
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.gait import PARAMETERS, build_step, check_knots, parameter_names
@@ -152,6 +156,16 @@ class Costs(_Record):
     energy_per_metre: float = _cost(
         "J/m", "energy per metre walked", lambda model, step, ev: ev.energy / step.step_length
     )
+    # Added with the actuators: a file written before has none (read, and left so).
+    electrical: float | None = unit_field(
+        CRITERION_UNITS["electrical"],
+        metadata={
+            "label": "electrical energy per metre walked (no regeneration)",
+            "of": lambda model, step, ev: ev.electrical / step.step_length,
+            "optional": True,
+        },
+        default=None,
+    )
 
     @classmethod
     def of(cls, model: Biped, step, evaluation) -> Costs:
@@ -171,6 +185,59 @@ class Costs(_Record):
             for f, value in fields
             if value is not None
         ]
+
+
+def _per_joint(unit: str, label: str):
+    """A field of ``Electrical`` per joint (``JOINTS``): its unit and what it is."""
+    return unit_field(unit, JOINTS, metadata={"label": label})
+
+
+@dataclass(frozen=True, eq=False)
+class Electrical(_Record):
+    """What the motors draw to walk the gait (``biped.model.actuators``: current i, voltage
+    u, power P = u i at each joint), on the check grid; energies per step unless per metre.
+    Without regeneration a joint's negative power is lost (∫ max(P, 0) dt), with it it is
+    recovered (∫ P dt). The cost of transport is the energy per metre over the weight m g."""
+
+    current_peak: list = _per_joint("A", "largest current")
+    current_rms: list = _per_joint("A", "RMS current over the step")
+    voltage_peak: list = _per_joint("V", "largest voltage")
+    copper: list = _per_joint("J", "copper losses R i² over the step")
+    friction: list = _per_joint("J", "friction losses over the step")
+    energy: list = _per_joint("J", "electrical energy over the step, no regeneration")
+    energy_regenerated: list = _per_joint("J", "electrical energy over the step, regeneration")
+    energy_per_step: float = unit_field("J")
+    energy_per_metre: float = unit_field("J/m")
+    cost_of_transport: float = unit_field(PURE)
+    regenerated_energy_per_step: float = unit_field("J")
+    regenerated_energy_per_metre: float = unit_field("J/m")
+    regenerated_cost_of_transport: float = unit_field(PURE)
+
+    @classmethod
+    def of(cls, model: Biped, step, ev) -> Electrical:
+        """The electrical figures of a gait's step and its evaluation on the check grid."""
+        weights = step.period * simpson_weights(len(ev.t) // (step.knots + 1) - 1, step.knots)
+        drive, length = ev.drive, step.step_length
+        weight = model.robot.total_mass * model.robot.gravity
+
+        def integral(rate) -> list:
+            return [float(v) for v in weights @ rate]
+
+        return cls(
+            current_peak=np.abs(drive.current).max(axis=0).tolist(),
+            current_rms=np.sqrt(np.array(integral(drive.current**2)) / step.period).tolist(),
+            voltage_peak=np.abs(drive.voltage).max(axis=0).tolist(),
+            copper=integral(drive.copper),
+            friction=integral(drive.friction),
+            energy=integral(np.maximum(drive.power, 0.0)),
+            energy_regenerated=integral(drive.power),
+            energy_per_step=ev.electrical,
+            energy_per_metre=ev.electrical / length,
+            cost_of_transport=ev.electrical / (length * weight),
+            regenerated_energy_per_step=ev.electrical_net,
+            regenerated_energy_per_metre=ev.electrical_net / length,
+            regenerated_cost_of_transport=ev.electrical_net / (length * weight),
+        )
 
 
 # The worst Ψ_i of each constraint on the check grid less its safety margin (>= 0 when met),
@@ -244,10 +311,11 @@ class Gait:
     safety: Safety = unit_field(Safety)  # margins beyond the paper's constraints
     feasible: bool  # every constraint holds on the check grid
     costs: Costs = unit_field(Costs)
-    robot: Robot = unit_field({f.name: robot_unit(f.name) for f in dataclasses.fields(Robot)})
+    robot: Robot = unit_field({f.name: robot_unit(f.name) for f in Robot.body_fields()})
     parameters: dict = unit_field({name: parameter_unit(name) for name in PARAMETERS})
     constraints: Constraints | None = unit_field(Constraints)  # None: a file without them
     impact: Impact | None = unit_field(Impact)  # None: a file without it
+    electrical: Electrical | None = unit_field(Electrical)  # None: a file without it
     optimizer: Optimizer = unit_field(Optimizer)
     provenance: dict
     samples: Samples = unit_field(Samples)
@@ -351,19 +419,31 @@ class Gait:
         fields = {f.name: content.get(f.name) for f in dataclasses.fields(cls)}
         records = {
             name: record.from_content(content.get(name), name, bad)
-            for name, record in (("costs", Costs), ("constraints", Constraints), ("impact", Impact))
+            for name, record in (
+                ("costs", Costs),
+                ("constraints", Constraints),
+                ("impact", Impact),
+                ("electrical", Electrical),
+            )
         }
         parsed = {"safety": safety, "robot": robot, "optimizer": optimizer, "knots": knots}
         return cls(**{**fields, **records, **parsed, "samples": _samples(content, bad)})
 
     @staticmethod
-    def units(criterion: str, knots: int = 1, knee_bend: bool = False) -> dict:
+    def units(
+        criterion: str, knots: int = 1, knee_bend: bool = False, actuators: bool = False
+    ) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion`` in the family of
-        ``knots`` interior knots, with a least knee bend if ``knee_bend``, from the fields'
+        ``knots`` interior knots, with a least knee bend if ``knee_bend``, with the robot's
+        actuators if ``actuators`` (a robot file's, not the default set), from the fields'
         declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
         units = declared_units(Gait, "", criterion)
         if not knee_bend:  # the paper's knees: the file does not write it
             del units["safety.knee_bend"]
+        if actuators:
+            for kind in KINDS:
+                for name, unit in ACTUATOR_UNITS.items():
+                    units[f"robot.actuators.{kind}.{name}"] = unit
         if knots == 1:
             return units
         units["knots"] = PURE
@@ -376,7 +456,12 @@ class Gait:
         return units
 
     def _units(self) -> dict:
-        return self.units(self.criterion, self.knots, bool(self.safety.knee_bend))
+        return self.units(
+            self.criterion,
+            self.knots,
+            bool(self.safety.knee_bend),
+            self.robot.actuators is not None,
+        )
 
     def to_dict(self) -> dict:
         """The JSON-ready content of the gait's file."""
@@ -390,9 +475,7 @@ class Gait:
             if hasattr(value, "to_dict"):  # the samples, records, robot
                 value = value.to_dict()
             elif dataclasses.is_dataclass(value):  # the safety margins, a knee bend if asked
-                value = dataclasses.asdict(value)
-                if not value["knee_bend"]:
-                    del value["knee_bend"]
+                value = safety_dict(value)
             content[f.name] = value
         return content
 
@@ -451,6 +534,8 @@ class Gait:
             )
         if self.impact is not None:
             _check_impact(self.impact, expected["impact"], bad)
+        if self.electrical is not None:  # a file written before the actuators has none
+            _check_group(self.electrical, "electrical", expected["electrical"], units, bad)
 
 
 def _derived(model: Biped, step, evaluation) -> dict:
@@ -464,6 +549,7 @@ def _derived(model: Biped, step, evaluation) -> dict:
             **dict(zip(CONSTRAINTS, map(float, evaluation.worst), strict=True))
         ),
         "impact": Impact.of(model, step),
+        "electrical": Electrical.of(model, step, evaluation),
         "samples": Samples(
             **{f.name: getattr(evaluation, f.name) for f in dataclasses.fields(Samples)}
         ),
@@ -490,6 +576,13 @@ def _finite_number(value) -> bool:
         return math.isfinite(float(value))
     except OverflowError:
         return False
+
+
+def _finite_numbers(value) -> bool:
+    """A finite JSON number, or a list of them (a figure per joint)."""
+    if isinstance(value, list):
+        return bool(value) and all(map(_finite_number, value))
+    return _finite_number(value)
 
 
 def _finite_or_none(value):
@@ -659,10 +752,13 @@ def _check_group(stored, group: str, expected, units: dict, bad) -> None:
     """The costs or the constraints (records) against the parameters'."""
     if stored is None:
         raise bad(f"{group} missing")
+    optional = {f.name for f in dataclasses.fields(stored) if f.metadata.get("optional")}
     for name, wanted in expected.to_dict().items():
         path = f"{group}.{name}"
         value = getattr(stored, name)
-        if not _finite_number(value) or _mismatch(value, wanted):
+        if value is None and name in optional:  # a figure added since the file was written
+            continue
+        if not _finite_numbers(value) or _mismatch(value, wanted):
             raise bad(
                 f"{path} = {value!r}{_shown(units, path)}, its parameters give "
                 f"{wanted!r}{_shown(units, path)}"

@@ -114,6 +114,17 @@ class Settings(campaign.Settings):
     knots: int  # interior knots of the spline family
     seed: int
     starts: int
+    actuator_limits: bool = False  # Safety.actuator_limits; recorded only when asked
+
+    def to_dict(self) -> dict:
+        content = super().to_dict()
+        if not self.actuator_limits:  # an atlas without them records what it did before
+            del content["actuator_limits"]
+        return content
+
+    @classmethod
+    def from_dict(cls, content: dict):
+        return super().from_dict({"actuator_limits": False, **content})
 
     def cells(self) -> list[Cell]:
         return [
@@ -134,7 +145,11 @@ class Settings(campaign.Settings):
 
     def problem(self, point: Point, knots: int | None = None, samples=None) -> GaitProblem:
         cell = point.cell
-        safety = Safety(clearance=cell.clearance, knee_bend=cell.knee_bend)
+        safety = Safety(
+            clearance=cell.clearance,
+            knee_bend=cell.knee_bend,
+            actuator_limits=self.actuator_limits,
+        )
         model = Biped(self.robot, point.knee)
         knots = self.knots if knots is None else knots
         return GaitProblem(model, cell.speed, point.criterion, safety, samples, knots)
@@ -180,6 +195,7 @@ def _record(optimum: Optimum, seconds: float) -> dict:
             "sthenic": ev.sthenic,
             "energy": ev.energy,
             "energy-per-metre": ev.energy / optimum.step.step_length,
+            "electrical": ev.electrical / optimum.step.step_length,
         },
         "starts": report.starts,
         "starts_at_best": report.starts_at_best,

@@ -39,6 +39,7 @@ _READ = {
     "Safety": lambda value: Safety(**value),
     "tuple": tuple,
     "int": int,
+    "bool": bool,
     "float": float,
     "str": lambda value: value,
 }
@@ -66,8 +67,10 @@ class Settings:
             value = getattr(self, field.name)
             if isinstance(value, Robot):
                 value = value.to_dict()
-            elif isinstance(value, Safety):
+            elif isinstance(value, Safety):  # the actuator limits only when asked
                 value = dataclasses.asdict(value)
+                if not value["actuator_limits"]:
+                    del value["actuator_limits"]
             content[field.name] = list(value) if isinstance(value, tuple) else value
         return {**content, **self.stamp()}
 
