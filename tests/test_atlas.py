@@ -42,6 +42,11 @@ def test_energy_per_metre_is_the_energy_per_step_over_the_step_length():
         gait.costs.energy / gait.step_length, rel=1e-12
     )
     assert optimum.value == pytest.approx(gait.costs.energy_per_metre, rel=1e-12)
+    weight = 70.0 * 9.81  # Table 1's mass [kg] times g [m/s²]
+    assert ROBOT.weight == pytest.approx(weight, rel=1e-12)
+    assert gait.costs.cost_of_transport == pytest.approx(
+        gait.costs.energy / (weight * gait.step_length), rel=1e-12
+    )
 
 
 def test_a_difference_no_larger_than_its_uncertainty_is_not_distinguishable():
@@ -53,8 +58,23 @@ def test_a_difference_no_larger_than_its_uncertainty_is_not_distinguishable():
     empty = Difference(None, 0.0, 0.0, 0.0, None, "rolling INFEASIBLE")
     assert not empty.distinguishable
     row = pages.Row("sthenic", Cell(0.3, 0.0, 0.0), near, None, None)
-    line = pages.csv_text([row]).splitlines()[1].split(",")
+    line = pages.csv_text([row], ROBOT.weight).splitlines()[1].split(",")
     assert line[pages.COLUMNS.index("distinguishable")] == "no"
+
+
+def test_the_csv_gives_the_cost_of_transport_of_the_energies_per_metre_only():
+    """The cost of transport of a per-metre energy is its value over m g; the sthenic
+    criterion has none."""
+    diff = Difference(-1.0, discretization=0.1, tolerance=0.0, starts=0.1, richer=None, why="")
+    for criterion, expected in (("energy-per-metre", 300.0 / ROBOT.weight), ("sthenic", None)):
+        finals = [{"costs": {criterion: value}, "starts_at_best": 2} for value in (300.0, 297.0)]
+        row = pages.Row(criterion, Cell(0.3, 0.0, 0.0), diff, *finals)
+        line = pages.csv_text([row], ROBOT.weight).splitlines()[1].split(",")
+        value = line[pages.COLUMNS.index("cost of transport revolute")]
+        if expected is None:
+            assert value == ""
+        else:
+            assert float(value) == pytest.approx(expected, rel=1e-5)
 
 
 @pytest.fixture(scope="module")

@@ -316,7 +316,7 @@ def _tracking_figures(biped, samples, sim: Simulation, reaction, walked: int, re
     steady = sim.phase[:end] >= LANDING * samples.period
     wrench_ref, zmp_ref = wrench_ref[:end], zmp_ref[:end]
     compared = ~np.isnan(cop) & steady  # single support, steady
-    weight = biped.robot.total_mass * biped.robot.gravity
+    weight = biped.robot.weight
     feedforward, feedback = sim.feedforward()[:end], sim.feedback()[:end]
     rates = -sim.layout.joint_angles(sim.qvel[:end])  # θ̇ of eq. (32), JOINT_ORDER
     power = np.abs((feedforward + feedback) * rates).sum(axis=1)

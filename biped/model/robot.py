@@ -259,6 +259,12 @@ class Robot:
         """[kg] Mass of the whole robot (two feet, two shanks, two thighs, trunk)."""
         return 2 * (self.foot_mass + self.shank_mass + self.thigh_mass) + self.trunk_mass
 
+    @property
+    def weight(self) -> float:
+        """[N] Weight of the whole robot, m g (what a cost of transport divides by, with the
+        distance)."""
+        return self.total_mass * self.gravity
+
     def sole_edges(self) -> dict[str, float]:
         """[m] x of the heel and the toe from the ankle, by name (``SOLE_EDGES``)."""
         return dict(

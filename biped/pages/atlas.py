@@ -65,12 +65,18 @@ COLUMNS = (
     "starts at best revolute",
     "starts at best rolling",
     f"difference with {RICHER_KNOTS} knots [%]",
+    "cost of transport revolute",
+    "cost of transport rolling",
     "why empty",
 )
+# The criteria that are an energy per metre walked: their cost of transport is the value over
+# the robot's weight m g (dimensionless).
+PER_METRE_ENERGIES = ("energy-per-metre", "electrical")
 
 
-def csv_text(table: list[Row]) -> str:
-    """``atlas.csv``: one line per cell and criterion, in ``COLUMNS``."""
+def csv_text(table: list[Row], weight: float) -> str:
+    """``atlas.csv``: one line per cell and criterion, in ``COLUMNS``; ``weight`` [N] is the
+    robot's, m g, for the cost of transport of the per-metre energies."""
 
     def number(value, digits):
         return "" if value is None else f"{value:.{digits}g}"
@@ -102,6 +108,12 @@ def csv_text(table: list[Row]) -> str:
             number(d.starts, 3),
             *starts,
             number(d.richer, 6),
+            *(
+                number(
+                    None if c is None or row.criterion not in PER_METRE_ENERGIES else c / weight, 6
+                )
+                for c in costs
+            ),
             f'"{d.why}"' if d.why else "",
         ]
         lines.append(",".join(cells))
@@ -290,7 +302,7 @@ def write(folder, out=None, walks=()) -> list[Path]:
     out = Path(folder if out is None else out)
     out.mkdir(parents=True, exist_ok=True)
     table = rows(folder, settings)
-    written = [atomic_write_text(out / "atlas.csv", csv_text(table))]
+    written = [atomic_write_text(out / "atlas.csv", csv_text(table, settings.robot.weight))]
     for criterion in settings.criteria:
         path = out / f"atlas-{criterion}.png"
         with atomic_path(path) as tmp:

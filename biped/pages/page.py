@@ -30,7 +30,7 @@ from matplotlib.ticker import FuncFormatter
 
 from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
-from biped.model.gait import build_step, parameter_names, piece_grid
+from biped.model.gait import breakpoints, build_step, parameter_names, piece_grid
 from biped.model.units import CONSTRAINT_UNITS, parameter_unit
 from biped.optimization.problem import CHECK_SAMPLES, SOLVER_SAMPLES
 from biped.pages.figures import (
@@ -65,8 +65,13 @@ ORBIT_FIGURE = "orbit.png"
 # A constraint dips below δ_i where Ψ_i < δ_i (1 − DIP_TOLERANCE): IPOPT holds its
 # constraints to about 1e-9 (the gait file's optimizer.constraint_violation), a millionth of δ.
 DIP_TOLERANCE = 1e-6
-# Mid-step, where the two spline pieces of eqs. (25)-(26) meet [t/T].
+# Mid-step, where the two spline pieces of eqs. (25)-(26) meet [t/T]: a knot of every family
+# (1, 3, 5 interior knots), where the jumps are measured.
 KNOT = 0.5
+KNOTS_WHY = (
+    "the spline is C¹ at each knot, so the accelerations jump there, and the torques and the "
+    "ground reaction with them"
+)
 KNOT_WHY = (
     "the spline is C¹ at mid-step (eqs. 25-26, the paper's choice), so the accelerations "
     "jump there, and the torques and the ground reaction with them"
@@ -184,6 +189,24 @@ def dip_sentence(gait: Gait, dips: list[Dip]) -> str:
     )
 
 
+def knot_times(gait: Gait) -> list[float]:
+    """The interior knots of the gait's family [t/T] (``biped.model.gait.breakpoints``)."""
+    return [float(t) for t in breakpoints(gait.knots)[1:-1]]
+
+
+def _knots_text(gait: Gait) -> str:
+    """'the knot t/T = 0.5' or 'the knots t/T = 0.25, 0.5, 0.75'."""
+    times = ", ".join(f"{t:.3g}" for t in knot_times(gait))
+    return f"the knot{'s' if gait.knots > 1 else ''} t/T = {times}"
+
+
+def _jump_place(gait: Gait) -> str:
+    """Where the caption says the jumps are, up to the largest's value."""
+    if gait.knots == 1:
+        return f"t/T = {KNOT:g} (dash-dotted line; the largest jump "
+    return f"{_knots_text(gait)} (dash-dotted lines; the largest jump at t/T = {KNOT:g}: "
+
+
 def knot_index(gait: Gait) -> int | None:
     """The sample of the left limit at the mid-step knot (the next one is the right limit:
     the samples hold t = T/2 twice); None if they do not."""
@@ -208,8 +231,8 @@ def figure_captions(gait: Gait) -> dict[str, str]:
     if torques is not None:
         i = int(np.argmax(np.abs(torques)))
         captions["torques.png"] = (
-            f"The torques jump at t/T = {KNOT:g} (dash-dotted line; the largest jump "
-            f"{torques[i]:+.3g} N·m, {joint_label(i, JOINTS[i])}): {KNOT_WHY}."
+            f"The torques jump at {_jump_place(gait)}{torques[i]:+.3g} N·m, "
+            f"{joint_label(i, JOINTS[i])}): {KNOT_WHY if gait.knots == 1 else KNOTS_WHY}."
         )
         zmp = knot_jumps(gait, "zmp")
         captions["ground.png"] = (
@@ -255,14 +278,16 @@ def _free_side(ax, x: float, width: float) -> tuple[str, str]:
     return best[1], best[2]
 
 
-def _with_knot(panel: Panel, jump: float | None, legend: bool = False) -> Panel:
-    """``panel`` with the mid-step knot marked (a dash-dotted line) and, if given, the jump
-    of its values there written beside it in the panel's unit."""
+def _with_knot(panel: Panel, jump: float | None, knots: list[float], legend: bool = False) -> Panel:
+    """``panel`` with the ``knots`` [t/T] marked (dash-dotted lines) and, if given, the jump
+    of its values at the mid-step knot written beside it in the panel's unit."""
     unit = panel.ylabel.rsplit("[", 1)[-1].rstrip("]") if "[" in panel.ylabel else "1"
     unit = "" if unit == "1" else f" {unit}"
 
     def decorate(ax, gaits):
-        ax.axvline(KNOT, color="0.45", linestyle="-.", linewidth=1.0, label="knot: spline C¹")
+        for i, knot in enumerate(knots):
+            label = "knot: spline C¹" if i == 0 else None
+            ax.axvline(knot, color="0.45", linestyle="-.", linewidth=1.0, label=label)
         if panel.decorate is not None:
             panel.decorate(ax, gaits)
         elif legend:
@@ -291,6 +316,7 @@ def _knot_panels(gait: Gait, panels: tuple) -> tuple:
         _with_knot(
             panel,
             None if k is None else float(np.diff(panel.values(gait)[k : k + 2])[0]),
+            knot_times(gait),
             legend=i == 0,
         )
         for i, panel in enumerate(panels)
@@ -327,14 +353,21 @@ def _inset_place(ax, avoid: list) -> tuple[float, float]:
     )
 
 
+def solver_spacing(knots: int) -> float:
+    """[t/T] Between two of the solver's samples in a family of ``knots`` interior knots:
+    ``SOLVER_SAMPLES[knots]`` intervals per piece, knots + 1 pieces."""
+    return 1.0 / ((knots + 1) * SOLVER_SAMPLES[knots])
+
+
 def _dip_inset(
-    ax, dip: Dip, profile, solver_profile, color: str, solver_samples: bool, avoid: list
+    ax, dip: Dip, profile, solver_profile, color: str, samples: tuple[float, bool], avoid: list
 ) -> None:
     """A zoom on the dip of Ψ_i below δ_i, placed clear of the curve and of ``avoid`` (see
-    ``_inset_place``): the curve on the check grid, δ dotted and, with ``solver_samples``,
-    the solver's samples (dots) on either side of it."""
+    ``_inset_place``): the curve on the check grid, δ dotted; ``samples``: the spacing of
+    the solver's samples [t/T] (the zoom spans three) and whether to draw them (dots on
+    either side of it: an IPOPT optimum's)."""
     (t_n, psi, delta), (t_s, psi_s) = profile, solver_profile
-    spacing = KNOT / SOLVER_SAMPLES[1]
+    spacing, solver_samples = samples
     x0, x1 = dip.at - 1.5 * spacing, dip.at + 1.5 * spacing
     depth = dip.margin - dip.value
     y0, y1 = dip.value - 0.4 * depth, dip.margin + 1.2 * depth
@@ -357,7 +390,7 @@ def _constraint_panels(gait: Gait) -> tuple:
     t_n, psi, delta = constraint_profile(gait)
     t_s, psi_solver, _ = constraint_profile(gait, SOLVER_SAMPLES[gait.knots])
     dips = {dip.name: dip for dip in margin_dips(gait)}
-    solver_samples = gait.optimizer.method == "ipopt"
+    samples = (solver_spacing(gait.knots), gait.optimizer.method == "ipopt")
 
     def panel(i, name):
         def mark(ax, gaits):
@@ -379,7 +412,7 @@ def _constraint_panels(gait: Gait) -> tuple:
                     (t_n, psi[:, i], delta[:, i]),
                     (t_s, psi_solver[:, i]),
                     color,
-                    solver_samples,
+                    samples,
                     [(t_n[k], psi[k, i])],
                 )
 
@@ -409,13 +442,13 @@ def gait_figures(gait: Gait) -> dict[str, Figure]:
     return {
         "torques.png": time_figure(
             gaits,
-            f"joint torques, jumping at the knot t/T = {KNOT:g} where the spline is C¹",
+            f"joint torques, jumping at {_knots_text(gait)} where the spline is C¹",
             _knot_panels(gait, TORQUE_PANELS),
         ),
         "angles.png": time_figure(gaits, "absolute angles", ANGLE_PANELS),
         "ground.png": time_figure(
             gaits,
-            f"ground reaction on the stance foot, jumping at the knot t/T = {KNOT:g}",
+            f"ground reaction on the stance foot, jumping at {_knots_text(gait)}",
             _knot_panels(gait, GROUND_PANELS),
         ),
         "constraints.png": time_figure(

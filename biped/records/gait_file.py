@@ -156,6 +156,16 @@ class Costs(_Record):
     energy_per_metre: float = _cost(
         "J/m", "energy per metre walked", lambda model, step, ev: ev.energy / step.step_length
     )
+    # Added after the per-metre criteria: a file written before has none (read, and left so).
+    cost_of_transport: float | None = unit_field(
+        PURE,
+        metadata={
+            "label": "cost of transport C_E / (m g S)",
+            "of": lambda model, step, ev: ev.energy / (step.step_length * model.robot.weight),
+            "optional": True,
+        },
+        default=None,
+    )
     # Added with the actuators: a file written before has none (read, and left so).
     electrical: float | None = unit_field(
         CRITERION_UNITS["electrical"],
@@ -218,7 +228,7 @@ class Electrical(_Record):
         """The electrical figures of a gait's step and its evaluation on the check grid."""
         weights = step.period * simpson_weights(len(ev.t) // (step.knots + 1) - 1, step.knots)
         drive, length = ev.drive, step.step_length
-        weight = model.robot.total_mass * model.robot.gravity
+        weight = model.robot.weight
 
         def integral(rate) -> list:
             return [float(v) for v in weights @ rate]
