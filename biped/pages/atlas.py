@@ -123,7 +123,6 @@ def csv_text(table: list[Row], weight: float) -> str:
 def figure(settings: Settings, table: list[Row], criterion: str):
     """The figure of one criterion (matplotlib ``Figure``), as the module says."""
     from matplotlib.figure import Figure
-    from matplotlib.patches import Rectangle
 
     bends = settings.knee_bends
     fig = Figure(figsize=(5.2 * len(bends) + 5.6, 4.6), layout="constrained")
@@ -131,77 +130,10 @@ def figure(settings: Settings, table: list[Row], criterion: str):
     mine = [r for r in table if r.criterion == criterion]
     values = [r.difference.value for r in mine if r.difference.value is not None]
     top = max([abs(v) for v in values], default=1.0) or 1.0
-    speeds, clearances = np.array(settings.speeds), np.array(settings.clearances)
     for ax, bend in zip(axes[:-1], bends, strict=True):
-        grid = np.full((len(clearances), len(speeds)), np.nan)
-        for r in mine:
-            if r.cell.knee_bend != bend or r.difference.value is None:
-                continue
-            grid[list(clearances).index(r.cell.clearance), list(speeds).index(r.cell.speed)] = (
-                r.difference.value
-            )
-        image = ax.imshow(
-            grid,
-            origin="lower",
-            cmap="RdBu_r",
-            vmin=-top,
-            vmax=top,
-            aspect="auto",
-            extent=(-0.5, len(speeds) - 0.5, -0.5, len(clearances) - 0.5),
-        )
-        for r in mine:
-            if r.cell.knee_bend != bend:
-                continue
-            x, y = list(speeds).index(r.cell.speed), list(clearances).index(r.cell.clearance)
-            d = r.difference
-            if d.value is None:
-                ax.plot(x, y, "kx", markersize=10)
-            else:
-                dark = abs(d.value) > 0.6 * top  # white on the darkest cells
-                ax.text(
-                    x,
-                    y,
-                    f"{d.value:+.1f}\n±{d.uncertainty:.1f}",
-                    ha="center",
-                    va="center",
-                    fontsize=6.5,
-                    color="white" if dark else "black",
-                )
-                if not d.distinguishable:
-                    ax.add_patch(
-                        Rectangle((x - 0.5, y - 0.5), 1, 1, fill=False, hatch="//", lw=0, ec="0.55")
-                    )
-        ax.set_xticks(range(len(speeds)), [f"{s:g}" for s in speeds])
-        ax.set_yticks(range(len(clearances)), [f"{100 * c:g}" for c in clearances])
-        ax.set_xlabel("speed [m/s]")
-        ax.set_ylabel("swing-foot clearance [cm]")
+        _map_panel(fig, ax, settings, [r for r in mine if r.cell.knee_bend == bend], top)
         ax.set_title(f"{_bend_words(bend)}; cells: difference ± uncertainty [%]", fontsize=9)
-        fig.colorbar(image, ax=ax, label="rolling vs revolute [%]")
-    curves = axes[-1]
-    for k, clearance in enumerate(clearances):
-        picked = [
-            r
-            for r in mine
-            if r.cell.clearance == clearance
-            and r.cell.knee_bend == bends[0]
-            and r.difference.value is not None
-        ]
-        if not picked:
-            continue
-        curves.errorbar(
-            [r.cell.speed for r in picked],
-            [r.difference.value for r in picked],
-            yerr=[r.difference.uncertainty for r in picked],
-            fmt="o-",
-            capsize=3,
-            color=f"C{k}",
-            label=f"clearance {100 * clearance:g} cm",
-        )
-    curves.axhline(0.0, color="k", lw=0.8)
-    curves.set_xlabel("speed [m/s]")
-    curves.set_ylabel("(rolling − revolute) / revolute [%]")
-    curves.set_title(f"{_bend_words(bends[0])}; bars: uncertainty", fontsize=9)
-    curves.legend(fontsize=7)
+    _curves_panel(axes[-1], settings, [r for r in mine if r.cell.knee_bend == bends[0]])
     fig.suptitle(
         f"{CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: "
         "(rolling − revolute) / revolute knee\n"
@@ -210,6 +142,82 @@ def figure(settings: Settings, table: list[Row], criterion: str):
         fontsize=10,
     )
     return fig
+
+
+def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> None:
+    """The map of one knee bend's differences over speed x clearance, colours from -top to
+    top [%], each cell labelled (``_cell_label``)."""
+    speeds, clearances = list(settings.speeds), list(settings.clearances)
+    grid = np.full((len(clearances), len(speeds)), np.nan)
+    for r in rows_:
+        if r.difference.value is not None:
+            grid[clearances.index(r.cell.clearance), speeds.index(r.cell.speed)] = (
+                r.difference.value
+            )
+    image = ax.imshow(
+        grid,
+        origin="lower",
+        cmap="RdBu_r",
+        vmin=-top,
+        vmax=top,
+        aspect="auto",
+        extent=(-0.5, len(speeds) - 0.5, -0.5, len(clearances) - 0.5),
+    )
+    for r in rows_:
+        at = (speeds.index(r.cell.speed), clearances.index(r.cell.clearance))
+        _cell_label(ax, at, r.difference, top)
+    ax.set_xticks(range(len(speeds)), [f"{s:g}" for s in speeds])
+    ax.set_yticks(range(len(clearances)), [f"{100 * c:g}" for c in clearances])
+    ax.set_xlabel("speed [m/s]")
+    ax.set_ylabel("swing-foot clearance [cm]")
+    fig.colorbar(image, ax=ax, label="rolling vs revolute [%]")
+
+
+def _cell_label(ax, at: tuple[int, int], d: Difference, top: float) -> None:
+    """A cell's difference ± uncertainty (white on the darkest cells), hatched when not
+    distinguishable; a cross where a knee has no certified optimum."""
+    from matplotlib.patches import Rectangle
+
+    x, y = at
+    if d.value is None:
+        ax.plot(x, y, "kx", markersize=10)
+        return
+    dark = abs(d.value) > 0.6 * top
+    ax.text(
+        x,
+        y,
+        f"{d.value:+.1f}\n±{d.uncertainty:.1f}",
+        ha="center",
+        va="center",
+        fontsize=6.5,
+        color="white" if dark else "black",
+    )
+    if not d.distinguishable:
+        ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, fill=False, hatch="//", lw=0, ec="0.55"))
+
+
+def _curves_panel(ax, settings: Settings, rows_: list[Row]) -> None:
+    """The differences over speed, one curve per clearance, with their error bars."""
+    for k, clearance in enumerate(settings.clearances):
+        picked = [
+            r for r in rows_ if r.cell.clearance == clearance and r.difference.value is not None
+        ]
+        if not picked:
+            continue
+        ax.errorbar(
+            [r.cell.speed for r in picked],
+            [r.difference.value for r in picked],
+            yerr=[r.difference.uncertainty for r in picked],
+            fmt="o-",
+            capsize=3,
+            color=f"C{k}",
+            label=f"clearance {100 * clearance:g} cm",
+        )
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("speed [m/s]")
+    ax.set_ylabel("(rolling − revolute) / revolute [%]")
+    ax.set_title(f"{_bend_words(settings.knee_bends[0])}; bars: uncertainty", fontsize=9)
+    ax.legend(fontsize=7)
 
 
 def _bend_words(bend: float) -> str:

@@ -540,7 +540,26 @@ def markdown(page: Page, folder: Path) -> str:
         optimised = " (optimised)" if name == gait.criterion else ""
         lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
     lines += _drive_lines(gait)
+    lines += _constraint_lines(gait)
+    lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [
+        f"| {name} | {gait.parameters[name]:.6g} | {parameter_unit(name)} |"
+        for name in parameter_names(gait.knots)
+    ]
+    lines += ["", "## Figures", ""]
+    captions = figure_captions(gait)
+    for name in FIGURE_NAMES:
+        if captions.get(name):
+            lines += [captions[name], ""]
+        lines += [f"![{name[:-4]}]({page.name}/{name})", ""]
+    if page.validation is not None:
+        lines += _validation_lines(page, folder)
+    return "\n".join(lines) + "\n"
+
+
+def _constraint_lines(gait: Gait) -> list[str]:
+    """The section of the tightest margins, then the sentence on the dips below δ if any."""
+    lines = [
         "",
         "## Constraints: tightest margins",
         "",
@@ -561,22 +580,7 @@ def markdown(page: Page, folder: Path) -> str:
             f"{row.ratio:.3g} | {row.at:.3f} | {row.margin:g} |"
         ]
     dips = dip_sentence(gait, margin_dips(gait))
-    if dips:
-        lines += ["", dips]
-    lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
-    lines += [
-        f"| {name} | {gait.parameters[name]:.6g} | {parameter_unit(name)} |"
-        for name in parameter_names(gait.knots)
-    ]
-    lines += ["", "## Figures", ""]
-    captions = figure_captions(gait)
-    for name in FIGURE_NAMES:
-        if captions.get(name):
-            lines += [captions[name], ""]
-        lines += [f"![{name[:-4]}]({page.name}/{name})", ""]
-    if page.validation is not None:
-        lines += _validation_lines(page, folder)
-    return "\n".join(lines) + "\n"
+    return lines + (["", dips] if dips else [])
 
 
 def _drive_lines(gait: Gait) -> list[str]:
