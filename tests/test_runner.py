@@ -3,6 +3,7 @@ process, on a pool of processes and on a Dask cluster; a sweep on a two-worker D
 writes the files of a local sweep; a progress bar on a terminal only; numpy's warnings off the
 terminal; errors and unreachable schedulers are one line."""
 
+import faulthandler
 import io
 import json
 import os
@@ -514,3 +515,38 @@ def test_forked_runs_give_the_results_in_order_and_raise_errors():
         assert runner.free_cores() == 1
     finally:
         runner._IN_WORKER = before
+
+
+def test_a_second_ctrl_c_during_the_clean_up_still_ends_the_pool(monkeypatch, tmp_path):
+    """A forked run stopped by Ctrl-C whose second Ctrl-C comes while the pool is being
+    terminated (two forked starts each signalled the command) ends with KeyboardInterrupt,
+    its workers ended; without deferring it the termination stopped half-way and the pool's
+    join raised "Pool is still running" (or waited for ever)."""
+    import multiprocessing.pool
+
+    terminate, calls = multiprocessing.pool.Pool.terminate, []
+
+    def terminate_after_a_second_ctrl_c(self):
+        calls.append(self)
+        if len(calls) == 1:
+            signal.raise_signal(signal.SIGINT)  # its handler runs here
+        terminate(self)
+
+    def interrupted(x):
+        if x == 0:
+            os.kill(os.getppid(), signal.SIGINT)  # the first Ctrl-C, to the command
+        time.sleep(5)
+
+    monkeypatch.setattr(multiprocessing.pool.Pool, "terminate", terminate_after_a_second_ctrl_c)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    # A pool that never ends: the test process ends after 60 s, its tracebacks in a file.
+    with open(tmp_path / "hung.txt", "w") as hung:
+        faulthandler.dump_traceback_later(60.0, exit=True, file=hung)
+        try:
+            with pytest.raises(KeyboardInterrupt):
+                runner.run_forked(interrupted, [0, 1], 2)
+        finally:
+            faulthandler.cancel_dump_traceback_later()
+            signal.signal(signal.SIGINT, previous)
+    assert len(calls) == 1
+    assert all(p.exitcode is not None for p in calls[0]._pool)

@@ -198,10 +198,6 @@ def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
         yield from pool.imap_unordered(function, tasks)
 
 
-# How often the waiting main thread of ``run_forked`` wakes [s]: a signal's C handler may run
-# in another thread (the pool's), and Python runs the signal's handler only when the main
-# thread runs again: a wait that never woke would miss a Ctrl-C or SIGTERM until the end.
-_WAKE = 0.1
 # What the forked workers of ``run_forked`` call: (function, arguments), set before the fork.
 _FORKED: tuple = (None, ())
 
@@ -219,10 +215,7 @@ def run_forked(function: Callable, arguments: list, jobs: int) -> list:
     _FORKED = (function, arguments)
     try:
         with _pool("fork", jobs) as pool:
-            results = pool.map_async(_call_forked, range(len(arguments)), chunksize=1)
-            while not results.ready():  # wakes to run a signal's handler (see _WAKE)
-                results.wait(_WAKE)
-            return results.get()
+            return pool.map(_call_forked, range(len(arguments)), chunksize=1)
     finally:
         _FORKED = (None, ())
 
