@@ -103,3 +103,30 @@ def test_margins_only_make_the_penalty_larger(model):
     strict = evaluate_step(model, step, 40, margins=True)
     assert strict.penalty >= plain.penalty
     assert strict.sthenic == plain.sthenic and strict.energy == plain.energy
+
+
+@pytest.mark.parametrize("criterion", ["sthenic", "energy", "energy-per-metre", "electrical"])
+def test_each_criterion_without_penalty_is_its_definition_and_what_the_polish_minimises(
+    criterion,
+):
+    """C_Γ, C_E per step, C_E / S and E / S (the motors' energy per metre): ``value`` gives
+    each, and the SLSQP polish of the paper's method minimises that one (it took the energy
+    per step for the energy per metre)."""
+    from biped.optimization.penalty import POLISH_SAMPLES_PER_HALF, _Polish
+
+    model = biped.Biped(biped.Robot.paper(), "rolling")
+    problem = GaitProblem(model, SPEED, criterion)
+    parameters = problem.first_parameters()
+    step = build_step(model, SPEED, parameters)
+    ev = evaluate_step(model, step, POLISH_SAMPLES_PER_HALF, safety=problem.safety)
+    length = step.step_length
+    expected = {
+        "sthenic": ev.sthenic,
+        "energy": ev.energy,
+        "energy-per-metre": ev.energy / length,
+        "electrical": ev.electrical / length,
+    }[criterion]
+    assert ev.value(criterion, length) == expected
+    assert ev.cost(criterion, length) >= expected  # the penalty is never negative
+    polish = _Polish(problem, np.asarray(parameters, float), POLISH_SAMPLES_PER_HALF)
+    assert polish._evaluate(np.zeros(len(parameters)))[0] == pytest.approx(expected, rel=1e-12)

@@ -222,6 +222,15 @@ class StepEvaluation:
         """[J] ∫ Σ P_i dt: the motors' energy over the step, with regeneration."""
         return float(self.weights @ self.drive.power.sum(-1))
 
+    def value(self, criterion: str, step_length: float) -> float:
+        """The criterion ``criterion`` without the penalty: C_Γ, C_E, C_E / S or E / S."""
+        if criterion == "sthenic":
+            return self.sthenic
+        if criterion == "energy":
+            return self.energy
+        work = self.electrical if criterion == "electrical" else self.energy
+        return work / step_length
+
     def cost(self, criterion: str, step_length: float) -> float:
         """C_Γ, C_E, C_E / S or E / S with the penalty (Err = 0: the step was built)."""
         if criterion == "sthenic":

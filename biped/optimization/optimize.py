@@ -212,11 +212,7 @@ class Optimum:
     def costs(self) -> dict:
         """Both criteria of the paper and the motors' energy per metre (no penalty)."""
         ev = self.evaluation
-        return {
-            "sthenic": ev.sthenic,
-            "energy": ev.energy,
-            "electrical": ev.electrical / self.step.step_length,
-        }
+        return {c: ev.value(c, self.step.step_length) for c in ("sthenic", "energy", "electrical")}
 
 
 def check_method(method: str) -> str:

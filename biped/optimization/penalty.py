@@ -87,9 +87,7 @@ class _Polish:
             value = (None, -np.ones(self.margins.shape))
         else:
             ev = evaluate_step(problem.model, step, self.samples, safety=problem.safety)
-            criterion = ev.sthenic if problem.criterion == "sthenic" else ev.energy
-            if problem.criterion == "electrical":  # the motors' energy per metre
-                criterion = ev.electrical / step.step_length
+            criterion = ev.value(problem.criterion, step.step_length)
             psi = (ev.constraints[self.mask] - self.margins) / self.scales
             if not np.all(np.isfinite(psi)) or not np.isfinite(criterion):
                 value = (None, -np.ones(self.margins.shape))

@@ -199,22 +199,19 @@ class Solver:
         if criterion == "sthenic":
             self.slacks = 0
             return y, graph.on_symbols["sthenic"], constraints
-        if criterion == "electrical":  # E / S = Σ w s / V, s >= P (here), s >= 0 (bounds)
-            power = ca.vec(graph.on_symbols["electrical_power"])  # P_i, sample-major
-            slack = ca.SX.sym("s", power.shape[0])
-            self.slacks = power.shape[0]
-            weights = ca.vec(ca.repmat(graph.weights, 6, 1))
-            objective = ca.dot(weights, slack) / graph.speed
-            return ca.vertcat(y, slack), objective, ca.vertcat(constraints, slack - power)
-        power = ca.vec(graph.on_symbols["power"])  # Γ_i θ̇_i, sample-major
+        # The slacks bound the motors' P_i (s >= P, s >= 0 by the bounds: the electrical
+        # criterion) or the joints' Γ_i θ̇_i (s >= ±Γ θ̇: the energy criteria).
+        electrical = criterion == "electrical"
+        rows = graph.on_symbols["electrical_power" if electrical else "power"]
+        power = ca.vec(rows)  # sample-major
         slack = ca.SX.sym("s", power.shape[0])
         self.slacks = power.shape[0]
-        weights = ca.vec(ca.repmat(graph.weights, graph.on_symbols["power"].shape[0], 1))
+        weights = ca.vec(ca.repmat(graph.weights, rows.shape[0], 1))
         objective = period * ca.dot(weights, slack)  # C_E, per step
-        if criterion == "energy-per-metre":  # C_E / S = T Σ w s / (V T)
+        if criterion != "energy":  # per metre: T Σ w s / (V T)
             objective = ca.dot(weights, slack) / graph.speed
-        constraints = ca.vertcat(constraints, slack - power, slack + power)
-        return ca.vertcat(y, slack), objective, constraints
+        bounds = [slack - power] if electrical else [slack - power, slack + power]
+        return ca.vertcat(y, slack), objective, ca.vertcat(constraints, *bounds)
 
     def solve(
         self, problem, start, radii=None, hold_radii: bool = False, barrier: str = "adaptive"

@@ -41,7 +41,6 @@ from biped.model.criteria import (
     Safety,
     evaluate_step,
     safety_dict,
-    simpson_weights,
 )
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.gait import PARAMETERS, build_step, check_knots, parameter_names
@@ -226,8 +225,7 @@ class Electrical(_Record):
     @classmethod
     def of(cls, model: Biped, step, ev) -> Electrical:
         """The electrical figures of a gait's step and its evaluation on the check grid."""
-        weights = step.period * simpson_weights(len(ev.t) // (step.knots + 1) - 1, step.knots)
-        drive, length = ev.drive, step.step_length
+        weights, drive, length = ev.weights, ev.drive, step.step_length
         weight = model.robot.weight
 
         def integral(rate) -> list:

@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import CRITERION_UNITS, WORK_CRITERIA, Safety
+from biped.model.criteria import ALL_CRITERIA, CRITERION_UNITS, WORK_CRITERIA, Safety
 from biped.model.dynamics import Biped
 from biped.model.gait import check_knots
 from biped.model.kinematics import KNEES
@@ -191,12 +191,7 @@ def _record(optimum: Optimum, seconds: float) -> dict:
         "feasible": optimum.feasible,
         "certified": optimum.certified,
         "value": _finite(optimum.value),
-        "costs": {
-            "sthenic": ev.sthenic,
-            "energy": ev.energy,
-            "energy-per-metre": ev.energy / optimum.step.step_length,
-            "electrical": ev.electrical / optimum.step.step_length,
-        },
+        "costs": {c: ev.value(c, optimum.step.step_length) for c in ALL_CRITERIA},
         "starts": report.starts,
         "starts_at_best": report.starts_at_best,
         "single_start": single_start_note(report) if single else None,
