@@ -55,6 +55,19 @@ def _stdout_closed() -> None:
         os.dup2(devnull, sys.stdout.fileno())
 
 
+def _interrupt_behind(error: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C or SIGTERM an error stands for, if any: an interrupt raised while a pybind11
+    module (MuJoCo, matplotlib) loads comes out as ``ImportError: initialization failed``,
+    the interrupt as its cause."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
 def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bool = False) -> int:
     """Run a command and turn how it ends into an exit status with at most one line on stderr.
 
@@ -90,6 +103,11 @@ def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bo
         code = exit_.code
         return code if isinstance(code, int) else (EXIT_OK if code is None else EXIT_BAD_INPUT)
     except Exception as error:  # a bug: say so on one line, the traceback on demand
+        interrupt = _interrupt_behind(error)
+        if interrupt is not None:
+            status, signal_name = exit_status(interrupt)
+            say(f"interrupted ({signal_name})")
+            return status
         return fail(
             "internal error",
             f"{type(error).__name__}: {error}" if str(error) else type(error).__name__,

@@ -9,6 +9,7 @@ import time
 import numpy as np
 import pytest
 
+from biped.runtime import interrupts
 from biped_cli import main
 from biped_cli.progress import Progress
 
@@ -280,6 +281,30 @@ def test_sigterm_in_a_command_is_one_line_and_exit_143(capsys, monkeypatch):
     _replace_command(monkeypatch, terminated)
     assert "interrupted (SIGTERM)" in _one_line(capsys, main(["demo"]), 143)
     assert signal.getsignal(signal.SIGTERM) is previous
+
+
+@pytest.mark.parametrize(
+    "interrupt, status, name",
+    [(KeyboardInterrupt, 130, "Ctrl-C"), (interrupts.Terminated, 143, "SIGTERM")],
+)
+def test_an_interrupt_while_a_module_loads_is_the_interrupt(
+    capsys, monkeypatch, interrupt, status, name
+):
+    """A Ctrl-C or SIGTERM while a pybind11 module (MuJoCo, matplotlib) loads comes out of the
+    import as ``ImportError: initialization failed`` caused by the interrupt: the command ends
+    as interrupted (it said "internal error: ImportError"); an ImportError of its own stays a
+    bug."""
+
+    def loading(cause):
+        def command():
+            raise ImportError("initialization failed") from cause
+
+        return command
+
+    _replace_command(monkeypatch, loading(interrupt()))
+    assert _one_line(capsys, main(["demo"]), status) == f"biped demo: interrupted ({name})"
+    _replace_command(monkeypatch, loading(ValueError("a bug")))
+    assert "internal error: ImportError" in _one_line(capsys, main(["demo"]))
 
 
 def test_unexpected_error_is_one_line_with_a_hint(capsys, monkeypatch):

@@ -3,7 +3,6 @@ process, on a pool of processes and on a Dask cluster; a sweep on a two-worker D
 writes the files of a local sweep; a progress bar on a terminal only; numpy's warnings off the
 terminal; errors and unreachable schedulers are one line."""
 
-import faulthandler
 import io
 import json
 import os
@@ -539,14 +538,51 @@ def test_a_second_ctrl_c_during_the_clean_up_still_ends_the_pool(monkeypatch, tm
 
     monkeypatch.setattr(multiprocessing.pool.Pool, "terminate", terminate_after_a_second_ctrl_c)
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    # A pool that never ends: the test process ends after 60 s, its tracebacks in a file.
-    with open(tmp_path / "hung.txt", "w") as hung:
-        faulthandler.dump_traceback_later(60.0, exit=True, file=hung)
-        try:
-            with pytest.raises(KeyboardInterrupt):
-                runner.run_forked(interrupted, [0, 1], 2)
-        finally:
-            faulthandler.cancel_dump_traceback_later()
-            signal.signal(signal.SIGINT, previous)
+    # A pool that never ends: pytest's faulthandler_timeout (pyproject) ends the test run.
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            runner.run_forked(interrupted, [0, 1], 2)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert len(calls) == 1
     assert all(p.exitcode is not None for p in calls[0]._pool)
+
+
+# A command's pool stopped while its workers are still starting (their initializer made slow),
+# in a process of its own: it prints its workers' exit statuses once the pool is terminated.
+_TERMINATED_WHILE_STARTING = """
+import time
+from biped.runtime import interrupts, runner
+
+start = runner._worker_init
+runner._worker_init = lambda: (time.sleep(1.0), start())
+pools = []
+with interrupts.sigterm_interrupts():  # as every command
+    try:
+        with runner._pool("fork", 2) as pool:
+            pools.append(pool)
+            raise RuntimeError("stopped at once")
+    except RuntimeError:
+        print(sorted(worker.exitcode for worker in pools[0]._pool))
+"""
+
+
+@pytest.mark.skipif(
+    "fork" not in __import__("multiprocessing").get_all_start_methods(), reason="no fork"
+)
+def test_a_pool_terminated_while_its_workers_start_ends():
+    """A forked worker inherits the handlers of the process starting it (which only note a
+    signal until the pool is started): terminated before its initializer ran, it swallowed
+    its SIGTERM, then waited for a task for ever, and the pool's termination with it (a
+    Ctrl-C just after `biped optimize` forked its starts). Now each worker ends with its
+    SIGTERM's status once its initializer has run."""
+    command = [sys.executable, "-c", _TERMINATED_WHILE_STARTING]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        out, _ = process.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)  # the command and its workers
+        process.communicate()
+        pytest.fail("the pool's termination waited for a worker terminated while starting")
+    assert process.returncode == 0
+    assert out.split() == [f"[{interrupts.EXIT_TERMINATED},", f"{interrupts.EXIT_TERMINATED}]"]

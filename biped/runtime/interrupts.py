@@ -15,7 +15,8 @@ and ends with the files of an uninterrupted run. Moment by moment:
 - CasADi building a graph or IPOPT solving: CasADi stops at the signal but swallows the
   exception; ``kept_interrupts`` raises it again once CasADi has returned;
 - a worker pool starting: the signal takes effect once the pool is started
-  (``starting_workers``), never between a worker's start and its first instruction;
+  (``starting_workers``), never between a worker's start and its first instruction; a worker
+  terminated while it starts ends once its initializer has run;
 - a worker process (``worker_signals``): Ctrl-C is left to the main process; SIGTERM (the
   main process terminating its pool) raises ``SystemExit(143)``, again every
   ``EXIT_AGAIN_AFTER`` seconds until the worker has ended;
@@ -176,21 +177,27 @@ def deferred_signals() -> Iterator[None]:
 @contextlib.contextmanager
 def starting_workers() -> Iterator[None]:
     """Around the start of worker processes (``worker_signals`` in their initializer): they start
-    deaf to Ctrl-C from their first instruction, and a signal received meanwhile (by any
+    deaf to Ctrl-C from their first instruction, a SIGTERM that reaches one before its
+    initializer ends it once the initializer has run, and a signal received meanwhile (by any
     thread of this process) takes effect once the block is done.
 
-    A terminal's Ctrl-C reaches every process of its group, and a worker still importing
-    would print a traceback: the workers start with SIGINT blocked (a new process inherits
-    the signal mask of the thread that starts it; ``worker_signals`` then ignores SIGINT).
+    A new process inherits the signal mask of the thread that starts it, so the workers start
+    with SIGINT and SIGTERM blocked. A terminal's Ctrl-C reaches every process of its group, and
+    a worker still importing would print a traceback: ``worker_signals`` ignores SIGINT. A
+    forked worker inherits this process's handlers too, this block's among them, which only
+    note a signal: a pool terminated (SIGTERM) while a worker was still starting would have
+    that worker swallow its SIGTERM and then wait for a task for ever, the pool's termination
+    with it. Blocked, the SIGTERM waits until ``worker_signals`` has put the worker's own
+    handler in place.
     """
     with deferred_signals():
         if not hasattr(signal, "pthread_sigmask"):
             yield
             return
-        # The pool's locks start multiprocessing's resource tracker, which unblocks SIGINT
-        # after starting: start it first.
+        # The pool's locks start multiprocessing's resource tracker, which unblocks SIGINT and
+        # SIGTERM after starting: start it first.
         resource_tracker.ensure_running()
-        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS))
         try:
             yield
         finally:
@@ -200,9 +207,12 @@ def starting_workers() -> Iterator[None]:
 def worker_signals():
     """In a worker process: Ctrl-C is left to the main process, and SIGTERM (the main process
     terminating its workers) raises SystemExit, so a file being written is removed, never
-    left half-written."""
+    left half-written. A SIGTERM received while the worker was starting (``starting_workers``
+    blocked it) takes effect here."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _end_worker)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
 
 
 def _end_worker(signum, frame):
