@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from biped.errors import BipedError
-from biped.runtime.interrupts import exit_status, sigterm_interrupts
+from biped.runtime.interrupts import command_interrupts, exit_status, received_interrupt
 
 EXIT_OK = 0
 EXIT_CHECK_FAILED = 1
@@ -55,19 +55,6 @@ def _stdout_closed() -> None:
         os.dup2(devnull, sys.stdout.fileno())
 
 
-def _interrupt_behind(error: BaseException) -> KeyboardInterrupt | None:
-    """The Ctrl-C or SIGTERM an error stands for, if any: an interrupt raised while a pybind11
-    module (MuJoCo, matplotlib) loads comes out as ``ImportError: initialization failed``,
-    the interrupt as its cause."""
-    seen = set()
-    while error is not None and id(error) not in seen:
-        if isinstance(error, KeyboardInterrupt):
-            return error
-        seen.add(id(error))
-        error = error.__cause__ or error.__context__
-    return None
-
-
 def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bool = False) -> int:
     """Run a command and turn how it ends into an exit status with at most one line on stderr.
 
@@ -88,7 +75,7 @@ def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bo
         return EXIT_BAD_INPUT
 
     try:
-        with sigterm_interrupts(), quiet_numerics(debug):
+        with command_interrupts(), quiet_numerics(debug):
             return run()
     except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM (``Terminated``)
         status, signal_name = exit_status(interrupt)
@@ -103,7 +90,7 @@ def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bo
         code = exit_.code
         return code if isinstance(code, int) else (EXIT_OK if code is None else EXIT_BAD_INPUT)
     except Exception as error:  # a bug: say so on one line, the traceback on demand
-        interrupt = _interrupt_behind(error)
+        interrupt = received_interrupt()  # a library may have turned it into its own error
         if interrupt is not None:
             status, signal_name = exit_status(interrupt)
             say(f"interrupted ({signal_name})")

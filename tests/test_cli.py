@@ -9,7 +9,6 @@ import time
 import numpy as np
 import pytest
 
-from biped.runtime import interrupts
 from biped_cli import main
 from biped_cli.progress import Progress
 
@@ -284,27 +283,36 @@ def test_sigterm_in_a_command_is_one_line_and_exit_143(capsys, monkeypatch):
 
 
 @pytest.mark.parametrize(
-    "interrupt, status, name",
-    [(KeyboardInterrupt, 130, "Ctrl-C"), (interrupts.Terminated, 143, "SIGTERM")],
+    "signum, status, name", [(signal.SIGINT, 130, "Ctrl-C"), (signal.SIGTERM, 143, "SIGTERM")]
 )
-def test_an_interrupt_while_a_module_loads_is_the_interrupt(
-    capsys, monkeypatch, interrupt, status, name
+@pytest.mark.parametrize("turned_into", ["ImportError", "ArgumentError"])
+def test_an_interrupt_a_library_turns_into_its_error_is_the_interrupt(
+    capsys, monkeypatch, signum, status, name, turned_into
 ):
-    """A Ctrl-C or SIGTERM while a pybind11 module (MuJoCo, matplotlib) loads comes out of the
-    import as ``ImportError: initialization failed`` caused by the interrupt: the command ends
-    as interrupted (it said "internal error: ImportError"); an ImportError of its own stays a
-    bug."""
+    """A Ctrl-C or SIGTERM whose exception a library turns into its own error: a pybind11 module
+    loading (MuJoCo, matplotlib) raises ``ImportError: initialization failed`` caused by it,
+    ctypes ``ArgumentError: argument 1: Terminated:`` without it. The command ends as
+    interrupted (it said "internal error"); the same error with no signal stays a bug."""
+    import ctypes
 
-    def loading(cause):
+    def library(signalled):
         def command():
-            raise ImportError("initialization failed") from cause
+            try:
+                if signalled:
+                    os.kill(os.getpid(), signum)
+                time.sleep(0.01)
+                raise KeyboardInterrupt  # stands for the signal's exception without one
+            except KeyboardInterrupt as interrupt:
+                if turned_into == "ImportError":
+                    raise ImportError("initialization failed") from interrupt
+                raise ctypes.ArgumentError(f"argument 1: {type(interrupt).__name__}: ") from None
 
         return command
 
-    _replace_command(monkeypatch, loading(interrupt()))
+    _replace_command(monkeypatch, library(True))
     assert _one_line(capsys, main(["demo"]), status) == f"biped demo: interrupted ({name})"
-    _replace_command(monkeypatch, loading(ValueError("a bug")))
-    assert "internal error: ImportError" in _one_line(capsys, main(["demo"]))
+    _replace_command(monkeypatch, library(False))
+    assert f"internal error: {turned_into}" in _one_line(capsys, main(["demo"]))
 
 
 def test_unexpected_error_is_one_line_with_a_hint(capsys, monkeypatch):

@@ -557,7 +557,7 @@ from biped.runtime import interrupts, runner
 start = runner._worker_init
 runner._worker_init = lambda: (time.sleep(1.0), start())
 pools = []
-with interrupts.sigterm_interrupts():  # as every command
+with interrupts.command_interrupts():  # as every command
     try:
         with runner._pool("fork", 2) as pool:
             pools.append(pool)

@@ -10,7 +10,7 @@ and ends with the files of an uninterrupted run. Moment by moment:
 - loading (numpy, CasADi: a second or two): the program ends at once, nothing written yet
   (``biped_cli/__init__.py``: it must act before ``biped`` loads numpy);
 - a command, in the main thread: Ctrl-C raises ``KeyboardInterrupt``, SIGTERM ``Terminated``
-  (one, ``sigterm_interrupts``), so the same clean-up runs (``finally`` blocks, temporary
+  (one, ``command_interrupts``), so the same clean-up runs (``finally`` blocks, temporary
   files, worker pools); ``biped_cli.guard`` prints the line and exits with ``exit_status``;
 - CasADi building a graph or IPOPT solving: CasADi stops at the signal but swallows the
   exception; ``kept_interrupts`` raises it again once CasADi has returned;
@@ -52,8 +52,14 @@ def exit_status(interrupt: KeyboardInterrupt) -> tuple[int, str]:
     return EXIT_INTERRUPTED, "Ctrl-C"
 
 
-def _raise_terminated(signum, frame):
-    raise Terminated
+# The signals received in a ``command_interrupts`` block, first first.
+_received: list[int] = []
+
+
+def _interrupt(signum, frame):
+    """Ctrl-C raises ``KeyboardInterrupt``, SIGTERM ``Terminated``; each is remembered."""
+    _received.append(signum)
+    raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
 
 
 def _main_thread() -> bool:
@@ -61,16 +67,30 @@ def _main_thread() -> bool:
 
 
 @contextlib.contextmanager
-def sigterm_interrupts() -> Iterator[None]:
-    """Within the block, SIGTERM raises ``Terminated`` in the main thread (elsewhere: no-op)."""
+def command_interrupts() -> Iterator[None]:
+    """Within the block, SIGTERM raises ``Terminated`` and Ctrl-C ``KeyboardInterrupt`` in the
+    main thread (elsewhere: no-op; a Ctrl-C ignored stays ignored), each remembered for
+    ``received_interrupt``."""
     if not _main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _raise_terminated)
-    try:
+    _received.clear()
+    handled = [signal.SIGTERM]
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        handled.append(signal.SIGINT)
+    with _replaced({number: signal.getsignal(number) for number in handled}, _interrupt):
         yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+
+
+def received_interrupt() -> KeyboardInterrupt | None:
+    """The interrupt of the first signal the current ``command_interrupts`` block received,
+    if any. A library may turn the exception a signal raised into one of its own, the
+    interrupt lost (ctypes: ``ArgumentError: argument 1: Terminated``; a pybind11 module
+    loading: ``ImportError: initialization failed``): the command ends as interrupted all
+    the same."""
+    if not _received:
+        return None
+    return Terminated() if _received[0] == signal.SIGTERM else KeyboardInterrupt()
 
 
 def _python_handlers() -> dict:
