@@ -457,12 +457,13 @@ def _swallowing_worker(lock, ready):
     """A pool worker whose code swallows the SIGTERM's SystemExit (as CasADi does while it
     calls back into Python), then waits for a task that never comes."""
     runner._worker_init()
-    ready.set()
-    try:
-        while True:
-            time.sleep(0.01)
-    except BaseException:
-        pass
+    with interrupts.worker_task():
+        ready.set()
+        try:
+            while True:
+                time.sleep(0.01)
+        except BaseException:
+            pass
     with lock:
         pass
 
@@ -574,8 +575,8 @@ def test_a_pool_terminated_while_its_workers_start_ends():
     """A forked worker inherits the handlers of the process starting it (which only note a
     signal until the pool is started): terminated before its initializer ran, it swallowed
     its SIGTERM, then waited for a task for ever, and the pool's termination with it (a
-    Ctrl-C just after `biped optimize` forked its starts). Now each worker ends with its
-    SIGTERM's status once its initializer has run."""
+    Ctrl-C just after `biped optimize` forked its starts). Now each worker ends by its
+    SIGTERM once its initializer has run."""
     command = [sys.executable, "-c", _TERMINATED_WHILE_STARTING]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, start_new_session=True)
     try:
@@ -585,4 +586,46 @@ def test_a_pool_terminated_while_its_workers_start_ends():
         process.communicate()
         pytest.fail("the pool's termination waited for a worker terminated while starting")
     assert process.returncode == 0
-    assert out.split() == [f"[{interrupts.EXIT_TERMINATED},", f"{interrupts.EXIT_TERMINATED}]"]
+    assert out.split() == [f"[{-signal.SIGTERM},", f"{-signal.SIGTERM}]"]
+
+
+def _signalled_worker(moment: str):
+    """A pool worker sent SIGTERM at ``moment``: waiting for a task, in one, or as one ends
+    (the signal held until then), then waiting for the next task."""
+    interrupts.worker_signals()
+    if moment == "idle":
+        os.kill(os.getpid(), signal.SIGTERM)
+    else:
+        with interrupts.worker_task():
+            if moment == "task":
+                os.kill(os.getpid(), signal.SIGTERM)
+            else:
+                signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+                os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(5)
+    os._exit(0)
+
+
+@pytest.mark.skipif(
+    "fork" not in __import__("multiprocessing").get_all_start_methods(), reason="no fork"
+)
+@pytest.mark.parametrize(
+    "moment, status",
+    [("idle", -signal.SIGTERM), ("task", interrupts.EXIT_TERMINATED), ("ending", -signal.SIGTERM)],
+)
+def test_a_sigterm_ends_a_worker_at_any_moment(moment, status):
+    """A worker waiting for a task ends at a SIGTERM by the system's default action: with a
+    Python handler, a SIGTERM that came just before the worker blocked on the task queue's
+    lock (held by the pool terminating it) left its handler waiting to run, and the pool's
+    termination waiting for the worker (1 in 6 runs of the second-Ctrl-C test). In a task
+    the SIGTERM raises SystemExit(143), so the task's files are cleaned up; one that comes as
+    the task ends ends the worker there."""
+    import multiprocessing
+
+    worker = multiprocessing.get_context("fork").Process(target=_signalled_worker, args=(moment,))
+    worker.start()
+    worker.join(30)
+    if worker.is_alive():
+        worker.kill()
+        worker.join()
+    assert worker.exitcode == status

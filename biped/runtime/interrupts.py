@@ -18,7 +18,8 @@ and ends with the files of an uninterrupted run. Moment by moment:
   (``starting_workers``), never between a worker's start and its first instruction; a worker
   terminated while it starts ends once its initializer has run;
 - a worker process (``worker_signals``): Ctrl-C is left to the main process; SIGTERM (the
-  main process terminating its pool) raises ``SystemExit(143)``, again every
+  main process terminating its pool) ends a worker waiting for a task at once (the system's
+  default), and in a task (``worker_task``) raises ``SystemExit(143)``, again every
   ``EXIT_AGAIN_AFTER`` seconds until the worker has ended;
 - a Dask cluster: the futures are cancelled; a task already running on a worker finishes
   and writes its file whole (``biped.runtime.runner``).
@@ -226,13 +227,45 @@ def starting_workers() -> Iterator[None]:
 
 def worker_signals():
     """In a worker process: Ctrl-C is left to the main process, and SIGTERM (the main process
-    terminating its workers) raises SystemExit, so a file being written is removed, never
-    left half-written. A SIGTERM received while the worker was starting (``starting_workers``
-    blocked it) takes effect here."""
+    terminating its workers) ends a worker waiting for a task at once, by the system's
+    default action: nothing is being written then. A Python handler would run only once the
+    worker is back in Python code, and a SIGTERM that reaches a worker just before it blocks on
+    the task queue's lock (which the terminating pool holds) would leave it waiting for ever,
+    the pool's termination with it. A SIGTERM received while the worker was starting
+    (``starting_workers`` blocked it) takes effect here."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, _end_worker)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+
+
+@contextlib.contextmanager
+def worker_task() -> Iterator[None]:
+    """Around a worker's task: SIGTERM raises ``SystemExit`` (``_end_worker``), so a file being
+    written is removed, never left half-written. After it the system's default is back; a
+    SIGTERM received as the task ended, whose handler had yet to run, ends the worker there
+    (blocked meanwhile, a later one waits for the default)."""
+    if not _main_thread():
+        yield
+        return
+    signal.signal(signal.SIGTERM, _end_worker)
+    try:
+        yield
+    finally:
+        masks = hasattr(signal, "pthread_sigmask")
+        if masks:
+            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+        try:
+            _handlers_run()  # a SIGTERM noted by the C handler runs _end_worker here
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        finally:
+            if masks:
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+
+
+def _handlers_run() -> None:
+    """Nothing: calling a Python function runs the Python handlers of the signals received
+    (the interpreter checks for them on entering a function)."""
 
 
 def _end_worker(signum, frame):

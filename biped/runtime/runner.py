@@ -36,6 +36,7 @@ in a command's own process, none in a campaign's worker, whose siblings use them
 from __future__ import annotations
 
 import contextlib
+import functools
 import multiprocessing
 import os
 import sys
@@ -46,7 +47,12 @@ from typing import Protocol, TextIO
 import numpy as np
 
 from biped.errors import BipedError
-from biped.runtime.interrupts import deferred_signals, starting_workers, worker_signals
+from biped.runtime.interrupts import (
+    deferred_signals,
+    starting_workers,
+    worker_signals,
+    worker_task,
+)
 
 # How long to wait for a Dask scheduler to answer [s].
 CONNECT_TIMEOUT = 10.0
@@ -195,7 +201,13 @@ def _pool(method: str, jobs: int) -> Iterator:
 
 def _on_pool(function: Callable, tasks: list, jobs: int) -> Iterator:
     with _pool("spawn", jobs) as pool:
-        yield from pool.imap_unordered(function, tasks)
+        yield from pool.imap_unordered(functools.partial(_task, function), tasks)
+
+
+def _task(function: Callable, task):
+    """A pool worker's task (``biped.runtime.interrupts.worker_task``)."""
+    with worker_task():
+        return function(task)
 
 
 # What the forked workers of ``run_forked`` call: (function, arguments), set before the fork.
@@ -222,7 +234,8 @@ def run_forked(function: Callable, arguments: list, jobs: int) -> list:
 
 def _call_forked(index: int):
     function, arguments = _FORKED
-    return function(arguments[index])
+    with worker_task():
+        return function(arguments[index])
 
 
 def _connect(address: str):
