@@ -185,6 +185,30 @@ def test_figures_and_table(sweep, tmp_path):
     gaits = [gait_file.read(p) for p in folder.glob("*-*.json")]
     confirmed = sum(g.optimizer.starts_at_best >= 2 for g in gaits)
     assert f"{confirmed} of 8 optima were reached by at least two starts" in table
+    # the motors' energy per metre of the optima, from the gait files
+    least = f"{best['revolute'].costs.electrical:.2f} / {best['rolling'].costs.electrical:.2f}"
+    assert f"of the least sthenic optimum, revolute / rolling [J/m] | | {least} |" in table
+    electrical = {
+        (g.knee, round(g.speed, 6)): g.costs.electrical for g in gaits if g.criterion == "sthenic"
+    }
+    speeds = sorted(
+        {v for k, v in electrical if k == "rolling"} & {v for k, v in electrical if k == "revolute"}
+    )
+    mean = np.mean(
+        [100 * (electrical["rolling", v] / electrical["revolute", v] - 1) for v in speeds]
+    )
+    assert (
+        f"of the sthenic optima, rolling vs revolute, mean over the {len(speeds)} speeds both "
+        f"knees have | | {mean:+.1f} % |"
+    ) in table
+    # gait files written before the actuators have no electrical figures: no such rows
+    older = _copy(folder, tmp_path / "older", "*-*.json")
+    for path in older.glob("*-*.json"):
+        content = json.loads(path.read_text())
+        del content["costs"]["electrical"]
+        path.write_text(json.dumps(content))
+    older_table = make_figures(older, tmp_path / "older-figures")[-1].read_text()
+    assert "electrical" not in older_table and "| -17.0 % |" in older_table
 
 
 def test_figures_leave_out_uncertified_optima(sweep, tmp_path):

@@ -491,7 +491,29 @@ def _criterion_rows(series, criterion) -> list[str]:
         f"{best['revolute']:.{1 if criterion == 'sthenic' else 2}f} / "
         f"{best['rolling']:.{1 if criterion == 'sthenic' else 2}f} |"
     )
-    return rows
+    return rows + _electrical_rows(series, criterion)
+
+
+def _electrical_rows(series, criterion) -> list[str]:
+    """The motors' energy per metre without regeneration (the gait files' actuators) of the
+    ``criterion`` optima: at each knee's least one, and rolling vs revolute over the speeds
+    both knees have; none when a gait file was written before the actuators."""
+    if any(g.costs.electrical is None for k in KNEES for g in series[(k, criterion)]):
+        return []
+    least = {
+        knee: min(series[(knee, criterion)], key=lambda g: g.costs.criterion(criterion))
+        for knee in KNEES
+    }
+    speeds, differences = difference_curve(series, criterion, "electrical")
+    unit = CRITERION_UNITS["electrical"]
+    return [
+        f"| electrical energy per metre, no regeneration, of the least {criterion} optimum, "
+        f"revolute / rolling [{unit}] | | {least['revolute'].costs.electrical:.2f} / "
+        f"{least['rolling'].costs.electrical:.2f} |",
+        f"| electrical energy per metre of the {criterion} optima, rolling vs revolute, mean "
+        f"over the {len(speeds)} speeds both knees have | | "
+        f"{_percent(float(np.mean(differences)))} |",
+    ]
 
 
 def _detail_rows(series) -> tuple[list[str], dict]:
