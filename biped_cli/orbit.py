@@ -129,10 +129,11 @@ def boundary_lines(content: dict) -> list[str]:
         (a, b), (left, right) = boundary["between"], boundary["verdicts"]
         at = boundary["radius_crosses_1_at"]
         crossing = "" if at is None else f"; ρ crosses 1 at {knob} x {at:.3g}"
-        if "spectral_radius" not in content["orbits"][content["values"].index(a)]:
-            crossing = f"; the walk falls at {knob} x {a:g}"
-        elif "spectral_radius" not in content["orbits"][content["values"].index(b)]:
-            crossing = f"; the walk falls at {knob} x {b:g}"
+        for value in (a, b):
+            orbit = content["orbits"][content["values"].index(value)]
+            if "spectral_radius" not in orbit:  # no orbit: why, as its first note says
+                crossing = f"; at {knob} x {value:g} {orbit['notes'][0].split(':')[0]}"
+                break
         out.append(f"  boundary: {left} at {knob} x {a:g}, {right} at {knob} x {b:g}{crossing}")
     if not content["boundaries"]:
         verdicts = sorted({o["verdict"] for o in content["orbits"]})

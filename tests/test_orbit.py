@@ -195,3 +195,30 @@ def test_orbit_command_writes_the_multipliers(tmp_path, capsys):
         err = _refusal(capsys, main(["orbit", str(path), *argv, "--out", str(fresh)]))
         assert named in err and "allowed" in err, err
         assert not fresh.exists()
+
+
+def test_a_boundary_at_a_value_without_orbit_says_why():
+    """Where the orbit search ends without an orbit, the boundary line says why, as the
+    orbit's note does (a walk that missed the section did not fall)."""
+    from biped_cli.orbit import boundary_lines
+
+    missed = "the walk did not reach the section in step 2: no orbit (an orbit that cannot "
+    content = {
+        "knob": "speed",
+        "values": [0.0, 0.25],
+        "orbits": [
+            {"verdict": "unstable", "notes": [missed + "be found is unstable)"]},
+            {"verdict": "stable", "spectral_radius": 0.69, "notes": ["slowest"]},
+        ],
+        "boundaries": [
+            {
+                "between": [0.0, 0.25],
+                "verdicts": ["unstable", "stable"],
+                "radius_crosses_1_at": None,
+            }
+        ],
+    }
+    assert boundary_lines(content) == [
+        "  boundary: unstable at speed x 0, stable at speed x 0.25; at speed x 0 the walk did "
+        "not reach the section in step 2"
+    ]
