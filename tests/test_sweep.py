@@ -396,6 +396,23 @@ def test_figures_are_written_all_or_none(sweep, tmp_path, monkeypatch):
     assert after == before
 
 
+def test_knees_certified_at_different_speeds_give_no_mean(sweep, tmp_path):
+    """Where the knees have no speed in common, each mean difference (the criterion's and
+    the motors' energy) says so; no row reads 'nan'."""
+    folder, _ = sweep
+    low, high = (f"{v:.3f}" for v in SPEEDS)
+    disjoint = _copy(folder, tmp_path / "disjoint", "*-*.json")
+    for path in [
+        *disjoint.glob(f"rolling-*-{low}.json"),
+        *disjoint.glob(f"revolute-*-{high}.json"),
+    ]:
+        path.unlink()
+    table = make_figures(disjoint, tmp_path / "figures", stream=io.StringIO())[-1].read_text()
+    assert "nan" not in table.lower()
+    none = "speeds both knees have | | none: no speed where both knees are certified |"
+    assert table.count(none) == 4  # per criterion: its own and the motors' energy
+
+
 def _copy(folder, destination, pattern):
     destination.mkdir()
     for path in folder.glob(pattern):

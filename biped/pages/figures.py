@@ -468,11 +468,7 @@ def _criterion_rows(series, criterion) -> list[str]:
     speed = {knee: _minimum(series, knee, criterion)[0] for knee in KNEES}
     best = {knee: _minimum(series, knee, criterion)[1] for knee in KNEES}
     speeds, differences = difference_curve(series, criterion, criterion)
-    mean = (
-        _percent(float(np.mean(differences)))
-        if len(speeds)
-        else "none: no speed where both knees are certified"
-    )
+    mean = _mean_difference(differences)
     paper = _percent(PAPER[f"{criterion}_difference"])
     rows = [
         f"| {criterion} criterion, rolling vs revolute, at each knee's best speed "
@@ -511,9 +507,15 @@ def _electrical_rows(series, criterion) -> list[str]:
         f"revolute / rolling [{unit}] | | {least['revolute'].costs.electrical:.2f} / "
         f"{least['rolling'].costs.electrical:.2f} |",
         f"| electrical energy per metre of the {criterion} optima, rolling vs revolute, mean "
-        f"over the {len(speeds)} speeds both knees have | | "
-        f"{_percent(float(np.mean(differences)))} |",
+        f"over the {len(speeds)} speeds both knees have | | {_mean_difference(differences)} |",
     ]
+
+
+def _mean_difference(differences) -> str:
+    """The mean of the differences [%] at the speeds both knees have, or why there is none."""
+    if not len(differences):
+        return "none: no speed where both knees are certified"
+    return _percent(float(np.mean(differences)))
 
 
 def _detail_rows(series) -> tuple[list[str], dict]:
