@@ -2,8 +2,10 @@
 an earlier version kept here ("before": CasADi's Hessian of the whole graph, IPOPT's
 gradient scaling, the first guesses and, for the energy criterion, the sthenic optimum under
 both barriers, one start after the other), in the same process: setup, solve, value, starts
-at the best value, ratios. ``biped optimize`` is timed as a whole process; ``--sweep`` times
-the default sweep both ways, ``--pipeline`` the pipeline without videos.
+at the best value, ratios; and beside today's method without its coarse search of the
+sthenic starts ("fine grid alone": every start solved on the problem's grid). ``biped
+optimize`` is timed as a whole process; ``--sweep`` times the default sweep both ways,
+``--pipeline`` the pipeline without videos.
 
     python benchmarks/bench_optimize.py [--repeats N] [--sweep] [--pipeline]
 """
@@ -94,11 +96,12 @@ def one_optimization(repeats: int) -> None:
     )
     print(
         f"{'':18}{'setup [s]':>20}{'solve [s]':>20}{'value':>24}{'starts at best':>18}"
-        f"{'process [s]':>13}"
+        f"{'process [s]':>13}{'fine grid alone [s]':>27}"
     )
     print(
         f"{'knee, criterion':18}{'before':>10}{'now':>7}{'ratio':>6}{'before':>10}{'now':>7}"
         f"{'ratio':>6}{'before':>12}{'now':>12}{'before':>9}{'now':>9}{'now':>13}"
+        f"{'solve':>9}{'ratio':>6}{'value':>12}"
     )
     for criterion in ("sthenic", "energy"):
         for knee in biped.KNEES:
@@ -114,6 +117,8 @@ def one_optimization(repeats: int) -> None:
             setup_now = prepare(problem)
             solve_before, old = median_time(optimize_before, problem, before, repeats=repeats)
             solve_now, new = median_time(optimize, problem, repeats=repeats)
+            with mock.patch.object(optimize_module, "COARSE_CRITERIA", ()):
+                solve_fine, fine = median_time(optimize, problem, repeats=repeats)
             process = whole_process(knee, criterion, repeats)
             print(
                 f"{knee + ', ' + criterion:18}{setup_before:10.2f}{setup_now:7.2f}"
@@ -121,6 +126,7 @@ def one_optimization(repeats: int) -> None:
                 f"{solve_now / solve_before:6.2f}{old.report.value:12.6f}{new.report.value:12.6f}"
                 f"{f'{old.report.starts_at_best}/{old.report.starts}':>9}"
                 f"{f'{new.report.starts_at_best}/{new.report.starts}':>9}{process:13.2f}"
+                f"{solve_fine:9.2f}{solve_now / solve_fine:6.2f}{fine.report.value:12.6f}"
             )
     print(
         "targets: a solve (all starts) <= "

@@ -447,3 +447,64 @@ def test_starts_solved_on_several_processes_end_as_on_one():
     serial, forked = (optimize(problem, jobs=jobs) for jobs in (1, 2))
     assert forked.report.history == serial.report.history
     np.testing.assert_array_equal(forked.variables, serial.variables)
+
+
+def test_a_sthenic_search_on_the_coarse_grid_ends_where_the_fine_grid_alone_ends():
+    """The sthenic starts searched on the coarse grid and polished on the problem's end at
+    the optimum the problem's grid alone reaches from them (to 1e-9, relative), the end
+    evaluated on the problem's grid: at a speed of each end of the default sweep."""
+    from biped.optimization import optimize as module
+
+    for knee, speed in (("rolling", 0.15), ("revolute", 0.45)):
+        problem = GaitProblem(biped.Biped(ROBOT, knee), speed)
+        assert module.coarse_problem(problem).samples_per_half < problem.samples_per_half
+        searched = optimize(problem)
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(module, "COARSE_CRITERIA", ())
+            alone = optimize(problem)
+        assert searched.certified and alone.certified
+        assert searched.report.value == pytest.approx(alone.report.value, rel=1e-9)
+        assert searched.report.confirmed
+        fine = solver_for(problem).evaluate(searched.variables, speed)[0]
+        assert float(fine) == pytest.approx(searched.report.value, rel=1e-12)
+
+
+def test_only_the_sthenic_paper_spline_on_its_own_grid_is_searched_coarsely():
+    """The energy criteria (close local minima a polish does not keep), richer families and
+    grids asked for (an error bar's twice as many samples) are solved on their own grid."""
+    from biped.optimization.optimize import coarse_problem
+
+    model = biped.Biped(ROBOT, "rolling")
+    assert coarse_problem(GaitProblem(model, 0.3)) is not None
+    assert coarse_problem(GaitProblem(model, 0.3, "energy-per-metre")) is None
+    assert coarse_problem(GaitProblem(model, 0.3, knots=3)) is None
+    assert coarse_problem(GaitProblem(model, 0.3, samples_per_half=50)) is None
+
+
+def test_starts_at_one_coarse_optimum_are_polished_once_and_others_apart():
+    """Searches ending at one value (within AGREEMENT) share one polish; a search at another
+    value is polished from its own end; one that did not converge is solved from its start
+    on the problem's grid. Each end counts the iterations of both grids."""
+    from biped.optimization.optimize import coarse_to_fine
+    from biped.optimization.solver import Solution
+
+    def solution(value, status="Solve_Succeeded", iterations=10):
+        return Solution(np.array([value]), value, status, iterations, 0.0, 0.0, 0.5)
+
+    searches = {
+        1.0: solution(10.0),
+        2.0: solution(10.0 * (1 + AGREEMENT / 10)),
+        3.0: solution(12.0),
+        4.0: solution(11.0, "Maximum_Iterations_Exceeded"),
+    }
+    polished = []
+
+    def polish(start, barrier):
+        polished.append((float(start[0]), barrier))
+        return solution(float(start[0]) - 1, iterations=5)
+
+    candidates = [(f"start {z:g}", np.array([z])) for z in searches]
+    ends = coarse_to_fine(candidates, lambda z, _: searches[float(z[0])], polish, jobs=1)
+    assert polished == [(10.0, "adaptive"), (12.0, "adaptive"), (4.0, "adaptive")]
+    assert [end.value for end in ends] == [9.0, 9.0, 11.0, 3.0]
+    assert [end.iterations for end in ends] == [15, 15, 15, 15]

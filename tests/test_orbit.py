@@ -48,7 +48,9 @@ def test_the_optimal_gaits_walk_a_stable_orbit(knee):
     assert result.failure is None and result.verdict == "stable", o.notes(result)
     assert m.radius < 1.0 and m.upper < 1.0
     assert 0.0 < m.spread < 0.2  # the landing's noise, averaged over the grid
-    assert m.flow_gain < 0.1 * m.radius  # the flow is mapped to (nearly) 0: the section
+    # the flow is mapped to 0 within the grid's noise, which leaves 1 (a map that kept the
+    # flow, test_a_map_that_keeps_the_flow_is_told_by_its_gain) far out
+    assert m.flow_gain < o.MARGIN_SPREADS * m.flow_noise and o.MARGIN_SPREADS * m.flow_noise < 0.5
     assert abs(result.period_ratio - 1.0) < 0.03
     distance = np.abs(result.fixed_point - result.file_state)
     assert distance[:6].max() < 0.01 and distance[6:].max() < 0.1  # rad, rad/s
@@ -222,3 +224,21 @@ def test_a_boundary_at_a_value_without_orbit_says_why():
         "  boundary: unstable at speed x 0, stable at speed x 0.25; at speed x 0 the walk did "
         "not reach the section in step 2"
     ]
+
+
+def test_a_map_that_keeps_the_flow_is_told_by_its_gain():
+    """The flow's gain tells a section that removes the flow (J f = 0 within the noise)
+    from a map that keeps it (J f = f, gain 1), on responses with the grid's noise."""
+    rng = np.random.default_rng(3)
+    steps = o.Steps()
+    flow = rng.standard_normal(12) * steps.vector()
+    basis = o.section_basis(flow, steps)
+    scale = steps.vector()[:, None]
+    jacobian = 0.5 * np.eye(12)  # any contraction across the flow
+    for kept in (0.0, 1.0):
+        mean = jacobian @ basis * scale  # responses to the basis times the steps
+        mean[:, 0] = kept * basis[:, 0] * steps.vector()
+        noise = 0.1 * rng.standard_normal((o.PHASES, 12, 12)) * scale
+        m = o.multipliers(mean + noise, basis, steps)
+        removed = m.flow_gain < o.MARGIN_SPREADS * m.flow_noise
+        assert removed == (kept == 0.0), (kept, m.flow_gain, m.flow_noise)

@@ -26,8 +26,8 @@ contact holds) and the rolling knee's equality are not coordinates: a perturbed 
 the reference state's (``ReturnMap.lift``: the walk's mean state on the section), so a
 perturbation never lifts the stance foot or pushes it into the floor. The section fixes one
 more direction, the flow along the orbit: a state moved along it reaches the same next state
-(J f = 0, a structural multiplier 0, measured as ``Multipliers.flow_gain``, 0.04-0.07 for the
-optimal gaits). The dynamic multipliers are those of J on the 11 directions across the flow
+(J f = 0, a structural multiplier 0, measured as ``Multipliers.flow_gain``: within about
+its noise, ``Multipliers.flow_noise``, for the optimal gaits). The dynamic multipliers are those of J on the 11 directions across the flow
 (``section_basis``), along which the map is perturbed.
 
 The closed loop carries nothing else across steps: the controller reads the phase from the
@@ -309,6 +309,9 @@ class Multipliers:
             coordinates (rad, rad/s), scaled so that its largest component over its step
             (``Steps``) is 1: a perturbation of about one step.
         flow_gain: |J f| / |f| in the coordinates over their steps: the structural 0.
+        flow_noise: what the grid's noise alone gives ``flow_gain`` (the root sum of squares
+            of the standard errors of J f's components over the grid positions): a true 0
+            measures about this.
         spread: the standard deviation of ``radius`` over ``BOOTSTRAP`` resamplings of the
             grid positions.
     """
@@ -317,6 +320,7 @@ class Multipliers:
     vectors: np.ndarray
     flow_gain: float
     spread: float
+    flow_noise: float = float("nan")
 
     @property
     def radius(self) -> float:
@@ -342,14 +346,18 @@ def multipliers(responses: np.ndarray, basis: np.ndarray, steps: Steps, seed=0) 
     order = np.argsort(-np.abs(values), kind="stable")
     values, vectors = values[order], across @ vectors[:, order]
     vectors = vectors / vectors[np.abs(vectors).argmax(axis=0), np.arange(11)]
-    flow_gain = float(np.linalg.norm(responses.mean(axis=0)[:, 0] / scale))
+    flow = responses[:, :, 0] / scale  # (phases, 12): J f at each grid position
+    flow_gain = float(np.linalg.norm(flow.mean(axis=0)))
+    flow_noise = float(np.linalg.norm(flow.std(axis=0, ddof=1) / np.sqrt(len(flow))))
     rng = np.random.default_rng(seed)
     phases = len(responses)
     radii = [
         np.abs(np.linalg.eigvals(block(responses[rng.integers(0, phases, phases)].mean(0)))).max()
         for _ in range(BOOTSTRAP)
     ]
-    return Multipliers(values, vectors * scale[:, None], flow_gain, float(np.std(radii)))
+    return Multipliers(
+        values, vectors * scale[:, None], flow_gain, float(np.std(radii)), flow_noise
+    )
 
 
 @dataclass(frozen=True)
@@ -493,6 +501,7 @@ def figures(result: Orbit) -> dict:
         multipliers_imag=m.values.imag.tolist(),
         multipliers_modulus=np.abs(m.values).tolist(),
         flow_multiplier=m.flow_gain,
+        flow_multiplier_noise=m.flow_noise,
         coordinates=list(COORDINATES),
         slowest_mode_real=mode.real.tolist(),
         slowest_mode_imag=mode.imag.tolist(),

@@ -75,6 +75,7 @@ class OrbitFigures:
     multipliers_imag: list | None = unit_field(PURE, default=None)
     multipliers_modulus: list | None = unit_field(PURE, default=None)
     flow_multiplier: float | None = unit_field(PURE, default=None)
+    flow_multiplier_noise: float | None = unit_field(PURE, default=None)
     coordinates: list | None = None
     slowest_mode_real: list | None = unit_field(SECTION_UNITS, default=None)
     slowest_mode_imag: list | None = unit_field(SECTION_UNITS, default=None)

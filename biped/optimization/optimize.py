@@ -290,7 +290,7 @@ def perturbed(guess, rng: np.random.Generator, knots: int = 1) -> np.ndarray:
     return np.clip(z, lower, upper)
 
 
-def multistart(candidates, solve, seed: int, began: float, jobs: int | None = None):
+def multistart(candidates, solve, seed: int, began: float, jobs: int | None = None, search=None):
     """The best solution from the starts ``candidates`` and its ``Report``: the multistart of
     gaits (``optimize``) and designs (``biped.optimization.design``), each giving its starts
     and what solves one.
@@ -302,6 +302,9 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
         began: ``time.perf_counter()`` when the search began, for the report's seconds.
         jobs: processes solving the starts at once (``biped.runtime.runner.run_forked``;
             default ``biped.runtime.runner.free_cores()``); the result is the same.
+        search: ``search(start, barrier)`` -> ``Solution`` on a coarser grid: each start
+            is searched there, then polished by ``solve`` (``coarse_to_fine``); None: each
+            start solved by ``solve`` alone.
 
     Returns:
         (best, report): the converged solution of least value (of every solution when none
@@ -310,7 +313,10 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
     if not candidates:
         raise BipedError("no start: allowed starts >= 1 or given starts")
     jobs = free_cores() if jobs is None else jobs
-    ends = run_forked(lambda c: solve(c[1], barrier_of(c[0])), list(candidates), jobs)
+    if search is None:
+        ends = run_forked(lambda c: solve(c[1], barrier_of(c[0])), list(candidates), jobs)
+    else:
+        ends = coarse_to_fine(list(candidates), search, solve, jobs)
     solutions = list(zip([kind for kind, _ in candidates], ends, strict=True))
     converged = [s for _, s in solutions if s.converged]
     pool = converged or [s for _, s in solutions]
@@ -332,9 +338,73 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
     return best, report
 
 
+def coarse_to_fine(candidates, search, solve, jobs: int) -> list:
+    """The end of each start (kind, z) of ``candidates``: searched on the coarse grid
+    (``search``), then polished from there on the problem's own (``solve``, IPOPT's adaptive
+    barrier). Starts whose searches end at one value (within ``AGREEMENT``) are one coarse
+    optimum, polished once: they share its end. A search that did not converge is solved on
+    the problem's grid from its start instead. Each end counts the iterations and seconds of
+    both grids."""
+    searched = run_forked(lambda c: search(c[1], barrier_of(c[0])), candidates, jobs)
+    groups = []  # [index of the search polished, indices of the starts sharing it]
+    for index, end in enumerate(searched):
+        shared = next(
+            (
+                g
+                for g in groups
+                if end.converged
+                and searched[g[0]].converged
+                and abs(end.value - searched[g[0]].value) <= AGREEMENT * abs(end.value)
+            ),
+            None,
+        )
+        if shared is None:
+            groups.append([index, [index]])
+        else:
+            shared[1].append(index)
+
+    def polish(group):
+        first = searched[group[0]]
+        if first.converged:
+            return solve(first.variables, "adaptive")
+        return solve(candidates[group[0]][1], barrier_of(candidates[group[0]][0]))
+
+    polished = run_forked(polish, groups, jobs)
+    ends = [None] * len(candidates)
+    for (_, members), end in zip(groups, polished, strict=True):
+        for index in members:
+            ends[index] = dataclasses.replace(
+                end,
+                iterations=searched[index].iterations + end.iterations,
+                seconds=searched[index].seconds + end.seconds,
+            )
+    return ends
+
+
+# Samples per spline piece of the coarse grid a sthenic optimum is searched on before it is
+# polished on the problem's (``coarse_to_fine``): an iteration there costs about half, and
+# from its optimum the polish takes 17-19 iterations, where a start takes 35-100 on the fine
+# grid alone (``benchmarks/bench_optimize.py``). The energy criteria's landscape has close
+# local minima that a polish from the coarse optimum does not keep: solved on their own grid.
+COARSE_SAMPLES_PER_HALF = 8
+COARSE_CRITERIA = ("sthenic",)
+
+
+def coarse_problem(problem: GaitProblem) -> GaitProblem | None:
+    """The problem on the coarse grid its starts are searched on, or None: it is solved on
+    its own (another criterion than ``COARSE_CRITERIA``, a richer family than the paper's
+    spline, or a grid that is not the default)."""
+    own = dataclasses.replace(problem, samples_per_half=None).samples_per_half
+    default = problem.samples_per_half == own
+    if problem.criterion not in COARSE_CRITERIA or problem.knots != 1 or not default:
+        return None
+    return dataclasses.replace(problem, samples_per_half=COARSE_SAMPLES_PER_HALF)
+
+
 def prepare(problem: GaitProblem) -> float:
     """Build the solvers an optimization of ``problem`` needs (``solver_for``, once per
-    process: the energy criterion's sthenic twin's too) with both barriers; returns the
+    process: the energy criterion's sthenic twin's too, and the coarse grid's of a sthenic
+    search, ``coarse_problem``) with both barriers; returns the
     seconds it took (0 when they were built already)."""
     began = time.perf_counter()
     criteria = (
@@ -350,6 +420,9 @@ def prepare(problem: GaitProblem) -> float:
             solver_for(family if knots == 1 or family == problem else family).prepare(
                 ("adaptive", "monotone")
             )
+            coarse = coarse_problem(family)
+            if coarse is not None:
+                solver_for(coarse).prepare(("adaptive", "monotone"))
     return time.perf_counter() - began
 
 
@@ -420,8 +493,22 @@ def optimize(
         except BipedError:
             continue  # a Nelder-Mead point out of reach starts nothing
     solver.prepare({barrier_of(kind) for kind, _ in candidates})
+    search = None
+    coarse = coarse_problem(problem) if solvers is None else None
+    if coarse is not None:
+        coarse_solver = solver_for(coarse)
+        coarse_solver.prepare({barrier_of(kind) for kind, _ in candidates})
+
+        def search(z, barrier):
+            return coarse_solver.solve(coarse, z, barrier=barrier)
+
     best, report = multistart(
-        candidates, lambda z, barrier: solver.solve(problem, z, barrier=barrier), seed, began, jobs
+        candidates,
+        lambda z, barrier: solver.solve(problem, z, barrier=barrier),
+        seed,
+        began,
+        jobs,
+        search,
     )
     return checked(problem, best.variables, report)
 
