@@ -27,8 +27,9 @@ the reference state's (``ReturnMap.lift``: the walk's mean state on the section)
 perturbation never lifts the stance foot or pushes it into the floor. The section fixes one
 more direction, the flow along the orbit: a state moved along it reaches the same next state
 (J f = 0, a structural multiplier 0, measured as ``Multipliers.flow_gain``: within about
-its noise, ``Multipliers.flow_noise``, for the optimal gaits). The dynamic multipliers are those of J on the 11 directions across the flow
-(``section_basis``), along which the map is perturbed.
+its noise, ``Multipliers.flow_noise``, for the optimal gaits). The dynamic multipliers are
+those of J on the 11 directions across the flow (``section_basis``), along which the map
+is perturbed.
 
 The closed loop carries nothing else across steps: the controller reads the phase from the
 state at each reading (``RESYNC``), its speed loop is proportional (no memory), the gains
