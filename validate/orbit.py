@@ -349,7 +349,11 @@ def multipliers(responses: np.ndarray, basis: np.ndarray, steps: Steps, seed=0) 
     vectors = vectors / vectors[np.abs(vectors).argmax(axis=0), np.arange(11)]
     flow = responses[:, :, 0] / scale  # (phases, 12): J f at each grid position
     flow_gain = float(np.linalg.norm(flow.mean(axis=0)))
-    flow_noise = float(np.linalg.norm(flow.std(axis=0, ddof=1) / np.sqrt(len(flow))))
+    flow_noise = (  # one grid position has no spread to measure
+        float(np.linalg.norm(flow.std(axis=0, ddof=1) / np.sqrt(len(flow))))
+        if len(flow) > 1
+        else float("nan")
+    )
     rng = np.random.default_rng(seed)
     phases = len(responses)
     radii = [
