@@ -506,7 +506,8 @@ def figures(result: Orbit) -> dict:
         multipliers_imag=m.values.imag.tolist(),
         multipliers_modulus=np.abs(m.values).tolist(),
         flow_multiplier=m.flow_gain,
-        flow_multiplier_noise=m.flow_noise,
+        # not measured (None, left out of the JSON) on a single grid position
+        flow_multiplier_noise=m.flow_noise if np.isfinite(m.flow_noise) else None,
         coordinates=list(COORDINATES),
         slowest_mode_real=mode.real.tolist(),
         slowest_mode_imag=mode.imag.tolist(),
