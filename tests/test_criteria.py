@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from scipy.integrate import quad
+from scipy.integrate import quad, simpson
 
 import biped
 from biped.model.criteria import (
@@ -11,8 +11,9 @@ from biped.model.criteria import (
     constraints,
     evaluate_step,
     penalty_rate,
+    simpson_weights,
 )
-from biped.model.gait import build_step, evaluate
+from biped.model.gait import breakpoints, build_step, evaluate
 from biped.optimization.problem import GaitProblem
 
 SPEED = 0.3
@@ -25,6 +26,32 @@ def torques_at(model, step, t):
     angles, rates, accel = evaluate(step, t_n, piece)
     q, qd, qdd = model.stance_state(angles, rates, accel)
     return model.inverse_dynamics(q, qd, qdd)[0], model.joint_angles(qd)
+
+
+@pytest.mark.parametrize("knots", [1, 3, 5])
+@pytest.mark.parametrize("samples", [1, 2, 3, 8, 9, 13, 25, 34, 50, 100])
+def test_simpson_weights_are_scipys_rule_and_exact_where_simpson_is(knots, samples):
+    """The written-out weights equal scipy's Simpson's rule on each piece (to the rounding
+    of its sums), integrate every quadratic exactly (cubics too with an even number of
+    intervals), and repeat on every piece."""
+    n, length = samples + 1, breakpoints(knots)[1]
+    weights = simpson_weights(samples, knots)
+    x = np.linspace(0.0, length, n)
+    reference = simpson(np.eye(n), x=x, axis=-1)
+    assert weights.shape == (n * (knots + 1),)
+    np.testing.assert_allclose(weights[:n], reference, rtol=0, atol=1e-14 * length)
+    np.testing.assert_array_equal(
+        weights.reshape(knots + 1, n), np.tile(weights[:n], (knots + 1, 1))
+    )
+    degrees = range(4 if samples % 2 == 0 else 3) if n > 2 else range(2)
+    for degree in degrees:
+        exact = length ** (degree + 1) / (degree + 1)
+        assert weights[:n] @ x**degree == pytest.approx(exact, rel=1e-13), degree
+
+
+def test_simpson_weights_refuse_an_empty_piece():
+    with pytest.raises(biped.BipedError, match="samples per half = 0"):
+        simpson_weights(0)
 
 
 def test_criteria_match_adaptive_quadrature(model):

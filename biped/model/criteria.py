@@ -29,7 +29,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import simpson
 
 from biped.errors import BipedError
 from biped.model.actuators import LIMITS, Actuators, Drive, drive, limit_margins
@@ -173,11 +172,25 @@ def clearance_profile(samples_per_half: int, clearance: float, knots: int = 1) -
 def simpson_weights(samples_per_half: int, knots: int = 1) -> np.ndarray:
     """Weights w with Σ w f(t_n) = Simpson's rule on every piece of the normalised grid.
 
-    Simpson's rule is linear in the samples, so scipy's rule applied to the identity gives
-    its weights once for all.
+    On each piece of n = samples + 1 evenly spaced samples h apart: h/3 (1, 4, 2, ..., 4, 1)
+    for an odd n; for an even n the same on the first n - 1 and Cartwright's parabola
+    through the last three on the last interval, h (-1, 8, 5)/12: the rule of
+    ``scipy.integrate.simpson`` (``tests/test_criteria.py`` holds them equal), written out
+    because importing scipy's integrators costs every process 0.6 s.
     """
+    if samples_per_half < 1:
+        raise BipedError(f"samples per half = {samples_per_half}: allowed 1 or more")
     n = samples_per_half + 1
-    piece = simpson(np.eye(n), x=np.linspace(0.0, breakpoints(knots)[1], n), axis=-1)
+    h = breakpoints(knots)[1] / samples_per_half
+    piece = np.zeros(n)
+    if n == 2:
+        piece[:] = h / 2
+    else:
+        odd = n if n % 2 else n - 1  # samples of the composite rule
+        piece[:odd] += np.array([1.0] + [4.0, 2.0] * ((odd - 3) // 2) + [4.0, 1.0]) * h / 3
+        if odd < n:
+            piece[-3:] += np.array([-1.0, 8.0, 5.0]) * h / 12
+    piece.setflags(write=False)
     return np.concatenate([piece] * (knots + 1))
 
 

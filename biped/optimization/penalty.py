@@ -16,7 +16,6 @@ for the benchmark that compares the two.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize
 
 from biped.errors import UnreachableError
 from biped.model.criteria import (
@@ -106,6 +105,14 @@ class _Polish:
 
     def constraints(self, z):
         return self._evaluate(z)[1]
+
+
+def minimize(*args, **kwargs):
+    """``scipy.optimize.minimize``, imported on first use: importing it costs every process
+    0.2 s, and an optimization by IPOPT needs none of it."""
+    from scipy.optimize import minimize as scipy_minimize
+
+    return scipy_minimize(*args, **kwargs)
 
 
 def polish(problem: GaitProblem, parameters, max_iterations=POLISH_ITERATIONS):
