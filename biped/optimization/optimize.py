@@ -404,8 +404,8 @@ def coarse_problem(problem: GaitProblem) -> GaitProblem | None:
 def prepare(problem: GaitProblem) -> float:
     """Build the solvers an optimization of ``problem`` needs (``solver_for``, once per
     process: the energy criterion's sthenic twin's too, and the coarse grid's of a sthenic
-    search, ``coarse_problem``) with both barriers; returns the
-    seconds it took (0 when they were built already)."""
+    search, ``coarse_problem``) with the barriers its starts are solved with
+    (``barriers_of``); returns the seconds it took (0 when they were built already)."""
     began = time.perf_counter()
     criteria = (
         {problem.criterion, "sthenic"}
@@ -417,13 +417,18 @@ def prepare(problem: GaitProblem) -> float:
             family = dataclasses.replace(
                 problem, criterion=criterion, knots=knots, samples_per_half=None
             )
-            solver_for(family if knots == 1 or family == problem else family).prepare(
-                ("adaptive", "monotone")
-            )
+            solver_for(family).prepare(barriers_of(family))
             coarse = coarse_problem(family)
             if coarse is not None:
-                solver_for(coarse).prepare(("adaptive", "monotone"))
+                solver_for(coarse).prepare(barriers_of(coarse))
     return time.perf_counter() - began
+
+
+def barriers_of(problem: GaitProblem) -> tuple[str, ...]:
+    """The barriers (``barrier_of``) the starts of an optimization of ``problem`` are solved
+    with: the adaptive one, and for the criteria of work the monotone one too (their table
+    start, ``table_starts``, and the energy per step's first guesses)."""
+    return ("adaptive", "monotone") if problem.criterion in WORK_CRITERIA else ("adaptive",)
 
 
 def optimize(
