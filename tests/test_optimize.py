@@ -397,12 +397,15 @@ def test_solver_that_does_not_converge_fails_loudly(tmp_path, monkeypatch, capsy
         ("rolling", "energy", None, 3),
     ],
 )
-def test_hessian_built_sample_by_sample_is_casadis_hessian(knee, criterion, radii, knots):
-    """The Hessian of the Lagrangian that IPOPT uses (built per sample and chained through
-    the head, ``biped.optimization.hessian``) equals CasADi's own Hessian of the whole NLP
-    to 1e-12 at random variables and multipliers, with a clearance margin, a design's radii
-    and the energy criterion's slacks; another robot's differs."""
-    from biped.optimization.hessian import dense, full_hessian
+def test_derivatives_built_sample_by_sample_are_casadis(knee, criterion, radii, knots):
+    """The derivatives IPOPT uses (built per sample and chained through the head,
+    ``biped.optimization.derivatives``): the Hessian of the Lagrangian, the constraints'
+    Jacobian and the objective's gradient, equal CasADi's own of the whole NLP to 1e-12 at
+    random variables and multipliers, with a clearance margin, a design's radii and the energy
+    criterion's slacks, the Jacobian's sparsity holding every nonzero of CasADi's, the gradient
+    dense; another
+    robot's differ."""
+    from biped.optimization.derivatives import dense, full_hessian
     from biped.optimization.solver import Solver
 
     model = biped.Biped(UNEQUAL, knee)
@@ -412,6 +415,7 @@ def test_hessian_built_sample_by_sample_is_casadis_hessian(knee, criterion, radi
     x, p = oracle.sx_in(0), oracle.sx_in(1)
     f, g = oracle.call([x, p])[:2]
     reference = full_hessian(x, p, f, g)
+    first = ca.Function("first", [x, p], [f, ca.gradient(f, x), g, ca.jacobian(g, x)])
     rng = np.random.default_rng(4)
     problem = GaitProblem(model, 0.3, criterion, knots=knots)
     for _ in range(2):
@@ -421,16 +425,28 @@ def test_hessian_built_sample_by_sample_is_casadis_hessian(knee, criterion, radi
         expected = dense(reference(xs, 0.3, 1.7, lam_g))
         found = dense(solver.hessian(xs, 0.3, 1.7, lam_g))
         np.testing.assert_allclose(found, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+        value, gradient, constraints, jacobian = map(dense, first(xs, 0.3))
+        chained = [dense(m) for m in (*solver.gradient(xs, 0.3), *solver.jacobian(xs, 0.3))]
+        for found_, expected_ in zip(
+            chained, (value, gradient, constraints, jacobian), strict=True
+        ):
+            scale = np.abs(expected_).max()
+            np.testing.assert_allclose(found_, expected_, rtol=0, atol=1e-12 * scale)
+    pattern = np.asarray(ca.DM(solver.jacobian.sparsity_out(1), 1))
+    assert np.all(pattern[jacobian != 0] == 1)
+    assert solver.gradient.sparsity_out(1).is_dense()  # IPOPT reads it as a dense vector
     heavier = dataclasses.replace(UNEQUAL, trunk_mass=1.1 * UNEQUAL.trunk_mass)
     other = Solver(biped.Biped(heavier, knee), criterion, Safety(clearance=0.02), 6, bounds_, knots)
     wrong = dense(other.hessian(xs, 0.3, 1.7, lam_g))  # another robot's: told apart
     assert np.abs(wrong - expected).max() > 1e-6 * np.abs(expected).max()
+    wrong = dense(other.jacobian(xs, 0.3)[1])
+    assert np.abs(wrong - jacobian).max() > 1e-6 * np.abs(jacobian).max()
 
 
 def test_hessian_needs_an_nlp_linear_in_the_samples_quantities():
     """The sample-by-sample Hessian holds only for an objective linear in the samples'
     quantities; another is refused, not differentiated wrongly."""
-    from biped.optimization.hessian import lagrangian_hessian
+    from biped.optimization.derivatives import lagrangian_hessian
 
     graph = StepGraph(biped.Biped(ROBOT, "revolute"), 4, PAPER_SAFETY)
     x = ca.SX.sym("x", 21)

@@ -1,10 +1,10 @@
 """Optimal gaits: the nonlinear program of one step (``problem``), its exact CasADi graph built
-from the model's own constants (``symbolic``) and its Hessian sample by sample (``hessian``),
-IPOPT on it (``solver``), the paper's penalised Nelder-Mead (``penalty``), the multistart
-optimizer (``optimize``) with the shipped table of optima among its starts (``table``), the
-knee radii designed with the gait (``design``), and the words and sign with which optima are
-compared (``comparison``: a difference between knees, "certified", the two grids of a
-criterion).
+from the model's own constants (``symbolic``) and its derivatives sample by sample
+(``derivatives``), IPOPT on it (``solver``), the paper's penalised Nelder-Mead (``penalty``),
+the multistart optimizer (``optimize``) with the shipped table of optima among its starts
+(``table``), the knee radii designed with the gait (``design``), and the words and sign with
+which optima are compared (``comparison``: a difference between knees, "certified", the two
+grids of a criterion).
 
 May import: ``biped.model``, ``biped.runtime``, ``biped.errors``, numpy, scipy, casadi.
 """

@@ -1,23 +1,30 @@
-"""The Hessian of the Lagrangian of a step's NLP, built sample by sample (IPOPT's ``hess_lag``).
+"""The derivatives of a step's NLP IPOPT uses, built sample by sample: the Hessian of the
+Lagrangian (``hess_lag``), the constraints' Jacobian (``jac_g``) and the objective's gradient
+(``grad_f``).
 
 The solver's NLP (``biped.optimization.solver``) has variables x (the scaled gait
 variables, the knee radii of a design, the energy criterion's slacks) and the parameter p
 (the speed). Its objective f and constraints g are written on the step's head h(x)
 (``StepGraph.head``: spline coefficients, T, radii, hip height), on the samples' quantities
-Q (``StepGraph.quantities``), on x and on p, linearly in Q; sample j's quantities are
-Q_j = sample(B_j h(x)), B_j a constant matrix (``StepGraph.basis``). With
-L = λ_f f + λ_gᵀ g, whose weights of the quantities M = ∂L/∂Q then depend on λ and p alone:
+Q (``StepGraph.quantities``), on x and on p; sample j's quantities are
+Q_j = sample(B_j h(x)), B_j a constant matrix (``StepGraph.basis``). The chain rule through
+the samples and the head gives the first derivatives of any e(Q, h, x, p),
+
+    de/dx = ∂e/∂Q · diag_j(∂sample/∂v (v_j)) · B · J + ∂e/∂h · J + ∂e/∂x,    J = ∂h/∂x,
+
+and, with f and g linear in Q, so that L = λ_f f + λ_gᵀ g weighs the quantities by
+M = ∂L/∂Q depending on λ and p alone, the second:
 
     ∇²L = Jᵀ (Σ_j B_jᵀ ∇²_v (M_j · sample)(v_j) B_j) J + ∇²_x (G · h(x)) + Aᵀ (∇²_w L) A
 
-with J = ∂h/∂x, G = Σ_j B_jᵀ ∇_v (M_j · sample)(v_j) + ∂L/∂h held fixed in the second
-term, w = (h, x) the other arguments of f and g and A = ∂w/∂x = [J; I].
+with G = Σ_j B_jᵀ ∇_v (M_j · sample)(v_j) + ∂L/∂h held fixed in the second term,
+w = (h, x) the other arguments of f and g and A = ∂w/∂x = [J; I].
 
-CasADi's own Hessian of the whole graph differentiates every sample with respect to all of
-x, twice; here each sample is differentiated in its own 19 inputs (21 with the radii) by one
-small function mapped over the samples, and the chain rule through the head is applied
-once. The same matrix (a test holds them equal to 1e-12), built in a fraction of the time
-and cheaper per call (``benchmarks/bench_optimize.py``).
+CasADi's own derivatives of the whole graph differentiate every sample with respect to all
+of x (its Hessian twice); here each sample is differentiated in its own 19 inputs (21 with
+the radii) by one small function mapped over the samples, and the chain rule through the
+head is applied once. The same matrices (tests hold them equal to 1e-12), built in a
+fraction of the time and cheaper per call (``benchmarks/bench_optimize.py``).
 """
 
 from __future__ import annotations
@@ -87,6 +94,64 @@ def lagrangian_hessian(graph: StepGraph, x, p, head, f, g) -> ca.Function:
         ["x", "p", "lam_f", "lam_g"],
         ["hess_gamma_x_x"],
     )
+
+
+def constraint_jacobian(graph: StepGraph, x, p, head, g) -> ca.Function:
+    """IPOPT's ``jac_g``: (x, p) -> (g, ∂g/∂x), chained through the samples' Jacobians
+    (forward) and the head.
+
+    Args: as ``lagrangian_hessian``'s; ``g`` may be any expression of the samples'
+    quantities, the head, x and p.
+    """
+    quantities = ca.vec(graph.quantities)
+    v = ca.SX.sym("v", graph.sample.size1_in(0))
+    sample = ca.Function("sample", [v], [graph.sample(v), ca.jacobian(graph.sample(v), v)])
+    tail = ca.Function(
+        "tail",
+        [quantities, graph.head_symbol, x, p],
+        [g, ca.jacobian(g, quantities), ca.jacobian(g, graph.head_symbol), ca.jacobian(g, x)],
+    )
+    X, P, h, J, basis, inputs = _head(graph, x, p, head)
+    values, blocks = sample.map(inputs.shape[1])(inputs)
+    per_sample = ca.diagcat(*ca.horzsplit(blocks, v.shape[0]))  # ∂Q/∂v, block-diagonal
+    value, by_quantities, by_head, by_x = tail(ca.vec(values), h, X, P)
+    jacobian = by_quantities @ (per_sample @ (basis @ J)) + by_head @ J + by_x
+    return ca.Function("nlp_jac_g", [X, P], [value, jacobian], ["x", "p"], ["g", "jac_g_x"])
+
+
+def objective_gradient(graph: StepGraph, x, p, head, f) -> ca.Function:
+    """IPOPT's ``grad_f``: (x, p) -> (f, ∇_x f), chained through each sample's gradient of
+    its quantities weighted by M_j = ∂f/∂Q_j (reverse) and the head; dense, as IPOPT reads
+    it. ``f`` linear in the samples' quantities (M on the head, x and p alone)."""
+    quantities = graph.quantities
+    v = ca.SX.sym("v", graph.sample.size1_in(0))
+    w = ca.SX.sym("w", quantities.shape[0])
+    sample = ca.Function(
+        "sample", [v, w], [graph.sample(v), ca.gradient(ca.dot(w, graph.sample(v)), v)]
+    )
+    weights = ca.reshape(ca.gradient(f, ca.vec(quantities)), quantities.shape)
+    if ca.depends_on(weights, ca.vec(quantities)):
+        raise ValueError("the objective is not linear in the samples' quantities")
+    rest = [ca.vec(quantities), graph.head_symbol, x, p]
+    tail = ca.Function("tail", rest, [f, ca.gradient(f, graph.head_symbol), ca.gradient(f, x)])
+    head_weights = ca.Function("weights", rest[1:], [weights])
+    X, P, h, J, basis, inputs = _head(graph, x, p, head)
+    values, per_sample = sample.map(inputs.shape[1])(inputs, head_weights(h, X, P))
+    value, by_head, by_x = tail(ca.vec(values), h, X, P)
+    gradient = ca.densify(J.T @ (basis.T @ ca.vec(per_sample) + by_head) + by_x)
+    return ca.Function("nlp_grad_f", [X, P], [value, gradient], ["x", "p"], ["f", "grad_f_x"])
+
+
+def _head(graph: StepGraph, x, p, head):
+    """MX symbols X, P of the NLP's variables and parameter, the head h and J = ∂h/∂x on
+    them, the samples' basis and their inputs (one column per sample)."""
+    head_function = ca.Function("head", [x, p], [head, ca.jacobian(head, x)])
+    X, P = ca.MX.sym("x", x.shape[0]), ca.MX.sym("p")
+    h, J = head_function(X, P)
+    basis = ca.sparsify(ca.DM(graph.basis))
+    width = graph.sample.size1_in(0)
+    inputs = ca.reshape(basis @ h, width, graph.basis.shape[0] // width)
+    return X, P, h, J, basis, inputs
 
 
 def full_hessian(x, p, f, g) -> ca.Function:

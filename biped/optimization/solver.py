@@ -38,7 +38,11 @@ from biped.errors import BipedError
 from biped.model.criteria import Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import Robot
-from biped.optimization.hessian import lagrangian_hessian
+from biped.optimization.derivatives import (
+    constraint_jacobian,
+    lagrangian_hessian,
+    objective_gradient,
+)
 from biped.optimization.problem import GaitProblem, bounds, scales, variable_names
 from biped.optimization.symbolic import StepGraph
 from biped.runtime.interrupts import kept_interrupts
@@ -171,6 +175,8 @@ class Solver:
         head = ca.substitute(graph.head, ca.vertcat(*unknowns), ca.vertcat(*scaled))
         flat = ca.substitute([graph.flat(ca.vertcat(objective, g))], unknowns, scaled)[0]
         self.hessian = lagrangian_hessian(graph, x, graph.speed, head, objective, g)
+        self.jacobian = constraint_jacobian(graph, x, graph.speed, head, g)
+        self.gradient = objective_gradient(graph, x, graph.speed, head, objective)
         nlp = {"x": x, "p": graph.speed, "f": flat[0], "g": flat[1:]}
         name = "design" if design else "gait"
         self.nlp = ca.nlpsol(name, "ipopt", nlp, self._options("adaptive"))
@@ -239,14 +245,11 @@ class Solver:
         return self._nlps[barrier]
 
     def _options(self, barrier: str) -> dict:
-        """nlpsol's options: ``IPOPT_OPTIONS`` with those of ``barrier``, the Hessian built
-        sample by sample (``biped.optimization.hessian``)."""
+        """nlpsol's options: ``IPOPT_OPTIONS`` with those of ``barrier``, the derivatives built
+        sample by sample (``biped.optimization.derivatives``)."""
         options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
         options.update({f"ipopt.{key}": value for key, value in BARRIERS[barrier].items()})
-        derivatives = {"hess_lag": self.hessian}
-        if hasattr(self, "nlp"):  # another barrier's: the same derivatives, built once
-            derivatives["jac_g"] = self.nlp.get_function("nlp_jac_g")
-            derivatives["grad_f"] = self.nlp.get_function("nlp_grad_f")
+        derivatives = {"hess_lag": self.hessian, "jac_g": self.jacobian, "grad_f": self.gradient}
         return {**options, "print_time": False, **derivatives}
 
     def _solve(self, problem, start, radii, hold_radii, barrier) -> Solution:

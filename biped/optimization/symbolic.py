@@ -276,7 +276,7 @@ def sample_function(c: _Constants, robot, safety, radii=None, motors=False) -> c
     T (, r1, r2)] -> the ``QUANTITIES`` (41,), with ``motors`` also the ``MOTOR_QUANTITIES``
     of ``robot.drive_actuators`` (53,). Every sample of a step is this function of a
     linear map of the step's head (``StepGraph.basis``), which lets the solver build the
-    Hessian of its Lagrangian sample by sample (``biped.optimization.hessian``)."""
+    Hessian of its Lagrangian sample by sample (``biped.optimization.derivatives``)."""
     motion, period = ca.SX.sym("motion", SAMPLE_MOTION), ca.SX.sym("period")
     angles = motion[:6]
     rates, accels = motion[6:12] / period, motion[12:] / period**2
