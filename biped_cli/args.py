@@ -75,6 +75,49 @@ def add_command(commands, name: str, help: str, run):
     return parser
 
 
+class Commands(dict):
+    """The subcommands' parsers by name (argparse's map of them, ``add_subparsers``), whose
+    arguments may be added when the parser is first looked up (``complete_later``): a
+    command then runs without the imports another's options need (MuJoCo's, 0.15 s)."""
+
+    def __init__(self):
+        super().__init__()
+        self.pending = {}  # name -> what completes its parser, in order
+
+    def complete_later(self, name: str, complete) -> None:
+        self.pending.setdefault(name, []).append(complete)
+
+    def __getitem__(self, name):
+        parser = super().__getitem__(name)
+        for complete in self.pending.pop(name, ()):
+            complete(parser)
+        return parser
+
+    def get(self, name, default=None):
+        return self[name] if name in self else default
+
+    def values(self):
+        return [self[name] for name in self]
+
+    def items(self):
+        return [(name, self[name]) for name in self]
+
+
+def lazy_commands(subcommands) -> Commands:
+    """Make the parsers of argparse's ``subcommands`` (not added yet) a ``Commands``."""
+    subcommands._name_parser_map = subcommands.choices = Commands()
+    return subcommands.choices
+
+
+def complete_later(commands, name: str, complete) -> None:
+    """Add the arguments of ``name``'s parser by ``complete(parser)`` when it is first looked
+    up (now when ``commands`` does not defer, ``Commands``)."""
+    if isinstance(commands.choices, Commands):
+        commands.choices.complete_later(name, complete)
+    else:
+        complete(commands.choices[name])
+
+
 # Gait files whose outputs share a name (named from their folder and file names).
 SAME_FOLDERS = "gait files in folders of the same name"
 

@@ -12,6 +12,7 @@ import sys
 
 from biped.records.provenance import command_line, version
 from biped_cli import atlas, commands, design, orbit, report, robustness, size
+from biped_cli.args import complete_later, lazy_commands
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
 
 DEBUG_HELP = "on an error, print its traceback before the one-line message"
@@ -49,6 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     subcommands = parser.add_subparsers(
         dest="command", required=True, metavar="COMMAND", parser_class=_Parser
     )
+    lazy_commands(subcommands)
     for add in (
         commands.add_demo,
         commands.add_optimize,
@@ -65,12 +67,14 @@ def build_parser() -> argparse.ArgumentParser:
         size.add_parser,
     ):
         add(subcommands)
-    for command in subcommands.choices.values():  # after the command too: biped demo --debug
-        command.add_argument(
-            "--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP
-        )
+    for name in subcommands.choices:  # after the command too: biped demo --debug
+        complete_later(subcommands, name, _add_debug)
     parser.command_parsers = subcommands.choices  # each command's own parser, by name
     return parser
+
+
+def _add_debug(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -74,11 +74,15 @@ def step(text: str) -> float:
 
 
 def add_parser(commands) -> None:
+    help = "Floquet multipliers of gaits' walks in MuJoCo: is the walk a stable orbit"
+    types.add_command(commands, "orbit", help, cmd_orbit)
+    types.complete_later(commands, "orbit", _add_arguments)
+
+
+def _add_arguments(parser) -> None:
     from validate.orbit import PHASES, RATE_STEP, STEP
     from validate.orbit_study import KNOBS
 
-    help = "Floquet multipliers of gaits' walks in MuJoCo: is the walk a stable orbit"
-    parser = types.add_command(commands, "orbit", help, cmd_orbit)
     types.add_gaits(parser)
     knobs = "; ".join(f"{name}: {scaled}" for name, (_, scaled) in KNOBS.items())
     parser.add_argument(

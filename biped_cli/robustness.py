@@ -31,11 +31,15 @@ SHOWN = {
 
 
 def add_parser(commands) -> None:
+    help = "robustness map of gaits in MuJoCo: pushes, friction, trunk mass, gains"
+    types.add_command(commands, "robustness", help, cmd_robustness)
+    types.complete_later(commands, "robustness", _add_arguments)
+
+
+def _add_arguments(parser) -> None:
     from validate.robustness import RobustnessSettings
 
     default = RobustnessSettings()
-    help = "robustness map of gaits in MuJoCo: pushes, friction, trunk mass, gains"
-    parser = types.add_command(commands, "robustness", help, cmd_robustness)
     types.add_gaits(parser)
     types.add_options(
         parser,

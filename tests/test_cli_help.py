@@ -134,3 +134,26 @@ def test_a_repeated_value_is_named(capsys, tmp_path, argv, named):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and named in err and "allowed" in err, err
     assert not out.exists()
+
+
+def test_a_solver_command_imports_neither_mujoco_nor_scipy(tmp_path):
+    """``biped optimize`` parses and runs without importing what other commands' options or
+    the paper's method need (MuJoCo, scipy, matplotlib: 0.8 s of every process); those
+    commands' parsers still get their options when they are looked up."""
+    import subprocess
+    import sys
+
+    script = (
+        "import sys\n"
+        "from biped_cli.main import build_parser, main\n"
+        "status = main(['optimize', '--knee', 'revolute', '--speed', '0.3', '--starts', '1',\n"
+        f"              '--out', {str(tmp_path / 'gait.json')!r}])\n"
+        "print(status, sorted({m.split('.')[0] for m in sys.modules} & "
+        "{'mujoco', 'scipy', 'matplotlib'}))\n"
+        "orbit = build_parser().command_parsers['orbit']\n"
+        "print(any('--phases' in a.option_strings for a in orbit._actions))\n"
+    )
+    lines = subprocess.run(
+        [sys.executable, "-c", script], check=True, capture_output=True, text=True
+    ).stdout.splitlines()
+    assert lines[-2:] == ["0 []", "True"]
