@@ -1,6 +1,7 @@
 """The derivatives of a step's NLP IPOPT uses, built sample by sample: the Hessian of the
-Lagrangian (``hess_lag``), the constraints' Jacobian (``jac_g``) and the objective's gradient
-(``grad_f``).
+Lagrangian (``hess_lag``) and the constraints' Jacobian (``jac_g``). (The objective's
+gradient is CasADi's reverse mode on the flat graph: cheaper a call than chained, 0.06-0.3
+ms against 0.8-0.9, and built in 0.04 s.)
 
 The solver's NLP (``biped.optimization.solver``) has variables x (the scaled gait
 variables, the knee radii of a design, the energy criterion's slacks) and the parameter p
@@ -117,29 +118,6 @@ def constraint_jacobian(graph: StepGraph, x, p, head, g) -> ca.Function:
     value, by_quantities, by_head, by_x = tail(ca.vec(values), h, X, P)
     jacobian = by_quantities @ (per_sample @ (basis @ J)) + by_head @ J + by_x
     return ca.Function("nlp_jac_g", [X, P], [value, jacobian], ["x", "p"], ["g", "jac_g_x"])
-
-
-def objective_gradient(graph: StepGraph, x, p, head, f) -> ca.Function:
-    """IPOPT's ``grad_f``: (x, p) -> (f, ∇_x f), chained through each sample's gradient of
-    its quantities weighted by M_j = ∂f/∂Q_j (reverse) and the head; dense, as IPOPT reads
-    it. ``f`` linear in the samples' quantities (M on the head, x and p alone)."""
-    quantities = graph.quantities
-    v = ca.SX.sym("v", graph.sample.size1_in(0))
-    w = ca.SX.sym("w", quantities.shape[0])
-    sample = ca.Function(
-        "sample", [v, w], [graph.sample(v), ca.gradient(ca.dot(w, graph.sample(v)), v)]
-    )
-    weights = ca.reshape(ca.gradient(f, ca.vec(quantities)), quantities.shape)
-    if ca.depends_on(weights, ca.vec(quantities)):
-        raise ValueError("the objective is not linear in the samples' quantities")
-    rest = [ca.vec(quantities), graph.head_symbol, x, p]
-    tail = ca.Function("tail", rest, [f, ca.gradient(f, graph.head_symbol), ca.gradient(f, x)])
-    head_weights = ca.Function("weights", rest[1:], [weights])
-    X, P, h, J, basis, inputs = _head(graph, x, p, head)
-    values, per_sample = sample.map(inputs.shape[1])(inputs, head_weights(h, X, P))
-    value, by_head, by_x = tail(ca.vec(values), h, X, P)
-    gradient = ca.densify(J.T @ (basis.T @ ca.vec(per_sample) + by_head) + by_x)
-    return ca.Function("nlp_grad_f", [X, P], [value, gradient], ["x", "p"], ["f", "grad_f_x"])
 
 
 def _head(graph: StepGraph, x, p, head):

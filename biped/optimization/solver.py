@@ -38,11 +38,7 @@ from biped.errors import BipedError
 from biped.model.criteria import Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import Robot
-from biped.optimization.derivatives import (
-    constraint_jacobian,
-    lagrangian_hessian,
-    objective_gradient,
-)
+from biped.optimization.derivatives import constraint_jacobian, lagrangian_hessian
 from biped.optimization.problem import GaitProblem, bounds, scales, variable_names
 from biped.optimization.symbolic import StepGraph
 from biped.runtime.interrupts import kept_interrupts
@@ -176,7 +172,12 @@ class Solver:
         flat = ca.substitute([graph.flat(ca.vertcat(objective, g))], unknowns, scaled)[0]
         self.hessian = lagrangian_hessian(graph, x, graph.speed, head, objective, g)
         self.jacobian = constraint_jacobian(graph, x, graph.speed, head, g)
-        self.gradient = objective_gradient(graph, x, graph.speed, head, objective)
+        # CasADi's reverse mode on the flat graph (cheaper a call than chained through the
+        # samples), dense as IPOPT reads it.
+        gradient = ca.densify(ca.gradient(flat[0], x))
+        self.gradient = ca.Function(
+            "nlp_grad_f", [x, graph.speed], [flat[0], gradient], ["x", "p"], ["f", "grad_f_x"]
+        )
         nlp = {"x": x, "p": graph.speed, "f": flat[0], "g": flat[1:]}
         name = "design" if design else "gait"
         self.nlp = ca.nlpsol(name, "ipopt", nlp, self._options("adaptive"))
