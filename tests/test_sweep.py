@@ -19,6 +19,9 @@ from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep, sweep_settings
 
 SPEEDS = (0.275, 0.3)
 FAST = dict(jobs=1)
+# Two processes: the module's sweep, and what an interrupted sweep resumes on (the files are
+# the same on any number of processes).
+TWO = dict(jobs=2)
 
 
 def _settings(robot=None, speeds=SPEEDS, seed=0, starts=1):
@@ -28,10 +31,10 @@ def _settings(robot=None, speeds=SPEEDS, seed=0, starts=1):
 
 @pytest.fixture(scope="module")
 def sweep(tmp_path_factory):
-    """A small sweep, both knees and both criteria, two speeds, one process."""
+    """A small sweep, both knees and both criteria, two speeds, two processes."""
     folder = tmp_path_factory.mktemp("sweep")
     log = io.StringIO()
-    run_sweep(folder, _settings(), stream=log, **FAST)
+    run_sweep(folder, _settings(), stream=log, **TWO)
     return folder, log.getvalue()
 
 
@@ -79,7 +82,8 @@ def test_interrupted_sweep_resumes_to_the_same_files(sweep, tmp_path, monkeypatc
     """A sweep stopped after any number of written files (in any stage: with both criteria,
     after 6 the energy optima started from the sthenic ones are being written), with a
     stale temporary file left behind, and run again ends with the files of an uninterrupted
-    sweep and no temporary file."""
+    sweep and no temporary file. It is stopped on one process (the files written
+    there are the ones counted), resumed on two."""
     folder, _ = sweep
     write = gait_file.write_json
     count = [0]
@@ -97,7 +101,7 @@ def test_interrupted_sweep_resumes_to_the_same_files(sweep, tmp_path, monkeypatc
     assert count[0] == after
     monkeypatch.setattr(gait_file, "write_json", write)
     (tmp_path / INDEPENDENT / ".rolling-sthenic-0.300.json.abc123.tmp").write_text('{"cut')
-    run_sweep(tmp_path, _settings(robot), criteria=criteria, stream=io.StringIO(), **FAST)
+    run_sweep(tmp_path, _settings(robot), criteria=criteria, stream=io.StringIO(), **TWO)
     expected = {k: v for k, v in _content(folder).items() if k.split("-")[1] in criteria}
     assert _content(tmp_path) == expected
     assert not list(tmp_path.rglob("*.tmp"))
