@@ -78,7 +78,7 @@ def add_command(commands, name: str, help: str, run):
 class Commands(dict):
     """The subcommands' parsers by name (argparse's map of them, ``add_subparsers``), whose
     arguments may be added when the parser is first looked up (``complete_later``): a
-    command then runs without the imports another's options need (MuJoCo's, 0.15 s)."""
+    command then runs without the imports another's options need (MuJoCo's)."""
 
     def __init__(self):
         super().__init__()
@@ -111,11 +111,8 @@ def lazy_commands(subcommands) -> Commands:
 
 def complete_later(commands, name: str, complete) -> None:
     """Add the arguments of ``name``'s parser by ``complete(parser)`` when it is first looked
-    up (now when ``commands`` does not defer, ``Commands``)."""
-    if isinstance(commands.choices, Commands):
-        commands.choices.complete_later(name, complete)
-    else:
-        complete(commands.choices[name])
+    up (``commands``: argparse's subcommands, made ``lazy_commands``)."""
+    commands.choices.complete_later(name, complete)
 
 
 # Gait files whose outputs share a name (named from their folder and file names).

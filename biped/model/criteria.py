@@ -190,8 +190,9 @@ def simpson_weights(samples_per_half: int, knots: int = 1) -> np.ndarray:
         piece[:odd] += np.array([1.0] + [4.0, 2.0] * ((odd - 3) // 2) + [4.0, 1.0]) * h / 3
         if odd < n:
             piece[-3:] += np.array([-1.0, 8.0, 5.0]) * h / 12
-    piece.setflags(write=False)
-    return np.concatenate([piece] * (knots + 1))
+    weights = np.concatenate([piece] * (knots + 1))
+    weights.setflags(write=False)  # cached: shared by every caller
+    return weights
 
 
 @dataclass(frozen=True)

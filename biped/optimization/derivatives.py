@@ -1,7 +1,7 @@
 """The derivatives of a step's NLP IPOPT uses, built sample by sample: the Hessian of the
 Lagrangian (``hess_lag``) and the constraints' Jacobian (``jac_g``). (The objective's
-gradient is CasADi's reverse mode on the flat graph: cheaper a call than chained, 0.06-0.3
-ms against 0.8-0.9, and built in 0.04 s.)
+gradient is CasADi's reverse mode on the flat graph, ``biped.optimization.solver``: cheaper
+a call than chained through the samples.)
 
 The solver's NLP (``biped.optimization.solver``) has variables x (the scaled gait
 variables, the knee radii of a design, the energy criterion's slacks) and the parameter p
@@ -69,23 +69,18 @@ def lagrangian_hessian(graph: StepGraph, x, p, head, f, g) -> ca.Function:
         [weights, ca.gradient(lagrangian, head_symbol), ca.hessian(lagrangian, rest)[0]],
     )
     gradient_symbol = ca.SX.sym("gradient", head.shape[0])
-    head_function = ca.Function(
-        "head",
-        [x, p, gradient_symbol],
-        [head, ca.jacobian(head, x), ca.hessian(ca.dot(gradient_symbol, head), x)[0]],
+    curvature = ca.Function(  # ∇²_x (G · h(x)), G held fixed
+        "curvature", [x, p, gradient_symbol], [ca.hessian(ca.dot(gradient_symbol, head), x)[0]]
     )
 
-    X, P = ca.MX.sym("x", x.shape[0]), ca.MX.sym("p")
+    X, P, h, J, basis, inputs = _head(graph, x, p, head)
     LF, LG = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", g.shape[0])
-    h, J, _ = head_function(X, P, ca.MX.zeros(head.shape[0]))
     M, dl_dh, hessian_rest = tail(h, X, P, LF, LG)
-    basis = ca.sparsify(ca.DM(graph.basis))
-    inputs = ca.reshape(basis @ h, v.shape[0], samples)
     blocks, gradients = sample_hessian.map(samples)(inputs, M)
     width = v.shape[0]
     sampled = basis.T @ ca.diagcat(*ca.horzsplit(blocks, width)) @ basis
     G = basis.T @ ca.vec(gradients) + dl_dh
-    _, _, second = head_function(X, P, G)
+    second = curvature(X, P, G)
     A = ca.vertcat(J, ca.MX(ca.DM.eye(x.shape[0])))
     total = J.T @ sampled @ J + second + A.T @ hessian_rest @ A
     return ca.Function(
