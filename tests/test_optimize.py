@@ -324,6 +324,55 @@ def test_same_optimum_on_other_kernels(environment):
     assert value == pytest.approx(optimal_gait("rolling").value, rel=1e-6)
 
 
+_SOLVE_PROBE = """
+import hashlib, json, numpy as np, biped
+from biped.model.gait import spline_basis
+from biped.optimization.problem import GaitProblem
+from biped.optimization.solver import solver_for
+def digest(array):
+    return hashlib.sha256(np.ascontiguousarray(array, dtype=float).tobytes()).hexdigest()
+problem = GaitProblem(biped.Biped(biped.Robot.paper(), "rolling"), 0.35, "energy")
+end = solver_for(problem).solve(problem, problem.first_guess(0.1 / 0.35), barrier="monotone")
+u = np.linspace(0.0, 1.0, 1001)
+print(json.dumps({
+    "bases": digest(np.concatenate([b.ravel() for b in spline_basis(25)[1]])),
+    "solution": digest(end.variables), "status": end.status,
+    "numpy power": digest(u ** 3),
+}))
+"""
+
+
+@functools.cache
+def _probe(kernels: str) -> dict:
+    """What ``_SOLVE_PROBE`` prints, run with all of numpy's kernels or without AVX-512's."""
+    env = dict(os.environ)
+    if kernels == "no AVX-512":
+        env["NPY_DISABLE_CPU_FEATURES"] = "AVX512_ICL X86_V4"
+    out = subprocess.run(
+        [sys.executable, "-c", _SOLVE_PROBE], env=env, capture_output=True, text=True, check=True
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_a_solve_is_the_same_bits_without_avx512_kernels():
+    """The solver's constant matrices (the spline bases) and an energy solve from one start
+    are the same bits with numpy's AVX-512 kernels off: IPOPT and CasADi do not use numpy,
+    and its kernels enter nothing they compute, so a basin of the energy criterion cannot
+    change with the machine."""
+    here, there = _probe("all"), _probe("no AVX-512")
+    assert here["status"] == "Solve_Succeeded"
+    assert (here["bases"], here["solution"]) == (there["bases"], there["solution"])
+
+
+def test_numpy_power_differs_without_avx512_kernels_on_this_machine():
+    """The check above can fail: numpy's power, which the bases avoid (``u * u * u``), gives
+    other bits without AVX-512 kernels, where the machine has them."""
+    here, there = _probe("all"), _probe("no AVX-512")
+    if here["numpy power"] == there["numpy power"]:
+        pytest.skip("numpy dispatches the same power kernel with and without AVX-512 here")
+    assert here["numpy power"] != there["numpy power"]
+
+
 @pytest.mark.parametrize(
     "speed, criterion, needle",
     [

@@ -297,8 +297,11 @@ def spline_basis(samples_per_piece: int, knots: int = 1):
         origin, sign = piece_variable(knots, j)
         u = (sign * (t - origin))[:, None]
         zero, one = np.zeros_like(u), np.ones_like(u)
-        value = np.hstack([one, u, u**2, u**3])
-        rate = np.hstack([zero, one, 2 * u, 3 * u**2])
+        # u * u * u, not u**3: numpy's power has other kernels on other CPUs (AVX-512 or
+        # not) that differ in the last bit, and these matrices are the solver's constants.
+        square = u * u
+        value = np.hstack([one, u, square, square * u])
+        rate = np.hstack([zero, one, 2 * u, 3 * square])
         accel = np.hstack([zero, zero, 2 * one, 6 * u])
         for block, matrix, scale in zip(bases, (value, rate, accel), (1.0, sign, 1.0), strict=True):
             block[j * n : (j + 1) * n, 4 * j : 4 * j + 4] = scale * matrix
