@@ -135,7 +135,7 @@ def cmd_optimize(args) -> int:
     status) or the optimum is infeasible (naming the violated constraints); the file is
     written only when feasible, with the solver's status in it.
     """
-    from biped.optimization.optimize import optimize, prepare
+    from biped.optimization.optimize import confirm, optimize, prepare
     from biped.optimization.problem import GaitProblem
     from biped.records import gait_file
     from biped.runtime.runner import free_cores
@@ -146,7 +146,7 @@ def cmd_optimize(args) -> int:
     check_output(args.out)
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
     setup = prepare(problem) if args.method == "ipopt" else 0.0
-    optimum = optimize(problem, **budget(args))
+    optimum = confirm(problem, optimize(problem, **budget(args)))
     ev = optimum.evaluation
     print(optimum_line(args.knee, args.criterion, args.speed, optimum))
     report = optimum.report

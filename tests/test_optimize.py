@@ -17,12 +17,15 @@ from biped.model.criteria import PAPER_SAFETY, Safety, clearance_profile, evalua
 from biped.model.gait import build_step
 from biped.optimization.optimize import (
     AGREEMENT,
+    CONFIRM,
     GUESS_PERIODS,
     MONOTONE,
     MONOTONE_START,
     STHENIC_START,
     Report,
     Start,
+    barrier_of,
+    confirm,
     optimize,
     starts_at_value,
 )
@@ -246,6 +249,48 @@ def test_one_point_solved_under_both_barriers_is_one_start_at_the_best():
     assert starts_at_value([start("first guess S = 0.1 m" + MONOTONE)] + pair, value) == 2
     assert starts_at_value([start("first guess"), start("given")], value) == 2
     assert starts_at_value([start(MONOTONE_START), start("given", 2.0)], value) == 1
+
+
+def test_a_point_solved_under_three_barriers_is_one_start_at_the_best():
+    """The confirmation's barrier (``CONFIRM``) names the same start: a point re-solved from
+    mu = 1e-3 does not confirm itself; another start's re-solve does; given starts, which
+    share a kind, count as many as the most of one barrier."""
+    value = 1.0
+
+    def start(kind, v=value):
+        return Start(kind, v, "Solve_Succeeded", 50)
+
+    other = [start(OTHER_KNEE_START), start(OTHER_KNEE_START + MONOTONE)]
+    assert starts_at_value(other + [start(OTHER_KNEE_START + CONFIRM)], value) == 1
+    assert starts_at_value([start(OTHER_KNEE_START + CONFIRM), start("first guess")], value) == 2
+    given = [start("given"), start("given"), start("given" + CONFIRM)]
+    assert starts_at_value(given, value) == 2
+    assert starts_at_value(given + [start("given" + CONFIRM)] * 2, value) == 3
+    assert [barrier_of(k) for k in ("given", "given" + CONFIRM, TABLE_START + MONOTONE)] == [
+        "adaptive",
+        "confirm",
+        "monotone",
+    ]
+
+
+def test_a_best_reached_by_one_start_is_confirmed_by_the_near_starts():
+    """At 0.25 m/s the revolute knee's least energy per step is reached by one start of
+    ``optimize``; ``confirm`` reaches it again from the other knee's optimum under the
+    monotone barrier, names that start in the history and finds nothing worse. A confirmed
+    optimum is returned as it is."""
+    problem = GaitProblem(biped.Biped(ROBOT, "revolute"), 0.25, "energy")
+    single = optimize(problem)
+    assert single.certified and single.report.starts_at_best == 1
+    confirmed = confirm(problem, single)
+    assert confirmed.certified and confirmed.report.confirmed
+    assert confirmed.report.value <= single.report.value * (1 + AGREEMENT)
+    at_best = [
+        s.kind
+        for s in confirmed.report.history
+        if abs(s.value - confirmed.report.value) <= AGREEMENT * confirmed.report.value
+    ]
+    assert any(kind.endswith((CONFIRM, MONOTONE)) and "other knee" in kind for kind in at_best)
+    assert confirm(problem, confirmed) is confirmed
 
 
 def test_a_single_start_says_which_start_and_how_far_the_next_optimum_lies():

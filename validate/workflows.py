@@ -159,14 +159,14 @@ def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool
 def _optimum(pipeline: Pipeline, knee: str, optima: dict, say: Callable):
     """The knee's optimal gait, also started from the optima of the knees before it."""
     from biped.model.dynamics import Biped
-    from biped.optimization.optimize import optimize
+    from biped.optimization.optimize import confirm, optimize
     from biped.optimization.problem import GaitProblem
 
     say(f"[{knee}] optimizing at {pipeline.speed} m/s ({pipeline.criterion})...")
     model = Biped(pipeline.robot, knee)
     problem = GaitProblem(model, pipeline.speed, pipeline.criterion, pipeline.safety)
     given = [o.variables for o in optima.values() if np.all(np.isfinite(o.variables))]
-    optimum = optimize(problem, given=given, **pipeline.budget)
+    optimum = confirm(problem, optimize(problem, given=given, **pipeline.budget), given)
     ev = optimum.evaluation
     say(
         f"[{knee}] sthenic {ev.sthenic:.4g} N²·m·s, energy {ev.energy:.4g} J, period "

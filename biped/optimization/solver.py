@@ -65,6 +65,9 @@ IPOPT_OPTIONS = {
 BARRIERS = {
     "adaptive": {},
     "monotone": {"mu_strategy": "monotone", "mu_init": 1e-2},
+    # From mu = 1e-3: a start near an optimum keeps closer to it, along another path through
+    # the energy criteria's close local minima (``biped.optimization.optimize.confirm``).
+    "confirm": {"mu_strategy": "monotone", "mu_init": 1e-3},
     # From a converged point, a hundred times tighter: what ``IPOPT_OPTIONS``' tolerance
     # leaves of an optimum (the atlas's error bar).
     "tight": {"tol": 1e-11, "constr_viol_tol": 1e-11},

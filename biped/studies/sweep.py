@@ -49,6 +49,7 @@ from biped.optimization.optimize import (
     Optimum,
     best_of,
     checked,
+    confirm,
     optimize,
     single_start_note,
 )
@@ -145,6 +146,7 @@ def _solve_with_neighbours(task: Task) -> str:
     if given:
         again = optimize(problem, seed=settings.seed, starts=0, given=given)
         optimum = best_of(problem, [own, again])
+    optimum = confirm(problem, optimum, given)  # a best reached by one start tried again
     gait_file.Gait.from_optimum(optimum, settings.robot).write(task.path)
     return _line("final", point, optimum)
 
