@@ -46,6 +46,7 @@ from biped.optimization.optimize import (
     Report,
     best_of,
     checked,
+    confirm,
     optimize,
     refine,
     single_start_note,
@@ -271,6 +272,8 @@ def _solve_final(task: Task) -> str:
     if starts:
         again = optimize(problem, seed=settings.seed, starts=0, given=starts, jobs=1)
         optimum = again if own is None else best_of(problem, [own, again])
+    if optimum is not None:  # a best reached by one start tried again
+        optimum = confirm(problem, optimum, starts, jobs=1)
     content = _write(task, optimum, began)
     gait = gait_file.Gait.from_optimum(optimum, settings.robot)
     gait.write(Path(task.folder) / point.gait_filename())
