@@ -485,7 +485,27 @@ def optimize(
         candidates += _paper_start(problem, seed, starts, solvers, jobs)
     if problem.criterion in WORK_CRITERIA and starts > 0:
         candidates += _sthenic_start(problem, seed, starts, solvers, sthenic, jobs)
-    for k in range(nelder_mead_starts):
+    candidates += _nelder_mead_starts(
+        problem, seed, nelder_mead_starts, max_restarts, evaluations_per_run
+    )
+    barriers = {barrier_of(kind) for kind, _ in candidates}
+    solver.prepare(barriers)
+    best, report = multistart(
+        candidates,
+        lambda z, barrier: solver.solve(problem, z, barrier=barrier),
+        seed,
+        began,
+        jobs,
+        _coarse_search(problem, barriers) if solvers is None else None,
+    )
+    return checked(problem, best.variables, report)
+
+
+def _nelder_mead_starts(problem, seed, count, max_restarts, evaluations_per_run) -> list:
+    """The ends of the paper's Nelder-Mead from the first guess with the seeds ``seed``,
+    ``seed + 1``, ... (``count`` runs), as IPOPT's starts."""
+    starts = []
+    for k in range(count):
         parameters, *_ = nelder_mead(
             problem,
             problem.to_parameters(problem.first_guess()),
@@ -494,28 +514,21 @@ def optimize(
             evaluations_per_run,
         )
         try:
-            candidates.append(("nelder-mead", problem.from_parameters(parameters)))
+            starts.append(("nelder-mead", problem.from_parameters(parameters)))
         except BipedError:
             continue  # a Nelder-Mead point out of reach starts nothing
-    solver.prepare({barrier_of(kind) for kind, _ in candidates})
-    search = None
-    coarse = coarse_problem(problem) if solvers is None else None
-    if coarse is not None:
-        coarse_solver = solver_for(coarse)
-        coarse_solver.prepare({barrier_of(kind) for kind, _ in candidates})
+    return starts
 
-        def search(z, barrier):
-            return coarse_solver.solve(coarse, z, barrier=barrier)
 
-    best, report = multistart(
-        candidates,
-        lambda z, barrier: solver.solve(problem, z, barrier=barrier),
-        seed,
-        began,
-        jobs,
-        search,
-    )
-    return checked(problem, best.variables, report)
+def _coarse_search(problem: GaitProblem, barriers):
+    """``search(z, barrier)`` on the coarse grid of ``problem`` (``coarse_problem``), its
+    solver built with ``barriers``; None when the problem is solved on its own grid."""
+    coarse = coarse_problem(problem)
+    if coarse is None:
+        return None
+    coarse_solver = solver_for(coarse)
+    coarse_solver.prepare(barriers)
+    return lambda z, barrier: coarse_solver.solve(coarse, z, barrier=barrier)
 
 
 def table_starts(problem: GaitProblem, starts: int) -> list:
