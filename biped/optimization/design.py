@@ -335,9 +335,11 @@ def optimize_at(
     so that a map of many radii builds one graph per process."""
     radii = check_radii(problem.robot, radii)
 
-    def held(gait: GaitProblem) -> _HeldRadii:  # once per criterion, not per start
-        design = solver_for(dataclasses.replace(problem, criterion=gait.criterion))
-        return _HeldRadii(design, radii)
+    def held(gait: GaitProblem) -> _HeldRadii:  # once per criterion and grid, not per start
+        family = dataclasses.replace(
+            problem, criterion=gait.criterion, samples_per_half=gait.samples_per_half
+        )
+        return _HeldRadii(solver_for(family), radii)
 
     gait = problem.gait_problem(radii)
     return optimize(gait, seed=seed, starts=starts, given=given, solvers=held)

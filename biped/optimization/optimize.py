@@ -460,7 +460,8 @@ def optimize(
         solvers: ``solvers(problem)`` gives what solves a problem from a start,
             ``.solve(problem, z, barrier=...)`` (default ``biped.optimization.solver.solver_for``;
             ``barrier`` one of ``biped.optimization.solver.BARRIERS``; ``biped.optimization.design``
-            gives its graph with the knee radii held, which serves every radius).
+            gives its graph with the knee radii held, which serves every radius); asked for
+            the coarse grid's problem too (``coarse_problem``).
         sthenic: for the energy criterion, the sthenic optimum of the same problem with
             the same ``seed`` and ``starts``, if already known (a sweep's): it starts the
             energy criterion as the one this call would compute (None: computed here).
@@ -496,7 +497,7 @@ def optimize(
         seed,
         began,
         jobs,
-        _coarse_search(problem, barriers) if solvers is None else None,
+        _coarse_search(problem, barriers, solvers),
     )
     return checked(problem, best.variables, report)
 
@@ -520,13 +521,14 @@ def _nelder_mead_starts(problem, seed, count, max_restarts, evaluations_per_run)
     return starts
 
 
-def _coarse_search(problem: GaitProblem, barriers):
+def _coarse_search(problem: GaitProblem, barriers, solvers=None):
     """``search(z, barrier)`` on the coarse grid of ``problem`` (``coarse_problem``), its
-    solver built with ``barriers``; None when the problem is solved on its own grid."""
+    solver (``solvers``' of the coarse problem, as ``optimize``'s) built with ``barriers``;
+    None when the problem is solved on its own grid."""
     coarse = coarse_problem(problem)
     if coarse is None:
         return None
-    coarse_solver = solver_for(coarse)
+    coarse_solver = (solver_for if solvers is None else solvers)(coarse)
     coarse_solver.prepare(barriers)
     return lambda z, barrier: coarse_solver.solve(coarse, z, barrier=barrier)
 
