@@ -379,10 +379,13 @@ def digest(array):
 problem = GaitProblem(biped.Biped(biped.Robot.paper(), "rolling"), 0.35, "energy")
 end = solver_for(problem).solve(problem, problem.first_guess(0.1 / 0.35), barrier="monotone")
 u = np.linspace(0.0, 1.0, 1001)
+reach = np.linspace(0.4, 0.83, 400)[:, None] * np.array([[np.sin(0.3), -np.cos(0.3)]])
+angles = [biped.Biped(biped.Robot.paper(), k).leg_angles(-reach) for k in biped.KNEES]
 print(json.dumps({
     "bases": digest(np.concatenate([b.ravel() for b in spline_basis(25)[1]])),
+    "leg angles": digest(np.concatenate([a.ravel() for a in angles])),
     "solution": digest(end.variables), "status": end.status,
-    "numpy power": digest(u ** 3),
+    "numpy power": digest(u ** 3), "numpy arctan2": digest(np.arctan2(u - 0.5, u + 0.1)),
 }))
 """
 
@@ -400,22 +403,26 @@ def _probe(kernels: str) -> dict:
 
 
 def test_a_solve_is_the_same_bits_without_avx512_kernels():
-    """The solver's constant matrices (the spline bases) and an energy solve from one start
-    are the same bits with numpy's AVX-512 kernels off: IPOPT and CasADi do not use numpy,
-    and its kernels enter nothing they compute, so a basin of the energy criterion cannot
-    change with the machine."""
+    """The solver's constant matrices (the spline bases), the legs' inverse geometry that
+    starts it and builds every step, and an energy solve from one start are the same bits
+    with numpy's AVX-512 kernels off: IPOPT and CasADi do not use numpy, and its kernels
+    enter nothing they compute, so a basin of the energy criterion cannot change with the
+    machine."""
     here, there = _probe("all"), _probe("no AVX-512")
     assert here["status"] == "Solve_Succeeded"
-    assert (here["bases"], here["solution"]) == (there["bases"], there["solution"])
+    fields = ("bases", "leg angles", "solution")
+    assert [here[f] for f in fields] == [there[f] for f in fields]
 
 
-def test_numpy_power_differs_without_avx512_kernels_on_this_machine():
-    """The check above can fail: numpy's power, which the bases avoid (``u * u * u``), gives
-    other bits without AVX-512 kernels, where the machine has them."""
+@pytest.mark.parametrize("function", ["numpy power", "numpy arctan2"])
+def test_numpy_kernels_differ_without_avx512_on_this_machine(function):
+    """The check above can fail: numpy's power and arc tangent, which the bases and the
+    inverse geometry avoid (``u * u * u``, the C library's ``atan2``), give other bits
+    without AVX-512 kernels, where the machine has them."""
     here, there = _probe("all"), _probe("no AVX-512")
-    if here["numpy power"] == there["numpy power"]:
-        pytest.skip("numpy dispatches the same power kernel with and without AVX-512 here")
-    assert here["numpy power"] != there["numpy power"]
+    if here[function] == there[function]:
+        pytest.skip(f"numpy dispatches the same {function} kernel with and without AVX-512")
+    assert here[function] != there[function]
 
 
 @pytest.mark.parametrize(

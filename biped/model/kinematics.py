@@ -22,12 +22,19 @@ All functions take leading batch dimensions.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from biped.errors import BipedError, UnreachableError
 from biped.model.robot import Robot
+
+# The C library's arc cosine and arc tangent element by element: numpy's own have other
+# kernels on other CPUs (AVX-512 or not) that differ in the last bit, and these angles start
+# the solver (``biped.optimization.problem``) and build every step.
+_acos = np.vectorize(math.acos, otypes=[float])
+_atan2 = np.vectorize(math.atan2, otypes=[float])
 
 KNEES = ("revolute", "rolling")
 
@@ -361,7 +368,7 @@ class Chain:
         shank, thigh = self.robot.shank_length - r1, self.robot.thigh_length - r2
         if r1 + r2 == 0.0:  # revolute: closed form
             l1, l2 = self.robot.shank_length, self.robot.thigh_length
-            flexion = np.arccos(np.clip((dist2 - l1**2 - l2**2) / (2 * l1 * l2), -1.0, 1.0))
+            flexion = _acos(np.clip((dist2 - l1**2 - l2**2) / (2 * l1 * l2), -1.0, 1.0))
         else:  # Newton on the monotone f(θ) from the tabulated inverse
             flexion = np.interp(dist2, self._reach_table[::-1], self._flexion_table[::-1])
             for _ in range(20):
@@ -378,7 +385,7 @@ class Chain:
         gamma = r2 * flexion / link if link > 0.0 else 0.0
         vx = link * np.sin(gamma) + thigh * np.sin(flexion)
         vz = -shank - link * np.cos(gamma) - thigh * np.cos(flexion)
-        shank_angle = np.arctan2(d[..., 1], d[..., 0]) - np.arctan2(-vz, -vx)
+        shank_angle = _atan2(d[..., 1], d[..., 0]) - _atan2(-vz, -vx)
         shank_angle = (shank_angle + np.pi) % (2 * np.pi) - np.pi
         return np.stack([shank_angle, shank_angle + flexion], axis=-1)
 
