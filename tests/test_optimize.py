@@ -291,6 +291,14 @@ def test_a_best_reached_by_one_start_is_confirmed_by_the_near_starts():
     ]
     assert any(kind.endswith((CONFIRM, MONOTONE)) and "other knee" in kind for kind in at_best)
     assert confirm(problem, confirmed) is confirmed
+    unconverged = dataclasses.replace(
+        single, report=dataclasses.replace(single.report, status="Maximum_Iterations_Exceeded")
+    )
+    assert confirm(problem, unconverged) is unconverged
+    with pytest.raises(biped.BipedError, match="problem = 0.25: allowed a biped"):
+        confirm(0.25, single)
+    with pytest.raises(biped.BipedError, match="optimum = None: allowed a biped"):
+        confirm(problem, None)
 
 
 def test_a_single_start_says_which_start_and_how_far_the_next_optimum_lies():

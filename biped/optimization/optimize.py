@@ -615,16 +615,20 @@ CONFIRM = ", monotone barrier from 1e-3"
 BARRIER_ENDINGS = {TIGHT: "tight", MONOTONE: "monotone", CONFIRM: "confirm"}
 
 
+def _ending(kind: str) -> str:
+    """The ending of ``BARRIER_ENDINGS`` a start's kind has, or ""."""
+    return next((end for end in BARRIER_ENDINGS if kind.endswith(end)), "")
+
+
 def barrier_of(kind: str) -> str:
     """The barrier strategy (``biped.optimization.solver.BARRIERS``) a start of this kind is solved
     with."""
-    return next((b for end, b in BARRIER_ENDINGS.items() if kind.endswith(end)), "adaptive")
+    return BARRIER_ENDINGS.get(_ending(kind), "adaptive")
 
 
 def start_of(kind: str) -> str:
     """The start a kind names, without the barrier it was solved with (``BARRIER_ENDINGS``)."""
-    end = next((end for end in BARRIER_ENDINGS if kind.endswith(end)), "")
-    return kind[: len(kind) - len(end)]
+    return kind[: len(kind) - len(_ending(kind))]
 
 
 def refine(problem: GaitProblem, start, kind: str = "given", seed: int = 0) -> Optimum:
@@ -668,7 +672,8 @@ def starts_at_value(history, value: float) -> int:
     ]
     most: dict[str, int] = {}
     for kind in set(kinds):
-        most[start_of(kind)] = max(most.get(start_of(kind), 0), kinds.count(kind))
+        start = start_of(kind)
+        most[start] = max(most.get(start, 0), kinds.count(kind))
     return sum(most.values())
 
 
@@ -683,10 +688,16 @@ def confirm(problem: GaitProblem, optimum: Optimum, given=(), jobs: int | None =
     is reached from the other knee's optimum under the monotone barrier); they may also
     reach a lower optimum, which replaces ``optimum`` only when lower on the solver's
     samples too (the problem IPOPT solves; ``best_of`` ranks by the check grid): a
-    confirmation never leaves a higher optimum. The starts run on ``jobs`` processes
+    confirmation never leaves a higher optimum. An optimum whose solver did not converge is
+    returned as it is (there is nothing to confirm). The starts run on ``jobs`` processes
     (``multistart``)."""
+    if not isinstance(problem, GaitProblem):
+        raise BipedError(f"problem = {problem!r}: allowed a biped.optimization.problem.GaitProblem")
+    if not isinstance(optimum, Optimum):
+        raise BipedError(f"optimum = {optimum!r}: allowed a biped.optimization.optimize.Optimum")
     report = optimum.report
-    if report.method != "ipopt" or report.confirmed or problem.criterion not in WORK_CRITERIA:
+    settled = report.method != "ipopt" or not report.converged or report.confirmed
+    if settled or problem.criterion not in WORK_CRITERIA:
         return optimum
     near = [(kind, z) for kind, z in table_starts(problem, 1) if not kind.endswith(MONOTONE)]
     candidates = [(kind + CONFIRM, z) for kind, z in near]
