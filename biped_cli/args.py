@@ -31,7 +31,7 @@ FOLDER_CREATED = "created if missing"
 ROBOT_HELP = (
     "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1); a "
     "table [actuator] sets every joint's motor and gear, [actuators.knee] (ankle, hip) one "
-    "kind's (fields left out keep the default AK80 motor behind a 64:1 gear)"
+    "kind's (fields left out keep the default actuator's, the AK80-64 of the catalog)"
 )
 ACTUATOR_LIMITS_HELP = (
     "every joint's torque, speed and voltage within its motor's peak torque, top speed and "

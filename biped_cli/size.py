@@ -154,8 +154,8 @@ def add_parser(commands) -> None:
     parser.add_argument(
         "--catalog",
         metavar="FILE",
-        help="catalog of motors and gears, JSON (default: the package's, biped/model/"
-        "catalog.json: the AK80 motor behind gears of 6:1 to 100:1)",
+        help="catalog of actuators, JSON (default: the package's, biped/model/"
+        "catalog.json: seven CubeMars / T-Motor actuators of 6:1 to 64:1, from their datasheets)",
     )
     parser.add_argument(
         "--margin",

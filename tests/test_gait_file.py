@@ -1,11 +1,14 @@
 """Gait files: written with their provenance, read back with errors that name the bad field."""
 
+import dataclasses
 import json
 
 import pytest
 
-from biped import Robot
+from biped import Biped, Robot
 from biped.errors import BipedError
+from biped.model.actuators import Actuators
+from biped.optimization.optimize import checked
 from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped.records.provenance import PACKAGE
@@ -180,3 +183,26 @@ def test_report_and_figures_say_what_the_file_is_and_what_they_take(tmp_path, ca
     assert error.count("\n") == 1 and "design-map.json' is a design map's record" in error
     assert "allowed --sweep a folder of the gait files that biped sweep writes" in error
     assert not (tmp_path / "figures").exists() and not (tmp_path / "reports").exists()
+
+
+def test_a_gait_file_of_format_2_without_actuators_reads_with_the_set_of_its_time(
+    content, tmp_path
+):
+    """A gait file of format 2 whose robot names no actuators was computed with the default
+    set of its time (``Actuators.legacy``): it reads, consistent, with that set. The same file
+    read as format 3 (the catalog's default set) is refused: its electrical figures are not
+    the default set's."""
+    optimum = small_optimum("rolling")
+    legacy = dataclasses.replace(Robot.paper(), actuators=Actuators.legacy())
+    problem = dataclasses.replace(optimum.problem, model=Biped(legacy, "rolling"))
+    then = checked(problem, None, optimum.report, optimum.parameters)
+    old = Gait.from_optimum(then, legacy).to_dict()
+    del old["robot"]["actuators"]
+    old["units"] = {k: v for k, v in old["units"].items() if not k.startswith("robot.actuators")}
+    old["format"] = "biped-gait/2"
+    gait = gait_file.read_consistent(gait_file.write_json(tmp_path / "old.json", old))
+    assert gait.robot.actuators == Actuators.legacy() != Actuators.default()
+    assert gait.costs.electrical == old["costs"]["electrical"]
+    old["format"] = gait_file.FORMAT
+    message = refusal(gait_file.read_consistent, gait_file.write_json(tmp_path / "new.json", old))
+    assert "inconsistent: costs.electrical = " in message

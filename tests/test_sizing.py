@@ -6,6 +6,8 @@ from importlib import resources
 import numpy as np
 import pytest
 
+from biped.errors import BipedError
+from biped.model.actuators import AK80_MOTOR, Actuator
 from biped.model.sizing import Requirement, choose, load_catalog
 from biped_cli.main import main
 from tests.conftest import gait_of, optimal_gait
@@ -19,25 +21,107 @@ def gait_path(tmp_path_factory):
     return path
 
 
+def _package_catalog() -> dict:
+    return json.loads(resources.files("biped.model").joinpath("catalog.json").read_text())
+
+
 def _catalog(tmp_path, peak_torque: float, name="weak.json"):
-    """The package's catalog with one motor whose peak torque is ``peak_torque`` at the
-    motor (N·m) and one gear, 6:1."""
-    content = json.loads(resources.files("biped.model").joinpath("catalog.json").read_text())
-    motor = content["motors"]["AK80"]
-    motor["motor_peak_torque"] = peak_torque
-    motor["motor_continuous_torque"] = min(motor["motor_continuous_torque"], peak_torque)
-    content["gears"] = content["gears"][:1]
+    """The package's catalog with its AK80-6 alone, its peak torque ``peak_torque`` at the
+    joint (N·m)."""
+    content = _package_catalog()
+    entry = next(e for e in content["actuators"] if e["name"] == "AK80-6")
+    sheet = entry["datasheet"]
+    sheet["peak_torque [N·m]"] = peak_torque
+    sheet["rated_torque [N·m]"] = min(sheet["rated_torque [N·m]"], peak_torque)
+    content["actuators"] = [entry]
     path = tmp_path / name
     path.write_text(json.dumps(content))
     return path
 
 
-def test_package_catalog_every_motor_behind_every_gear():
-    """The shipped catalog gives each motor behind each gear, each motor cited."""
+def test_package_catalog_holds_cited_datasheets():
+    """The shipped catalog: integrated actuators of several gear ratios, each cited, every
+    field of its datasheet or assumed and named; the default actuator is its AK80-64."""
     catalog = load_catalog()
-    assert len(catalog) == 5 and all("http" in c.source for c in catalog)
-    ratios = sorted(c.actuator.gear_ratio for c in catalog)
-    assert ratios == [6.0, 9.0, 36.0, 64.0, 100.0]
+    assert len(catalog) == 7 and all("http" in c.source for c in catalog)
+    assert sorted({c.actuator.gear_ratio for c in catalog}) == [6.0, 8.0, 9.0, 39.0, 64.0]
+    ak80_64 = next(c.actuator for c in catalog if c.name == "AK80-64 KV80")
+    assert Actuator.default() == ak80_64
+    assert (ak80_64.gear_ratio, ak80_64.peak_torque, ak80_64.continuous_torque) == (64, 120, 48)
+    assert ak80_64.rotor_inertia == pytest.approx(564.5e-7) and ak80_64.mass == 0.85
+    assert ak80_64.max_speed == pytest.approx(75 * 2 * np.pi / 60)  # its no-load speed
+    assert ak80_64.coulomb_friction == 4.7  # its back-drive torque
+
+
+def _printed_precision(value: float) -> float:
+    """Half a unit of the last digit a datasheet's figure is printed with, relative."""
+    decimals = len(repr(float(value)).split(".")[1].rstrip("0")) if "." in repr(value) else 0
+    return 0.5 * 10.0**-decimals / abs(value)
+
+
+def _motor_constant_errors(content) -> dict:
+    """Each entry's k_t / √R against the motor constant K_m its datasheet prints, relative,
+    and what the printed digits of the three allow."""
+    errors = {}
+    for entry in content["actuators"]:
+        printed = entry.get("checks", {}).get("motor_constant [N·m/√W]")
+        if printed is not None:
+            actuator = Actuator.from_datasheet(entry)
+            km = actuator.torque_constant / np.sqrt(actuator.resistance)
+            sheet = entry["datasheet"]
+            allowed = (
+                _printed_precision(printed)
+                + _printed_precision(sheet["torque_constant [N·m/A]"])
+                + 0.5 * _printed_precision(next(v for k, v in sheet.items() if "resistance" in k))
+            )
+            errors[entry["name"]] = (abs(km / printed - 1.0), allowed)
+    return errors
+
+
+def test_datasheet_figures_agree_with_their_motor_constant():
+    """Where a datasheet prints K_m, the k_t and phase-to-phase R read from it (units
+    converted) give it within the digits printed: a figure typed or converted wrong does not
+    (the AK80-64's resistance read in Ω instead of mΩ)."""
+    content = _package_catalog()
+    errors = _motor_constant_errors(content)
+    assert len(errors) == 5 and all(error <= allowed for error, allowed in errors.values())
+    wrong = next(e for e in content["actuators"] if e["name"] == "AK80-64 KV80")
+    sheet = wrong["datasheet"]
+    sheet["phase_to_phase_resistance [Ω]"] = sheet.pop("phase_to_phase_resistance [mΩ]")
+    error, allowed = _motor_constant_errors(content)["AK80-64 KV80"]
+    assert error > 0.9 > allowed
+
+
+def test_earlier_catalog_of_motors_and_gears_still_reads(tmp_path):
+    """A catalog of format biped-actuator-catalog/1: every motor behind every gear, its joint
+    torques N η times the motor's."""
+    content = {
+        "format": "biped-actuator-catalog/1",
+        "motors": {"AK80": {**AK80_MOTOR, "source": "https://example.org/ak80"}},
+        "gears": [
+            {"name": "6:1", "ratio": 6.0, "efficiency": 0.9, "mass": 0.485},
+            {"name": "36:1", "ratio": 36.0, "efficiency": 0.81, "mass": 0.605},
+        ],
+    }
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(content))
+    catalog = load_catalog(path)
+    assert [c.name for c in catalog] == ["AK80 6:1", "AK80 36:1"]
+    peak = 36 * 0.81 * AK80_MOTOR["motor_peak_torque"]
+    assert catalog[1].actuator.peak_torque == pytest.approx(peak)
+
+
+def test_bad_datasheet_entry_names_the_figure(tmp_path):
+    """A datasheet figure of an unknown unit, or a field neither given nor assumed: refused,
+    naming it."""
+    content = _package_catalog()
+    entry = content["actuators"][0]
+    entry["datasheet"]["weight [lb]"] = entry["datasheet"].pop("weight [g]")
+    with pytest.raises(BipedError, match=r"weight \[lb\]"):
+        Actuator.from_datasheet(entry)
+    del entry["datasheet"]["weight [lb]"]
+    with pytest.raises(BipedError, match=r"\.mass = None .*given by the datasheet or assumed"):
+        Actuator.from_datasheet(entry)
 
 
 def test_requirement_of_both_joints_of_a_kind():
@@ -56,14 +140,14 @@ def test_size_chooses_the_lightest_combination_with_the_margin(gait_path, capsys
     its requirements by 20 %, and the total mass of six actuators."""
     assert main(["size", str(gait_path)]) == 0
     out = capsys.readouterr().out
-    assert out.count("AK80 6:1") == 3  # the nearly passive optimum: the lightest for all
+    assert out.count("AK80-6 (0.485 kg") == 3  # the nearly passive optimum: the lightest
     assert "total actuator mass: 2.910 kg" in out
 
 
 def test_torque_above_every_peak_is_refused_naming_joint_and_limit(gait_path, tmp_path, capsys):
     """A catalog whose motors' peak torque is below the gait's: the joint and the limit are
     named, exit 1."""
-    catalog = _catalog(tmp_path, peak_torque=0.5)  # 6 x 0.9 x 0.5 = 2.7 N·m at the joint
+    catalog = _catalog(tmp_path, peak_torque=2.7)
     assert main(["size", str(gait_path), "--catalog", str(catalog)]) == 1
     out = capsys.readouterr().out
     assert "no combination drives the hip: peak torque" in out
@@ -82,7 +166,7 @@ def test_choose_names_every_limit_no_candidate_meets():
 
 @pytest.mark.parametrize(
     "content, needle",
-    [("{", "not valid JSON"), ('{"format": "x"}', "biped-actuator-catalog/1")],
+    [("{", "not valid JSON"), ('{"format": "x"}', "biped-actuator-catalog/2")],
 )
 def test_bad_catalog_is_one_line_exit_2(gait_path, tmp_path, capsys, content, needle):
     """A catalog that is not one: one line on stderr naming it, exit 2."""

@@ -28,17 +28,22 @@ joint is lost, E = ∫ Σ_i max(P_i, 0) dt; with regeneration E_r = ∫ Σ_i P_i
 actuator (R = 0, b = c = 0, J_r = 0, η = 1) has P_i = Γ_i θ̇_i, so that E is the joints'
 positive work and 2 E − E_r = ∫ Σ |Γ_i θ̇_i| dt, the paper's energy criterion C_E (eq. 31).
 
-The default set (``Actuators.default``) is built on the T-Motor AK80-6's motor, whose
-constants are those of its documentation (cited at ``AK80_MOTOR``), behind a 64:1 gear sized
-for the 70 kg robot of Table 1 (its knee holds 72 N·m standing on one leg, ``biped demo``).
+The default set (``Actuators.default``) is the CubeMars AK80-64 at every joint, an integrated
+actuator (motor, 64:1 planetary gear, drive) whose figures are its datasheet's, read from the
+package's catalog (``catalog.json``, each entry cited; ``Actuator.from_datasheet``): 48 N·m
+rated and 120 N·m peak at the joint, sized for the 70 kg robot of Table 1 (its knee holds
+72 N·m standing on one leg, ``biped demo``). What no datasheet gives is assumed and named in
+the catalog: the gear's efficiency and the viscous friction.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
+import json
 import math
 from dataclasses import dataclass
+from importlib import resources
 
 import numpy as np
 
@@ -51,6 +56,42 @@ KINDS = ("ankle", "knee", "hip")
 JOINT_KINDS = ("ankle", "knee", "hip", "hip", "knee", "ankle")
 # [rad/s] Rate over which the Coulomb friction's sign is smoothed (tanh(θ̇ / ω_c)).
 COULOMB_SMOOTHING = 1e-2
+
+# The package's catalog of actuators (``biped.model.sizing``), of which the default actuator.
+CATALOG = "catalog.json"
+CATALOG_FORMAT = "biped-actuator-catalog/2"
+DEFAULT_ACTUATOR = "AK80-64 KV80"
+# A datasheet's figure (its key, "name [unit]" as the vendor prints it) -> the actuator's field
+# and the unit's factor to SI.
+DATASHEET_FIELDS = {
+    "reduction_ratio": "gear_ratio",
+    "torque_constant": "torque_constant",
+    "phase_to_phase_resistance": "resistance",
+    "rotor_inertia": "rotor_inertia",
+    "rated_torque": "continuous_torque",
+    "peak_torque": "peak_torque",
+    "no_load_speed": "max_speed",
+    "max_speed": "max_speed",
+    "voltage": "supply_voltage",
+    "weight": "mass",
+    # The torque that turns the unpowered actuator from its output: its friction at the joint.
+    "back_drive_torque": "coulomb_friction",
+}
+# A unit of the datasheets -> (numerator, denominator) of its factor to SI.
+DATASHEET_UNITS = {
+    "": (1.0, 1.0),
+    "N·m/A": (1.0, 1.0),
+    "mΩ": (1.0, 1e3),
+    "Ω": (1.0, 1.0),
+    "g·cm²": (1.0, 1e7),
+    "kg·m²": (1.0, 1.0),
+    "N·m": (1.0, 1.0),
+    "rpm": (2.0 * math.pi, 60.0),
+    "rad/s": (1.0, 1.0),
+    "V": (1.0, 1.0),
+    "g": (1.0, 1e3),
+    "kg": (1.0, 1.0),
+}
 
 # The T-Motor AK80-6 motor (before its 6:1 transmission), from the DFKI underactuated lab's
 # documentation of the actuator (https://dfki-ric-underactuated-lab.github.io/double_pendulum/
@@ -67,14 +108,14 @@ AK80_MOTOR = {
     "motor_max_speed": 251.2,
     "supply_voltage": 24.0,
 }
-# The default gear: ratio 64 in three planetary stages of efficiency 0.9 each (assumed, not a
-# datasheet's), 850 g with the motor (assumed: the AK80-6's 485 g and two more stages).
-DEFAULT_GEAR_RATIO = 64.0
-DEFAULT_GEAR_EFFICIENCY = 0.9**3
-DEFAULT_MASS = 0.85
-# The joint's friction behind the gear (assumed, typical of a planetary gear of this size).
-DEFAULT_VISCOUS = 0.1  # [N·m·s/rad]
-DEFAULT_COULOMB = 0.5  # [N·m]
+# The default set before the catalog's datasheets (``Actuator.legacy``: what a gait file of
+# format biped-gait/2 without actuators was computed with): the AK80-6's motor behind a
+# modelled 64:1 gear of three stages of efficiency 0.9, 850 g, with assumed friction.
+LEGACY_GEAR_RATIO = 64.0
+LEGACY_GEAR_EFFICIENCY = 0.9**3
+LEGACY_MASS = 0.85
+LEGACY_VISCOUS = 0.1  # [N·m·s/rad]
+LEGACY_COULOMB = 0.5  # [N·m]
 
 _POSITIVE = (
     "torque_constant",
@@ -113,7 +154,7 @@ class Actuator:
     """[rad/s] Largest joint speed; > 0."""
     supply_voltage: float
     """[V] Voltage of the supply, the largest |u| the drive applies; > 0."""
-    mass: float = DEFAULT_MASS
+    mass: float
     """[kg] Mass of motor and gear; 0 or more."""
 
     def __post_init__(self):
@@ -147,8 +188,8 @@ class Actuator:
             rotor_inertia=motor["rotor_inertia"],
             gear_ratio=ratio,
             gear_efficiency=efficiency,
-            viscous_friction=friction.get("viscous_friction", DEFAULT_VISCOUS),
-            coulomb_friction=friction.get("coulomb_friction", DEFAULT_COULOMB),
+            viscous_friction=friction.get("viscous_friction", LEGACY_VISCOUS),
+            coulomb_friction=friction.get("coulomb_friction", LEGACY_COULOMB),
             continuous_torque=ratio * efficiency * motor["motor_continuous_torque"],
             peak_torque=ratio * efficiency * motor["motor_peak_torque"],
             max_speed=motor["motor_max_speed"] / ratio,
@@ -158,8 +199,52 @@ class Actuator:
 
     @classmethod
     def default(cls) -> Actuator:
-        """The AK80-6's motor behind a 64:1 gear (see the module)."""
-        return cls.geared(AK80_MOTOR, DEFAULT_GEAR_RATIO, DEFAULT_GEAR_EFFICIENCY, DEFAULT_MASS)
+        """The AK80-64 of the package's catalog (``DEFAULT_ACTUATOR``, see the module)."""
+        return package_catalog()[DEFAULT_ACTUATOR]
+
+    @classmethod
+    def legacy(cls) -> Actuator:
+        """The default actuator before the catalog's datasheets: the AK80-6's motor behind a
+        modelled 64:1 gear (``LEGACY_GEAR_RATIO``), for the gait files written with it."""
+        return cls.geared(AK80_MOTOR, LEGACY_GEAR_RATIO, LEGACY_GEAR_EFFICIENCY, LEGACY_MASS)
+
+    @classmethod
+    def from_datasheet(cls, entry, source: str = "catalog") -> Actuator:
+        """The actuator of a catalog entry: ``datasheet``, the vendor's figures keyed
+        "name [unit]" (``DATASHEET_FIELDS``, ``DATASHEET_UNITS``) converted to SI, and
+        ``assumed``, the fields no datasheet gives, by their names; every field once."""
+        if not isinstance(entry, dict) or not isinstance(entry.get("datasheet"), dict):
+            raise ParameterError(source, entry, "a table with a datasheet table")
+        values = {}
+        for key, value in entry["datasheet"].items():
+            name, _, unit = key.partition(" [")
+            unit = unit.removesuffix("]")
+            if name not in DATASHEET_FIELDS or unit not in DATASHEET_UNITS:
+                allowed = (
+                    f"'name [unit]' of {sorted(DATASHEET_FIELDS)} in {sorted(DATASHEET_UNITS)}"
+                )
+                raise ParameterError(f"{source}.datasheet.{key}", value, allowed)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ParameterError(f"{source}.datasheet.{key}", value, "a real number")
+            numerator, denominator = DATASHEET_UNITS[unit]
+            values[DATASHEET_FIELDS[name]] = value * numerator / denominator
+        assumed = entry.get("assumed", {})
+        if not isinstance(assumed, dict):
+            raise ParameterError(f"{source}.assumed", assumed, "a table of field = value")
+        twice = sorted(set(values) & set(assumed))
+        if twice:
+            raise ParameterError(
+                f"{source}.assumed.{twice[0]}",
+                assumed[twice[0]],
+                "a field the datasheet does not give",
+            )
+        fields = {f.name for f in dataclasses.fields(cls)}
+        missing = sorted(fields - set(values) - set(assumed))
+        if missing:
+            raise ParameterError(
+                f"{source}.{missing[0]}", None, "given by the datasheet or assumed"
+            )
+        return cls.from_mapping({**values, **assumed}, base=None, source=source, complete=True)
 
     @classmethod
     def lossless(cls, **changes) -> Actuator:
@@ -175,9 +260,11 @@ class Actuator:
         return cls(**{**values, **changes})
 
     @classmethod
-    def from_mapping(cls, values, base: Actuator | None = None, source: str = "actuator"):
+    def from_mapping(
+        cls, values, base: Actuator | None = None, source: str = "actuator", complete=False
+    ):
         """An actuator from a mapping of field names; missing fields take ``base``'s (the
-        default actuator's)."""
+        default actuator's), or none is missing (``complete``)."""
         if not isinstance(values, dict):
             raise ParameterError(source, type(values).__name__, "a table of field = value")
         known = [f.name for f in dataclasses.fields(cls)]
@@ -185,10 +272,32 @@ class Actuator:
         if unknown:
             raise ParameterError(f"{source}.{unknown[0]}", values[unknown[0]], f"one of {known}")
         try:
+            if complete:
+                return cls(**values)
             return dataclasses.replace(base or cls.default(), **values)
         except ParameterError as error:  # named as the file names it
             name = error.field.split(".", 1)[1]
             raise ParameterError(f"{source}.{name}", error.value, error.allowed) from None
+
+
+@functools.cache
+def package_catalog() -> dict[str, Actuator]:
+    """The actuators of the package's catalog (``CATALOG``) by name (read once)."""
+    text = resources.files("biped.model").joinpath(CATALOG).read_text(encoding="utf-8")
+    return catalog_actuators(json.loads(text), f"biped/model/{CATALOG}")
+
+
+def catalog_actuators(content, source: str) -> dict[str, Actuator]:
+    """The actuators of a catalog's JSON content (format ``CATALOG_FORMAT``) by name."""
+    if not isinstance(content, dict) or not isinstance(content.get("actuators"), list):
+        raise ParameterError(source, type(content).__name__, "a catalog with a list of actuators")
+    actuators = {}
+    for index, entry in enumerate(content["actuators"]):
+        name = entry.get("name") if isinstance(entry, dict) else None
+        if not isinstance(name, str) or name in actuators:
+            raise ParameterError(f"{source} actuators[{index}].name", name, "a name of its own")
+        actuators[name] = Actuator.from_datasheet(entry, f"{source} {name!r}")
+    return actuators
 
 
 UNITS = {
@@ -219,6 +328,12 @@ class Actuators:
     @classmethod
     def default(cls) -> Actuators:
         return cls.same(Actuator.default())
+
+    @classmethod
+    def legacy(cls) -> Actuators:
+        """``Actuator.legacy`` at every joint: the set of gait files of format biped-gait/2
+        written without actuators."""
+        return cls.same(Actuator.legacy())
 
     @classmethod
     def same(cls, actuator: Actuator) -> Actuators:

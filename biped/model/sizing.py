@@ -9,12 +9,14 @@ stance and swing joint's torques and θ̇ their rates (``Requirement.of``):
     peak torque  max |Γ|                     RMS torque  √((∫ Γ_s² dt + ∫ Γ_w² dt) / 2T)
     peak speed   max |θ̇|                    peak power  max |Γ θ̇|
 
-A combination (``Candidate``: a motor behind a gear, ``biped.model.actuators.Actuator``)
+A candidate (``Candidate``: a motor behind a gear, ``biped.model.actuators.Actuator``)
 meets a requirement with the margin m when peak torque × (1 + m) <= its peak torque, RMS
 torque × (1 + m) <= its continuous torque, peak speed × (1 + m) <= its top speed and the
 largest voltage of its drive over the gait (``biped.model.actuators.drive``) × (1 + m) <= its
-supply voltage. The catalog (``CATALOG``, a JSON file of motors and gears, each cited) ships
-with the package; ``load_catalog`` reads another.
+supply voltage. The catalog (``biped/model/catalog.json``, format ``CATALOG_FORMAT``: integrated
+actuators, each with its datasheet's figures and its source, what no datasheet gives assumed and
+named) ships with the package; ``load_catalog`` reads another, or one of the earlier format
+``MOTORS_AND_GEARS_FORMAT`` (every motor behind every gear).
 """
 
 from __future__ import annotations
@@ -27,11 +29,18 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.actuators import JOINT_KINDS, KINDS, Actuator, drive
+from biped.model.actuators import (
+    CATALOG,
+    CATALOG_FORMAT,
+    JOINT_KINDS,
+    KINDS,
+    Actuator,
+    catalog_actuators,
+    drive,
+)
 
-CATALOG_FORMAT = "biped-actuator-catalog/1"
-# The package's catalog (``biped/model/catalog.json``).
-CATALOG = "catalog.json"
+# The earlier catalogs' format: motors and gears, every motor behind every gear.
+MOTORS_AND_GEARS_FORMAT = "biped-actuator-catalog/1"
 # The default margin on every requirement: 20 %.
 DEFAULT_MARGIN = 0.2
 # The limits a combination must meet, in order: (name, unit) as printed.
@@ -105,7 +114,7 @@ class Requirement:
 
 @dataclass(frozen=True)
 class Candidate:
-    """One combination of the catalog: a motor behind a gear."""
+    """One actuator of the catalog: a motor behind a gear."""
 
     name: str
     actuator: Actuator
@@ -127,8 +136,8 @@ class Choice:
 
 
 def load_catalog(path: str | Path | None = None) -> list[Candidate]:
-    """The candidates of a catalog file (default: the package's ``CATALOG``): every motor
-    behind every gear."""
+    """The candidates of a catalog file (default: the package's ``CATALOG``): its actuators, or
+    every motor behind every gear of a catalog of ``MOTORS_AND_GEARS_FORMAT``."""
     if path is None:
         text = resources.files("biped.model").joinpath(CATALOG).read_text(encoding="utf-8")
         source = f"biped/model/{CATALOG}"
@@ -142,8 +151,21 @@ def load_catalog(path: str | Path | None = None) -> list[Candidate]:
         content = json.loads(text)
     except ValueError as error:
         raise BipedError(f"catalog {source!r} is not valid JSON ({error})") from None
-    if not isinstance(content, dict) or content.get("format") != CATALOG_FORMAT:
-        raise BipedError(f"catalog {source!r}: allowed a JSON file of format {CATALOG_FORMAT!r}")
+    found = content.get("format") if isinstance(content, dict) else None
+    if found == CATALOG_FORMAT:
+        try:
+            actuators = catalog_actuators(content, f"catalog {source!r}")
+        except BipedError as error:
+            raise BipedError(f"{error} (an actuator of the catalog is corrupt)") from None
+        return [
+            Candidate(name, actuator, str(entry.get("source", "")))
+            for (name, actuator), entry in zip(actuators.items(), content["actuators"], strict=True)
+        ]
+    if found != MOTORS_AND_GEARS_FORMAT:
+        raise BipedError(
+            f"catalog {source!r}: allowed a JSON file of format {CATALOG_FORMAT!r} (or the "
+            f"earlier {MOTORS_AND_GEARS_FORMAT!r})"
+        )
     try:
         motors, gears = dict(content["motors"]), list(content["gears"])
         return [_candidate(name, motor, gear) for name, motor in motors.items() for gear in gears]

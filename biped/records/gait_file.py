@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.actuators import KINDS
+from biped.model.actuators import KINDS, Actuators
 from biped.model.actuators import UNITS as ACTUATOR_UNITS
 from biped.model.criteria import (
     ALL_CRITERIA,
@@ -67,7 +67,12 @@ from biped.optimization.problem import (
 from biped.records.provenance import provenance as make_provenance
 from biped.runtime.files import atomic_write_text
 
-FORMAT = "biped-gait/2"  # 2: safety margins recorded
+# 2: safety margins recorded; 3: a robot without actuators has the catalog's default set
+# (``biped.model.actuators.Actuators.default``).
+FORMAT = "biped-gait/3"
+# Earlier formats read: a file of format 2 whose robot names no actuators was computed with
+# the default set of its time (``Actuators.legacy``), which it is read with.
+EARLIER_FORMATS = ("biped-gait/2",)
 # Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
 MIN_STEP_LENGTH = 1e-3
 # What a gait file is and who writes it, for a message refusing another file.
@@ -377,7 +382,8 @@ class Gait:
         if kind is not None:  # a valid file of another kind is not corrupt
             raise BipedError(f"{str(path)!r} is {kind}, not a gait file: allowed {allowed}")
         found = content.get("format") if isinstance(content, dict) else None
-        if isinstance(found, str) and found.startswith("biped-gait/") and found != FORMAT:
+        known = (FORMAT, *EARLIER_FORMATS)
+        if isinstance(found, str) and found.startswith("biped-gait/") and found not in known:
             raise BipedError(
                 f"gait file {str(path)!r} has format {found!r}, another version's: "
                 f"allowed {allowed}"
@@ -395,7 +401,7 @@ class Gait:
         def bad(what):
             return BipedError(f"{source} is corrupt: {what}")
 
-        if not isinstance(content, dict) or content.get("format") != FORMAT:
+        if not isinstance(content, dict) or content.get("format") not in (FORMAT, *EARLIER_FORMATS):
             raise bad(f"format is not {FORMAT!r}")
         _check_scalars(content, bad)
         try:
@@ -405,7 +411,7 @@ class Gait:
         _check_kinds(content, bad)
         try:
             knots = check_knots(content.get("knots", 1))
-            robot = Robot.from_mapping(content["robot"], source="robot")
+            robot = _robot(content)
             names = set(content["parameters"])
         except (KeyError, TypeError) as error:
             raise bad(f"robot or parameters missing ({error})") from None
@@ -544,6 +550,15 @@ class Gait:
             _check_impact(self.impact, expected["impact"], bad)
         if self.electrical is not None:  # a file written before the actuators has none
             _check_group(self.electrical, "electrical", expected["electrical"], units, bad)
+
+
+def _robot(content: dict) -> Robot:
+    """The robot of a gait file's content; one of an earlier format without actuators has the
+    default set of its time (``EARLIER_FORMATS``)."""
+    robot = Robot.from_mapping(content["robot"], source="robot")
+    if content["format"] in EARLIER_FORMATS and robot.actuators is None:
+        return dataclasses.replace(robot, actuators=Actuators.legacy())
+    return robot
 
 
 def _derived(model: Biped, step, evaluation) -> dict:
