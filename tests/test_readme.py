@@ -43,3 +43,26 @@ def test_command_table_names_real_commands_and_options():
                 assert word.strip("[]") in options, (cell, word)
         for option in re.findall(r"`(--[a-z-]+)", line):
             assert option in options, (cell, option)
+
+
+def test_robot_file_example_is_the_catalogs_actuator():
+    """The README's robot file reads, its [actuator] the catalog's AK10-9 V3.0 (to the
+    digits written), its knees' resistance changed; a field of another actuator would not
+    match."""
+    import dataclasses
+    import tomllib
+
+    import pytest
+
+    from biped import Robot
+    from biped.model.actuators import package_catalog
+
+    text = re.search(r"```toml\n(.*?)```", README, re.S).group(1)
+    values = tomllib.loads(text)
+    robot = Robot.from_mapping(values)
+    catalog = package_catalog()["AK10-9 V3.0 KV60"]
+    ankle = dataclasses.asdict(robot.actuators.ankle)
+    assert ankle == pytest.approx(dataclasses.asdict(catalog), rel=1e-4)
+    assert robot.actuators.knee == dataclasses.replace(robot.actuators.ankle, resistance=0.3)
+    other = dataclasses.asdict(package_catalog()["AK70-9 V3.0 KV60"])
+    assert ankle != pytest.approx(other, rel=1e-4)
