@@ -9,10 +9,12 @@ from biped import Biped, Robot
 from biped.errors import BipedError
 from biped.model.actuators import Actuators
 from biped.optimization.optimize import checked
+from biped.pages.page import drive_lines
 from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped.records.provenance import PACKAGE
 from tests.conftest import edited_gait_file, refusal, small_optimum
+from validate.model import committed_model
 
 
 @pytest.fixture(scope="module")
@@ -203,6 +205,9 @@ def test_a_gait_file_of_format_2_without_actuators_reads_with_the_set_of_its_tim
     gait = gait_file.read_consistent(gait_file.write_json(tmp_path / "old.json", old))
     assert gait.robot.actuators == Actuators.legacy() != Actuators.default()
     assert gait.costs.electrical == old["costs"]["electrical"]
+    assert "## Drive (the earlier default set's actuators" in "\n".join(drive_lines(gait))
+    assert committed_model(Biped(gait.robot, "rolling")) == committed_model(gait.biped)
+    assert committed_model(gait.biped) is not None  # the body is Table 1's
     old["format"] = gait_file.FORMAT
     message = refusal(gait_file.read_consistent, gait_file.write_json(tmp_path / "new.json", old))
     assert "inconsistent: costs.electrical = " in message

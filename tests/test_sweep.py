@@ -167,6 +167,21 @@ def test_sweep_refuses_other_settings(sweep):
         run_sweep(folder, _settings(starts=2), jobs=1)
 
 
+def test_a_sweep_of_the_earlier_format_is_refused_not_resumed(sweep, tmp_path):
+    """A sweep folder of format biped-sweep/2 (its robot without actuators had the earlier
+    default set, whose electrical figures are not the catalog's) is neither resumed nor
+    tabled: both say its format, naming the folder's record."""
+    folder, _ = sweep
+    old = _copy(folder, tmp_path / "old", "*.json")
+    record = json.loads((old / MANIFEST).read_text())
+    (old / MANIFEST).write_text(json.dumps({**record, "format": "biped-sweep/2"}))
+    with pytest.raises(biped.BipedError, match="made with format = 'biped-sweep/2'"):
+        run_sweep(old, _settings(), **FAST)
+    with pytest.raises(biped.BipedError, match="'biped-sweep/2', another version's"):
+        sweep_module.optima_table(old)
+    assert sweep_module.optima_table(folder)["series"]
+
+
 def test_sweep_checks_its_input_before_any_work(tmp_path):
     """An unwalkable speed or a knee named twice fails at once, writing nothing."""
     with pytest.raises(biped.BipedError, match="speed = 3.5"):

@@ -19,6 +19,7 @@ trips on it.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -65,9 +66,11 @@ def knee_of(model: mujoco.MjModel, source: str = "the model") -> str:
 
 
 def committed_model(biped: Biped) -> Path | None:
-    """The committed scene of ``biped``'s knee (``mjcf/scene_<knee>.xml``) when its robot is
-    Table 1 (``Robot.paper()``); None for another robot (its model is generated)."""
-    return FOLDER / f"scene_{biped.knee}.xml" if biped.robot == Robot.paper() else None
+    """The committed scene of ``biped``'s knee (``mjcf/scene_<knee>.xml``) when its robot's
+    body is Table 1's (``Robot.paper()``; the actuators are not in the model); None for
+    another robot (its model is generated)."""
+    body = dataclasses.replace(biped.robot, actuators=None)
+    return FOLDER / f"scene_{biped.knee}.xml" if body == Robot.paper() else None
 
 
 def model_spec(biped: Biped, path: str | Path | None = None) -> mujoco.MjSpec:

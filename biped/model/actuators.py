@@ -40,14 +40,14 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import json
 import math
 from dataclasses import dataclass
 from importlib import resources
 
 import numpy as np
 
-from biped.errors import ParameterError
+from biped.errors import BipedError, ParameterError
+from biped.model import datasheets
 
 # The kinds of joint, each driven by one actuator model; the kind of each joint of eq. (32),
 # in the order of ``biped.model.dynamics.JOINTS`` (which imports the robot, hence this module:
@@ -57,41 +57,10 @@ JOINT_KINDS = ("ankle", "knee", "hip", "hip", "knee", "ankle")
 # [rad/s] Rate over which the Coulomb friction's sign is smoothed (tanh(θ̇ / ω_c)).
 COULOMB_SMOOTHING = 1e-2
 
-# The package's catalog of actuators (``biped.model.sizing``), of which the default actuator.
+# The package's catalog of actuators (``biped.model.sizing``, ``biped.model.datasheets``), of
+# which the default actuator.
 CATALOG = "catalog.json"
-CATALOG_FORMAT = "biped-actuator-catalog/2"
 DEFAULT_ACTUATOR = "AK80-64 KV80"
-# A datasheet's figure (its key, "name [unit]" as the vendor prints it) -> the actuator's field
-# and the unit's factor to SI.
-DATASHEET_FIELDS = {
-    "reduction_ratio": "gear_ratio",
-    "torque_constant": "torque_constant",
-    "phase_to_phase_resistance": "resistance",
-    "rotor_inertia": "rotor_inertia",
-    "rated_torque": "continuous_torque",
-    "peak_torque": "peak_torque",
-    "no_load_speed": "max_speed",
-    "max_speed": "max_speed",
-    "voltage": "supply_voltage",
-    "weight": "mass",
-    # The torque that turns the unpowered actuator from its output: its friction at the joint.
-    "back_drive_torque": "coulomb_friction",
-}
-# A unit of the datasheets -> (numerator, denominator) of its factor to SI.
-DATASHEET_UNITS = {
-    "": (1.0, 1.0),
-    "N·m/A": (1.0, 1.0),
-    "mΩ": (1.0, 1e3),
-    "Ω": (1.0, 1.0),
-    "g·cm²": (1.0, 1e7),
-    "kg·m²": (1.0, 1.0),
-    "N·m": (1.0, 1.0),
-    "rpm": (2.0 * math.pi, 60.0),
-    "rad/s": (1.0, 1.0),
-    "V": (1.0, 1.0),
-    "g": (1.0, 1e3),
-    "kg": (1.0, 1.0),
-}
 
 # The T-Motor AK80-6 motor (before its 6:1 transmission), from the DFKI underactuated lab's
 # documentation of the actuator (https://dfki-ric-underactuated-lab.github.io/double_pendulum/
@@ -209,42 +178,19 @@ class Actuator:
         return cls.geared(AK80_MOTOR, LEGACY_GEAR_RATIO, LEGACY_GEAR_EFFICIENCY, LEGACY_MASS)
 
     @classmethod
-    def from_datasheet(cls, entry, source: str = "catalog") -> Actuator:
-        """The actuator of a catalog entry: ``datasheet``, the vendor's figures keyed
-        "name [unit]" (``DATASHEET_FIELDS``, ``DATASHEET_UNITS``) converted to SI, and
-        ``assumed``, the fields no datasheet gives, by their names; every field once."""
-        if not isinstance(entry, dict) or not isinstance(entry.get("datasheet"), dict):
-            raise ParameterError(source, entry, "a table with a datasheet table")
-        values = {}
-        for key, value in entry["datasheet"].items():
-            name, _, unit = key.partition(" [")
-            unit = unit.removesuffix("]")
-            if name not in DATASHEET_FIELDS or unit not in DATASHEET_UNITS:
-                allowed = (
-                    f"'name [unit]' of {sorted(DATASHEET_FIELDS)} in {sorted(DATASHEET_UNITS)}"
-                )
-                raise ParameterError(f"{source}.datasheet.{key}", value, allowed)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ParameterError(f"{source}.datasheet.{key}", value, "a real number")
-            numerator, denominator = DATASHEET_UNITS[unit]
-            values[DATASHEET_FIELDS[name]] = value * numerator / denominator
-        assumed = entry.get("assumed", {})
-        if not isinstance(assumed, dict):
-            raise ParameterError(f"{source}.assumed", assumed, "a table of field = value")
-        twice = sorted(set(values) & set(assumed))
-        if twice:
-            raise ParameterError(
-                f"{source}.assumed.{twice[0]}",
-                assumed[twice[0]],
-                "a field the datasheet does not give",
-            )
-        fields = {f.name for f in dataclasses.fields(cls)}
-        missing = sorted(fields - set(values) - set(assumed))
-        if missing:
-            raise ParameterError(
-                f"{source}.{missing[0]}", None, "given by the datasheet or assumed"
-            )
-        return cls.from_mapping({**values, **assumed}, base=None, source=source, complete=True)
+    def from_datasheet(cls, entry: dict, source: str = "catalog") -> Actuator:
+        """The actuator of a catalog entry (``biped.model.datasheets``): its datasheet's
+        figures in SI units and its assumed fields; a BipedError naming the figure as the
+        file has it when one is not allowed."""
+        names = [f.name for f in dataclasses.fields(cls)]
+        values, origins = datasheets.fields_of(entry, names, _POSITIVE, source)
+        try:
+            return cls(**values)
+        except ParameterError as error:  # a rule between fields: named as the file has them
+            field = error.field.rsplit(".", 1)[-1]
+            raise BipedError(
+                f"{source}: {origins[field]} is invalid: allowed {error.allowed}"
+            ) from None
 
     @classmethod
     def lossless(cls, **changes) -> Actuator:
@@ -260,11 +206,9 @@ class Actuator:
         return cls(**{**values, **changes})
 
     @classmethod
-    def from_mapping(
-        cls, values, base: Actuator | None = None, source: str = "actuator", complete=False
-    ):
+    def from_mapping(cls, values, base: Actuator | None = None, source: str = "actuator"):
         """An actuator from a mapping of field names; missing fields take ``base``'s (the
-        default actuator's), or none is missing (``complete``)."""
+        default actuator's)."""
         if not isinstance(values, dict):
             raise ParameterError(source, type(values).__name__, "a table of field = value")
         known = [f.name for f in dataclasses.fields(cls)]
@@ -272,8 +216,6 @@ class Actuator:
         if unknown:
             raise ParameterError(f"{source}.{unknown[0]}", values[unknown[0]], f"one of {known}")
         try:
-            if complete:
-                return cls(**values)
             return dataclasses.replace(base or cls.default(), **values)
         except ParameterError as error:  # named as the file names it
             name = error.field.split(".", 1)[1]
@@ -284,20 +226,17 @@ class Actuator:
 def package_catalog() -> dict[str, Actuator]:
     """The actuators of the package's catalog (``CATALOG``) by name (read once)."""
     text = resources.files("biped.model").joinpath(CATALOG).read_text(encoding="utf-8")
-    return catalog_actuators(json.loads(text), f"biped/model/{CATALOG}")
+    source = f"biped/model/{CATALOG}"
+    return catalog_actuators(datasheets.loads(text, source), source)
 
 
 def catalog_actuators(content, source: str) -> dict[str, Actuator]:
-    """The actuators of a catalog's JSON content (format ``CATALOG_FORMAT``) by name."""
-    if not isinstance(content, dict) or not isinstance(content.get("actuators"), list):
-        raise ParameterError(source, type(content).__name__, "a catalog with a list of actuators")
-    actuators = {}
-    for index, entry in enumerate(content["actuators"]):
-        name = entry.get("name") if isinstance(entry, dict) else None
-        if not isinstance(name, str) or name in actuators:
-            raise ParameterError(f"{source} actuators[{index}].name", name, "a name of its own")
-        actuators[name] = Actuator.from_datasheet(entry, f"{source} {name!r}")
-    return actuators
+    """The actuators of a catalog's JSON content (``biped.model.datasheets.CATALOG_FORMAT``)
+    by name."""
+    return {
+        entry["name"]: Actuator.from_datasheet(entry, f"catalog {source!r} {entry['name']!r}")
+        for entry in datasheets.entries(content, source)
+    }
 
 
 UNITS = {

@@ -21,7 +21,6 @@ named) ships with the package; ``load_catalog`` reads another, or one of the ear
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -29,9 +28,9 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model import datasheets
 from biped.model.actuators import (
     CATALOG,
-    CATALOG_FORMAT,
     JOINT_KINDS,
     KINDS,
     Actuator,
@@ -39,6 +38,7 @@ from biped.model.actuators import (
     drive,
 )
 
+CATALOG_FORMAT = datasheets.CATALOG_FORMAT
 # The earlier catalogs' format: motors and gears, every motor behind every gear.
 MOTORS_AND_GEARS_FORMAT = "biped-actuator-catalog/1"
 # The default margin on every requirement: 20 %.
@@ -147,20 +147,12 @@ def load_catalog(path: str | Path | None = None) -> list[Candidate]:
             text = Path(path).read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as error:
             raise BipedError(f"catalog {source!r} cannot be read ({error})") from None
-    try:
-        content = json.loads(text)
-    except ValueError as error:
-        raise BipedError(f"catalog {source!r} is not valid JSON ({error})") from None
+    content = datasheets.loads(text, source)
     found = content.get("format") if isinstance(content, dict) else None
     if found == CATALOG_FORMAT:
-        try:
-            actuators = catalog_actuators(content, f"catalog {source!r}")
-        except BipedError as error:
-            raise BipedError(f"{error} (an actuator of the catalog is corrupt)") from None
-        return [
-            Candidate(name, actuator, str(entry.get("source", "")))
-            for (name, actuator), entry in zip(actuators.items(), content["actuators"], strict=True)
-        ]
+        actuators = catalog_actuators(content, source)
+        sources = {entry["name"]: entry["source"] for entry in content["actuators"]}
+        return [Candidate(name, a, sources[name]) for name, a in actuators.items()]
     if found != MOTORS_AND_GEARS_FORMAT:
         raise BipedError(
             f"catalog {source!r}: allowed a JSON file of format {CATALOG_FORMAT!r} (or the "
@@ -168,12 +160,15 @@ def load_catalog(path: str | Path | None = None) -> list[Candidate]:
         )
     try:
         motors, gears = dict(content["motors"]), list(content["gears"])
-        return [_candidate(name, motor, gear) for name, motor in motors.items() for gear in gears]
-    except (KeyError, TypeError, ValueError, BipedError) as error:
+        candidates = [_candidate(n, motor, gear) for n, motor in motors.items() for gear in gears]
+        if not candidates:
+            raise ValueError("no motor or no gear")
+    except (KeyError, TypeError, ValueError, OverflowError, BipedError) as error:
         raise BipedError(
             f"catalog {source!r} is corrupt ({error}): allowed motors with "
             f"{', '.join(_MOTOR_FIELDS)} and gears with name, ratio, efficiency, mass"
         ) from None
+    return candidates
 
 
 def _candidate(name: str, motor: dict, gear: dict) -> Candidate:

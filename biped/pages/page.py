@@ -28,6 +28,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
+from biped.model.actuators import Actuators
 from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
 from biped.model.gait import breakpoints, build_step, parameter_names, piece_grid
@@ -539,7 +540,7 @@ def markdown(page: Page, folder: Path) -> str:
     for name, label, value, unit in gait.costs.labelled():
         optimised = " (optimised)" if name == gait.criterion else ""
         lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
-    lines += _drive_lines(gait)
+    lines += drive_lines(gait)
     lines += _constraint_lines(gait)
     lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [
@@ -583,14 +584,16 @@ def _constraint_lines(gait: Gait) -> list[str]:
     return lines + (["", dips] if dips else [])
 
 
-def _drive_lines(gait: Gait) -> list[str]:
+def drive_lines(gait: Gait) -> list[str]:
     """The motors' figures (``Electrical``; none for a file written before the actuators):
     a row per joint, then the energies per step and per metre and the cost of transport,
     without and with regeneration."""
     electrical = gait.electrical
     if electrical is None:
         return []
-    which = "the robot file's" if gait.robot.actuators is not None else "the default set's"
+    which = {None: "the default set's", Actuators.legacy(): "the earlier default set's"}.get(
+        gait.robot.actuators, "the robot file's"
+    )
     per_joint = [f for f in dataclasses.fields(electrical) if f.metadata.get("columns")]
     totals = [f for f in dataclasses.fields(electrical) if not f.metadata.get("columns")]
     lines = [

@@ -106,7 +106,8 @@ class Point:
 class Settings(campaign.Settings):
     """What shapes an atlas's numbers, recorded in its folder."""
 
-    FORMAT = "biped-atlas/1"
+    # 2: a robot without actuators has the catalog's default set (biped-gait/3)
+    FORMAT = "biped-atlas/2"
     robot: Robot
     speeds: tuple  # [m/s]
     clearances: tuple  # [m] of the swing foot (Safety.clearance)

@@ -87,7 +87,8 @@ class MapPoint:
 class MapSettings(campaign.Settings):
     """What shapes a map's numbers, recorded in its folder."""
 
-    FORMAT = "biped-design-map/1"
+    # 2: a robot without actuators has the catalog's default set (biped-gait/3)
+    FORMAT = "biped-design-map/2"
     robot: Robot
     criterion: str
     safety: Safety

@@ -52,7 +52,8 @@ DEFAULT_SEEDS = 5
 class PaperMethod(campaign.Settings):
     """What shapes the paper-method runs of a sweep folder."""
 
-    FORMAT = "biped-paper-method/1"
+    # 2: a robot without actuators has the catalog's default set (biped-gait/3)
+    FORMAT = "biped-paper-method/2"
     robot: Robot
     safety: Safety
     speed: float  # [m/s]

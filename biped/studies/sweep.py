@@ -80,7 +80,8 @@ class Point:
 class Settings(campaign.Settings):
     """What shapes a sweep's numbers, recorded in its folder."""
 
-    FORMAT = "biped-sweep/2"
+    # 3: a robot without actuators has the catalog's default set (biped-gait/3)
+    FORMAT = "biped-sweep/3"
     robot: Robot
     safety: Safety
     speeds: tuple  # [m/s], sorted
@@ -291,6 +292,11 @@ def optima_table(folder) -> dict:
     found = SWEEP.read(folder)
     if found is None:
         raise BipedError(f"{folder} has no {MANIFEST}: allowed a folder biped sweep wrote")
+    if found.get("format") != Settings.FORMAT:
+        raise BipedError(
+            f"{folder / MANIFEST} has format {found.get('format')!r}, another version's: "
+            f"allowed a sweep of format {Settings.FORMAT!r} (run biped sweep again)"
+        )
     settings = Settings.from_dict(found)
     if settings.knots != 1:
         raise BipedError(
