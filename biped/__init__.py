@@ -17,10 +17,14 @@ model = biped.Biped(biped.Robot.paper(), knee="rolling")
 torques, wrench = model.inverse_dynamics(q, qd, qdd)
 """
 
-from biped.errors import BipedError, ParameterError, UnreachableError
-from biped.model.dynamics import JOINTS, Biped
-from biped.model.kinematics import COORDINATES, KNEES, swap_legs
-from biped.model.robot import Robot
+from biped.runtime.blas import pin_kernels
+
+pin_kernels()  # OpenBLAS's kernels, the same on every x86-64 machine with AVX2: before numpy
+
+from biped.errors import BipedError, ParameterError, UnreachableError  # noqa: E402
+from biped.model.dynamics import JOINTS, Biped  # noqa: E402
+from biped.model.kinematics import COORDINATES, KNEES, swap_legs  # noqa: E402
+from biped.model.robot import Robot  # noqa: E402
 
 __all__ = [
     "COORDINATES",

@@ -2,7 +2,8 @@
 
 Versions are read from the installed packages' metadata (``importlib.metadata``), so asking
 for MuJoCo's version does not import MuJoCo. Nothing here depends on the time or the host's
-state beyond the installed software, so two runs of the same command give the same record.
+state beyond the installed software and the BLAS kernels asked for (``biped.runtime.blas``),
+so two runs of the same command give the same record.
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ import platform
 import shlex
 import sys
 from collections.abc import Iterator, Sequence
+
+from biped.runtime.blas import kernels
 
 # The distribution name of this project (pyproject.toml).
 PACKAGE = "biped-rolling-knee"
@@ -54,8 +57,9 @@ def provenance(argv: Sequence[str] | None = None) -> dict:
 
     Returns:
         ``{"package", "version", "python", "platform", "numpy", "scipy", "casadi", "mujoco",
-        "command"}``: versions are strings, None for a package that is not installed;
-        ``command`` is the command line as one shell-quoted string.
+        "blas_kernels", "command"}``: versions are strings, None for a package that is not
+        installed; ``blas_kernels`` the OpenBLAS kernels asked for
+        (``biped.runtime.blas``); ``command`` is the command line as one shell-quoted string.
     """
     if argv is None:
         argv = _command if _command is not None else sys.argv
@@ -65,5 +69,6 @@ def provenance(argv: Sequence[str] | None = None) -> dict:
         "python": platform.python_version(),
         "platform": platform.platform(),
         **{name: version(name) for name in DEPENDENCIES},
+        "blas_kernels": kernels(),
         "command": shlex.join(str(a) for a in argv),
     }
