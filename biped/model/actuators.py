@@ -222,12 +222,21 @@ class Actuator:
             raise ParameterError(f"{source}.{name}", error.value, error.allowed) from None
 
 
+# Where the package's catalog is, as messages name it.
+CATALOG_SOURCE = f"biped/model/{CATALOG}"
+
+
+@functools.cache
+def package_catalog_text() -> str:
+    """The package's catalog (``CATALOG``), as its file holds it (read once)."""
+    return resources.files("biped.model").joinpath(CATALOG).read_text(encoding="utf-8")
+
+
 @functools.cache
 def package_catalog() -> dict[str, Actuator]:
-    """The actuators of the package's catalog (``CATALOG``) by name (read once)."""
-    text = resources.files("biped.model").joinpath(CATALOG).read_text(encoding="utf-8")
-    source = f"biped/model/{CATALOG}"
-    return catalog_actuators(datasheets.loads(text, source), source)
+    """The actuators of the package's catalog by name (read once)."""
+    content = datasheets.loads(package_catalog_text(), CATALOG_SOURCE)
+    return catalog_actuators(content, CATALOG_SOURCE)
 
 
 def catalog_actuators(content, source: str) -> dict[str, Actuator]:

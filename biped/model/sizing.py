@@ -22,7 +22,6 @@ named) ships with the package; ``load_catalog`` reads another, or one of the ear
 from __future__ import annotations
 
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -30,12 +29,13 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model import datasheets
 from biped.model.actuators import (
-    CATALOG,
+    CATALOG_SOURCE,
     JOINT_KINDS,
     KINDS,
     Actuator,
     catalog_actuators,
     drive,
+    package_catalog_text,
 )
 
 CATALOG_FORMAT = datasheets.CATALOG_FORMAT
@@ -136,11 +136,10 @@ class Choice:
 
 
 def load_catalog(path: str | Path | None = None) -> list[Candidate]:
-    """The candidates of a catalog file (default: the package's ``CATALOG``): its actuators, or
+    """The candidates of a catalog file (default: the package's): its actuators, or
     every motor behind every gear of a catalog of ``MOTORS_AND_GEARS_FORMAT``."""
     if path is None:
-        text = resources.files("biped.model").joinpath(CATALOG).read_text(encoding="utf-8")
-        source = f"biped/model/{CATALOG}"
+        text, source = package_catalog_text(), CATALOG_SOURCE
     else:
         source = str(path)
         try:

@@ -73,6 +73,7 @@ FORMAT = "biped-gait/3"
 # Earlier formats read: a file of format 2 whose robot names no actuators was computed with
 # the default set of its time (``Actuators.legacy``), which it is read with.
 EARLIER_FORMATS = ("biped-gait/2",)
+READ_FORMATS = (FORMAT, *EARLIER_FORMATS)
 # Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
 MIN_STEP_LENGTH = 1e-3
 # What a gait file is and who writes it, for a message refusing another file.
@@ -382,8 +383,7 @@ class Gait:
         if kind is not None:  # a valid file of another kind is not corrupt
             raise BipedError(f"{str(path)!r} is {kind}, not a gait file: allowed {allowed}")
         found = content.get("format") if isinstance(content, dict) else None
-        known = (FORMAT, *EARLIER_FORMATS)
-        if isinstance(found, str) and found.startswith("biped-gait/") and found not in known:
+        if isinstance(found, str) and found.startswith("biped-gait/") and found not in READ_FORMATS:
             raise BipedError(
                 f"gait file {str(path)!r} has format {found!r}, another version's: "
                 f"allowed {allowed}"
@@ -401,7 +401,7 @@ class Gait:
         def bad(what):
             return BipedError(f"{source} is corrupt: {what}")
 
-        if not isinstance(content, dict) or content.get("format") not in (FORMAT, *EARLIER_FORMATS):
+        if not isinstance(content, dict) or content.get("format") not in READ_FORMATS:
             raise bad(f"format is not {FORMAT!r}")
         _check_scalars(content, bad)
         try:
