@@ -1,6 +1,7 @@
 """Optimal gaits: the nonlinear program of one step (``problem``), its exact CasADi graph built
 from the model's own constants (``symbolic``) and its derivatives sample by sample
-(``derivatives``), IPOPT on it (``solver``), the paper's penalised Nelder-Mead (``penalty``),
+(``derivatives``, compiled to machine code and cached on disk where a C compiler is found:
+``compiled``), IPOPT on it (``solver``), the paper's penalised Nelder-Mead (``penalty``),
 the multistart optimizer (``optimize``) with the shipped table of optima among its starts
 (``table``), the knee radii designed with the gait (``design``), and the words and sign with
 which optima are compared (``comparison``: a difference between knees, "certified", the two
