@@ -3,7 +3,9 @@ an earlier version kept here ("before": CasADi's Hessian of the whole graph, IPO
 gradient scaling, the first guesses and, for the energy criterion, the sthenic optimum under
 both barriers, one start after the other), in the same process: setup, solve, value, starts
 at the best value, ratios; and beside today's method without its coarse search of the
-sthenic starts ("fine grid alone": every start solved on the problem's grid). ``biped
+sthenic starts ("fine grid alone": every start solved on the problem's grid), and beside
+today's method with CasADi's interpreter for its derivatives instead of compiled code
+("interpreted", ``biped.optimization.compiled``: the same optimum to the bit). ``biped
 optimize`` is timed as a whole process; ``--sweep`` times the default sweep both ways,
 ``--pipeline`` the pipeline without videos.
 
@@ -27,6 +29,7 @@ import numpy as np  # noqa: E402
 from timing import median_time  # noqa: E402
 
 import biped  # noqa: E402
+from biped.optimization import compiled as compiled_module  # noqa: E402
 from biped.optimization import optimize as optimize_module  # noqa: E402
 from biped.optimization import solver as solver_module  # noqa: E402
 from biped.optimization.optimize import (  # noqa: E402
@@ -96,12 +99,12 @@ def one_optimization(repeats: int) -> None:
     )
     print(
         f"{'':18}{'setup [s]':>20}{'solve [s]':>20}{'value':>24}{'starts at best':>18}"
-        f"{'process [s]':>13}{'fine grid alone [s]':>27}"
+        f"{'process [s]':>13}{'fine grid alone [s]':>27}{'interpreted [s]':>24}"
     )
     print(
         f"{'knee, criterion':18}{'before':>10}{'now':>7}{'ratio':>6}{'before':>10}{'now':>7}"
         f"{'ratio':>6}{'before':>12}{'now':>12}{'before':>9}{'now':>9}{'now':>13}"
-        f"{'solve':>9}{'ratio':>6}{'value':>12}"
+        f"{'solve':>9}{'ratio':>6}{'value':>12}{'solve':>9}{'ratio':>6}{'same bits':>10}"
     )
     for criterion in ("sthenic", "energy"):
         for knee in biped.KNEES:
@@ -114,6 +117,9 @@ def one_optimization(repeats: int) -> None:
             for solver in before.values():
                 solver.prepare(("adaptive", "monotone"))
             setup_before = time.perf_counter() - began
+            with interpreted():
+                prepare(problem)
+                solve_interpreted, slow = median_time(optimize, problem, repeats=repeats)
             setup_now = prepare(problem)
             solve_before, old = median_time(optimize_before, problem, before, repeats=repeats)
             solve_now, new = median_time(optimize, problem, repeats=repeats)
@@ -127,12 +133,27 @@ def one_optimization(repeats: int) -> None:
                 f"{f'{old.report.starts_at_best}/{old.report.starts}':>9}"
                 f"{f'{new.report.starts_at_best}/{new.report.starts}':>9}{process:13.2f}"
                 f"{solve_fine:9.2f}{solve_now / solve_fine:6.2f}{fine.report.value:12.6f}"
+                f"{solve_interpreted:9.2f}{solve_now / solve_interpreted:6.2f}"
+                f"{str(np.array_equal(slow.variables, new.variables)):>10}"
             )
     print(
         "targets: a solve (all starts) <= "
         + ", ".join(f"{t} s {c}" for c, t in TARGETS.items())
         + " once set up; biped optimize <= 2 s as a process"
     )
+
+
+@contextlib.contextmanager
+def interpreted():
+    """Within the block, solvers built anew with CasADi's interpreter for their derivatives;
+    after it, built anew compiled."""
+    os.environ[compiled_module.SWITCH] = "0"
+    solver_module._solver.cache_clear()
+    try:
+        yield
+    finally:
+        del os.environ[compiled_module.SWITCH]
+        solver_module._solver.cache_clear()
 
 
 @contextlib.contextmanager

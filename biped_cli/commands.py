@@ -137,6 +137,7 @@ def cmd_optimize(args) -> int:
     """
     from biped.optimization.optimize import confirm, optimize, prepare
     from biped.optimization.problem import GaitProblem
+    from biped.optimization.compiled import mode as derivatives_mode
     from biped.records import gait_file
     from biped.runtime.runner import free_cores
 
@@ -153,7 +154,8 @@ def cmd_optimize(args) -> int:
     print(report.summary())
     if args.method == "ipopt":
         print(
-            f"time: setup {setup:.2f} s (IPOPT and its exact derivatives built), solve "
+            f"time: setup {setup:.2f} s (IPOPT and its exact derivatives built, "
+            f"{derivatives_mode()}), solve "
             f"{report.seconds:.2f} s ({report.starts} starts on {min(free_cores(), report.starts)} "
             "processes)"
         )

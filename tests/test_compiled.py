@@ -165,13 +165,17 @@ def test_without_a_working_compiler_the_interpreter_runs_and_says_so(
     """No compiler, or one that fails: the interpreted function, the same numbers, and one
     warning naming why; ``BIPED_COMPILE=0``: the interpreter without a warning."""
     monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled_module, "_FAILED", set())
     monkeypatch.setenv("CC", _fake_compiler(tmp_path, 1) if compiler == "fake" else compiler)
     sample = _sample_function()
     with pytest.warns(CompileWarning, match=re.escape(needle)):
         found = compiled(sample)
     assert found is sample
     assert not list(tmp_path.rglob("*.so"))
+    expected = "interpreted in part" if compiler == "fake" else "interpreted"
+    assert compiled_module.mode() == expected
     monkeypatch.setenv(compiled_module.SWITCH, "0")
+    assert compiled_module.mode() == "interpreted"
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert compiled(sample) is sample

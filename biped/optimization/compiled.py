@@ -49,6 +49,7 @@ import casadi as ca
 # -ffast-math) and no fused multiply-add (each product rounded, as the interpreter's).
 FLAGS = ("-O1", "-fPIC", "-shared", "-ffp-contract=off")
 SWITCH = "BIPED_COMPILE"  # "0" (or "off", "no", "false"): the interpreter always
+_FAILED: set[str] = set()  # the functions whose build or load failed in this process
 
 
 class CompileWarning(UserWarning):
@@ -71,6 +72,7 @@ def compiled(function: ca.Function) -> ca.Function:
             _build(source, compiler, library)
         return ca.external(function.name(), str(library))
     except (OSError, RuntimeError, subprocess.SubprocessError) as error:
+        _FAILED.add(function.name())
         _warn(f"{function.name()} could not be compiled ({str(error).splitlines()[0]})")
         return function
 
@@ -78,6 +80,14 @@ def compiled(function: ca.Function) -> ca.Function:
 def enabled() -> bool:
     """Whether compiling is asked for (``BIPED_COMPILE`` is not 0/off/no/false)."""
     return os.environ.get(SWITCH, "1").strip().lower() not in ("0", "off", "no", "false")
+
+
+def mode() -> str:
+    """How derivatives run in this process: ``"compiled"`` or ``"interpreted"`` (a build
+    that fails also warns)."""
+    if not enabled() or _compiler() is None:
+        return "interpreted"
+    return "interpreted in part" if _FAILED else "compiled"
 
 
 def cache_folder() -> Path:
