@@ -1,4 +1,5 @@
-"""Exceptions of the biped package: each message names the bad value and what is allowed."""
+"""Exceptions of the biped package: each message names the bad value and what is allowed;
+and its one warning."""
 
 
 class BipedError(Exception):
@@ -15,3 +16,8 @@ class ParameterError(BipedError, ValueError):
 
 class UnreachableError(BipedError, ValueError):
     """The inverse geometric model has no solution (the hip is out of the leg's reach)."""
+
+
+class CompileWarning(UserWarning):
+    """The solver's derivatives run in CasADi's interpreter instead of compiled code (the
+    same numbers, slower; ``biped.optimization.compiled``)."""

@@ -135,9 +135,9 @@ def cmd_optimize(args) -> int:
     status) or the optimum is infeasible (naming the violated constraints); the file is
     written only when feasible, with the solver's status in it.
     """
+    from biped.optimization.compiled import mode as derivatives_mode
     from biped.optimization.optimize import confirm, optimize, prepare
     from biped.optimization.problem import GaitProblem
-    from biped.optimization.compiled import mode as derivatives_mode
     from biped.records import gait_file
     from biped.runtime.runner import free_cores
 

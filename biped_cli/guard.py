@@ -10,6 +10,8 @@
 
 Floating-point warnings of numpy (overflow in ``expm1`` while the optimiser explores) are
 expected and handled where they matter; they never reach the terminal unless ``--debug``.
+The package's own warning (``biped.errors.CompileWarning``: derivatives interpreted, not
+compiled) is one line on stderr, as the failures are.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from biped.errors import BipedError
+from biped.errors import BipedError, CompileWarning
 from biped.runtime.interrupts import command_interrupts, exit_status, received_interrupt
 
 EXIT_OK = 0
@@ -40,6 +42,24 @@ def quiet_numerics(debug: bool = False) -> Iterator[None]:
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         yield
+
+
+@contextlib.contextmanager
+def warnings_as_lines(say: Callable[[str], None]) -> Iterator[None]:
+    """Within the block, the package's ``CompileWarning`` is said as one line."""
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, CompileWarning):
+            say(f"warning: {one_line(message)}")
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = shown
 
 
 def one_line(text: str) -> str:
@@ -75,7 +95,7 @@ def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bo
         return EXIT_BAD_INPUT
 
     try:
-        with command_interrupts(), quiet_numerics(debug):
+        with command_interrupts(), quiet_numerics(debug), warnings_as_lines(say):
             return run()
     except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM (``Terminated``)
         status, signal_name = exit_status(interrupt)

@@ -3,8 +3,12 @@ bit, in every family of the solver; a compiler allowed to fuse products and sums
 bits; without a compiler the interpreter runs and says so once."""
 
 import dataclasses
+import json
+import os
 import re
 import stat
+import subprocess
+import sys
 import warnings
 from pathlib import Path
 
@@ -12,9 +16,10 @@ import numpy as np
 import pytest
 
 import biped
+from biped.errors import CompileWarning
 from biped.model.criteria import Safety
 from biped.optimization import compiled as compiled_module
-from biped.optimization.compiled import CompileWarning, compiled
+from biped.optimization.compiled import compiled
 from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 from biped.runtime.blas import cpu_flags
@@ -140,6 +145,24 @@ def test_a_compiled_library_is_loaded_from_the_cache_without_the_compiler(monkey
     assert not [p for p in (tmp_path / "compiled").iterdir() if p.name.startswith(".build-")]
 
 
+@needs_compiler
+def test_a_damaged_library_in_the_cache_is_built_again(monkeypatch, tmp_path):
+    """A library that does not load (here: a file of other bytes under its name) is removed
+    and compiled again, without a warning."""
+    monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
+    sample = _sample_function()
+    digest = compiled_module._digest(compiled_module._source(sample), compiled_module._compiler())
+    library = tmp_path / "compiled" / f"{sample.name()}-{digest}.so"
+    library.parent.mkdir(parents=True)
+    library.write_bytes(b"\x7fELF and nothing else")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        again = compiled(sample)
+    inputs = np.random.default_rng(5).uniform(-1.0, 1.0, (sample.size1_in(0), 3))
+    np.testing.assert_array_equal(np.asarray(again.map(3)(inputs)), sample.map(3)(inputs))
+    assert library.stat().st_size > 1000
+
+
 def _fake_compiler(tmp_path, build_exit: int) -> str:
     """A ``cc`` that prints a version and exits ``build_exit`` when asked to compile."""
     path = tmp_path / "fake-cc"
@@ -166,11 +189,15 @@ def test_without_a_working_compiler_the_interpreter_runs_and_says_so(
     warning naming why; ``BIPED_COMPILE=0``: the interpreter without a warning."""
     monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
     monkeypatch.setattr(compiled_module, "_FAILED", set())
+    monkeypatch.setattr(compiled_module, "_SAID", set())
     monkeypatch.setenv("CC", _fake_compiler(tmp_path, 1) if compiler == "fake" else compiler)
     sample = _sample_function()
     with pytest.warns(CompileWarning, match=re.escape(needle)):
         found = compiled(sample)
     assert found is sample
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert compiled(sample) is sample  # said once a process
     assert not list(tmp_path.rglob("*.so"))
     expected = "interpreted in part" if compiler == "fake" else "interpreted"
     assert compiled_module.mode() == expected
@@ -189,3 +216,25 @@ def test_the_cache_folder_follows_the_environment(monkeypatch, tmp_path):
     assert compiled_module.cache_folder() == tmp_path / "xdg" / "biped" / "compiled"
     monkeypatch.delenv("XDG_CACHE_HOME")
     assert compiled_module.cache_folder() == Path.home() / ".cache" / "biped" / "compiled"
+
+
+@needs_compiler
+def test_biped_optimize_without_a_compiler_says_so_once_and_writes_the_same_gait(tmp_path):
+    """``biped optimize`` without a compiler: one warning line on stderr (no traceback, no
+    Python warning format), "interpreted" in its time line, and the gait file's variables
+    the same bits as with the compiled derivatives."""
+    gaits = {}
+    for name, compiler in (("compiled", "cc"), ("interpreted", "/nonexistent/cc")):
+        env = {**os.environ, "CC": compiler, "BIPED_CACHE": str(tmp_path / "cache")}
+        out = tmp_path / f"{name}.json"
+        argv = [sys.executable, "-m", "biped", "optimize", "--knee", "revolute"]
+        done = subprocess.run(
+            argv + ["--speed", "0.3", "--out", str(out)], env=env, capture_output=True, text=True
+        )
+        assert done.returncode == 0, done.stderr
+        assert f"exact derivatives built, {name})" in done.stdout
+        warned = [line for line in done.stderr.splitlines() if "warning: no C compiler" in line]
+        assert len(warned) == (name == "interpreted")
+        assert "Traceback" not in done.stderr and "CompileWarning" not in done.stderr
+        gaits[name] = json.loads(out.read_text())["optimizer"]["variables"]
+    assert gaits["compiled"] == gaits["interpreted"]

@@ -24,10 +24,11 @@ The policy, whole:
   version and the machine's architecture. A process finds it there and loads it in
   milliseconds; the first builds it (about 2 s for a Hessian, 0.5 s for a Jacobian). It is
   written to a temporary file and renamed into place, and processes building the same one
-  at once wait on a lock, so none reads half a library.
+  at once wait on a lock, so none reads half a library; one that does not load is built
+  again.
 - ``BIPED_COMPILE=0`` asks for the interpreter. Without a C compiler, or where a build or a
   load fails, the interpreter runs, and one warning says why: the numbers are the same, only
-  slower.
+  slower (``biped.errors.CompileWarning``; the CLI prints it as one line).
 """
 
 from __future__ import annotations
@@ -45,15 +46,14 @@ from pathlib import Path
 
 import casadi as ca
 
+from biped.errors import CompileWarning
+
 # The compiler's flags: optimised, position-independent, IEEE arithmetic kept (no
 # -ffast-math) and no fused multiply-add (each product rounded, as the interpreter's).
 FLAGS = ("-O1", "-fPIC", "-shared", "-ffp-contract=off")
 SWITCH = "BIPED_COMPILE"  # "0" (or "off", "no", "false"): the interpreter always
 _FAILED: set[str] = set()  # the functions whose build or load failed in this process
-
-
-class CompileWarning(UserWarning):
-    """The interpreter runs instead of compiled code (the same numbers, slower)."""
+_SAID: set[str] = set()  # the warnings given in this process
 
 
 def compiled(function: ca.Function) -> ca.Function:
@@ -68,13 +68,24 @@ def compiled(function: ca.Function) -> ca.Function:
     source = _source(function)
     library = cache_folder() / f"{function.name()}-{_digest(source, compiler)}.so"
     try:
-        if not library.exists():
-            _build(source, compiler, library)
-        return ca.external(function.name(), str(library))
+        return _load(function.name(), source, compiler, library)
     except (OSError, RuntimeError, subprocess.SubprocessError) as error:
         _FAILED.add(function.name())
         _warn(f"{function.name()} could not be compiled ({str(error).splitlines()[0]})")
         return function
+
+
+def _load(name: str, source: str, compiler, library: Path) -> ca.Function:
+    """The function ``name`` of ``library``, built first if missing; a library that does
+    not load (damaged, copied from elsewhere) is built again once."""
+    if not library.exists():
+        _build(source, compiler, library)
+    try:
+        return ca.external(name, str(library))
+    except RuntimeError:
+        library.unlink(missing_ok=True)
+        _build(source, compiler, library)
+        return ca.external(name, str(library))
 
 
 def enabled() -> bool:
@@ -165,6 +176,10 @@ def _locked(path: Path):
 
 
 def _warn(why: str) -> None:
+    """Warn once a process for each reason."""
+    if why in _SAID:
+        return
+    _SAID.add(why)
     warnings.warn(
         f"{why}: CasADi's interpreter evaluates the derivatives (the same numbers, slower; "
         f"{SWITCH}=0 asks for it without this warning)",
