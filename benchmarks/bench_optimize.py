@@ -147,12 +147,16 @@ def one_optimization(repeats: int) -> None:
 def interpreted():
     """Within the block, solvers built anew with CasADi's interpreter for their derivatives;
     after it, built anew compiled."""
+    before = os.environ.get(compiled_module.SWITCH)
     os.environ[compiled_module.SWITCH] = "0"
     solver_module._solver.cache_clear()
     try:
         yield
     finally:
-        del os.environ[compiled_module.SWITCH]
+        if before is None:
+            del os.environ[compiled_module.SWITCH]
+        else:
+            os.environ[compiled_module.SWITCH] = before
         solver_module._solver.cache_clear()
 
 

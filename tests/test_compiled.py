@@ -1,17 +1,18 @@
 """Compiled derivatives (``biped.optimization.compiled``): the interpreter's numbers, bit for
 bit, in every family of the solver; a compiler allowed to fuse products and sums gives other
-bits; without a compiler the interpreter runs and says so once."""
+bits, and is refused when its library is loaded; without a working compiler the interpreter
+runs and says so once."""
 
 import dataclasses
 import json
 import os
+import platform
 import re
 import stat
 import subprocess
 import sys
-import warnings
-from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -24,11 +25,30 @@ from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 from biped.runtime.blas import cpu_flags
 
+# A fallback to the interpreter is a failure here unless a test expects it (pytest.warns).
+pytestmark = pytest.mark.filterwarnings("error::biped.errors.CompileWarning")
+
 ROBOT = biped.Robot.paper()
 UNEQUAL = dataclasses.replace(ROBOT, r1=0.03, r2=0.08)
 needs_compiler = pytest.mark.skipif(
     compiled_module._compiler() is None, reason="no C compiler on this machine"
 )
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    """A compile cache of this file's own (not the user's)."""
+    return tmp_path_factory.mktemp("cache")
+
+
+@pytest.fixture(autouse=True)
+def fresh_state(monkeypatch, cache):
+    """Each test with the module's state of a new process, and this file's cache."""
+    monkeypatch.setenv("BIPED_CACHE", str(cache))
+    monkeypatch.delenv(compiled_module.SWITCH, raising=False)
+    for name, empty in (("_said", set), ("_outcomes", dict), ("_failed_builds", dict)):
+        monkeypatch.setattr(compiled_module, name, empty())
+    monkeypatch.setattr(compiled_module, "_broken_compiler", [])
 
 
 def _solver(monkeypatch, switch: str, knee, criterion, safety, radii, knots) -> Solver:
@@ -43,6 +63,10 @@ def _inputs(solver: Solver, knee: str, knots: int, rng) -> tuple:
     extra = rng.uniform(0.5, 2.0, solver.nlp.size1_in(0) - solver.size - solver.slacks)
     x = np.concatenate([z / solver.scales, extra, rng.random(solver.slacks)])
     return x, rng.standard_normal(solver.n_constraints)
+
+
+def _outputs(result) -> list:
+    return list(result) if isinstance(result, (list, tuple)) else [result]
 
 
 @needs_compiler
@@ -65,6 +89,7 @@ def test_compiled_derivatives_are_the_interpreters_bits(
     (a design's radii, the slacks, the richer family, the motors' criterion)."""
     interpreted = _solver(monkeypatch, "0", knee, criterion, safety, radii, knots)
     machine = _solver(monkeypatch, "1", knee, criterion, safety, radii, knots)
+    assert compiled_module.mode() == "compiled"  # the other is not the interpreter again
     rng = np.random.default_rng(7)
     for _ in range(3):
         x, lam_g = _inputs(machine, knee, knots, rng)
@@ -74,10 +99,6 @@ def test_compiled_derivatives_are_the_interpreters_bits(
             found = getattr(machine, name)(*arguments)
             for a, b in zip(_outputs(expected), _outputs(found), strict=True):
                 np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
-
-
-def _outputs(result) -> list:
-    return list(result) if isinstance(result, (list, tuple)) else [result]
 
 
 @needs_compiler
@@ -91,6 +112,7 @@ def test_an_energy_solve_is_the_same_bits_compiled_and_interpreted(monkeypatch):
         monkeypatch.setenv(compiled_module.SWITCH, switch)
         solver = Solver(problem.model, "energy", problem.safety, problem.samples_per_half)
         ends.append(solver.solve(problem, start, barrier="monotone"))
+    assert compiled_module.mode() == "compiled"
     interpreted, machine = ends
     assert interpreted.converged
     np.testing.assert_array_equal(machine.variables, interpreted.variables)
@@ -103,51 +125,70 @@ def _sample_function():
     return StepGraph(biped.Biped(UNEQUAL, "rolling"), 6, Safety()).sample
 
 
+def _fusing_flags() -> tuple:
+    """Flags under which the compiler fuses a product and a sum (``-O2``, and on x86-64 the
+    FMA instructions), or skip where the CPU has none."""
+    if platform.machine() in ("x86_64", "AMD64"):
+        if "fma" not in cpu_flags():
+            pytest.skip("the CPU has no fused multiply-add")
+        return ("-O2", "-mfma")
+    if platform.machine() in ("aarch64", "arm64"):
+        return ("-O2",)
+    pytest.skip(f"no fused multiply-add flags known for {platform.machine()}")
+
+
 @needs_compiler
-@pytest.mark.skipif("fma" not in cpu_flags(), reason="the CPU has no fused multiply-add")
-def test_a_compiler_fusing_multiply_add_gives_other_bits(monkeypatch, tmp_path):
-    """The check above can fail: the same code compiled with fused multiply-adds allowed
-    (``-O2 -mfma -ffp-contract=fast``) rounds products and sums once, not twice, and gives other
-    bits than the interpreter; with ``FLAGS`` the same."""
-    monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
+def test_without_ffp_contract_off_a_fusing_compiler_gives_other_bits(monkeypatch):
+    """Why ``-ffp-contract=off``: at ``-O2`` with the FMA instructions, the same code keeps
+    the interpreter's bits with it, and gives other bits without it (products and sums
+    rounded once, not twice), which the check of a loaded library refuses: the interpreter
+    runs, with a warning."""
     sample = _sample_function()
     inputs = np.random.default_rng(3).uniform(-1.0, 1.0, (sample.size1_in(0), 40))
     expected = np.asarray(sample.map(40)(inputs))
+    kept = (*compiled_module.FLAGS, *_fusing_flags())
+    monkeypatch.setattr(compiled_module, "FLAGS", kept)
     same = compiled(sample)
     assert same.class_name() != sample.class_name()  # compiled, not the interpreter
     np.testing.assert_array_equal(np.asarray(same.map(40)(inputs)), expected)
-    fused = ("-O2", *compiled_module.FLAGS[1:-1], "-mfma", "-ffp-contract=fast")
+    fused = tuple(f for f in kept if f != "-ffp-contract=off") + ("-ffp-contract=fast",)
     monkeypatch.setattr(compiled_module, "FLAGS", fused)
-    other = np.asarray(compiled(sample).map(40)(inputs))
+    source = compiled_module._source(sample)
+    compiler = compiled_module._compiler()
+    library = (
+        compiled_module.cache_folder() / f"fused-{compiled_module._digest(source, compiler)}.so"
+    )
+    compiled_module._build(source, compiler, library)
+    other = np.asarray(ca.external(sample.name(), str(library)).map(40)(inputs))
     np.testing.assert_allclose(other, expected, rtol=1e-9, atol=1e-9)
     assert not np.array_equal(other, expected)
-    assert len(list((tmp_path / "compiled").glob("*.so"))) == 2  # one library per flag set
+    with pytest.warns(CompileWarning, match="does not give the interpreter's bits"):
+        assert compiled(sample) is sample
 
 
 @needs_compiler
 def test_a_compiled_library_is_loaded_from_the_cache_without_the_compiler(monkeypatch, tmp_path):
     """A second process (here: a second call) finds the library by its digest and does not
-    compile again; an interrupted build leaves no library behind."""
+    compile again; no build folder is left behind."""
     monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
     sample = _sample_function()
     compiled(sample)
-    libraries = list((tmp_path / "compiled").glob("*.so"))
+    folder = compiled_module.cache_folder()
+    libraries = list(folder.glob(f"{sample.name()}-*.so"))
     assert len(libraries) == 1
 
     def no_build(*args, **kwargs):
         raise AssertionError("compiled again")
 
     monkeypatch.setattr(compiled_module, "_build", no_build)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        again = compiled(sample)
+    again = compiled(sample)
     assert again.class_name() != sample.class_name()
-    assert not [p for p in (tmp_path / "compiled").iterdir() if p.name.startswith(".build-")]
+    assert not [p for p in folder.iterdir() if p.name.startswith(".build-")]
 
 
 @needs_compiler
 def test_a_damaged_library_in_the_cache_is_built_again(monkeypatch, tmp_path):
-    """A library that does not load (here: a file of other bytes under its name) is removed
+    """A library that does not load (here: a file of other bytes under its name) is replaced
     and compiled again, without a warning."""
     monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
     sample = _sample_function()
@@ -155,12 +196,24 @@ def test_a_damaged_library_in_the_cache_is_built_again(monkeypatch, tmp_path):
     library = tmp_path / "compiled" / f"{sample.name()}-{digest}.so"
     library.parent.mkdir(parents=True)
     library.write_bytes(b"\x7fELF and nothing else")
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        again = compiled(sample)
+    again = compiled(sample)
     inputs = np.random.default_rng(5).uniform(-1.0, 1.0, (sample.size1_in(0), 3))
     np.testing.assert_array_equal(np.asarray(again.map(3)(inputs)), sample.map(3)(inputs))
     assert library.stat().st_size > 1000
+
+
+@needs_compiler
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="-z defs is GNU ld's")
+def test_a_function_the_c_library_lacks_fails_the_build_not_the_call():
+    """``erfinv`` is CasADi's, not the C library's: the build fails (``-Wl,-z,defs``) and
+    the interpreter runs, instead of a library that would end the process at its first
+    call."""
+    x = ca.SX.sym("x")
+    inverse = ca.Function("inverse_erf", [x], [ca.erfinv(x)])
+    with pytest.warns(CompileWarning, match="erfinv"):
+        assert compiled(inverse) is inverse
+    assert float(inverse(0.5)) == pytest.approx(0.4769362762044699)
+    assert compiled_module.mode() == "interpreted"
 
 
 def _fake_compiler(tmp_path, build_exit: int) -> str:
@@ -169,7 +222,8 @@ def _fake_compiler(tmp_path, build_exit: int) -> str:
     path.write_text(
         "#!/bin/sh\n"
         'if [ "$1" = "--version" ]; then echo "fake-cc 1.0"; exit 0; fi\n'
-        f'echo "fake-cc: cannot compile" >&2; exit {build_exit}\n'
+        'if [ "$1" = "-dumpmachine" ]; then echo "fake"; exit 0; fi\n'
+        f'echo "fake-cc: error: cannot compile" >&2; exit {build_exit}\n'
     )
     path.chmod(path.stat().st_mode | stat.S_IEXEC)
     return str(path)
@@ -179,33 +233,34 @@ def _fake_compiler(tmp_path, build_exit: int) -> str:
     "compiler, needle",
     [
         ("/nonexistent/cc", "no C compiler (/nonexistent/cc) found"),
-        ("fake", "could not be compiled"),
+        ("fake", "failed (exit 1: fake-cc: error: cannot compile)"),
     ],
 )
 def test_without_a_working_compiler_the_interpreter_runs_and_says_so(
     monkeypatch, tmp_path, compiler, needle
 ):
     """No compiler, or one that fails: the interpreted function, the same numbers, and one
-    warning naming why; ``BIPED_COMPILE=0``: the interpreter without a warning."""
+    warning naming why, once; ``BIPED_COMPILE=0``: the interpreter without a warning."""
     monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
-    monkeypatch.setattr(compiled_module, "_FAILED", set())
-    monkeypatch.setattr(compiled_module, "_SAID", set())
     monkeypatch.setenv("CC", _fake_compiler(tmp_path, 1) if compiler == "fake" else compiler)
     sample = _sample_function()
     with pytest.warns(CompileWarning, match=re.escape(needle)):
         found = compiled(sample)
     assert found is sample
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert compiled(sample) is sample  # said once a process
+    assert compiled(sample) is sample  # said once a process (a second warning would fail)
     assert not list(tmp_path.rglob("*.so"))
-    expected = "interpreted in part" if compiler == "fake" else "interpreted"
-    assert compiled_module.mode() == expected
-    monkeypatch.setenv(compiled_module.SWITCH, "0")
     assert compiled_module.mode() == "interpreted"
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert compiled(sample) is sample
+    monkeypatch.setenv(compiled_module.SWITCH, "0")
+    assert compiled(sample) is sample
+
+
+def test_a_compiler_command_with_arguments_is_one_compiler(monkeypatch):
+    """``CC="cc -m64"``: the command and its arguments, not "no C compiler"."""
+    if compiled_module._compiler() is None:
+        pytest.skip("no C compiler on this machine")
+    monkeypatch.setenv("CC", "cc -m64" if platform.machine() == "x86_64" else "cc -O1")
+    command, identity = compiled_module._compiler()
+    assert len(command) == 2 and identity
 
 
 def test_the_cache_folder_follows_the_environment(monkeypatch, tmp_path):
@@ -214,18 +269,33 @@ def test_the_cache_folder_follows_the_environment(monkeypatch, tmp_path):
     monkeypatch.delenv("BIPED_CACHE")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     assert compiled_module.cache_folder() == tmp_path / "xdg" / "biped" / "compiled"
-    monkeypatch.delenv("XDG_CACHE_HOME")
-    assert compiled_module.cache_folder() == Path.home() / ".cache" / "biped" / "compiled"
+
+
+def test_a_home_that_cannot_be_found_leaves_the_interpreter(monkeypatch):
+    """No cache folder to be had (no ``HOME``, no user entry): the interpreter, a warning,
+    no error."""
+    monkeypatch.delenv("BIPED_CACHE")
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+
+    def nowhere():
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.setattr(compiled_module.Path, "home", staticmethod(nowhere))
+    if compiled_module._compiler() is None:
+        pytest.skip("no C compiler on this machine")
+    sample = _sample_function()
+    with pytest.warns(CompileWarning, match="Could not determine home directory"):
+        assert compiled(sample) is sample
 
 
 @needs_compiler
-def test_biped_optimize_without_a_compiler_says_so_once_and_writes_the_same_gait(tmp_path):
+def test_biped_optimize_without_a_compiler_says_so_once_and_writes_the_same_gait(tmp_path, cache):
     """``biped optimize`` without a compiler: one warning line on stderr (no traceback, no
     Python warning format), "interpreted" in its time line, and the gait file's variables
     the same bits as with the compiled derivatives."""
     gaits = {}
     for name, compiler in (("compiled", "cc"), ("interpreted", "/nonexistent/cc")):
-        env = {**os.environ, "CC": compiler, "BIPED_CACHE": str(tmp_path / "cache")}
+        env = {**os.environ, "CC": compiler, "BIPED_CACHE": str(cache)}
         out = tmp_path / f"{name}.json"
         argv = [sys.executable, "-m", "biped", "optimize", "--knee", "revolute"]
         done = subprocess.run(

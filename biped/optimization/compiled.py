@@ -11,24 +11,33 @@ The policy, whole:
 
 - ``compiled(function)`` returns a function of the same inputs and outputs: ``function``
   compiled, else ``function`` itself (the interpreter).
-- The compiled code is CasADi's own C code of the function (``CodeGenerator``), the same
-  operations in the same order, compiled by the system's C compiler (``$CC``, else ``cc``)
-  with ``FLAGS``: no fast-math, and no fused multiply-add contraction (``-ffp-contract=off``:
-  a compiler may otherwise fuse a product and a sum into one rounding on CPUs that have the
-  instruction). Each operation then rounds as the interpreter's does, and the results are
-  the same bits (tests compare them over every family of the solver, and an optimum's every
-  digit both ways).
-- A compiled library is kept in the cache folder (``$BIPED_CACHE``, else
-  ``$XDG_CACHE_HOME/biped``, else ``~/.cache/biped``), under ``compiled/``, named by a digest
-  of everything that defines it: the C source, the compiler's version, the flags, CasADi's
-  version and the machine's architecture. A process finds it there and loads it in
-  milliseconds; the first builds it (about 2 s for a Hessian, 0.5 s for a Jacobian). It is
-  written to a temporary file and renamed into place, and processes building the same one
-  at once wait on a lock, so none reads half a library; one that does not load is built
-  again.
-- ``BIPED_COMPILE=0`` asks for the interpreter. Without a C compiler, or where a build or a
-  load fails, the interpreter runs, and one warning says why: the numbers are the same, only
-  slower (``biped.errors.CompileWarning``; the CLI prints it as one line).
+- The compiled code is CasADi's own C code of the function (``CodeGenerator``): the
+  interpreter's operations, in its order. It is compiled by the system's C compiler
+  (``$CC``, else ``cc``) with ``FLAGS``: IEEE arithmetic (no fast-math), no fused
+  multiply-add (``-ffp-contract=off``: a product and a sum each rounded, as the
+  interpreter's, which a compiler may otherwise fuse at ``-O2`` or on CPUs where the
+  instruction is standard), no library call rewritten (``-fno-builtin``: ``sin`` and ``cos``
+  of one angle stay two calls of the C library's, not its ``sincos``) and, on Linux, no
+  symbol left unresolved (``-Wl,-z,defs``: a function the C library lacks fails the build,
+  not the first call).
+- Each library is checked when loaded: its outputs at a few fixed inputs must be the
+  interpreter's, bit for bit, or the interpreter runs (a compiler wrapper adding its own
+  flags, another C library). Tests compare both over every family of the solver, and an
+  optimum's every digit both ways.
+- A library is kept in the cache folder (``$BIPED_CACHE``, else ``$XDG_CACHE_HOME/biped``,
+  else ``~/.cache/biped``), under ``compiled/``, named by a digest of everything that
+  defines it: the C source, the compiler's command and whole ``--version``, the flags,
+  CasADi's version, the platform (architecture, pointer size, C library). A process finds it
+  there and loads it in milliseconds; the first builds it (about 2 s for a Hessian, 0.5 s
+  for a Jacobian). It is built in a temporary folder and renamed into place under a lock
+  (waited on for ``LOCK_WAIT`` at most; a file system without locks builds without), so that
+  processes building the same one at once build it once and none reads half a library; one
+  that does not load is built again, once.
+- ``BIPED_COMPILE=0`` asks for the interpreter. Without a C compiler, where a build fails
+  or outlasts ``BUILD_TIMEOUT``, or where a library does not load or check, the interpreter
+  runs, and one warning a process says why: the numbers are the same, only slower
+  (``biped.errors.CompileWarning``; the CLI prints it as one line). A library whose build
+  failed is not tried again in the process, nor the compiler once it has hung.
 """
 
 from __future__ import annotations
@@ -38,22 +47,43 @@ import functools
 import hashlib
 import os
 import platform
+import shlex
 import shutil
+import struct
 import subprocess
+import sys
 import tempfile
+import time
 import warnings
 from pathlib import Path
 
 import casadi as ca
+import numpy as np
 
 from biped.errors import CompileWarning
 
-# The compiler's flags: optimised, position-independent, IEEE arithmetic kept (no
-# -ffast-math) and no fused multiply-add (each product rounded, as the interpreter's).
-FLAGS = ("-O1", "-fPIC", "-shared", "-ffp-contract=off")
+# The compiler's flags (the module's docstring says why each).
+FLAGS = (
+    "-O1",
+    "-fPIC",
+    "-shared",
+    "-ffp-contract=off",
+    "-fno-builtin",
+    *(("-Wl,-z,defs",) if sys.platform.startswith("linux") else ()),
+)
 SWITCH = "BIPED_COMPILE"  # "0" (or "off", "no", "false"): the interpreter always
-_FAILED: set[str] = set()  # the functions whose build or load failed in this process
-_SAID: set[str] = set()  # the warnings given in this process
+BUILD_TIMEOUT = 300.0  # [s] a compilation still running then is abandoned
+LOCK_WAIT = 600.0  # [s] the longest wait for another process's build of the same library
+CHECK_COLUMNS = 3  # the fixed inputs a loaded library is checked at
+
+_said: set[str] = set()  # the warnings given in this process
+_outcomes: dict[str, bool] = {}  # the functions compiled (True) or not (False), by name
+_broken_compiler: list[str] = []  # why the compiler hung, once it has
+_failed_builds: dict[str, str] = {}  # why a library could not be built, by its path
+
+
+class NotCompiled(Exception):
+    """Why a function runs in the interpreter (said in a ``CompileWarning``)."""
 
 
 def compiled(function: ca.Function) -> ca.Function:
@@ -61,31 +91,23 @@ def compiled(function: ca.Function) -> ca.Function:
     first if needed; ``function`` itself when compiling is off or impossible."""
     if not enabled():
         return function
-    compiler = _compiler()
-    if compiler is None:
-        _warn(f"no C compiler ({os.environ.get('CC', 'cc')}) found")
-        return function
-    source = _source(function)
-    library = cache_folder() / f"{function.name()}-{_digest(source, compiler)}.so"
     try:
-        return _load(function.name(), source, compiler, library)
-    except (OSError, RuntimeError, subprocess.SubprocessError) as error:
-        _FAILED.add(function.name())
-        _warn(f"{function.name()} could not be compiled ({str(error).splitlines()[0]})")
+        if _broken_compiler:
+            raise NotCompiled(_broken_compiler[0])
+        compiler = _compiler()
+        if compiler is None:
+            raise NotCompiled(f"no C compiler ({os.environ.get('CC', 'cc')}) found")
+        machine = _load(function, compiler)
+    except NotCompiled as why:
+        _outcomes[function.name()] = False
+        _warn(str(why))
         return function
-
-
-def _load(name: str, source: str, compiler, library: Path) -> ca.Function:
-    """The function ``name`` of ``library``, built first if missing; a library that does
-    not load (damaged, copied from elsewhere) is built again once."""
-    if not library.exists():
-        _build(source, compiler, library)
-    try:
-        return ca.external(name, str(library))
-    except RuntimeError:
-        library.unlink(missing_ok=True)
-        _build(source, compiler, library)
-        return ca.external(name, str(library))
+    except Exception as error:  # anything else: the interpreter, and why
+        _outcomes[function.name()] = False
+        _warn(f"{function.name()} could not be compiled ({_first_line(error)})")
+        return function
+    _outcomes[function.name()] = True
+    return machine
 
 
 def enabled() -> bool:
@@ -94,16 +116,16 @@ def enabled() -> bool:
 
 
 def mode() -> str:
-    """How derivatives run in this process: ``"compiled"`` or ``"interpreted"`` (a build
-    that fails also warns)."""
-    if not enabled() or _compiler() is None:
+    """How derivatives run in this process: ``"compiled"``, ``"interpreted"`` or
+    ``"interpreted in part"`` (some functions; each such case also warns)."""
+    if not enabled() or not any(_outcomes.values()):
         return "interpreted"
-    return "interpreted in part" if _FAILED else "compiled"
+    return "compiled" if all(_outcomes.values()) else "interpreted in part"
 
 
 def cache_folder() -> Path:
-    """Where compiled libraries are kept: ``$BIPED_CACHE/compiled``, else under
-    ``$XDG_CACHE_HOME/biped`` or ``~/.cache/biped``."""
+    """Where compiled libraries are kept: ``$BIPED_CACHE/compiled``, else
+    ``$XDG_CACHE_HOME/biped/compiled`` or ``~/.cache/biped/compiled``."""
     root = os.environ.get("BIPED_CACHE")
     if not root:
         xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
@@ -111,22 +133,69 @@ def cache_folder() -> Path:
     return Path(root) / "compiled"
 
 
-@functools.cache
-def _compiler_identity(path: str) -> str | None:
-    """The compiler's first line of ``--version`` (None if it does not run)."""
+def _load(function: ca.Function, compiler: tuple) -> ca.Function:
+    """The compiled ``function`` from the cache, built first if missing, built again once
+    if it does not load; checked against the interpreter."""
+    source = _source(function)
+    library = cache_folder() / f"{function.name()}-{_digest(source, compiler)}.so"
+    if str(library) in _failed_builds:
+        raise NotCompiled(_failed_builds[str(library)])
+    if not library.exists():
+        _build(source, compiler, library)
     try:
-        done = subprocess.run([path, "--version"], capture_output=True, text=True, timeout=30)
-    except (OSError, subprocess.SubprocessError):
+        machine = ca.external(function.name(), str(library))
+    except RuntimeError:  # damaged, or made elsewhere: replaced whole
+        _build(source, compiler, library, again=True)
+        machine = ca.external(function.name(), str(library))
+    if not _same_bits(function, machine):
+        raise NotCompiled(
+            f"{function.name()} compiled does not give the interpreter's bits ({library})"
+        )
+    return machine
+
+
+def _same_bits(function: ca.Function, machine: ca.Function) -> bool:
+    """Whether ``machine`` gives ``function``'s outputs, bit for bit, at fixed inputs."""
+    rng = np.random.default_rng(0)
+    inputs = [
+        rng.uniform(-1.0, 1.0, (function.size1_in(k), function.size2_in(k) * CHECK_COLUMNS))
+        for k in range(function.n_in())
+    ]
+    mapped = [function.map(CHECK_COLUMNS), machine.map(CHECK_COLUMNS)]
+    expected, found = (f.call(inputs) for f in mapped)
+    return all(
+        np.asarray(a).tobytes() == np.asarray(b).tobytes()
+        for a, b in zip(expected, found, strict=True)
+    )
+
+
+def _compiler() -> tuple[tuple[str, ...], str] | None:
+    """(command, identity) of the C compiler ``$CC`` (a command with its arguments) or
+    ``cc``; None without one that runs."""
+    words = shlex.split(os.environ.get("CC", "cc"))
+    path = shutil.which(words[0]) if words else None
+    if path is None:
         return None
-    lines = done.stdout.splitlines()
-    return lines[0] if done.returncode == 0 and lines else None
+    command = (path, *words[1:])
+    identity = _identity(command)
+    return (command, identity) if identity else None
 
 
-def _compiler() -> tuple[str, str] | None:
-    """(path, identity) of the C compiler ``$CC`` or ``cc``, None without one."""
-    path = shutil.which(os.environ.get("CC", "cc"))
-    identity = path and _compiler_identity(path)
-    return (path, identity) if identity else None
+@functools.cache
+def _identity(command: tuple[str, ...]) -> str | None:
+    """The compiler's whole ``--version`` and its target (None if it does not run)."""
+    said = []
+    for question in ("--version", "-dumpmachine"):
+        try:
+            done = subprocess.run(
+                [*command, question], capture_output=True, timeout=30, stdin=subprocess.DEVNULL
+            )
+        except (OSError, subprocess.SubprocessError):
+            return None
+        if question == "--version" and done.returncode != 0:
+            return None
+        said.append(done.stdout.decode(errors="replace").strip())
+    return "\n".join(said) or None
 
 
 def _source(function: ca.Function) -> str:
@@ -135,51 +204,102 @@ def _source(function: ca.Function) -> str:
     return generator.dump()
 
 
-def _digest(source: str, compiler: tuple[str, str]) -> str:
-    defining = [source, compiler[1], *FLAGS, ca.__version__, platform.machine()]
+def _digest(source: str, compiler: tuple) -> str:
+    command, identity = compiler
+    platform_ = [sys.platform, platform.machine(), str(struct.calcsize("P")), *platform.libc_ver()]
+    defining = [source, *command, identity, *FLAGS, ca.__version__, *platform_]
     return hashlib.sha256("\0".join(defining).encode()).hexdigest()[:32]
 
 
-def _build(source: str, compiler: tuple[str, str], library: Path) -> None:
-    """Compile ``source`` into ``library``, atomically, one process at a time."""
+def _build(source: str, compiler: tuple, library: Path, again: bool = False) -> None:
+    """Compile ``source`` into ``library``, atomically, one process at a time; ``again``:
+    replace the library there unless another process did since this one failed to load it."""
     library.parent.mkdir(parents=True, exist_ok=True)
+    before = _stamp(library)
     with _locked(library.with_suffix(".lock")):
-        if library.exists():  # built by another process while this one waited
-            return
+        if library.exists() and (not again or _stamp(library) != before):
+            return  # built by another process while this one waited
         with tempfile.TemporaryDirectory(dir=library.parent, prefix=".build-") as work:
             c_file, built = Path(work) / "function.c", Path(work) / "function.so"
             c_file.write_text(source)
-            done = subprocess.run(
-                [compiler[0], *FLAGS, str(c_file), "-o", str(built), "-lm"],
-                capture_output=True,
-                text=True,
-            )
+            command = [*compiler[0], *FLAGS, str(c_file), "-o", str(built), "-lm"]
+            try:
+                done = subprocess.run(
+                    command, capture_output=True, timeout=BUILD_TIMEOUT, stdin=subprocess.DEVNULL
+                )
+            except subprocess.TimeoutExpired:
+                _broken_compiler.append(f"{command[0]} ran over {BUILD_TIMEOUT:g} s")
+                raise NotCompiled(_broken_compiler[0]) from None
             if done.returncode != 0:
-                raise RuntimeError(f"{compiler[0]} exit {done.returncode}: {done.stderr.strip()}")
+                said = done.stderr.decode(errors="replace").replace(f"{work}{os.sep}", "")
+                why = f"{command[0]} failed (exit {done.returncode}: {_error_line(said)})"
+                _failed_builds[str(library)] = why
+                raise NotCompiled(why)
             os.replace(built, library)
+
+
+def _stamp(path: Path):
+    try:
+        stat = path.stat()
+    except OSError:
+        return None
+    return (stat.st_ino, stat.st_mtime_ns, stat.st_size)
 
 
 @contextlib.contextmanager
 def _locked(path: Path):
-    """An exclusive lock on ``path`` where the platform has ``fcntl`` (else none)."""
+    """An exclusive lock on ``path``, waited on for ``LOCK_WAIT`` at most; none where the
+    platform or the file system has none (the rename alone keeps a library whole)."""
     try:
         import fcntl
-    except ImportError:  # pragma: no cover - Windows: two builds may race; each renames whole
+    except ImportError:  # Windows: two builds may race; each renames its library whole
         yield
         return
     with open(path, "a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
+        held = _acquire(handle, fcntl)
         try:
             yield
         finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+            if held:
+                fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _acquire(handle, fcntl) -> bool:
+    deadline = time.monotonic() + LOCK_WAIT
+    while True:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return True
+        except BlockingIOError:
+            if time.monotonic() > deadline:
+                return False  # another build hangs: build without it
+            time.sleep(0.05)
+        except OSError:  # a file system without locks
+            return False
+
+
+def _error_line(text: str) -> str:
+    """The compiler's first line that names an error (not the linker driver's summary),
+    else its last line."""
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    errors = [
+        line
+        for line in lines
+        if ("error" in line.lower() or "undefined" in line) and not line.startswith("collect2")
+    ]
+    return errors[0] if errors else (lines or ["no message"])[-1]
+
+
+def _first_line(error: BaseException) -> str:
+    lines = str(error).strip().splitlines()
+    return lines[0] if lines else type(error).__name__
 
 
 def _warn(why: str) -> None:
     """Warn once a process for each reason."""
-    if why in _SAID:
+    if why in _said:
         return
-    _SAID.add(why)
+    _said.add(why)
     warnings.warn(
         f"{why}: CasADi's interpreter evaluates the derivatives (the same numbers, slower; "
         f"{SWITCH}=0 asks for it without this warning)",
