@@ -17,13 +17,14 @@ import numpy as np
 import pytest
 
 import biped
-from biped.errors import CompileWarning
+from biped.errors import BipedError, CompileWarning
 from biped.model.criteria import Safety
 from biped.optimization import compiled as compiled_module
 from biped.optimization.compiled import compiled
 from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 from biped.runtime.blas import cpu_flags
+from biped.runtime.files import is_temporary
 
 # A fallback to the interpreter is a failure here unless a test expects it (pytest.warns).
 pytestmark = pytest.mark.filterwarnings("error::biped.errors.CompileWarning")
@@ -46,7 +47,12 @@ def fresh_state(monkeypatch, cache):
     """Each test with the module's state of a new process, and this file's cache."""
     monkeypatch.setenv("BIPED_CACHE", str(cache))
     monkeypatch.delenv(compiled_module.SWITCH, raising=False)
-    for name, empty in (("_said", set), ("_outcomes", dict), ("_failed_builds", dict)):
+    for name, empty in (
+        ("_said", set),
+        ("_outcomes", dict),
+        ("_failed_builds", dict),
+        ("_loaded", dict),
+    ):
         monkeypatch.setattr(compiled_module, name, empty())
     monkeypatch.setattr(compiled_module, "_broken_compiler", [])
 
@@ -153,12 +159,10 @@ def test_without_ffp_contract_off_a_fusing_compiler_gives_other_bits(monkeypatch
     np.testing.assert_array_equal(np.asarray(same.map(40)(inputs)), expected)
     fused = tuple(f for f in kept if f != "-ffp-contract=off") + ("-ffp-contract=fast",)
     monkeypatch.setattr(compiled_module, "FLAGS", fused)
-    source = compiled_module._source(sample)
     compiler = compiled_module._compiler()
-    library = (
-        compiled_module.cache_folder() / f"fused-{compiled_module._digest(source, compiler)}.so"
-    )
-    compiled_module._build(source, compiler, library)
+    digest = compiled_module._digest(sample, compiler)
+    library = compiled_module.cache_folder() / f"fused-{digest}.so"
+    compiled_module._build(sample, compiler, library)
     other = np.asarray(ca.external(sample.name(), str(library)).map(40)(inputs))
     np.testing.assert_allclose(other, expected, rtol=1e-9, atol=1e-9)
     assert not np.array_equal(other, expected)
@@ -168,11 +172,12 @@ def test_without_ffp_contract_off_a_fusing_compiler_gives_other_bits(monkeypatch
 
 @needs_compiler
 def test_a_compiled_library_is_loaded_from_the_cache_without_the_compiler(monkeypatch, tmp_path):
-    """A second process (here: a second call) finds the library by its digest and does not
-    compile again; no build folder is left behind."""
+    """Another solver of the process (another grid: the same per-sample function) gets the
+    library already loaded; another process (here: the process's libraries forgotten) finds
+    it by its digest and does not compile again; no temporary file is left behind."""
     monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
     sample = _sample_function()
-    compiled(sample)
+    first = compiled(sample)
     folder = compiled_module.cache_folder()
     libraries = list(folder.glob(f"{sample.name()}-*.so"))
     assert len(libraries) == 1
@@ -181,9 +186,14 @@ def test_a_compiled_library_is_loaded_from_the_cache_without_the_compiler(monkey
         raise AssertionError("compiled again")
 
     monkeypatch.setattr(compiled_module, "_build", no_build)
+    from biped.optimization.symbolic import StepGraph
+
+    other_grid = StepGraph(biped.Biped(UNEQUAL, "rolling"), 13, Safety()).sample
+    assert compiled(other_grid) is first
+    monkeypatch.setattr(compiled_module, "_loaded", {})
     again = compiled(sample)
-    assert again.class_name() != sample.class_name()
-    assert not [p for p in folder.iterdir() if p.name.startswith(".build-")]
+    assert again is not first and again.class_name() != sample.class_name()
+    assert not [p for p in folder.iterdir() if is_temporary(p)]
 
 
 @needs_compiler
@@ -192,7 +202,7 @@ def test_a_damaged_library_in_the_cache_is_built_again(monkeypatch, tmp_path):
     and compiled again, without a warning."""
     monkeypatch.setenv("BIPED_CACHE", str(tmp_path))
     sample = _sample_function()
-    digest = compiled_module._digest(compiled_module._source(sample), compiled_module._compiler())
+    digest = compiled_module._digest(sample, compiled_module._compiler())
     library = tmp_path / "compiled" / f"{sample.name()}-{digest}.so"
     library.parent.mkdir(parents=True)
     library.write_bytes(b"\x7fELF and nothing else")
@@ -308,3 +318,20 @@ def test_biped_optimize_without_a_compiler_says_so_once_and_writes_the_same_gait
         assert "Traceback" not in done.stderr and "CompileWarning" not in done.stderr
         gaits[name] = json.loads(out.read_text())["optimizer"]["variables"]
     assert gaits["compiled"] == gaits["interpreted"]
+
+
+def test_a_bad_switch_is_refused_naming_it(monkeypatch, tmp_path):
+    """``BIPED_COMPILE=maybe``: an error naming the value and what is allowed, not a silent
+    choice; ``biped optimize`` says it on one line and exits 2."""
+    monkeypatch.setenv(compiled_module.SWITCH, "maybe")
+    with pytest.raises(BipedError, match=r"BIPED_COMPILE = 'maybe': allowed 1, on, yes, true"):
+        compiled(_sample_function())
+    argv = [sys.executable, "-m", "biped", "optimize", "--knee", "revolute", "--speed", "0.3"]
+    argv += ["--out", str(tmp_path / "gait.json")]
+    done = subprocess.run(argv, env=dict(os.environ), capture_output=True, text=True)
+    assert done.returncode == 2 and not (tmp_path / "gait.json").exists()
+    lines = [line for line in done.stderr.splitlines() if not line.startswith("optimizing")]
+    assert lines == [
+        "biped optimize: error: BIPED_COMPILE = 'maybe': allowed 1, on, yes, "
+        "true (compile) or 0, off, no, false"
+    ]

@@ -26,13 +26,15 @@ The policy, whole:
   optimum's every digit both ways.
 - A library is kept in the cache folder (``$BIPED_CACHE``, else ``$XDG_CACHE_HOME/biped``,
   else ``~/.cache/biped``), under ``compiled/``, named by a digest of everything that
-  defines it: the C source, the compiler's command and whole ``--version``, the flags,
-  CasADi's version, the platform (architecture, pointer size, C library). A process finds it
-  there and loads it in milliseconds; the first builds it (about 2 s for a Hessian, 0.5 s
-  for a Jacobian). It is built in a temporary folder and renamed into place under a lock
-  (waited on for ``LOCK_WAIT`` at most; a file system without locks builds without), so that
-  processes building the same one at once build it once and none reads half a library; one
-  that does not load is built again, once.
+  defines it: the function (CasADi's serialization of it, from which its C source follows),
+  the compiler's command and whole ``--version``, the flags, CasADi's version, the platform
+  (architecture, pointer size, C library). A process finds it there and loads it in
+  milliseconds, once for all its solvers; the first builds it (about 2 s for a Hessian,
+  0.5 s for a Jacobian). It is written through a temporary file and renamed into place
+  (``biped.runtime.files.atomic_path``) under a lock (waited on for ``LOCK_WAIT`` at most; a
+  file system without locks builds without), so that processes building the same one at
+  once build it once and none reads half a library; one that does not load is built again,
+  once.
 - ``BIPED_COMPILE=0`` asks for the interpreter. Without a C compiler, where a build fails
   or outlasts ``BUILD_TIMEOUT``, or where a library does not load or check, the interpreter
   runs, and one warning a process says why: the numbers are the same, only slower
@@ -52,7 +54,6 @@ import shutil
 import struct
 import subprocess
 import sys
-import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -60,7 +61,8 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from biped.errors import CompileWarning
+from biped.errors import BipedError, CompileWarning
+from biped.runtime.files import atomic_path
 
 # The compiler's flags (the module's docstring says why each).
 FLAGS = (
@@ -71,7 +73,8 @@ FLAGS = (
     "-fno-builtin",
     *(("-Wl,-z,defs",) if sys.platform.startswith("linux") else ()),
 )
-SWITCH = "BIPED_COMPILE"  # "0" (or "off", "no", "false"): the interpreter always
+SWITCH = "BIPED_COMPILE"  # one of OFF: the interpreter always
+ON, OFF = ("1", "on", "yes", "true"), ("0", "off", "no", "false")
 BUILD_TIMEOUT = 300.0  # [s] a compilation still running then is abandoned
 LOCK_WAIT = 600.0  # [s] the longest wait for another process's build of the same library
 CHECK_COLUMNS = 3  # the fixed inputs a loaded library is checked at
@@ -80,6 +83,7 @@ _said: set[str] = set()  # the warnings given in this process
 _outcomes: dict[str, bool] = {}  # the functions compiled (True) or not (False), by name
 _broken_compiler: list[str] = []  # why the compiler hung, once it has
 _failed_builds: dict[str, str] = {}  # why a library could not be built, by its path
+_loaded: dict[str, ca.Function] = {}  # the libraries loaded and checked, by their path
 
 
 class NotCompiled(Exception):
@@ -111,8 +115,14 @@ def compiled(function: ca.Function) -> ca.Function:
 
 
 def enabled() -> bool:
-    """Whether compiling is asked for (``BIPED_COMPILE`` is not 0/off/no/false)."""
-    return os.environ.get(SWITCH, "1").strip().lower() not in ("0", "off", "no", "false")
+    """Whether compiling is asked for: ``BIPED_COMPILE`` unset or one of ``ON``, not one of
+    ``OFF``; another value is refused, naming it."""
+    value = os.environ.get(SWITCH, "1")
+    if value.strip().lower() not in ON + OFF:
+        raise BipedError(
+            f"{SWITCH} = {value!r}: allowed {', '.join(ON)} (compile) or {', '.join(OFF)}"
+        )
+    return value.strip().lower() in ON
 
 
 def mode() -> str:
@@ -134,23 +144,25 @@ def cache_folder() -> Path:
 
 
 def _load(function: ca.Function, compiler: tuple) -> ca.Function:
-    """The compiled ``function`` from the cache, built first if missing, built again once
-    if it does not load; checked against the interpreter."""
-    source = _source(function)
-    library = cache_folder() / f"{function.name()}-{_digest(source, compiler)}.so"
+    """The compiled ``function`` from this process's libraries or the cache, built first if
+    missing, built again once if it does not load; checked against the interpreter."""
+    library = cache_folder() / f"{function.name()}-{_digest(function, compiler)}.so"
+    if str(library) in _loaded:  # the same function of another solver (grid, barrier)
+        return _loaded[str(library)]
     if str(library) in _failed_builds:
         raise NotCompiled(_failed_builds[str(library)])
     if not library.exists():
-        _build(source, compiler, library)
+        _build(function, compiler, library)
     try:
         machine = ca.external(function.name(), str(library))
     except RuntimeError:  # damaged, or made elsewhere: replaced whole
-        _build(source, compiler, library, again=True)
+        _build(function, compiler, library, again=True)
         machine = ca.external(function.name(), str(library))
     if not _same_bits(function, machine):
         raise NotCompiled(
             f"{function.name()} compiled does not give the interpreter's bits ({library})"
         )
+    _loaded[str(library)] = machine
     return machine
 
 
@@ -204,38 +216,42 @@ def _source(function: ca.Function) -> str:
     return generator.dump()
 
 
-def _digest(source: str, compiler: tuple) -> str:
+def _digest(function: ca.Function, compiler: tuple) -> str:
+    """What names a library: the function (CasADi's serialization of it, which the C source
+    follows and is three times slower to make), the compiler, the flags, CasADi, the
+    platform."""
     command, identity = compiler
     platform_ = [sys.platform, platform.machine(), str(struct.calcsize("P")), *platform.libc_ver()]
-    defining = [source, *command, identity, *FLAGS, ca.__version__, *platform_]
+    defining = [function.serialize(), *command, identity, *FLAGS, ca.__version__, *platform_]
     return hashlib.sha256("\0".join(defining).encode()).hexdigest()[:32]
 
 
-def _build(source: str, compiler: tuple, library: Path, again: bool = False) -> None:
-    """Compile ``source`` into ``library``, atomically, one process at a time; ``again``:
-    replace the library there unless another process did since this one failed to load it."""
+def _build(function: ca.Function, compiler: tuple, library: Path, again: bool = False) -> None:
+    """Compile ``function``'s C code into ``library``, atomically (``atomic_path``), one
+    process at a time; ``again``: replace the library there unless another process did
+    since this one failed to load it."""
     library.parent.mkdir(parents=True, exist_ok=True)
     before = _stamp(library)
     with _locked(library.with_suffix(".lock")):
         if library.exists() and (not again or _stamp(library) != before):
             return  # built by another process while this one waited
-        with tempfile.TemporaryDirectory(dir=library.parent, prefix=".build-") as work:
-            c_file, built = Path(work) / "function.c", Path(work) / "function.so"
-            c_file.write_text(source)
-            command = [*compiler[0], *FLAGS, str(c_file), "-o", str(built), "-lm"]
+        with atomic_path(library) as built:
+            command = [*compiler[0], *FLAGS, "-x", "c", "-", "-o", str(built), "-lm"]
             try:
                 done = subprocess.run(
-                    command, capture_output=True, timeout=BUILD_TIMEOUT, stdin=subprocess.DEVNULL
+                    command,
+                    input=_source(function).encode(),
+                    capture_output=True,
+                    timeout=BUILD_TIMEOUT,
                 )
             except subprocess.TimeoutExpired:
                 _broken_compiler.append(f"{command[0]} ran over {BUILD_TIMEOUT:g} s")
                 raise NotCompiled(_broken_compiler[0]) from None
             if done.returncode != 0:
-                said = done.stderr.decode(errors="replace").replace(f"{work}{os.sep}", "")
-                why = f"{command[0]} failed (exit {done.returncode}: {_error_line(said)})"
+                said = _error_line(done.stderr.decode(errors="replace"))
+                why = f"{command[0]} failed (exit {done.returncode}: {said})"
                 _failed_builds[str(library)] = why
                 raise NotCompiled(why)
-            os.replace(built, library)
 
 
 def _stamp(path: Path):
