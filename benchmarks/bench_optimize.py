@@ -70,7 +70,7 @@ def optimize_before(problem, solvers: dict):
     also the sthenic optimum of the same problem (itself optimized so) under both barriers."""
     began = time.perf_counter()
     solver = solvers[problem.criterion]
-    candidates = first_guesses(problem, 3, 0)
+    candidates = first_guesses(problem, 3, 0, by_table=False)
     if problem.criterion == "energy":
         twin = GaitProblem(problem.model, problem.speed, "sthenic", problem.safety)
         sthenic = optimize_before(twin, solvers)
@@ -174,7 +174,7 @@ def solvers_before():
     def optimize_old(problem, seed=0, starts=3, given=(), sthenic=None, **kwargs):
         began = time.perf_counter()
         solver = before(problem)
-        candidates = first_guesses(problem, starts, seed)
+        candidates = first_guesses(problem, starts, seed, by_table=False)
         candidates += [("given", np.asarray(z, dtype=float)) for z in given]
         if problem.criterion == "energy" and starts > 0:
             if sthenic is None:

@@ -3,9 +3,10 @@ in both and its relative change, the starts at the best in both; then how many a
 ``EQUAL``), lower and higher. What a change of the optimizer is checked with: a sweep before
 it and one after, run the same way.
 
-    python benchmarks/compare_sweeps.py BEFORE_FOLDER AFTER_FOLDER
+    python benchmarks/compare_sweeps.py BEFORE_FOLDER AFTER_FOLDER [--tolerance 1e-6]
 
-Exit status 1 when an optimum of the second is higher than the first's.
+Exit status 1 when an optimum of the second is higher than the first's by more than the
+tolerance (relative; default ``EQUAL``).
 """
 
 import argparse
@@ -21,7 +22,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("before", type=Path)
     parser.add_argument("after", type=Path)
+    parser.add_argument("--tolerance", type=float, default=EQUAL, help="relative (default 1e-9)")
     args = parser.parse_args()
+    equal_to = args.tolerance
     changes = []
     for path in sorted(args.before.glob("*-*-*.json")):
         other = args.after / path.name
@@ -31,15 +34,15 @@ def main() -> int:
         a, b = gait_file.read(path).optimizer, gait_file.read(other).optimizer
         change = (b.value - a.value) / abs(a.value)
         changes.append(change)
-        mark = "" if abs(change) <= EQUAL else ("  lower" if change < 0 else "  HIGHER")
+        mark = "" if abs(change) <= equal_to else ("  lower" if change < 0 else "  HIGHER")
         print(
             f"{path.name:32} {a.value:.10g} {b.value:.10g} {change:+.2e}  starts at best "
             f"{a.starts_at_best} -> {b.starts_at_best}{mark}"
         )
-    equal = sum(abs(c) <= EQUAL for c in changes)
-    lower = sum(c < -EQUAL for c in changes)
-    higher = sum(c > EQUAL for c in changes)
-    print(f"{len(changes)} optima: {equal} equal to {EQUAL:g}, {lower} lower, {higher} higher")
+    equal = sum(abs(c) <= equal_to for c in changes)
+    lower = sum(c < -equal_to for c in changes)
+    higher = sum(c > equal_to for c in changes)
+    print(f"{len(changes)} optima: {equal} equal to {equal_to:g}, {lower} lower, {higher} higher")
     return 1 if higher else 0
 
 

@@ -291,8 +291,10 @@ def add_budget(parser, sweep: bool = False):
     )
     add_options(
         parser,
-        ("--starts", positive, DEFAULT_STARTS, "N", f"IPOPT starts: the first guess and N-1 "
-         f"perturbations of it (default {DEFAULT_STARTS}); {CERTIFIED_HELP}"),
+        ("--starts", positive, DEFAULT_STARTS, "N", "IPOPT's own starts: first guesses of "
+         f"several step periods, then perturbations (default {DEFAULT_STARTS}); the table of "
+         "optima's starts come with them, and for the energy criterion take the place of the "
+         f"first {DEFAULT_STARTS} where the table covers the problem; {CERTIFIED_HELP}"),
         ("--nelder-mead-starts", non_negative, 0, "K",
          "IPOPT also starts from the paper's Nelder-Mead with K seeds (default 0)"),
         ("--seed", non_negative, 0, "N",

@@ -506,6 +506,18 @@ def test_forked_runs_give_the_results_in_order_and_raise_errors():
     with pytest.raises(ZeroDivisionError):
         runner.run_forked(lambda x: 1 / (x - 3), list(range(5)), 2)
     assert runner.free_cores() >= 1
+    # the calls named first are handed out first, the results still in order
+    import time
+
+    def timed(x):
+        began = time.monotonic()
+        time.sleep(0.05)
+        return x * x, began
+
+    results = runner.run_forked(timed, list(range(6)), 2, first=[5, 4])
+    assert [r for r, _ in results] == [x * x for x in range(6)]
+    began = [b for _, b in results]
+    assert max(began[4], began[5]) < min(began[:4])
     # a campaign run in this process: each task on one core, this process itself afterwards
     cores = runner.free_cores()
     seen = list(runner.run_tasks(lambda _: runner.free_cores(), [0, 1], jobs=1, stream=None))

@@ -85,3 +85,61 @@ def test_optimization_starts_from_the_table():
     assert abs(kinds[table.TABLE_START].value / optimum.report.value - 1) < 1e-6
     again = optimize(problem, starts=0, given=[optimum.variables])
     assert [s.kind for s in again.report.history] == ["given"]
+
+
+def test_the_table_covers_its_robot_safety_knee_criterion_and_speeds(small):
+    """A table covers a problem of its robot's body, safety, knee and criterion between its
+    speeds; another robot, a clearance, a knee bend, a speed beyond them, a series it lacks
+    or a richer spline family are not covered."""
+    from biped.model.criteria import Safety
+
+    assert table.covers(_problem("rolling", 0.25), small)
+    assert table.covers(_problem("rolling", 0.2), small) and table.covers(
+        _problem("rolling", 0.4), small
+    )
+    assert not table.covers(_problem("rolling", 0.45), small)  # beyond its speeds
+    assert not table.covers(_problem("rolling", 0.3, "sthenic"), small)  # no such series
+    heavier = biped.Robot.from_mapping({**ROBOT.to_dict(), "trunk_mass": 40.0}, source="test")
+    assert not table.covers(GaitProblem(biped.Biped(heavier, "rolling"), 0.3, "energy"), small)
+    for safety in (Safety(clearance=0.02), Safety(knee_bend=0.1)):
+        model = biped.Biped(ROBOT, "rolling")
+        assert not table.covers(GaitProblem(model, 0.3, "energy", safety), small)
+    richer = GaitProblem(biped.Biped(ROBOT, "rolling"), 0.3, "energy", knots=3)
+    assert not table.covers(richer, small)
+    assert not table.covers(_problem("rolling", 0.3), small.parent / "missing.json")
+
+
+def test_the_energy_criterion_replaces_its_first_guesses_by_the_table_where_it_covers():
+    """Where the shipped table covers an energy problem its starts (the neighbours' optima,
+    from mu = 1e-4 too; the other knee's, under the monotone barrier too) take the place of
+    the default first guesses, and only the starts asked beyond the default are first
+    guesses; beyond the table's speeds, or asked for by_table=False, all are solved."""
+    from biped.optimization.optimize import (
+        DEFAULT_STARTS,
+        MONOTONE,
+        NEAR,
+        barriers_of,
+        first_guesses,
+        table_starts,
+    )
+
+    covered, beyond = _problem("revolute", 0.3), _problem("revolute", 0.6)
+    assert table.covers(covered) and not table.covers(beyond)
+    assert first_guesses(covered, DEFAULT_STARTS, 0) == []
+    assert len(first_guesses(covered, DEFAULT_STARTS + 2, 0)) == 2
+    assert len(first_guesses(beyond, DEFAULT_STARTS, 0)) == DEFAULT_STARTS
+    assert len(first_guesses(covered, DEFAULT_STARTS, 0, by_table=False)) == DEFAULT_STARTS
+    assert [kind for kind, _ in table_starts(covered, 1)] == [
+        table.TABLE_START,
+        table.TABLE_START + NEAR,
+        table.OTHER_KNEE_START,
+        table.OTHER_KNEE_START + MONOTONE,
+        table.OTHER_KNEE_START + NEAR,
+    ]
+    sthenic = _problem("revolute", 0.3, "sthenic")
+    assert [kind for kind, _ in table_starts(sthenic, 1)] == [
+        table.TABLE_START,
+        table.OTHER_KNEE_START,
+    ]
+    assert "near" in barriers_of(covered)
+    assert "near" not in barriers_of(_problem("revolute", 0.3, "energy-per-metre"))

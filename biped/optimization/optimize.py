@@ -235,15 +235,19 @@ def start_schedule(starts: int, seed: int, periods) -> list[tuple[str, float | N
     ]
 
 
-def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[str, np.ndarray]]:
+def first_guesses(
+    problem: GaitProblem, starts: int, seed: int, by_table: bool = True
+) -> list[tuple[str, np.ndarray]]:
     """``starts`` first guesses in the bounds: the default first guess, then first guesses of
     other step periods (``GUESS_PERIODS``: the step length a gait settles on is its largest
     choice, and the basins of the optima follow it), then perturbations of the default. For
     the energy criterion per step, the family of short steps ``ENERGY_GUESS_LENGTHS`` under
     the monotone barrier instead (``energy_first_guesses``); the energy per metre takes steps
-    of the sthenic criterion's lengths (0.18 m at 0.3 m/s), which these first guesses reach."""
+    of the sthenic criterion's lengths (0.18 m at 0.3 m/s), which these first guesses reach.
+    ``by_table``: the energy criterion's default first guesses are replaced by the table's
+    starts where it covers the problem (``energy_first_guesses``; False: all solved)."""
     if problem.criterion == "energy":
-        return energy_first_guesses(problem, starts, seed)
+        return energy_first_guesses(problem, starts, seed, by_table)
     schedule = start_schedule(starts, seed, GUESS_PERIODS)
     guess, rng = problem.first_guess(), np.random.default_rng(seed)
     return [
@@ -263,10 +267,19 @@ def first_guesses(problem: GaitProblem, starts: int, seed: int) -> list[tuple[st
 ENERGY_GUESS_LENGTHS = (0.1, 0.08, 0.12)
 
 
-def energy_first_guesses(problem: GaitProblem, starts: int, seed: int) -> list:
+def energy_first_guesses(problem: GaitProblem, starts: int, seed: int, by_table=True) -> list:
     """``starts`` first guesses of the energy criterion, each solved under the monotone
     barrier: steps of the lengths ``ENERGY_GUESS_LENGTHS`` at the problem's speed, then
-    perturbations of the first."""
+    perturbations of the first. Where the table of optima covers the problem
+    (``biped.optimization.table.covers``) its starts (``table_starts``) take the place of
+    the default's ``DEFAULT_STARTS`` first guesses, and only those beyond are solved: over
+    the default sweep every optimum the first guesses reached, the table's starts and the
+    sthenic optimum's reached too, in 0.59 times the iterations."""
+    skipped = min(DEFAULT_STARTS, starts) if by_table and table.covers(problem) else 0
+    return _energy_guesses(problem, starts, seed)[skipped:]
+
+
+def _energy_guesses(problem: GaitProblem, starts: int, seed: int) -> list:
     lengths = ENERGY_GUESS_LENGTHS[:starts]
     guesses = [
         (f"first guess S = {length:g} m{MONOTONE}", problem.first_guess(length / problem.speed))
@@ -314,7 +327,8 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
         raise BipedError("no start: allowed starts >= 1 or given starts")
     jobs = free_cores() if jobs is None else jobs
     if search is None:
-        ends = run_forked(lambda c: solve(c[1], barrier_of(c[0])), list(candidates), jobs)
+        function = lambda c: solve(c[1], barrier_of(c[0]))  # noqa: E731
+        ends = run_forked(function, list(candidates), jobs, _far_first(candidates))
     else:
         ends = coarse_to_fine(list(candidates), search, solve, jobs)
     solutions = list(zip([kind for kind, _ in candidates], ends, strict=True))
@@ -336,6 +350,13 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
         value=best.value,
     )
     return best, report
+
+
+def _far_first(candidates) -> list[int]:
+    """The indices of the starts far from any optimum (the sthenic optimum of a criterion of
+    work: 90-170 IPOPT iterations, where the table's starts take 30-110), to be solved
+    first, so that the longest solves do not start last on the processes."""
+    return [i for i, (kind, _) in enumerate(candidates) if start_of(kind) == STHENIC_START]
 
 
 def coarse_to_fine(candidates, search, solve, jobs: int) -> list:
@@ -427,8 +448,11 @@ def prepare(problem: GaitProblem) -> float:
 def barriers_of(problem: GaitProblem) -> tuple[str, ...]:
     """The barriers (``barrier_of``) the starts of an optimization of ``problem`` are solved
     with: the adaptive one, and for the criteria of work the monotone one too (their table
-    start, ``table_starts``, and the energy per step's first guesses)."""
-    return ("adaptive", "monotone") if problem.criterion in WORK_CRITERIA else ("adaptive",)
+    start, ``table_starts``, and the energy per step's first guesses), for the energy per
+    step also the one from mu = 1e-4 (its table start, ``NEAR``)."""
+    if problem.criterion not in WORK_CRITERIA:
+        return ("adaptive",)
+    return ("adaptive", "monotone") + ("near",) * (problem.criterion == "energy")
 
 
 def optimize(
@@ -535,9 +559,14 @@ def _coarse_search(problem: GaitProblem, barriers, solvers=None):
 
 def table_starts(problem: GaitProblem, starts: int) -> list:
     """The start of the table of optima at the neighbouring speeds
-    (``biped.optimization.table``), with ``starts`` > 0, when the table has the problem's
-    knee and criterion; for the energy criterion under both barriers, whose paths from it
-    may end in different local minima."""
+    (``biped.optimization.table``) and the other knee's, with ``starts`` > 0, when the
+    table has the problem's knee and criterion. The criteria of work have close local
+    minima, and from one start each barrier may end in another: the neighbours' start is
+    solved under the monotone barrier too; for the energy criterion per step from mu = 1e-4
+    (``NEAR``), and the other knee's start under the monotone barrier and from mu = 1e-4
+    too: with the sthenic optimum's, the starts that reach every optimum of the default
+    sweep, and a lower one (revolute knee, 0.15 m/s: from the rolling knee's optimum, from
+    mu = 1e-4 alone)."""
     if starts == 0:
         return []
     found = [
@@ -545,9 +574,16 @@ def table_starts(problem: GaitProblem, starts: int) -> list:
         (OTHER_KNEE_START, _embedded(problem, table.other_knee_start(problem))),
     ]
     found = [(kind, start) for kind, start in found if start is not None]
-    if problem.criterion in WORK_CRITERIA and found and found[0][0] == TABLE_START:
-        found.insert(1, (TABLE_START + MONOTONE, found[0][1]))
-    return found
+    if problem.criterion not in WORK_CRITERIA:
+        return found
+    twins = {TABLE_START: (MONOTONE,)}
+    if problem.criterion == "energy":
+        twins = {TABLE_START: (NEAR,), OTHER_KNEE_START: (MONOTONE, NEAR)}
+    return [
+        pair
+        for kind, start in found
+        for pair in [(kind, start)] + [(kind + end, start) for end in twins.get(kind, ())]
+    ]
 
 
 def _embedded(problem: GaitProblem, variables):
@@ -611,8 +647,11 @@ TIGHT = ", tight tolerance"
 # A start solved under the monotone barrier from mu = 1e-3 (``BARRIERS["confirm"]``,
 # ``confirm``).
 CONFIRM = ", monotone barrier from 1e-3"
+# A start near an optimum solved under the monotone barrier from mu = 1e-4
+# (``BARRIERS["near"]``, ``table_starts``).
+NEAR = ", monotone barrier from 1e-4"
 # The barrier a start's kind names by its ending; no ending: the adaptive one.
-BARRIER_ENDINGS = {TIGHT: "tight", MONOTONE: "monotone", CONFIRM: "confirm"}
+BARRIER_ENDINGS = {TIGHT: "tight", MONOTONE: "monotone", CONFIRM: "confirm", NEAR: "near"}
 
 
 def _ending(kind: str) -> str:
@@ -699,9 +738,11 @@ def confirm(problem: GaitProblem, optimum: Optimum, given=(), jobs: int | None =
     settled = report.method != "ipopt" or not report.converged or report.confirmed
     if settled or problem.criterion not in WORK_CRITERIA:
         return optimum
-    near = [(kind, z) for kind, z in table_starts(problem, 1) if not kind.endswith(MONOTONE)]
+    near = [(kind, z) for kind, z in table_starts(problem, 1) if start_of(kind) == kind]
     candidates = [(kind + CONFIRM, z) for kind, z in near]
     candidates += [(kind + MONOTONE, z) for kind, z in near if kind == OTHER_KNEE_START]
+    solved = {start.kind for start in report.history}  # the same start again adds nothing
+    candidates = [(kind, z) for kind, z in candidates if kind not in solved]
     candidates += [("given" + CONFIRM, np.asarray(z, dtype=float)) for z in given]
     if not candidates:
         return optimum

@@ -68,6 +68,10 @@ BARRIERS = {
     # From mu = 1e-3: a start near an optimum keeps closer to it, along another path through
     # the energy criteria's close local minima (``biped.optimization.optimize.confirm``).
     "confirm": {"mu_strategy": "monotone", "mu_init": 1e-3},
+    # From mu = 1e-4: a start near an optimum (the table's, at a neighbouring speed) keeps to
+    # the local minimum nearest it, in 30-70 iterations where the barrier from 1e-2 takes
+    # 80-170 (the energy criterion's table starts, ``biped.optimization.optimize``).
+    "near": {"mu_strategy": "monotone", "mu_init": 1e-4},
     # From a converged point, a hundred times tighter: what ``IPOPT_OPTIONS``' tolerance
     # leaves of an optimum (the atlas's error bar).
     "tight": {"tol": 1e-11, "constr_viol_tol": 1e-11},

@@ -7,13 +7,18 @@ folder (``from_sweep``); the shipped file is made by
 
     biped sweep && biped table --out biped/optimization/optima.json
 
+(from an earlier version's sweep, its ``source`` says). It stays fixed: made again from
+today's sweep, the starts move, and with them some of the energy criterion's optima among
+its close local minima.
+
 An optimization starts from the table's optima at the neighbouring speeds (``start``): the
 optima interpolated linearly in speed between the nearest tabled speeds below and above, the
 speed itself left out, so a tabled optimum never starts its own point: the start is the
 neighbours', a start independent of the point's own, reaching the point's basin where the
 optima change smoothly with speed (the energy criterion's basins follow the step period).
 Beyond the table's speeds, the nearest tabled optimum. The table's fingerprint (``digest``)
-is recorded by the campaigns whose numbers it shapes.
+is recorded by the campaigns whose numbers it shapes. The table ``covers`` a problem of its
+robot, safety, knee and criterion within its speeds: its starts then lie near the optima.
 """
 
 from __future__ import annotations
@@ -56,6 +61,37 @@ def _read(path: str) -> dict:
     except (OSError, ValueError, KeyError, TypeError) as error:
         raise BipedError(f"{file}: not a table of optima ({error})") from None
     return series
+
+
+@functools.cache
+def _made_for(path: str) -> tuple:
+    """(robot's body fields, clearance, ZMP margin) of the table at ``path``, or () without
+    one."""
+    file = Path(path)
+    if not file.exists():
+        return ()
+    try:
+        content = json.loads(file.read_text())
+        robot = {k: v for k, v in content["robot"].items() if k != "actuators"}
+        return robot, content["safety"]["clearance"], content["safety"]["zmp_margin"]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
+        raise BipedError(f"{file}: not a table of optima ({error})") from None
+
+
+def covers(problem: GaitProblem, path: Path = SHIPPED) -> bool:
+    """Whether the table holds optima of ``problem``'s robot (its body), safety, knee and
+    criterion at speeds on both sides of its own or at it, of the paper's spline: its starts
+    (``start``, ``other_knee_start``) then lie near the problem's optima."""
+    series = _read(str(path)).get((problem.knee, problem.criterion))
+    if series is None or problem.knots != 1:
+        return False
+    robot, clearance, zmp_margin = _made_for(str(path))
+    safety = problem.safety
+    own = {k: v for k, v in problem.model.robot.to_dict().items() if k != "actuators"}
+    same = own == robot and (safety.clearance, safety.zmp_margin) == (clearance, zmp_margin)
+    same = same and safety.knee_bend == 0.0 and not safety.actuator_limits
+    speeds = series[0]
+    return same and speeds[0] - SAME_SPEED <= problem.speed <= speeds[-1] + SAME_SPEED
 
 
 def digest(path: Path = SHIPPED) -> str | None:

@@ -214,22 +214,28 @@ def _task(function: Callable, task):
 _FORKED: tuple = (None, ())
 
 
-def run_forked(function: Callable, arguments: list, jobs: int) -> list:
+def run_forked(function: Callable, arguments: list, jobs: int, first=()) -> list:
     """``[function(a) for a in arguments]``, on ``jobs`` processes forked from this one when
     ``jobs`` > 1 and the platform forks: they inherit this process's memory (a built solver),
     so ``function`` may be any callable and only the results are pickled. The results are
-    those of the calls in this process, in order. Interrupts as ``run_tasks``' pool: the
-    workers are terminated and the exception goes on up."""
+    those of the calls in this process, in order. The calls of the indices ``first`` (the
+    longest, so that none starts last) are handed out before the others. Interrupts as
+    ``run_tasks``' pool: the workers are terminated and the exception goes on up."""
     jobs = max(1, min(jobs, len(arguments)))
     if jobs == 1 or "fork" not in multiprocessing.get_all_start_methods():
         return [function(a) for a in arguments]
     global _FORKED
     _FORKED = (function, arguments)
+    order = list(dict.fromkeys([*first, *range(len(arguments))]))
     try:
         with _pool("fork", jobs) as pool:
-            return pool.map(_call_forked, range(len(arguments)), chunksize=1)
+            ends = pool.map(_call_forked, order, chunksize=1)
     finally:
         _FORKED = (None, ())
+    results = [None] * len(arguments)
+    for index, end in zip(order, ends, strict=True):
+        results[index] = end
+    return results
 
 
 def _call_forked(index: int):

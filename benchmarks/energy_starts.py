@@ -1,0 +1,118 @@
+"""Which starts reach the energy criterion's optima: at every point of the default sweep (both
+knees, 13 speeds), each start near an optimum (the table's neighbours, the other knee's, the
+sthenic optimum) solved under each barrier, and the default first guesses, one by one; then,
+for the start set of ``biped.optimization.optimize`` and for the one before it, the points
+where the set reaches the best value found, the points it confirms (two starts or more, a
+start's barriers counted once) and its IPOPT iterations in all.
+
+    python benchmarks/energy_starts.py [--jobs N] [--points revolute:0.15 ...]
+
+The best value of a point is the least any start reached (solver's samples); a set reaches it
+within ``AGREEMENT``. Takes about 4 minutes on 2 cores.
+"""
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"  # one BLAS thread, set before numpy loads its BLAS
+
+import argparse  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+import biped  # noqa: E402
+from biped.optimization import table  # noqa: E402
+from biped.optimization.optimize import (  # noqa: E402
+    AGREEMENT,
+    MONOTONE,
+    NEAR,
+    STHENIC_START,
+    Start,
+    barrier_of,
+    first_guesses,
+    optimize,
+    starts_at_value,
+    table_starts,
+)
+from biped.optimization.problem import GaitProblem  # noqa: E402
+from biped.optimization.solver import solver_for  # noqa: E402
+from biped.runtime.runner import free_cores, run_forked  # noqa: E402
+from biped.studies.sweep import DEFAULT_SPEEDS  # noqa: E402
+
+CONFIRM_FROM = ", monotone barrier from 1e-3"
+ENDINGS = ("", MONOTONE, CONFIRM_FROM, NEAR)  # the adaptive barrier, then monotone from 1e-2 ...
+NEAR_STARTS = (table.TABLE_START, table.OTHER_KNEE_START, STHENIC_START)
+FIRST_GUESSES = "first guesses"
+# The energy criterion's starts of ``optimize`` now, and before the table replaced its first
+# guesses (kinds as ``Start.kind``).
+NOW = [
+    kind
+    for kind, _ in table_starts(GaitProblem(biped.Biped(biped.Robot.paper()), 0.3, "energy"), 1)
+]
+NOW += [STHENIC_START, STHENIC_START + MONOTONE]
+BEFORE = [FIRST_GUESSES, table.TABLE_START, table.TABLE_START + MONOTONE]
+BEFORE += [table.OTHER_KNEE_START, STHENIC_START, STHENIC_START + MONOTONE]
+
+
+def solve_point(point) -> list[Start]:
+    """Every start of one point (knee, speed) solved alone: (kind, value, status, iterations)."""
+    knee, speed = point
+    problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), speed, "energy")
+    solver = solver_for(problem)
+    sthenic = optimize(GaitProblem(problem.model, speed, "sthenic"), jobs=1)
+    near = dict(table_starts(problem, 1))
+    near[STHENIC_START] = sthenic.variables
+    runs = [(f"{FIRST_GUESSES}: {kind}", z) for kind, z in first_guesses(problem, 3, 0, False)]
+    runs += [(start + end, near[start]) for start in NEAR_STARTS for end in ENDINGS]
+    found = []
+    for kind, z in runs:
+        end = solver.solve(problem, z, barrier=barrier_of(kind))
+        found.append(Start(kind, end.value, end.status, end.iterations))
+    return found
+
+
+def of_set(starts: list[Start], kinds: list[str]) -> list[Start]:
+    """The starts of a set: its kinds, the first guesses as one kind."""
+    return [
+        s
+        for s in starts
+        if s.kind in kinds or (FIRST_GUESSES in kinds and s.kind.startswith(FIRST_GUESSES))
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--jobs", type=int, default=free_cores())
+    parser.add_argument("--points", nargs="*", default=None, help="KNEE:SPEED, default the sweep's")
+    args = parser.parse_args()
+    points = [(k, float(v)) for k in biped.KNEES for v in DEFAULT_SPEEDS]
+    if args.points:
+        points = [(p.split(":")[0], float(p.split(":")[1])) for p in args.points]
+    results = run_forked(solve_point, points, args.jobs)
+    totals = {name: [0, 0, 0] for name in ("now", "before")}
+    for (knee, speed), starts in zip(points, results, strict=True):
+        best = min(s.value for s in starts if s.status == "Solve_Succeeded")
+        line = []
+        for name, kinds in (("now", NOW), ("before", BEFORE)):
+            chosen = of_set(starts, kinds)
+            value = min((s.value for s in chosen if s.status == "Solve_Succeeded"), default=np.inf)
+            reached = value <= best * (1 + AGREEMENT)
+            count = starts_at_value(chosen, value)
+            totals[name][0] += reached
+            totals[name][1] += reached and count >= 2
+            totals[name][2] += sum(s.iterations for s in chosen)
+            line.append(f"{name} {value:.9f} ({count} starts){'' if reached else ' ABOVE'}")
+        at_best = [s.kind for s in starts if abs(s.value - best) <= AGREEMENT * best]
+        print(f"{knee:8} {speed:.3f} best {best:.9f}: {'; '.join(line)}")
+        print(f"    at best: {', '.join(at_best)}")
+    for name, (reached, confirmed, iterations) in totals.items():
+        print(
+            f"{name}: reaches the best at {reached} of {len(points)} points, by two starts or "
+            f"more at {confirmed}, {iterations} IPOPT iterations"
+        )
+    print(f"iterations now / before: {totals['now'][2] / totals['before'][2]:.2f}")
+
+
+if __name__ == "__main__":
+    np.seterr(all="ignore")
+    main()
