@@ -22,9 +22,13 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("before", type=Path)
     parser.add_argument("after", type=Path)
-    parser.add_argument("--tolerance", type=float, default=EQUAL, help="relative (default 1e-9)")
+    parser.add_argument(
+        "--tolerance", type=float, default=EQUAL, help=f"relative, >= 0 (default {EQUAL:g})"
+    )
     args = parser.parse_args()
-    equal_to = args.tolerance
+    if not args.tolerance >= 0:
+        parser.error(f"--tolerance {args.tolerance}: allowed a number >= 0")
+    tolerance = args.tolerance
     changes = []
     for path in sorted(args.before.glob("*-*-*.json")):
         other = args.after / path.name
@@ -34,15 +38,15 @@ def main() -> int:
         a, b = gait_file.read(path).optimizer, gait_file.read(other).optimizer
         change = (b.value - a.value) / abs(a.value)
         changes.append(change)
-        mark = "" if abs(change) <= equal_to else ("  lower" if change < 0 else "  HIGHER")
+        mark = "" if abs(change) <= tolerance else ("  lower" if change < 0 else "  HIGHER")
         print(
             f"{path.name:32} {a.value:.10g} {b.value:.10g} {change:+.2e}  starts at best "
             f"{a.starts_at_best} -> {b.starts_at_best}{mark}"
         )
-    equal = sum(abs(c) <= equal_to for c in changes)
-    lower = sum(c < -equal_to for c in changes)
-    higher = sum(c > equal_to for c in changes)
-    print(f"{len(changes)} optima: {equal} equal to {equal_to:g}, {lower} lower, {higher} higher")
+    equal = sum(abs(c) <= tolerance for c in changes)
+    lower = sum(c < -tolerance for c in changes)
+    higher = sum(c > tolerance for c in changes)
+    print(f"{len(changes)} optima: {equal} equal to {tolerance:g}, {lower} lower, {higher} higher")
     return 1 if higher else 0
 
 

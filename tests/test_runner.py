@@ -506,9 +506,8 @@ def test_forked_runs_give_the_results_in_order_and_raise_errors():
     with pytest.raises(ZeroDivisionError):
         runner.run_forked(lambda x: 1 / (x - 3), list(range(5)), 2)
     assert runner.free_cores() >= 1
-    # the calls named first are handed out first, the results still in order
-    import time
 
+    # the calls named first are handed out first, the results still in order
     def timed(x):
         began = time.monotonic()
         time.sleep(0.05)
@@ -518,6 +517,9 @@ def test_forked_runs_give_the_results_in_order_and_raise_errors():
     assert [r for r, _ in results] == [x * x for x in range(6)]
     began = [b for _, b in results]
     assert max(began[4], began[5]) < min(began[:4])
+    for wrong in ([6], [-1], [0.5]):
+        with pytest.raises(biped.BipedError, match=r"first = .*allowed indices"):
+            runner.run_forked(timed, list(range(6)), 2, first=wrong)
     # a campaign run in this process: each task on one core, this process itself afterwards
     cores = runner.free_cores()
     seen = list(runner.run_tasks(lambda _: runner.free_cores(), [0, 1], jobs=1, stream=None))

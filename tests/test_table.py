@@ -1,6 +1,7 @@
 """The table of optima that starts every optimization: the neighbours' optima, never the
 point's own; the shipped table holds certified optima of its robot."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -98,10 +99,17 @@ def test_the_table_covers_its_robot_safety_knee_criterion_and_speeds(small):
         _problem("rolling", 0.4), small
     )
     assert not table.covers(_problem("rolling", 0.45), small)  # beyond its speeds
+    assert not table.covers(_problem("revolute", 0.3), small)  # only its own speed
+    from biped.model.actuators import Actuators
+
+    driven = dataclasses.replace(ROBOT, actuators=Actuators.default())  # the same body
+    assert table.covers(GaitProblem(biped.Biped(driven, "rolling"), 0.3, "energy"), small)
+    coarse = GaitProblem(biped.Biped(ROBOT, "rolling"), 0.3, "energy", samples_per_half=8)
+    assert not table.covers(coarse, small)
     assert not table.covers(_problem("rolling", 0.3, "sthenic"), small)  # no such series
     heavier = biped.Robot.from_mapping({**ROBOT.to_dict(), "trunk_mass": 40.0}, source="test")
     assert not table.covers(GaitProblem(biped.Biped(heavier, "rolling"), 0.3, "energy"), small)
-    for safety in (Safety(clearance=0.02), Safety(knee_bend=0.1)):
+    for safety in (Safety(clearance=0.02), Safety(zmp_margin=0.01), Safety(knee_bend=0.1)):
         model = biped.Biped(ROBOT, "rolling")
         assert not table.covers(GaitProblem(model, 0.3, "energy", safety), small)
     richer = GaitProblem(biped.Biped(ROBOT, "rolling"), 0.3, "energy", knots=3)
@@ -135,6 +143,11 @@ def test_the_energy_criterion_replaces_its_first_guesses_by_the_table_where_it_c
         table.OTHER_KNEE_START,
         table.OTHER_KNEE_START + MONOTONE,
         table.OTHER_KNEE_START + NEAR,
+    ]
+    assert [kind for kind, _ in table_starts(beyond, 1)] == [  # as before the table covered
+        table.TABLE_START,
+        table.TABLE_START + MONOTONE,
+        table.OTHER_KNEE_START,
     ]
     sthenic = _problem("revolute", 0.3, "sthenic")
     assert [kind for kind, _ in table_starts(sthenic, 1)] == [

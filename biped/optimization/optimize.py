@@ -267,15 +267,19 @@ def first_guesses(
 ENERGY_GUESS_LENGTHS = (0.1, 0.08, 0.12)
 
 
-def energy_first_guesses(problem: GaitProblem, starts: int, seed: int, by_table=True) -> list:
+def energy_first_guesses(
+    problem: GaitProblem, starts: int, seed: int, by_table: bool = True
+) -> list:
     """``starts`` first guesses of the energy criterion, each solved under the monotone
     barrier: steps of the lengths ``ENERGY_GUESS_LENGTHS`` at the problem's speed, then
     perturbations of the first. Where the table of optima covers the problem
     (``biped.optimization.table.covers``) its starts (``table_starts``) take the place of
-    the default's ``DEFAULT_STARTS`` first guesses, and only those beyond are solved: over
-    the default sweep every optimum the first guesses reached, the table's starts and the
-    sthenic optimum's reached too, in 0.59 times the iterations."""
-    skipped = min(DEFAULT_STARTS, starts) if by_table and table.covers(problem) else 0
+    the first guesses of those lengths, and only the perturbations beyond are solved: over
+    the default sweep the table's starts and the sthenic optimum's reach every optimum the
+    first guesses reached, and one lower, in 0.64 times the iterations
+    (``benchmarks/energy_starts.py``)."""
+    covered = by_table and table.covers(problem)
+    skipped = min(len(ENERGY_GUESS_LENGTHS), starts) if covered else 0
     return _energy_guesses(problem, starts, seed)[skipped:]
 
 
@@ -327,8 +331,12 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
         raise BipedError("no start: allowed starts >= 1 or given starts")
     jobs = free_cores() if jobs is None else jobs
     if search is None:
-        function = lambda c: solve(c[1], barrier_of(c[0]))  # noqa: E731
-        ends = run_forked(function, list(candidates), jobs, _far_first(candidates))
+
+        def solve_start(candidate):
+            kind, start = candidate
+            return solve(start, barrier_of(kind))
+
+        ends = run_forked(solve_start, list(candidates), jobs, _far_first(candidates))
     else:
         ends = coarse_to_fine(list(candidates), search, solve, jobs)
     solutions = list(zip([kind for kind, _ in candidates], ends, strict=True))
@@ -353,9 +361,10 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
 
 
 def _far_first(candidates) -> list[int]:
-    """The indices of the starts far from any optimum (the sthenic optimum of a criterion of
-    work: 90-170 IPOPT iterations, where the table's starts take 30-110), to be solved
-    first, so that the longest solves do not start last on the processes."""
+    """The indices of the starts from the sthenic optimum (of a criterion of work), to be
+    solved first: far from the criterion's optima, they are the longest at most points (at
+    0.3 m/s 89-169 IPOPT iterations, where the table's starts take 29-114), and a long
+    solve started last keeps one process busy alone."""
     return [i for i, (kind, _) in enumerate(candidates) if start_of(kind) == STHENIC_START]
 
 
@@ -452,7 +461,9 @@ def barriers_of(problem: GaitProblem) -> tuple[str, ...]:
     step also the one from mu = 1e-4 (its table start, ``NEAR``)."""
     if problem.criterion not in WORK_CRITERIA:
         return ("adaptive",)
-    return ("adaptive", "monotone") + ("near",) * (problem.criterion == "energy")
+    if problem.criterion == "energy":
+        return ("adaptive", "monotone", "near")
+    return ("adaptive", "monotone")
 
 
 def optimize(
@@ -473,7 +484,11 @@ def optimize(
     Args:
         seed: seed of the perturbed starts and of Nelder-Mead; the same seed gives the
             same result.
-        starts: IPOPT's own starts: the first guess and ``starts - 1`` perturbations.
+        starts: IPOPT's own starts (``first_guesses``): first guesses of several step
+            periods (of step lengths for the energy criterion), then perturbations; the
+            table's starts come with them (``table_starts``; with ``starts`` = 0, none),
+            and for the energy criterion replace its first guesses where the table covers
+            the problem.
         given: further starts, each the solvers' variables (21,) (e.g. the optimum at a
             neighbouring speed).
         nelder_mead_starts: IPOPT also starts from the paper's Nelder-Mead run with seeds
@@ -562,11 +577,12 @@ def table_starts(problem: GaitProblem, starts: int) -> list:
     (``biped.optimization.table``) and the other knee's, with ``starts`` > 0, when the
     table has the problem's knee and criterion. The criteria of work have close local
     minima, and from one start each barrier may end in another: the neighbours' start is
-    solved under the monotone barrier too; for the energy criterion per step from mu = 1e-4
-    (``NEAR``), and the other knee's start under the monotone barrier and from mu = 1e-4
-    too: with the sthenic optimum's, the starts that reach every optimum of the default
-    sweep, and a lower one (revolute knee, 0.15 m/s: from the rolling knee's optimum, from
-    mu = 1e-4 alone)."""
+    solved under the monotone barrier too; for the energy criterion per step where the
+    table covers the problem (``biped.optimization.table.covers``: its starts then replace
+    the first guesses), from mu = 1e-4 (``NEAR``) instead, and the other knee's start under
+    the monotone barrier and from mu = 1e-4 too: with the sthenic optimum's, the starts
+    that reach every optimum of the default sweep, and a lower one (revolute knee,
+    0.15 m/s: from the rolling knee's optimum, from mu = 1e-4 alone)."""
     if starts == 0:
         return []
     found = [
@@ -577,7 +593,7 @@ def table_starts(problem: GaitProblem, starts: int) -> list:
     if problem.criterion not in WORK_CRITERIA:
         return found
     twins = {TABLE_START: (MONOTONE,)}
-    if problem.criterion == "energy":
+    if problem.criterion == "energy" and table.covers(problem):
         twins = {TABLE_START: (NEAR,), OTHER_KNEE_START: (MONOTONE, NEAR)}
     return [
         pair
@@ -700,10 +716,10 @@ def _family(problem: GaitProblem) -> tuple:
 
 
 def starts_at_value(history, value: float) -> int:
-    """Converged starts within ``AGREEMENT`` of ``value``; one point solved under several
-    barriers (kinds "X", "X, monotone barrier", "X, monotone barrier from 1e-3") is one
-    start: it does not confirm itself. Of a kind several starts may reach the value (the
-    given ones): a start counts as many as the most of its barriers."""
+    """Converged starts within ``AGREEMENT`` of ``value``; one point solved under several barriers
+    (kinds "X", "X, monotone barrier", "X, monotone barrier from 1e-3", "X, monotone barrier
+    from 1e-4") is one start: it does not confirm itself. Of a kind several starts may reach the
+    value (the given ones): a start counts as many as the most of its barriers."""
     kinds = [
         s.kind
         for s in history
@@ -717,19 +733,20 @@ def starts_at_value(history, value: float) -> int:
 
 
 def confirm(problem: GaitProblem, optimum: Optimum, given=(), jobs: int | None = None):
-    """``optimum``, or, when IPOPT reached its best value of a criterion of work from a
-    single start, the best of it and of more starts, each near an optimum: the table's and
-    the other knee's (``table_starts``) and ``given`` (e.g. the optima at the neighbouring
-    speeds), under the monotone barrier from mu = 1e-3 (``CONFIRM``), the other knee's also
-    from mu = 1e-2. The energy criteria's local minima lie 0.01-0.1 % apart, and from the
-    same start these barriers follow other paths among them than the first starts'
-    (at 0.25 m/s the revolute knee's least energy per step, reached by one first guess alone,
-    is reached from the other knee's optimum under the monotone barrier); they may also
-    reach a lower optimum, which replaces ``optimum`` only when lower on the solver's
-    samples too (the problem IPOPT solves; ``best_of`` ranks by the check grid): a
-    confirmation never leaves a higher optimum. An optimum whose solver did not converge is
-    returned as it is (there is nothing to confirm). The starts run on ``jobs`` processes
-    (``multistart``)."""
+    """``optimum``, or, when IPOPT reached its best value of a criterion of work from a single
+    start, the best of it and of more starts, each near an optimum: the table's and the other
+    knee's (``table_starts``) and ``given`` (e.g. the optima at the neighbouring speeds), under
+    the monotone barrier from mu = 1e-3 (``CONFIRM``), the other knee's also from mu = 1e-2; a
+    start the optimum's history holds already (the energy criterion's other knee's from 1e-2) is
+    not solved again, as it would count its own value twice. The energy criteria's local minima
+    lie 0.01-0.1 % apart, and from the same start these barriers follow other paths among them
+    than the first starts' (at 0.25 m/s the revolute knee's least energy per step, reached by
+    the other knee's start under the monotone barrier alone, is reached again from the
+    neighbours' and the other knee's optima from mu = 1e-3); they may also reach a lower
+    optimum, which replaces ``optimum`` only when lower on the solver's samples too (the problem
+    IPOPT solves; ``best_of`` ranks by the check grid): a confirmation never leaves a higher
+    optimum. An optimum whose solver did not converge is returned as it is (there is nothing to
+    confirm). The starts run on ``jobs`` processes (``multistart``)."""
     if not isinstance(problem, GaitProblem):
         raise BipedError(f"problem = {problem!r}: allowed a biped.optimization.problem.GaitProblem")
     if not isinstance(optimum, Optimum):

@@ -23,6 +23,7 @@ robot, safety, knee and criterion within its speeds: its starts then lie near th
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import json
@@ -58,7 +59,7 @@ def _read(path: str) -> dict:
             optima = np.array(entry["optima"], dtype=float).reshape(len(speeds), len(VARIABLES))
             order = np.argsort(speeds)
             series[(entry["knee"], entry["criterion"])] = (speeds[order], optima[order])
-    except (OSError, ValueError, KeyError, TypeError) as error:
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
         raise BipedError(f"{file}: not a table of optima ({error})") from None
     return series
 
@@ -80,10 +81,16 @@ def _made_for(path: str) -> tuple:
 
 def covers(problem: GaitProblem, path: Path = SHIPPED) -> bool:
     """Whether the table holds optima of ``problem``'s robot (its body), safety, knee and
-    criterion at speeds on both sides of its own or at it, of the paper's spline: its starts
-    (``start``, ``other_knee_start``) then lie near the problem's optima."""
+    criterion at speeds on both sides of its own or at it, and the other knee's, of the
+    paper's spline on the solvers' default grid: its starts (``start``,
+    ``other_knee_start``) then lie near the problem's optima. (The table records the
+    clearance and ZMP margin of its sweep, not a knee bend or actuator limits: it covers
+    problems without those.)"""
     series = _read(str(path)).get((problem.knee, problem.criterion))
-    if series is None or problem.knots != 1:
+    default = dataclasses.replace(problem, samples_per_half=None).samples_per_half
+    if series is None or problem.knots != 1 or problem.samples_per_half != default:
+        return False
+    if start(problem, path) is None or other_knee_start(problem, path) is None:
         return False
     robot, clearance, zmp_margin = _made_for(str(path))
     safety = problem.safety

@@ -218,9 +218,15 @@ def run_forked(function: Callable, arguments: list, jobs: int, first=()) -> list
     """``[function(a) for a in arguments]``, on ``jobs`` processes forked from this one when
     ``jobs`` > 1 and the platform forks: they inherit this process's memory (a built solver),
     so ``function`` may be any callable and only the results are pickled. The results are
-    those of the calls in this process, in order. The calls of the indices ``first`` (the
-    longest, so that none starts last) are handed out before the others. Interrupts as
-    ``run_tasks``' pool: the workers are terminated and the exception goes on up."""
+    those of the calls in this process, in order. On several processes the calls of the
+    indices ``first`` (the longest, so that none starts last) are handed out before the
+    others. Interrupts as ``run_tasks``' pool: the workers are terminated and the exception
+    goes on up."""
+    wrong = [i for i in first if not (isinstance(i, int) and 0 <= i < len(arguments))]
+    if wrong:
+        raise BipedError(
+            f"first = {wrong!r}: allowed indices of the arguments, 0 to {len(arguments) - 1}"
+        )
     jobs = max(1, min(jobs, len(arguments)))
     if jobs == 1 or "fork" not in multiprocessing.get_all_start_methods():
         return [function(a) for a in arguments]
