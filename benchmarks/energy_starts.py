@@ -11,18 +11,13 @@ The best value of a point is the least any start reached (solver's samples); a s
 within ``AGREEMENT``. Takes 2 min 14 s on a 2-core AMD EPYC.
 """
 
-import os
+import argparse
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"  # one BLAS thread, set before numpy loads its BLAS
+import numpy as np
 
-import argparse  # noqa: E402
-
-import numpy as np  # noqa: E402
-
-import biped  # noqa: E402
-from biped.optimization import table  # noqa: E402
-from biped.optimization.optimize import (  # noqa: E402
+import biped
+from biped.optimization import table
+from biped.optimization.optimize import (
     AGREEMENT,
     CONFIRM,
     MONOTONE,
@@ -35,10 +30,10 @@ from biped.optimization.optimize import (  # noqa: E402
     starts_at_value,
     table_starts,
 )
-from biped.optimization.problem import GaitProblem  # noqa: E402
-from biped.optimization.solver import CONVERGED, solver_for  # noqa: E402
-from biped.runtime.runner import free_cores, run_forked  # noqa: E402
-from biped.studies.sweep import DEFAULT_SPEEDS  # noqa: E402
+from biped.optimization.problem import GaitProblem
+from biped.optimization.solver import CONVERGED, solver_for
+from biped.runtime.runner import free_cores, run_forked
+from biped.studies.sweep import DEFAULT_SPEEDS
 
 ENDINGS = ("", MONOTONE, CONFIRM, NEAR)  # the adaptive barrier, then monotone from 1e-2 ...
 NEAR_STARTS = (table.TABLE_START, table.OTHER_KNEE_START, STHENIC_START)
