@@ -29,6 +29,7 @@ from biped.optimization.optimize import (
     confirm,
     optimize,
     starts_at_value,
+    table_starts,
 )
 from biped.optimization.problem import SCALES, GaitProblem, bounds, max_walking_speed
 from biped.optimization.solver import solver_for
@@ -339,6 +340,26 @@ def test_confirm_solves_no_start_the_optimum_holds_already(monkeypatch):
     with pytest.raises(Asked):
         confirm(problem, single, given=[problem.first_guess()])
     assert asked == [TABLE_START + CONFIRM, OTHER_KNEE_START + CONFIRM, "given" + CONFIRM]
+
+
+def test_a_given_start_that_is_a_table_start_is_left_out():
+    """A given start within ``SAME_START`` of the variables' scales of one of the table's
+    starts (a campaign's other-knee optimum, the table's other-knee start) is that start:
+    ``apart_from_table`` leaves it out, an optimization with its own starts solves it once,
+    and a start farther away is kept."""
+    from biped.optimization.optimize import SAME_START, apart_from_table
+    from biped.optimization.problem import scales
+
+    problem = GaitProblem(biped.Biped(ROBOT, "revolute"), 0.3, "sthenic")
+    other = dict(table_starts(problem, 1))[OTHER_KNEE_START]
+    near = other + 0.1 * SAME_START * scales()
+    far = other + 10 * SAME_START * scales()
+    kept = apart_from_table(problem, [near, far, problem.first_guess()])
+    assert len(kept) == 2 and np.array_equal(kept[0], far)
+    optimum = optimize(problem, starts=1, given=[near])
+    assert [s.kind for s in optimum.report.history].count("given") == 0
+    with_far = optimize(problem, starts=1, given=[far])
+    assert [s.kind for s in with_far.report.history].count("given") == 1
 
 
 def test_a_single_start_says_which_start_and_how_far_the_next_optimum_lies():

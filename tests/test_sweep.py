@@ -11,11 +11,13 @@ import numpy as np
 import pytest
 
 import biped
-from biped.optimization.optimize import CONFIRM, MONOTONE
+from biped.optimization.optimize import CONFIRM, MONOTONE, apart_from_table
+from biped.optimization.problem import GaitProblem
 from biped.optimization.table import OTHER_KNEE_START
 from biped.pages.figures import LABELS, make_figures
 from biped.records import gait_file
 from biped.records.gait_file import Costs
+from biped.studies import campaign
 from biped.studies import sweep as sweep_module
 from biped.studies.sweep import INDEPENDENT, MANIFEST, run_sweep, sweep_settings
 
@@ -54,11 +56,26 @@ def test_sweep_saves_every_point_certified(sweep):
         # other knee's), its one neighbouring speed's and the other knee's optima; the
         # energy criterion: the table's starts in place of its own (the table covers these
         # speeds), the neighbours' under two barriers, the other knee's under three, the
-        # sthenic optimum of its own problem under two, and the two given; an energy point
-        # reached by a single start is confirmed by more (``confirm``)
+        # sthenic optimum of its own problem under two, and the given ones; an energy point
+        # reached by a single start is confirmed by more (``confirm``); a neighbour's optimum
+        # that is one of the table's starts is that start, not solved again
         kinds = [start.kind for start in gait.optimizer.report().history]
         more = [k for k in kinds if k.endswith(CONFIRM)]
-        assert gait.optimizer.starts == (9 if gait.criterion == "energy" else 5) + len(more)
+        point = sweep_module.Point(gait.knee, gait.criterion, gait.speed)
+        neighbours = sweep_module._neighbours(point, SPEEDS, biped.KNEES)
+        given = [
+            campaign.variables(
+                gait_file.read(folder / INDEPENDENT / n.filename()).optimizer.variables
+            )
+            for n in neighbours
+        ]
+        problem = GaitProblem(
+            biped.Biped(biped.Robot.paper(), gait.knee), gait.speed, gait.criterion
+        )
+        new = len(apart_from_table(problem, given))
+        assert kinds.count("given") == new <= len(given)
+        own = 7 if gait.criterion == "energy" else 3
+        assert gait.optimizer.starts == own + new + len(more)
         assert not more or gait.criterion == "energy"
         assert (OTHER_KNEE_START + MONOTONE in kinds) == (gait.criterion == "energy")
     assert "16 optimizations for 8 points" in log

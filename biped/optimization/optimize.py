@@ -520,6 +520,8 @@ def optimize(
         return _nelder_mead_only(problem, seed, max_restarts, evaluations_per_run, began)
     solver = (solver_for if solvers is None else solvers)(problem)
     candidates = first_guesses(problem, starts, seed) + table_starts(problem, starts)
+    if starts > 0:  # the table's starts are among these: a given one of them is that start
+        given = apart_from_table(problem, given)
     candidates += [("given", np.asarray(z, dtype=float)) for z in given]
     if problem.knots != 1 and starts > 0:
         candidates += _paper_start(problem, seed, starts, solvers, jobs)
@@ -600,6 +602,27 @@ def table_starts(problem: GaitProblem, starts: int) -> list:
         for kind, start in found
         for pair in [(kind, start)] + [(kind + end, start) for end in twins.get(kind, ())]
     ]
+
+
+# Two starts are one when their variables differ by less than this, in units of their
+# scales (``biped.optimization.problem.scales``): from both IPOPT ends at the same point.
+SAME_START = 1e-5
+
+
+def apart_from_table(problem: GaitProblem, given) -> list[np.ndarray]:
+    """The starts of ``given`` (variables) that are none of the table's (``table_starts``),
+    to ``SAME_START``. A campaign's other-knee optimum is the table's other-knee start when
+    the table was made from such a campaign (in the default sweep at 49 of its 52 points,
+    ``benchmarks/given_starts.py``): it is one of the point's own starts already, and
+    solved again it would reach the same end and count as a second start."""
+    own = [z for _, z in table_starts(problem, 1)]
+    scale = scales(problem.knots)
+
+    def known(z):
+        return any(np.max(np.abs((z - t) / scale)) < SAME_START for t in own)
+
+    given = [np.asarray(z, dtype=float) for z in given]
+    return [z for z in given if not known(z)]
 
 
 def _embedded(problem: GaitProblem, variables):
@@ -760,6 +783,7 @@ def confirm(problem: GaitProblem, optimum: Optimum, given=(), jobs: int | None =
     candidates += [(kind + MONOTONE, z) for kind, z in near if kind == OTHER_KNEE_START]
     solved = {start.kind for start in report.history}  # the same start again adds nothing
     candidates = [(kind, z) for kind, z in candidates if kind not in solved]
+    given = apart_from_table(problem, given)
     candidates += [("given" + CONFIRM, np.asarray(z, dtype=float)) for z in given]
     if not candidates:
         return optimum

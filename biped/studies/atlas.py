@@ -44,6 +44,7 @@ from biped.optimization.optimize import (
     TIGHT,
     Optimum,
     Report,
+    apart_from_table,
     best_of,
     checked,
     confirm,
@@ -269,6 +270,7 @@ def _solve_final(task: Task) -> str:
     problem = settings.problem(point)
     given = [read(task.folder, p) for p in task.given]
     starts = [np.array(c["variables"]) for c in given if c and None not in c["variables"]]
+    starts = apart_from_table(problem, starts)  # the table's were among the point's own
     optimum = own
     if starts:
         again = optimize(problem, seed=settings.seed, starts=0, given=starts, jobs=1)

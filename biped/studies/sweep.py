@@ -47,6 +47,7 @@ from biped.optimization.comparison import SINGLE_START
 from biped.optimization.optimize import (
     DEFAULT_STARTS,
     Optimum,
+    apart_from_table,
     best_of,
     checked,
     confirm,
@@ -141,8 +142,9 @@ def _solve_with_neighbours(task: Task) -> str:
         campaign.variables(gait_file.read(stage / p.filename()).optimizer.variables)
         for p in task.given
     ]
-    given = [variables for variables in given if variables is not None]
     problem = _problem(settings, point)
+    # the table's starts were among the point's own (stage 1): a given one of them is that start
+    given = apart_from_table(problem, [v for v in given if v is not None])
     optimum = own
     if given:
         again = optimize(problem, seed=settings.seed, starts=0, given=given)
