@@ -79,14 +79,25 @@ def of_set(starts: list[Start], kinds: list[str]) -> list[Start]:
     ]
 
 
+def point_of(text: str) -> tuple[str, float]:
+    """(knee, speed [m/s]) of "KNEE:SPEED"; an argparse error naming the text otherwise."""
+    knee, _, speed = text.partition(":")
+    try:
+        if knee in biped.KNEES:
+            return knee, float(speed)
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(f"{text!r}: allowed KNEE:SPEED, KNEE one of {biped.KNEES}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=free_cores())
-    parser.add_argument("--points", nargs="*", default=None, help="KNEE:SPEED, default the sweep's")
+    parser.add_argument(
+        "--points", nargs="*", type=point_of, default=None, help="KNEE:SPEED, default the sweep's"
+    )
     args = parser.parse_args()
-    points = [(k, float(v)) for k in biped.KNEES for v in DEFAULT_SPEEDS]
-    if args.points:
-        points = [(p.split(":")[0], float(p.split(":")[1])) for p in args.points]
+    points = args.points or [(k, float(v)) for k in biped.KNEES for v in DEFAULT_SPEEDS]
     results = run_forked(solve_point, points, args.jobs)
     totals = {name: [0, 0, 0] for name in ("now", "before")}
     for (knee, speed), starts in zip(points, results, strict=True):

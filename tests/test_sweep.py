@@ -62,7 +62,7 @@ def test_sweep_saves_every_point_certified(sweep):
         kinds = [start.kind for start in gait.optimizer.report().history]
         more = [k for k in kinds if k.endswith(CONFIRM)]
         point = sweep_module.Point(gait.knee, gait.criterion, gait.speed)
-        neighbours = sweep_module._neighbours(point, SPEEDS, biped.KNEES)
+        neighbours = sweep_module.neighbours(point, SPEEDS, biped.KNEES)
         given = [
             campaign.variables(
                 gait_file.read(folder / INDEPENDENT / n.filename()).optimizer.variables

@@ -424,9 +424,9 @@ def coarse_problem(problem: GaitProblem) -> GaitProblem | None:
     """The problem on the coarse grid its starts are searched on, or None: it is solved on
     its own (another criterion than ``COARSE_CRITERIA``, a richer family than the paper's
     spline, or a grid that is not the default)."""
-    own = dataclasses.replace(problem, samples_per_half=None).samples_per_half
-    default = problem.samples_per_half == own
-    if problem.criterion not in COARSE_CRITERIA or problem.knots != 1 or not default:
+    if problem.criterion not in COARSE_CRITERIA or problem.knots != 1:
+        return None
+    if not problem.on_default_grid:  # a grid asked for is solved on as it is
         return None
     return dataclasses.replace(problem, samples_per_half=COARSE_SAMPLES_PER_HALF)
 

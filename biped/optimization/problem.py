@@ -189,6 +189,12 @@ class GaitProblem:
         return self.model.knee
 
     @property
+    def on_default_grid(self) -> bool:
+        """Whether the solvers impose the constraints at the family's default samples
+        (``SOLVER_SAMPLES``)."""
+        return self.samples_per_half == SOLVER_SAMPLES[self.knots]
+
+    @property
     def variables(self) -> tuple:
         """The names of the solvers' variables (``variable_names``)."""
         return variable_names(self.knots)

@@ -42,13 +42,27 @@ OTHER_KNEE_START = "optima table, other knee"
 SAME_SPEED = 1e-9
 
 
+@dataclasses.dataclass(frozen=True)
+class _Table:
+    """A table file as read: its series {(knee, criterion): (speeds (K,) [m/s], variables
+    (K, 21))} and what they were made for: the robot's body fields and the margins [m]."""
+
+    series: dict
+    robot: dict
+    clearance: float
+    zmp_margin: float
+
+
+_NO_TABLE = _Table({}, {}, float("nan"), float("nan"))
+
+
 @functools.cache
-def _read(path: str) -> dict:
-    """The table's series {(knee, criterion): (speeds (K,), variables (K, 21))}, or {} when
-    the file is missing; a BipedError naming the file when it is not a table."""
+def _read(path: str) -> _Table:
+    """The table at ``path`` (``_NO_TABLE`` when the file is missing); a BipedError naming
+    the file when it is not a table."""
     file = Path(path)
     if not file.exists():
-        return {}
+        return _NO_TABLE
     try:
         content = json.loads(file.read_text())
         if content.get("format") != FORMAT or content.get("variables") != list(VARIABLES):
@@ -59,22 +73,9 @@ def _read(path: str) -> dict:
             optima = np.array(entry["optima"], dtype=float).reshape(len(speeds), len(VARIABLES))
             order = np.argsort(speeds)
             series[(entry["knee"], entry["criterion"])] = (speeds[order], optima[order])
-    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
-        raise BipedError(f"{file}: not a table of optima ({error})") from None
-    return series
-
-
-@functools.cache
-def _made_for(path: str) -> tuple:
-    """(robot's body fields, clearance, ZMP margin) of the table at ``path``, or () without
-    one."""
-    file = Path(path)
-    if not file.exists():
-        return ()
-    try:
-        content = json.loads(file.read_text())
         robot = {k: v for k, v in content["robot"].items() if k != "actuators"}
-        return robot, content["safety"]["clearance"], content["safety"]["zmp_margin"]
+        safety = content["safety"]
+        return _Table(series, robot, safety["clearance"], safety["zmp_margin"])
     except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
         raise BipedError(f"{file}: not a table of optima ({error})") from None
 
@@ -86,16 +87,16 @@ def covers(problem: GaitProblem, path: Path = SHIPPED) -> bool:
     ``other_knee_start``) then lie near the problem's optima. (The table records the
     clearance and ZMP margin of its sweep, not a knee bend or actuator limits: it covers
     problems without those.)"""
-    series = _read(str(path)).get((problem.knee, problem.criterion))
-    default = dataclasses.replace(problem, samples_per_half=None).samples_per_half
-    if series is None or problem.knots != 1 or problem.samples_per_half != default:
+    made = _read(str(path))
+    series = made.series.get((problem.knee, problem.criterion))
+    if series is None or problem.knots != 1 or not problem.on_default_grid:
         return False
     if start(problem, path) is None or other_knee_start(problem, path) is None:
         return False
-    robot, clearance, zmp_margin = _made_for(str(path))
     safety = problem.safety
     own = {k: v for k, v in problem.model.robot.to_dict().items() if k != "actuators"}
-    same = own == robot and (safety.clearance, safety.zmp_margin) == (clearance, zmp_margin)
+    margins = (safety.clearance, safety.zmp_margin) == (made.clearance, made.zmp_margin)
+    same = own == made.robot and margins
     same = same and safety.knee_bend == 0.0 and not safety.actuator_limits
     speeds = series[0]
     return same and speeds[0] - SAME_SPEED <= problem.speed <= speeds[-1] + SAME_SPEED
@@ -111,7 +112,9 @@ def start(problem: GaitProblem, path: Path = SHIPPED) -> np.ndarray | None:
     """The table's start of ``problem`` (variables (21,)): its knee's and criterion's optima
     at the tabled speeds other than its own, interpolated at its speed (the nearest beyond
     them); None when the table has no such series (or only the speed itself)."""
-    return _interpolated(_read(str(path)).get((problem.knee, problem.criterion)), problem, True)
+    return _interpolated(
+        _read(str(path)).series.get((problem.knee, problem.criterion)), problem, True
+    )
 
 
 def other_knee_start(problem: GaitProblem, path: Path = SHIPPED) -> np.ndarray | None:
@@ -120,7 +123,7 @@ def other_knee_start(problem: GaitProblem, path: Path = SHIPPED) -> np.ndarray |
     when the table has no such series."""
     others = [
         entry
-        for (knee, criterion), entry in _read(str(path)).items()
+        for (knee, criterion), entry in _read(str(path)).series.items()
         if knee != problem.knee and criterion == problem.criterion
     ]
     return _interpolated(others[0] if others else None, problem, False)

@@ -245,7 +245,7 @@ def _stages(folder: Path, settings: Settings, points, final, knees, saved: set) 
     that criterion) with the sthenic finals; the energy finals. ``saved``: the points whose
     independent optimum is in the folder."""
     speeds = settings.speeds
-    needed = {n for p in final for n in [p, *_neighbours(p, speeds, knees)]}
+    needed = {n for p in final for n in [p, *neighbours(p, speeds, knees)]}
     twins = {p: Point(p.knee, "sthenic", p.speed) for p in points if p.criterion in WORK_CRITERIA}
     if not any(p.criterion == "sthenic" for p in points):
         twins = {}
@@ -261,8 +261,8 @@ def _stages(folder: Path, settings: Settings, points, final, knees, saved: set) 
         return Task(_solve_independent, settings, p, str(folder / INDEPENDENT), given)
 
     def final_task(p):
-        neighbours = tuple(_neighbours(p, speeds, knees))
-        return Task(_solve_with_neighbours, settings, p, str(folder), neighbours)
+        given = tuple(neighbours(p, speeds, knees))
+        return Task(_solve_with_neighbours, settings, p, str(folder), given)
 
     early = [p for p in final if p not in twins]  # their neighbours are all in ``first``
     late = [p for p in final if p in twins]
@@ -275,7 +275,7 @@ def _stages(folder: Path, settings: Settings, points, final, knees, saved: set) 
     ]
 
 
-def _neighbours(point: Point, speeds, knees) -> list[Point]:
+def neighbours(point: Point, speeds, knees) -> list[Point]:
     """The points whose independent optima start ``point``'s second solve: the neighbouring speeds
     of its series, and the same speed with the other knees (the variables mean the same for
     both knees)."""
