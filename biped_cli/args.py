@@ -228,6 +228,8 @@ def check_output(path: str, option: str = "--out") -> None:
     target = Path(path)
     if target.is_dir():
         raise BipedError(f"{option} {path!r} is a folder: allowed a file path")
+    if target.exists() and not target.is_file():  # /dev/null: a rename would replace it
+        raise BipedError(f"{option} {path!r} is a device, a FIFO or a socket: allowed a file path")
     check_folder(str(target.parent), option, of=path)
 
 

@@ -1,9 +1,11 @@
 """Files written whole or not at all, and the temporaries of killed runs cleaned up."""
 
+import os
 import stat
 
 import pytest
 
+from biped.errors import BipedError
 from biped.records import gait_file
 from biped.runtime import files
 
@@ -92,3 +94,16 @@ def test_gait_file_with_nan_writes_nothing(tmp_path):
         gait_file.write_json(tmp_path / "sub" / "g.json", {"speed": float("nan")})
     assert _listing(tmp_path / "sub") == []
     assert gait_file.write_json(tmp_path / "sub" / "g.json", {"speed": 0.3}).exists()
+
+
+def test_a_fifo_is_refused_and_left_as_it_is(tmp_path):
+    """A destination that is no regular file (a FIFO here, /dev/null on a system) is refused by
+    name: a rename would replace it by a regular file. A regular file beside it is written."""
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    with pytest.raises(BipedError, match="'.*pipe'.*a device, a FIFO or a socket"):
+        files.atomic_write_text(fifo, "x")
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+    assert _listing(tmp_path) == ["pipe"]
+    files.atomic_write_text(tmp_path / "plain", "x")
+    assert (tmp_path / "plain").read_text() == "x"

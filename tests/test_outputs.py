@@ -4,6 +4,7 @@ work; validation reports carry a unit for every figure."""
 
 import json
 import os
+import stat
 from pathlib import Path
 
 import pytest
@@ -357,3 +358,18 @@ def test_a_frame_outside_the_walk_is_refused_naming_its_span():
     for at in (99.0, -1.0, 12.2):
         with pytest.raises(BipedError, match=rf"--at {at!r} s: allowed 0 to 12.10 s"):
             frame_index(walk, at)
+
+
+@pytest.mark.parametrize(
+    "command", [["optimize", "--knee", "rolling", "--speed", "0.3"], ["design", "--speed", "0.3"], ["table"]]
+)
+def test_a_file_output_that_is_a_fifo_is_refused_before_any_work(
+    command, tmp_path, monkeypatch, capsys
+):
+    """--out naming a FIFO (as /dev/null is a device) is one line naming --out and the path;
+    the FIFO stays one (an atomic rename would have replaced it by a regular file)."""
+    monkeypatch.chdir(tmp_path)
+    os.mkfifo("pipe")
+    line = _refusal(capsys, main([*command, "--out", "pipe"]))
+    assert "--out 'pipe'" in line and "a device, a FIFO or a socket" in line, line
+    assert stat.S_ISFIFO(Path("pipe").stat().st_mode)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -66,6 +67,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
             figure.savefig(tmp, format="png")
     """
     path = Path(path)
+    refuse_special(path)
     try:
         fd, name = tempfile.mkstemp(
             dir=path.parent, prefix=f".{path.name}.", suffix=TEMPORARY_SUFFIX
@@ -84,6 +86,20 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         tmp.unlink(missing_ok=True)
         raise
     _fsync_folder(path.parent)
+
+
+def refuse_special(path: Path) -> None:
+    """Refuse a destination that is a device, a FIFO or a socket (``/dev/null``): a rename would
+    replace it by a regular file, and the system's ``/dev/null`` with it."""
+    try:
+        mode = path.stat().st_mode
+    except OSError:  # none yet (or unreadable: the rename says why)
+        return
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        raise BipedError(
+            f"cannot write {str(path)!r}: it is a device, a FIFO or a socket; allowed a regular "
+            "file or a new path"
+        )
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
