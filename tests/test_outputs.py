@@ -361,7 +361,8 @@ def test_a_frame_outside_the_walk_is_refused_naming_its_span():
 
 
 @pytest.mark.parametrize(
-    "command", [["optimize", "--knee", "rolling", "--speed", "0.3"], ["design", "--speed", "0.3"], ["table"]]
+    "command",
+    [["optimize", "--knee", "rolling", "--speed", "0.3"], ["design", "--speed", "0.3"], ["table"]],
 )
 def test_a_file_output_that_is_a_fifo_is_refused_before_any_work(
     command, tmp_path, monkeypatch, capsys
