@@ -18,6 +18,16 @@ class UnreachableError(BipedError, ValueError):
     """The inverse geometric model has no solution (the hip is out of the leg's reach)."""
 
 
-class CompileWarning(UserWarning):
+class BipedWarning(UserWarning):
+    """Something the user should know that did not stop the work (the CLI says it as one
+    line, ``biped_cli.guard.warnings_as_lines``)."""
+
+
+class ViewerWarning(BipedWarning):
+    """No rerun viewer took a recording streamed to it (--spawn, --connect); the recording's
+    file is written all the same (``validate.record.record``)."""
+
+
+class CompileWarning(BipedWarning):
     """The solver's derivatives run in CasADi's interpreter instead of compiled code (the
     same numbers, slower; ``biped.optimization.compiled``)."""

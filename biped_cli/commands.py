@@ -479,7 +479,9 @@ def add_validate(commands) -> None:
     viewer.add_argument(
         "--spawn",
         action="store_true",
-        help="also stream the recording to a rerun viewer started for it",
+        help="also stream the recording to a rerun viewer started for it (the one on PATH, else "
+        "the one installed beside this Python); a viewer that does not take it is a warning, "
+        "the file and the checks stand",
     )
     viewer.add_argument(
         "--connect",
@@ -489,7 +491,8 @@ def add_validate(commands) -> None:
         default=None,
         type=types.viewer_url,
         help="also stream the recording to the rerun viewer running at URL (URL left out: its "
-        "local address; default: no stream)",
+        "local address, rerun+http://127.0.0.1:9876/proxy; default: no stream); a viewer that "
+        "does not take it is a warning, the file and the checks stand",
     )
     types.add_model(val)
 

@@ -10,8 +10,9 @@
 
 Floating-point warnings of numpy (overflow in ``expm1`` while the optimiser explores) are
 expected and handled where they matter; they never reach the terminal unless ``--debug``.
-The package's own warning (``biped.errors.CompileWarning``: derivatives interpreted, not
-compiled) is one line on stderr, as the failures are.
+The package's own warnings (``biped.errors.BipedWarning``: derivatives interpreted, not
+compiled; no viewer took a streamed recording) are one line on stderr each, as the failures
+are; they leave the exit status to the results.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from biped.errors import BipedError, CompileWarning
+from biped.errors import BipedError, BipedWarning
 from biped.runtime.interrupts import command_interrupts, exit_status, received_interrupt
 
 EXIT_OK = 0
@@ -46,11 +47,12 @@ def quiet_numerics(debug: bool = False) -> Iterator[None]:
 
 @contextlib.contextmanager
 def warnings_as_lines(say: Callable[[str], None]) -> Iterator[None]:
-    """Within the block, the package's ``CompileWarning`` is said as one line."""
+    """Within the block, the package's warnings (``BipedWarning``: no compiler, no viewer) are
+    said as one line each."""
     shown = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, CompileWarning):
+        if issubclass(category, BipedWarning):
             say(f"warning: {one_line(message)}")
         else:
             shown(message, category, filename, lineno, file, line)

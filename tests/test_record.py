@@ -273,3 +273,44 @@ def test_recording_draws_the_orbit_checks_multipliers(recorded):
         assert np.allclose(np.array(points[0]), expected, atol=1e-6)
     else:
         assert np.allclose(np.array(points[0]), [[0.0, 0.0]])
+
+
+def test_a_viewer_that_does_not_take_the_stream_is_a_warning_the_file_written(
+    recorded, monkeypatch, tmp_path
+):
+    """--connect to an address where no viewer listens: one ViewerWarning naming the address
+    and the file, which is written whole; the validation's results are not lost to an error."""
+    import re
+    import socket
+
+    import validate.record
+    from biped.errors import ViewerWarning
+
+    result, _, _ = recorded
+    with socket.socket() as probe:  # a port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    url = f"rerun+http://127.0.0.1:{port}/proxy"
+    monkeypatch.setattr(validate.record, "VIEWER_TIMEOUT", 0.5)
+    named = f"--connect {re.escape(repr(url))}.*no rerun viewer"
+    with pytest.warns(ViewerWarning, match=named) as caught:
+        path = validate.record.record(tmp_path / "live.rrd", result, connect=url)
+    assert str(tmp_path / "live.rrd") in str(caught[0].message)
+    assert len(rerun.chunk.RrdReader(path).stream().to_chunks()) > 0
+
+
+def test_the_viewer_is_found_beside_this_python_when_not_on_path(monkeypatch, tmp_path):
+    """Without the virtual environment's folder on PATH (not activated), --spawn starts the
+    viewer installed beside the running Python; with neither, rerun's own search."""
+    import sys
+    from pathlib import Path
+
+    from validate.record import viewer_executable
+
+    monkeypatch.setenv("PATH", str(tmp_path))
+    beside = Path(sys.executable).parent / "rerun"
+    assert viewer_executable() == (str(beside) if beside.is_file() else None)
+    fake = tmp_path / "rerun"
+    fake.write_text("#!/bin/sh\n")
+    fake.chmod(0o755)
+    assert viewer_executable() == str(fake)

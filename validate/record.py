@@ -40,6 +40,9 @@ than their plots and is a key in words beside them (``torque_key``).
 
 from __future__ import annotations
 
+import shutil
+import sys
+import warnings
 from pathlib import Path
 
 import mujoco
@@ -47,7 +50,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from biped.errors import BipedError
+from biped.errors import ViewerWarning
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.robot import SOLE_EDGES
 from biped.records.gait_file import Gait
@@ -61,6 +64,9 @@ from validate.simulate import Simulation, reference_along
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
 APPLICATION = "biped_validation"
+# rerun's viewer, and the address ``connect_grpc`` streams to when given none.
+VIEWER = "rerun"
+DEFAULT_VIEWER = "rerun+http://127.0.0.1:9876/proxy"
 # Longest wait [s] for a viewer (--spawn, --connect) to take the recording.
 VIEWER_TIMEOUT = 10.0
 # Series colours, the same in every plot (RGB), and line widths [UI points]: the gait's
@@ -384,26 +390,44 @@ def record(path: str | Path, validation, spawn: bool = False, connect: str | Non
         rec.disconnect()
         del rec
     if spawn or connect is not None:
-        # A stream of its own: a viewer that does not answer delays the command by at most
-        # VIEWER_TIMEOUT and never the file.
-        live = rr.RecordingStream(APPLICATION, recording_id=recording_id)
-        try:
-            if spawn:
-                live.spawn(default_blueprint=layout)
-            else:
-                live.connect_grpc(connect or None, default_blueprint=layout)
-            log_all(live)
-            live.flush(timeout_sec=VIEWER_TIMEOUT)
-        except RuntimeError as error:  # rerun's way to say no viewer took it
-            where = "the viewer it started" if spawn else f"--connect {connect or 'default'!r}"
-            raise BipedError(
-                f"{where}: no rerun viewer took the recording ({error}); it is written to "
-                f"{str(path)!r}: allowed a running viewer (start one with 'rerun')"
-            ) from None
-        finally:
-            live.disconnect()
-            del live
+        _stream(log_all, layout, recording_id, path, spawn, connect)
     return path
+
+
+def _stream(log_all, layout, recording_id: str, path: Path, spawn: bool, connect) -> None:
+    """The recording streamed on a stream of its own to a viewer started for it (``spawn``) or
+    at ``connect``: a viewer that does not answer delays the command by at most
+    ``VIEWER_TIMEOUT`` and never the file; it is a ``ViewerWarning``, the checks' results
+    stand."""
+    live = rr.RecordingStream(APPLICATION, recording_id=recording_id)
+    try:
+        if spawn:
+            rr.spawn(executable_path=viewer_executable(), recording=live, default_blueprint=layout)
+        else:
+            live.connect_grpc(connect or None, default_blueprint=layout)
+        log_all(live)
+        live.flush(timeout_sec=VIEWER_TIMEOUT)
+    except RuntimeError as error:  # rerun's way to say no viewer took it
+        where = "the viewer it started" if spawn else f"--connect {connect or DEFAULT_VIEWER!r}"
+        message = (
+            f"{where}: no rerun viewer took the recording ({error}); it is written to "
+            f"{str(path)!r}: open it with '{viewer_executable() or VIEWER} {path}'"
+        )
+        warnings.warn(ViewerWarning(message), stacklevel=3)
+    finally:
+        live.disconnect()
+        del live
+
+
+def viewer_executable() -> str | None:
+    """rerun's viewer: the one on PATH, else the one installed beside this Python (a virtual
+    environment's, whose folder is on PATH only when it is activated); None: rerun's own
+    search (which then says how to install it)."""
+    found = shutil.which(VIEWER)
+    if found is not None:
+        return found
+    beside = Path(sys.executable).parent / VIEWER
+    return str(beside) if beside.is_file() else None
 
 
 def _circle(radius: float, points: int = 181) -> np.ndarray:
