@@ -204,11 +204,19 @@ def cmd_sweep(args) -> int:
 
     Each optimization is saved as it completes; run the same command again to resume.
     Progress on stderr, with the time elapsed and an estimate of the time left: a bar on a
-    terminal, else a line at most every 10 s.
+    terminal, else a line at most every 10 s. Exits 0 when every point is certified, 1
+    otherwise (the summary names those that are not).
     """
     from biped.runtime.runner import check_dask
     from biped.studies import paper_method
-    from biped.studies.sweep import INDEPENDENT, MANIFEST, check_sweep, run_sweep, sweep_settings
+    from biped.studies.sweep import (
+        INDEPENDENT,
+        MANIFEST,
+        check_sweep,
+        run_sweep,
+        sweep_settings,
+        uncertified,
+    )
 
     robot = robot_of(args)
     check_folder(args.out, "--out")
@@ -238,7 +246,7 @@ def cmd_sweep(args) -> int:
         f"<knee>-<criterion>-<speed>.json, {INDEPENDENT}/ (each point's first solve)"
         f"{folder if runs else ''}"
     )
-    return 0
+    return 1 if uncertified(args.out, points, sweep) else 0
 
 
 def add_sweep(commands) -> None:

@@ -342,6 +342,17 @@ def test_sweep_names_the_files_of_its_folder(tmp_path, capsys):
     )
 
 
+def test_a_sweep_with_a_point_not_certified_exits_1(tmp_path, capsys):
+    """A knee bent 0.9 rad under a 20 cm clearance cannot be walked at 0.2 m/s: the point is
+    infeasible, the summary names it and the sweep exits 1 (``biped sweep && biped figures``
+    stops there); the same sweep without them is certified, exit 0."""
+    argv = ["sweep", "--speeds", "0.2", "--knees", "revolute", "--criteria", "sthenic"]
+    argv += ["--starts", "1", "--paper-seeds", "0", "--jobs", "1", "--clearance", "0.2"]
+    assert main([*argv, "--knee-bend", "0.9", "--out", str(tmp_path / "bent")]) == 1
+    assert "NOT: revolute-sthenic-0.200.json INFEASIBLE" in capsys.readouterr().err
+    assert main([*argv, "--out", str(tmp_path / "straight")]) == 0
+
+
 def test_a_frame_outside_the_walk_is_refused_naming_its_span():
     """--at beyond the walk's span, or before its start, is refused naming the value and the
     span; a time inside it picks the recorded state at that time."""

@@ -229,7 +229,8 @@ def _plan(folder: Path, points, final, stages, saved: set) -> str:
     to_run = sum(len(tasks) for tasks in stages)
     unneeded = 2 * len(points) - sum(done.values()) - to_run  # stage 1 of finished points
     text = (
-        f"sweep: {2 * len(points)} optimizations for {len(points)} points in {folder}, in 2 "
+        f"sweep: {2 * len(points)} optimizations for {len(points)} "
+        f"point{'' if len(points) == 1 else 's'} in {folder}, in 2 "
         f"stages (own starts, final): {sum(done.values())} already done "
         f"({done['independent']} of stage 1, {done['final']} of stage 2), {to_run} to run"
     )
@@ -319,8 +320,9 @@ def optima_table(folder) -> dict:
     return table.content(series, settings.robot, settings.safety, source)
 
 
-def summarize(folder: Path, points, settings: Settings) -> str:
-    """How many points are certified, and which are not."""
+def _why_not(folder: Path, points, settings: Settings):
+    """The points' final gait files (None: missing) and why a point is not certified (None:
+    it is)."""
     gaits = {p: _read_gait(Path(folder) / p.filename(), p, settings) for p in points}
 
     def why_not(p):
@@ -328,6 +330,19 @@ def summarize(folder: Path, points, settings: Settings) -> str:
         if gait is None:
             return "missing"
         return campaign.failure(gait.optimizer.status, gait.feasible)
+
+    return gaits, why_not
+
+
+def uncertified(folder: Path, points, settings: Settings) -> list[Point]:
+    """The points whose final optimum is missing, did not converge or is infeasible."""
+    _, why_not = _why_not(folder, points, settings)
+    return [p for p in points if why_not(p) is not None]
+
+
+def summarize(folder: Path, points, settings: Settings) -> str:
+    """How many points are certified, and which are not."""
+    gaits, why_not = _why_not(folder, points, settings)
 
     single = [
         f"{p.filename()} ({single_start_note(gaits[p].optimizer.report())})"
