@@ -252,9 +252,33 @@ def check_folder(path: str, option: str, of: str | None = None) -> None:
         ) from None
 
 
+class _Default(int):
+    """An option's default, told apart from the same number given (``given``)."""
+
+
+def given(args, name: str) -> bool:
+    """Whether the option ``name`` (its ``args`` attribute) was given on the command line."""
+    return not isinstance(getattr(args, name), _Default)
+
+
 def budget(args) -> dict:
     """The keyword arguments of ``biped.optimization.optimize.optimize`` given on the command
-    line."""
+    line; an option given that the method would not use is refused (BipedError)."""
+    nelder_mead = args.method == "nelder-mead" or args.nelder_mead_starts > 0
+    unused = [("--starts", "starts"), ("--nelder-mead-starts", "nelder_mead_starts")]
+    if args.method == "nelder-mead":
+        for option, name in unused:
+            if given(args, name):
+                raise BipedError(
+                    f"{option} {getattr(args, name)}: IPOPT's, allowed with --method ipopt "
+                    "(--method nelder-mead runs the paper's method alone, one start)"
+                )
+    for option, name in [("--restarts", "restarts"), ("--evaluations", "evaluations")]:
+        if given(args, name) and not nelder_mead:
+            raise BipedError(
+                f"{option} {getattr(args, name)}: Nelder-Mead's, allowed with --method "
+                "nelder-mead or --nelder-mead-starts K"
+            )
     return {
         "seed": args.seed,
         "method": args.method,
@@ -293,19 +317,28 @@ def add_budget(parser, sweep: bool = False):
     )
     add_options(
         parser,
-        ("--starts", positive, DEFAULT_STARTS, "N", "IPOPT's own starts: first guesses of "
-         f"several step periods, then perturbations (default {DEFAULT_STARTS}); the table of "
-         "optima's starts come with them, and for the energy criterion take the place of the "
-         f"first {DEFAULT_STARTS} where the table covers the problem; {CERTIFIED_HELP}"),
-        ("--nelder-mead-starts", non_negative, 0, "K",
-         "IPOPT also starts from the paper's Nelder-Mead with K seeds (default 0)"),
+        ("--starts", starts, _Default(DEFAULT_STARTS), "N", "IPOPT's own starts, 1 to "
+         f"{MAX_STARTS}: first guesses of several step periods, then perturbations (default "
+         f"{DEFAULT_STARTS}); the table of optima's starts come with them, and for the energy "
+         f"criterion take the place of the first {DEFAULT_STARTS} where the table covers the "
+         f"problem; {CERTIFIED_HELP}"),
         ("--seed", non_negative, 0, "N",
-         "seed of the perturbed starts and of Nelder-Mead (default 0)"),
-        ("--restarts", non_negative, MAX_RESTARTS, "N",
-         f"Nelder-Mead restarts from the best point at most (default {MAX_RESTARTS})"),
-        ("--evaluations", positive, EVALUATIONS_PER_RUN, "N",
-         f"criterion evaluations per Nelder-Mead run (default {EVALUATIONS_PER_RUN})"),
+         "seed of the perturbed starts" + ("" if sweep else " and of Nelder-Mead")
+         + " (default 0)"),
     )  # fmt: skip
+    if not sweep:  # a sweep's points are IPOPT's alone (the paper's method: --paper-seeds)
+        add_options(
+            parser,
+            ("--nelder-mead-starts", nelder_mead_starts, _Default(0), "K",
+             f"IPOPT also starts from the paper's Nelder-Mead with K seeds, 0 to {MAX_SEEDS} "
+             "(default 0)"),
+            ("--restarts", restarts, _Default(MAX_RESTARTS), "N",
+             f"Nelder-Mead restarts from the best point at most, 0 to {MAX_SEEDS} (default "
+             f"{MAX_RESTARTS}); with --method nelder-mead or --nelder-mead-starts"),
+            ("--evaluations", evaluations, _Default(EVALUATIONS_PER_RUN), "N",
+             f"criterion evaluations per Nelder-Mead run, 1 to {MAX_EVALUATIONS} (default "
+             f"{EVALUATIONS_PER_RUN}); with --method nelder-mead or --nelder-mead-starts"),
+        )  # fmt: skip
     add_safety(parser)
 
 
@@ -435,6 +468,14 @@ def bounded(low: int, high: int | None = None):
 
 non_negative = bounded(0)
 positive = bounded(1)
+# Counts of the optimizers' budget: each start, seed or restart costs up to seconds.
+MAX_STARTS = 100
+MAX_SEEDS = 100
+MAX_EVALUATIONS = 1_000_000
+starts = bounded(1, MAX_STARTS)
+nelder_mead_starts = bounded(0, MAX_SEEDS)
+restarts = bounded(0, MAX_SEEDS)
+evaluations = bounded(1, MAX_EVALUATIONS)
 steps = bounded(1, MAX_STEPS)
 jobs = bounded(1, MAX_JOBS)
 

@@ -151,8 +151,9 @@ def add_parser(commands) -> None:
         ("--knee-bends", knee_bends, np.array([0.0]), "B",
          f"[rad] least stance-knee bends, a list or START:STOP:COUNT, 0 to {MAX_KNEE_BEND:g} "
          "rad (default 0: the paper's knee, not inverted)"),
-        ("--starts", types.positive, DEFAULT_STARTS, "N",
-         f"IPOPT's own starts per point (default {DEFAULT_STARTS}); {types.CERTIFIED_HELP}"),
+        ("--starts", types.starts, DEFAULT_STARTS, "N",
+         f"IPOPT's own starts per point, 1 to {types.MAX_STARTS} (default {DEFAULT_STARTS}); "
+         f"{types.CERTIFIED_HELP}"),
         ("--seed", types.non_negative, 0, "N", "seed of the perturbed starts (default 0)"),
     )  # fmt: skip
     types.add_criterion(parser, several=True, default=DEFAULT_CRITERIA)

@@ -145,9 +145,10 @@ def cmd_optimize(args) -> int:
     model = Biped(robot, args.knee)
     problem = GaitProblem(model, args.speed, args.criterion, safety(args), knots=args.knots)
     check_output(args.out)
+    given = budget(args)  # an option the method would not use: refused before any work
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
     setup = prepare(problem) if args.method == "ipopt" else 0.0
-    optimum = confirm(problem, optimize(problem, **budget(args)))
+    optimum = confirm(problem, optimize(problem, **given))
     ev = optimum.evaluation
     print(optimum_line(args.knee, args.criterion, args.speed, optimum))
     report = optimum.report

@@ -36,9 +36,9 @@ def _add_common(parser) -> None:
     types.add_criterion(parser)
     types.add_options(
         parser,
-        ("--starts", types.positive, DEFAULT_STARTS, "N", "IPOPT starts of each optimization: "
-         "the first guess (at the robot's radii) and N-1 random ones (default "
-         f"{DEFAULT_STARTS}); {types.CERTIFIED_HELP}"),
+        ("--starts", types.starts, DEFAULT_STARTS, "N", "IPOPT starts of each optimization, 1 "
+         f"to {types.MAX_STARTS}: the first guess (at the robot's radii) and N-1 random ones "
+         f"(default {DEFAULT_STARTS}); {types.CERTIFIED_HELP}"),
         ("--seed", types.non_negative, 0, "N", "seed of the random starts (default 0)"),
     )  # fmt: skip
     types.add_safety(parser)

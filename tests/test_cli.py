@@ -212,6 +212,9 @@ def test_pipeline_refuses_a_rolling_knee_mujoco_cannot_model(capsys, robot_files
     assert "r1 = 0.0" in line and "allowed r1, r2 > 0" in line and not out.exists()
 
 
+OPTIMIZE = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "x.json"]
+
+
 @pytest.mark.parametrize(
     "argv, needles",
     [
@@ -240,6 +243,17 @@ def test_pipeline_refuses_a_rolling_knee_mujoco_cannot_model(capsys, robot_files
             ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "/proc/x.json"],
             ["--out '/proc/x.json'", "not writable", "allowed"],
         ),
+        # an option the method would not use, or a budget without bound
+        (
+            [*OPTIMIZE, "--method", "nelder-mead", "--starts", "5"],
+            ["--starts 5", "allowed with --method ipopt"],
+        ),
+        ([*OPTIMIZE, "--restarts", "3"], ["--restarts 3", "--nelder-mead-starts K"]),
+        ([*OPTIMIZE, "--evaluations", "10"], ["--evaluations 10", "--method nelder-mead"]),
+        (["pipeline", "--restarts", "3"], ["--restarts 3", "--nelder-mead-starts K"]),
+        ([*OPTIMIZE, "--starts", "100000"], ["--starts", "'100000'", "1 to 100"]),
+        (["sweep", "--nelder-mead-starts", "2"], ["unrecognized", "--nelder-mead-starts"]),
+        (["atlas", "--starts", "101"], ["--starts", "'101'", "1 to 100"]),
     ],
 )
 def test_refused_values_are_named_with_what_is_allowed(capsys, argv, needles):
