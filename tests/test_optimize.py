@@ -382,6 +382,28 @@ def test_a_single_start_says_which_start_and_how_far_the_next_optimum_lies():
     assert note == f"by the {TABLE_START} alone; the next optimum +0.1 %, by 2 starts"
 
 
+def test_a_single_start_under_several_barriers_is_named_once():
+    """One start that reached the best under two barriers is named once with both; a given
+    start says what it is."""
+    from biped.optimization.optimize import CONFIRM, NEAR, single_start_note
+
+    def start(kind, v):
+        return Start(kind, v, "Solve_Succeeded", 50)
+
+    history = (start(TABLE_START, 1.0), start(TABLE_START + NEAR, 1.0), start("given", 1.2))
+    report = Report("ipopt", "converged", 3, 2, 50, 1e-9, 1e-9, 1.0, 0, 1.0, history)
+    assert single_start_note(report).startswith(
+        f"by the {TABLE_START} under the adaptive barrier and the monotone barrier from 1e-4 "
+        "alone; the next optimum +20 %"
+    )
+    history = (start("given" + CONFIRM, 1.0), start(TABLE_START, 1.1))
+    report = Report("ipopt", "converged", 2, 1, 50, 1e-9, 1e-9, 1.0, 0, 1.0, history)
+    assert single_start_note(report).startswith(
+        "by a start given (in a sweep, a neighbour's optimum) under the monotone barrier from "
+        "1e-3 alone"
+    )
+
+
 def test_report_read_back_from_its_json_is_the_report():
     """A report written as JSON and read back is the same report: a value that is not
     finite written as null and read as NaN, a file without the best value read as NaN."""

@@ -811,13 +811,32 @@ def single_start_note(report: Report) -> str:
     best = report.value
     converged = [s for s in report.history if s.status in CONVERGED and np.isfinite(s.value)]
     at = [s.kind for s in converged if abs(s.value - best) <= AGREEMENT * abs(best)]
-    text = f"by the {' and the '.join(dict.fromkeys(at)) or 'best start'} alone"
+    text = f"by {_named_starts(at) or 'the best start'} alone"
     others = sorted(s.value for s in converged if s.value > best * (1 + AGREEMENT))
     if others:
         count = starts_at_value(converged, others[0])
         starts = "start" if count == 1 else "starts"
         text += f"; the next optimum {100 * (others[0] / best - 1):+.3g} %, by {count} {starts}"
     return text
+
+
+GIVEN_NAME = "a start given (in a sweep, a neighbour's optimum)"
+
+
+def _named_starts(kinds) -> str:
+    """Starts named once each, with the barriers they reached the value under: "the sthenic
+    optimum under the adaptive barrier and the monotone barrier from 1e-4"."""
+    barriers: dict[str, list[str]] = {}
+    for kind in dict.fromkeys(kinds):
+        barriers.setdefault(start_of(kind), []).append(_ending(kind).removeprefix(", "))
+    names = []
+    for start, endings in barriers.items():
+        name = GIVEN_NAME if start == "given" else f"the {start}"
+        if endings != [""]:
+            under = ", under " if "," in start else " under "  # "the optima table, other knee"
+            name += under + " and ".join(f"the {e or 'adaptive barrier'}" for e in endings)
+        names.append(name)
+    return " and ".join(names)
 
 
 def best_of(problem: GaitProblem, optima, best: Optimum | None = None) -> Optimum:
