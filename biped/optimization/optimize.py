@@ -820,7 +820,7 @@ def single_start_note(report: Report) -> str:
     return text
 
 
-GIVEN_NAME = "a start given (in a sweep, a neighbour's optimum)"
+GIVEN_NAME = "a start given (a neighbouring optimum: another speed's or the other knee's)"
 
 
 def _named_starts(kinds) -> str:
