@@ -370,6 +370,20 @@ def _synthetic_series(outlier=None):
     return series
 
 
+def test_a_far_out_value_within_the_panel_s_reach_is_drawn_on_the_axis():
+    """Fig. 8's differences of the default sweep: +1.0 % at 0.15 m/s is far out of the
+    others' quartiles (-1.7 to 0 %) but spanning it leaves them most of the axis: it is drawn
+    on the curve, not at the edge; a value ten times the bulk's span away is at the edge."""
+    from biped.pages.figures import bulk_limits, off_bulk
+
+    percent = [1.0, 0.0, -0.6, -0.8, -0.4, -0.5, -0.5, -0.6, -0.8, -0.8, -0.9, -1.1, -1.7, 0.0]
+    assert off_bulk(percent)[0]  # Tukey's far out
+    low, high = bulk_limits(percent)
+    assert low < -1.7 and high > 1.0
+    low, high = bulk_limits([-17.0, *percent[1:]])
+    assert low > -17.0 and low < -1.7 and high > 0.0
+
+
 def test_a_point_off_the_bulk_is_marked_and_does_not_set_the_axis():
     """An energy 30 times the others' (one gait) is drawn at the panel's edge with its value
     written, and the axis spans the other gaits, so the knees' curves stay apart; without

@@ -71,9 +71,12 @@ STYLE = {
 FLAGGED_COLOR = "0.35"
 FLAGGED_MARK = dict(linestyle="none", marker="x", markersize=9, markeredgewidth=2)
 # A value is off the bulk of its panel beyond FENCE interquartile ranges below the first
-# quartile or above the third (Tukey's "far out"), judged only with MIN_BULK values or more.
+# quartile or above the third (Tukey's "far out"), judged only with MIN_BULK values or more;
+# it is drawn at the panel's edge only when the axis spanning it would be more than SQUASH
+# times the bulk's span (the bulk squashed), else the axis spans it too.
 FENCE = 3.0
 MIN_BULK = 5
+SQUASH = 3.0
 # Room around the bulk, a fraction of its span on each side.
 PAD = 0.08
 DPI = 120
@@ -147,12 +150,16 @@ def off_bulk(values) -> np.ndarray:
 
 
 def bulk_limits(values) -> tuple[float, float]:
-    """Axis limits (low, high) spanning the values on the bulk (``off_bulk``), with ``PAD``."""
+    """Axis limits (low, high) with ``PAD``: spanning every value, or only those on the bulk
+    (``off_bulk``) where spanning every value would squash it (``SQUASH``)."""
     values = np.asarray(values, dtype=float)
-    bulk = values[np.isfinite(values) & ~off_bulk(values)]
+    finite = values[np.isfinite(values)]
+    bulk = finite[~off_bulk(finite)]
     if bulk.size == 0:
         return 0.0, 1.0
     low, high = float(bulk.min()), float(bulk.max())
+    if np.ptp(finite) <= SQUASH * max(high - low, 1e-12):
+        low, high = float(finite.min()), float(finite.max())
     pad = PAD * max(high - low, 0.05 * max(abs(low), abs(high)), 1e-12)
     return low - pad, high + pad
 
