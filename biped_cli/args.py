@@ -19,10 +19,12 @@ from biped.model.criteria import (
     MAX_ZMP_MARGIN,
     Safety,
 )
+from biped.model.dynamics import Biped
 from biped.model.gait import KNOTS
 from biped.model.kinematics import KNEES
+from biped.model.robot import Robot
 from biped.optimization.comparison import CERTIFIED
-from biped.optimization.problem import MIN_SPEED
+from biped.optimization.problem import MIN_SPEED, max_walking_speed
 from validate import DEFAULT_STEPS
 
 # What an option naming an output says of its missing folders (the path written is printed).
@@ -45,7 +47,10 @@ MAX_STEPS = 1000
 STEPS_HELP = f"steps to walk, 1 to {MAX_STEPS} (default {DEFAULT_STEPS})"
 # Most worker processes of a sweep.
 MAX_JOBS = 256
-SPEED_HELP = f"[m/s] walking speed, {MIN_SPEED} m/s or faster"
+SPEED_HELP = (
+    f"[m/s] walking speed, {MIN_SPEED} m/s or faster, up to √(g·leg length) "
+    f"({max_walking_speed(Biped(Robot.paper(), 'revolute')):.3g} m/s for Table 1's legs)"
+)
 JOBS_HELP = f"worker processes, 1 to {MAX_JOBS} (default: all cores)"
 # The terms of the help pages, defined once (a definition printed whole on every page that
 # uses the term; no hyphens, where argparse may break a line).

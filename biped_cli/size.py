@@ -63,8 +63,8 @@ def _line(choice) -> str:
 def cmd_size(args) -> int:
     """Size the actuators of each gait: per kind of joint (ankle, knee, hip; a leg's joint
     drives it standing and swinging) the peak torque, the RMS torque over two steps, the
-    peak speed and the peak power, and the lightest combination of the catalog (--catalog,
-    default the package's: motors behind gears, each cited) whose peak torque, continuous
+    peak speed and the peak power, and the lightest actuator of the catalog (--catalog,
+    default the package's: integrated actuators, each cited) whose peak torque, continuous
     torque, top speed and supply voltage exceed them by the margin (--margin); the total
     actuator mass of each gait, side by side. Exits 1 when a joint of a gait has no
     combination, naming the limit no combination meets.

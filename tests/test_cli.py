@@ -254,6 +254,8 @@ OPTIMIZE = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "x.json"
         ([*OPTIMIZE, "--starts", "100000"], ["--starts", "'100000'", "1 to 100"]),
         (["sweep", "--nelder-mead-starts", "2"], ["unrecognized", "--nelder-mead-starts"]),
         (["atlas", "--starts", "101"], ["--starts", "'101'", "1 to 100"]),
+        (["figures", "--sweep", "/nonexistent"], ["'/nonexistent' does not exist", "allowed"]),
+        (["figures", "--sweep", "README.md"], ["'README.md' is a file", "allowed a folder"]),
     ],
 )
 def test_refused_values_are_named_with_what_is_allowed(capsys, argv, needles):

@@ -116,6 +116,9 @@ def read_sweep(folder: str | Path) -> tuple[dict, list]:
     """The certified optima as {(knee, criterion): [gait, ...] sorted by speed}, and the
     gaits that are not certified (a list)."""
     folder = Path(folder)
+    if not folder.is_dir():
+        what = "is a file" if folder.exists() else "does not exist"
+        raise BipedError(f"sweep folder {str(folder)!r} {what}: allowed a folder of 'biped sweep'")
     files = sorted(p for p in folder.glob("*.json") if p.name != MANIFEST)
     if not files:
         raise BipedError(f"sweep folder {str(folder)!r} has no gait files: run 'biped sweep'")
