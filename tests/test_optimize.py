@@ -404,6 +404,16 @@ def test_a_single_start_under_several_barriers_is_named_once():
     )
 
 
+def test_a_nelder_mead_summary_says_its_constraints_are_penalties_not_nan():
+    """Nelder-Mead has no constraint or dual measure: its line says so instead of "nan";
+    IPOPT's gives both."""
+    nan = float("nan")
+    nelder_mead = Report("nelder-mead", "budget exhausted", 1, 1, 201, nan, nan, 0.5, 0, 1.0)
+    assert "nan" not in nelder_mead.summary() and "penalties" in nelder_mead.summary()
+    ipopt = Report("ipopt", "converged", 5, 5, 42, 1e-9, 8.9e-11, 0.5, 0, 1.0)
+    assert "constraint violation 1.0e-09, dual infeasibility 8.9e-11" in ipopt.summary()
+
+
 def test_report_read_back_from_its_json_is_the_report():
     """A report written as JSON and read back is the same report: a value that is not
     finite written as null and read as NaN, a file without the best value read as NaN."""

@@ -130,10 +130,15 @@ class Report:
             if self.method == "ipopt"
             else f"{self.starts} start"
         )
+        measures = (
+            f"constraint violation {self.constraint_violation:.1e}, dual infeasibility "
+            f"{self.dual_infeasibility:.1e}"
+            if self.method == "ipopt"
+            else "constraints as penalties (no solver measure of them)"
+        )
         return (
             f"{self.method}: {self.status}, {agreement}, {self.iterations} iterations, "
-            f"constraint violation {self.constraint_violation:.1e}, dual infeasibility "
-            f"{self.dual_infeasibility:.1e}, {self.seconds:.2f} s"
+            f"{measures}, {self.seconds:.2f} s"
         )
 
 
