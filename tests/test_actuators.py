@@ -258,7 +258,8 @@ def test_report_page_has_the_drive(tmp_path, capsys):
     assert main(["report", str(path), "--out", str(tmp_path / "pages")]) == 0
     page = next((tmp_path / "pages").glob("*.md")).read_text(encoding="utf-8")
     assert "## Drive (the default set's actuators" in page
-    assert "| swing_knee |" in page and "| cost of transport |" in page
+    assert "| swing_knee |" in page and "| cost of transport, no regeneration |" in page
+    assert "| energy drawn per step, with regeneration |" in page
     assert "electrical energy per metre walked (no regeneration)" in page
 
 

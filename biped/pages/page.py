@@ -586,8 +586,9 @@ def _constraint_lines(gait: Gait) -> list[str]:
 
 def drive_lines(gait: Gait) -> list[str]:
     """The motors' figures (``Electrical``; none for a file written before the actuators):
-    a row per joint, then the energies per step and per metre and the cost of transport,
-    without and with regeneration."""
+    a row per joint, then the energies drawn per step and per metre and the cost of
+    transport, without and with regeneration (the negative power recovered: equal where no
+    joint's power is negative)."""
     electrical = gait.electrical
     if electrical is None:
         return []
@@ -611,7 +612,7 @@ def drive_lines(gait: Gait) -> list[str]:
     lines += ["", "| figure | value | unit |", "|---|---|---|"]
     for f in totals:
         unit = f.metadata["unit"]
-        lines += [f"| {f.name.replace('_', ' ')} | {getattr(electrical, f.name):.5g} | {unit} |"]
+        lines += [f"| {f.metadata['label']} | {getattr(electrical, f.name):.5g} | {unit} |"]
     return lines
 
 

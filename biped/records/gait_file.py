@@ -207,6 +207,11 @@ def _per_joint(unit: str, label: str):
     return unit_field(unit, JOINTS, metadata={"label": label})
 
 
+def _total(unit: str, label: str):
+    """A field of ``Electrical`` for the whole gait: its unit and what it is."""
+    return unit_field(unit, metadata={"label": label})
+
+
 @dataclass(frozen=True, eq=False)
 class Electrical(_Record):
     """What the motors draw to walk the gait (``biped.model.actuators``: current i, voltage
@@ -221,12 +226,12 @@ class Electrical(_Record):
     friction: list = _per_joint("J", "friction losses over the step")
     energy: list = _per_joint("J", "electrical energy over the step, no regeneration")
     energy_regenerated: list = _per_joint("J", "electrical energy over the step, regeneration")
-    energy_per_step: float = unit_field("J")
-    energy_per_metre: float = unit_field("J/m")
-    cost_of_transport: float = unit_field(PURE)
-    regenerated_energy_per_step: float = unit_field("J")
-    regenerated_energy_per_metre: float = unit_field("J/m")
-    regenerated_cost_of_transport: float = unit_field(PURE)
+    energy_per_step: float = _total("J", "energy drawn per step, no regeneration")
+    energy_per_metre: float = _total("J/m", "energy drawn per metre, no regeneration")
+    cost_of_transport: float = _total(PURE, "cost of transport, no regeneration")
+    regenerated_energy_per_step: float = _total("J", "energy drawn per step, with regeneration")
+    regenerated_energy_per_metre: float = _total("J/m", "energy drawn per metre, with regeneration")
+    regenerated_cost_of_transport: float = _total(PURE, "cost of transport, with regeneration")
 
     @classmethod
     def of(cls, model: Biped, step, ev) -> Electrical:
