@@ -213,3 +213,18 @@ def test_an_unstable_walk_counts_its_warnings_and_writes_no_log(tmp_path, monkey
     assert list(tmp_path.iterdir()) == []
     assert capfd.readouterr() == ("", "")
     assert mujoco.get_mju_user_warning() is before
+
+
+def test_a_failed_forward_check_says_why_in_words():
+    """Zero torques: the forward check fails, and its first note says why (the steps walked
+    and the fall), so a line that gives only the notes (the atlas's) names the reason; the
+    optimal gait's check passes with no such note."""
+    from validate.checks import check_forward
+
+    gait = gait_of(small_optimum("revolute"))
+    limp = Walker(with_torques(gait, np.zeros_like(gait.samples.torques)))
+    check, _, _ = check_forward(limp, 3, energy=1.0)
+    assert not check.passed
+    assert check.notes[0].startswith("not a walk of 3 steps: walked 0 of 3 steps, fell")
+    check, _, _ = check_forward(Walker(gait), 2, energy=1.0)
+    assert check.passed and not any(n.startswith("not a walk") for n in check.notes)
