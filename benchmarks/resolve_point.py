@@ -8,6 +8,17 @@ README sentences, which no command of the package makes.
         the atlas's richer-family solve of the revolute knee at 1 m/s and 5 cm (from the final
         optima of both knees), in a process of its own under each OpenBLAS kernel set
         (OPENBLAS_CORETYPE, set before numpy loads): its status and value under each
+    python benchmarks/resolve_point.py per-metre SWEEP_FOLDER
+        each energy point of a sweep that one start alone reached, solved from the energy
+        per metre's optimum at its speed under each barrier: how far above the best it ends
+        (is the per-metre optimum a second start to its basin?)
+    python benchmarks/resolve_point.py mumps [--repeats 2]
+        the energy criterion's table starts at 0.3 m/s, both knees, solved under MUMPS's
+        orderings and scalings, each option set in a process of its own, in turn: ms an
+        IPOPT iteration, the iterations and the values (the same path, a cheaper KKT solve?)
+    python benchmarks/resolve_point.py first-stage OUT
+        the default sweep's first stage alone (its own starts, no second stage) written to
+        OUT: its wall time, to set beside `biped sweep`'s
 """
 
 import argparse
@@ -77,6 +88,89 @@ def kernels(folder: Path, names: list[str]) -> None:
         print(f"OPENBLAS_CORETYPE={name:12} {done.stdout.strip()}")
 
 
+def per_metre(folder: Path) -> None:
+    import biped
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
+    from biped.optimization.solver import BARRIERS, solver_for
+
+    for path in sorted(folder.glob("*-energy-*.json")):
+        gait = json.loads(path.read_text())
+        if gait["optimizer"]["starts_at_best"] >= 2:
+            continue
+        knee, speed, best = gait["knee"], gait["speed"], gait["optimizer"]["value"]
+        model = biped.Biped(biped.Robot.paper(), knee)
+        start = optimize(GaitProblem(model, speed, "energy-per-metre"), jobs=1).variables
+        problem = GaitProblem(model, speed, "energy")
+        solver = solver_for(problem)
+        ends = {b: solver.solve(problem, start, barrier=b) for b in BARRIERS if b != "tight"}
+        above = ", ".join(f"{b} {e.value / best - 1:+.2e} ({e.status})" for b, e in ends.items())
+        print(f"{path.name}: best {best:.6f} J; from the per-metre optimum: {above}")
+
+
+MUMPS_RUN = """
+import json, sys, time
+from biped.optimization import solver as S
+S.IPOPT_OPTIONS.update(json.loads(sys.argv[1]))
+import biped
+from biped.optimization.problem import GaitProblem
+from biped.optimization.optimize import table_starts, barrier_of
+for knee in ("revolute", "rolling"):
+    p = GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3, "energy")
+    s = S.solver_for(p)
+    starts = table_starts(p, 1)
+    s.prepare({barrier_of(k) for k, _ in starts})
+    seconds, iterations, values = 0.0, 0, []
+    for kind, z in starts:
+        began = time.perf_counter()
+        end = s.solve(p, z, barrier=barrier_of(kind))
+        seconds += time.perf_counter() - began
+        iterations += end.iterations
+        values.append(f"{end.value:.9f}")
+    print(f"{knee:8} {1e3 * seconds / iterations:5.2f} ms an iteration, {iterations} "
+          f"iterations, values {' '.join(values)}")
+"""
+MUMPS_OPTIONS = {
+    "default": {},
+    "AMD ordering": {"mumps_pivot_order": 0},
+    "AMF ordering": {"mumps_pivot_order": 2},
+    "METIS ordering": {"mumps_pivot_order": 5},
+    "no scaling": {"mumps_permuting_scaling": 0, "mumps_scaling": 0},
+    "pivot tolerance 1e-8": {"mumps_pivtol": 1e-8},
+}
+
+
+def mumps(repeats: int) -> None:
+    for _ in range(repeats):
+        for name, options in MUMPS_OPTIONS.items():
+            done = subprocess.run(
+                [sys.executable, "-c", MUMPS_RUN, json.dumps(options)],
+                capture_output=True,
+                text=True,
+                check=True,
+            )
+            for line in done.stdout.strip().splitlines():
+                print(f"{name:21} {line}")
+
+
+def first_stage(out: Path) -> None:
+    import time
+
+    import biped.studies.sweep as sweep
+    from biped_cli.main import main as biped_main
+
+    stages = sweep._stages
+
+    def own_starts_only(*args):  # each stage without its final tasks, in the same order
+        own = sweep._solve_independent
+        return [[t for t in tasks if t.solve is own] for tasks in stages(*args)]
+
+    sweep._stages = own_starts_only
+    began = time.perf_counter()
+    biped_main(["sweep", "--paper-seeds", "0", "--out", str(out)])  # exits 1: no final optima
+    print(f"the default sweep's first stage alone: {time.perf_counter() - began:.1f} s wall")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="check", required=True)
@@ -87,11 +181,20 @@ def main() -> None:
     two = sub.add_parser("kernels")
     two.add_argument("folder", type=Path)
     two.add_argument("--kernels", nargs="+", default=["Haswell", "Sandybridge", "Nehalem"])
+    sub.add_parser("per-metre").add_argument("folder", type=Path)
+    sub.add_parser("mumps").add_argument("--repeats", type=int, default=2)
+    sub.add_parser("first-stage").add_argument("out", type=Path)
     args = parser.parse_args()
     if args.check == "other-knee":
         other_knee(args.folder, args.criterion, args.speed)
-    else:
+    elif args.check == "kernels":
         kernels(args.folder, args.kernels)
+    elif args.check == "per-metre":
+        per_metre(args.folder)
+    elif args.check == "mumps":
+        mumps(args.repeats)
+    else:
+        first_stage(args.out)
 
 
 if __name__ == "__main__":
