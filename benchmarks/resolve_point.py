@@ -15,7 +15,9 @@ README sentences, which no command of the package makes.
     python benchmarks/resolve_point.py mumps [--repeats 2]
         the energy criterion's table starts at 0.3 m/s, both knees, solved under MUMPS's
         orderings and scalings, each option set in a process of its own, in turn: ms an
-        IPOPT iteration, the iterations and the values (the same path, a cheaper KKT solve?)
+        IPOPT iteration, the iterations and the values (the same path, a cheaper KKT solve?);
+        --ipopt '{"print_timing_statistics": "yes", "print_level": 5, "max_iter": 40}': where
+        an iteration's time goes
     python benchmarks/resolve_point.py first-stage OUT
         the default sweep's first stage alone (its own starts, no second stage) written to
         OUT: its wall time, to set beside `biped sweep`'s
@@ -140,11 +142,11 @@ MUMPS_OPTIONS = {
 }
 
 
-def mumps(repeats: int) -> None:
+def mumps(repeats: int, ipopt: dict) -> None:
     for _ in range(repeats):
         for name, options in MUMPS_OPTIONS.items():
             done = subprocess.run(
-                [sys.executable, "-c", MUMPS_RUN, json.dumps(options)],
+                [sys.executable, "-c", MUMPS_RUN, json.dumps({**options, **ipopt})],
                 capture_output=True,
                 text=True,
                 check=True,
@@ -182,7 +184,9 @@ def main() -> None:
     two.add_argument("folder", type=Path)
     two.add_argument("--kernels", nargs="+", default=["Haswell", "Sandybridge", "Nehalem"])
     sub.add_parser("per-metre").add_argument("folder", type=Path)
-    sub.add_parser("mumps").add_argument("--repeats", type=int, default=2)
+    solves = sub.add_parser("mumps")
+    solves.add_argument("--repeats", type=int, default=2)
+    solves.add_argument("--ipopt", type=json.loads, default={}, help="more IPOPT options, JSON")
     sub.add_parser("first-stage").add_argument("out", type=Path)
     args = parser.parse_args()
     if args.check == "other-knee":
@@ -192,7 +196,7 @@ def main() -> None:
     elif args.check == "per-metre":
         per_metre(args.folder)
     elif args.check == "mumps":
-        mumps(args.repeats)
+        mumps(args.repeats, args.ipopt)
     else:
         first_stage(args.out)
 
