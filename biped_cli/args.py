@@ -231,6 +231,8 @@ def speeds(text: str) -> np.ndarray:
 def check_output(path: str, option: str = "--out") -> None:
     """Fail before any work if ``path`` cannot become a file."""
     target = Path(path)
+    if target.is_symlink():  # /dev/stdout: a rename would replace the link
+        raise BipedError(f"{option} {path!r} is a symbolic link: allowed a file path")
     if target.is_dir():
         raise BipedError(f"{option} {path!r} is a folder: allowed a file path")
     if target.exists() and not target.is_file():  # /dev/null: a rename would replace it
@@ -270,7 +272,9 @@ def budget(args) -> dict:
     """The keyword arguments of ``biped.optimization.optimize.optimize`` given on the command
     line; an option given that the method would not use is refused (BipedError)."""
     nelder_mead = args.method == "nelder-mead" or args.nelder_mead_starts > 0
-    unused = [("--starts", "starts"), ("--nelder-mead-starts", "nelder_mead_starts")]
+    unused = [("--nelder-mead-starts", "nelder_mead_starts")]
+    if not getattr(args, "design", False):  # the pipeline's design stage is IPOPT's
+        unused.insert(0, ("--starts", "starts"))
     if args.method == "nelder-mead":
         for option, name in unused:
             if given(args, name):
@@ -322,11 +326,11 @@ def add_budget(parser, sweep: bool = False):
     )
     add_options(
         parser,
-        ("--starts", starts, _Default(DEFAULT_STARTS), "N", "IPOPT's own starts, 1 to "
-         f"{MAX_STARTS}: first guesses of several step periods, then perturbations (default "
-         f"{DEFAULT_STARTS}); the table of optima's starts come with them, and for the energy "
-         f"criterion take the place of the first {DEFAULT_STARTS} where the table covers the "
-         f"problem; {CERTIFIED_HELP}"),
+        ("--starts", starts, _Default(DEFAULT_STARTS), "N", "IPOPT's own starts (with --method "
+         f"ipopt, or a pipeline's --design), 1 to {MAX_STARTS}: first guesses of several step "
+         f"periods, then perturbations (default {DEFAULT_STARTS}); the table of optima's "
+         "starts come with them, and for the energy criterion take the place of the first "
+         f"{DEFAULT_STARTS} where the table covers the problem; {CERTIFIED_HELP}"),
         ("--seed", non_negative, 0, "N",
          "seed of the perturbed starts" + ("" if sweep else " and of Nelder-Mead")
          + " (default 0)"),
@@ -336,7 +340,7 @@ def add_budget(parser, sweep: bool = False):
             parser,
             ("--nelder-mead-starts", nelder_mead_starts, _Default(0), "K",
              f"IPOPT also starts from the paper's Nelder-Mead with K seeds, 0 to {MAX_SEEDS} "
-             "(default 0)"),
+             "(default 0; with --method ipopt)"),
             ("--restarts", restarts, _Default(MAX_RESTARTS), "N",
              f"Nelder-Mead restarts from the best point at most, 0 to {MAX_SEEDS} (default "
              f"{MAX_RESTARTS}); with --method nelder-mead or --nelder-mead-starts"),

@@ -425,7 +425,10 @@ def _check_video(args) -> str | None:
 
         check_suffix(args.video, "--video", ".mp4", " (--gif writes a GIF beside it)")
         check_output(args.video, "--video")
-    return str(Path(args.video).with_suffix(".gif")) if args.gif else None
+    gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
+    if gif is not None:
+        check_output(gif, "--gif")
+    return gif
 
 
 def _recordings(args) -> list:

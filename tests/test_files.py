@@ -107,3 +107,15 @@ def test_a_fifo_is_refused_and_left_as_it_is(tmp_path):
     assert _listing(tmp_path) == ["pipe"]
     files.atomic_write_text(tmp_path / "plain", "x")
     assert (tmp_path / "plain").read_text() == "x"
+
+
+def test_a_symbolic_link_is_refused_and_left_as_it_is(tmp_path):
+    """A destination that is a symbolic link (/dev/stdout is one) is refused: the rename
+    would replace the link, not write through it. Its target is left as it was."""
+    target = tmp_path / "target"
+    target.write_text("old")
+    link = tmp_path / "link"
+    link.symlink_to(target)
+    with pytest.raises(BipedError, match="'.*link'.*a symbolic link"):
+        files.atomic_write_text(link, "x")
+    assert link.is_symlink() and target.read_text() == "old"

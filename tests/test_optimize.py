@@ -399,8 +399,8 @@ def test_a_single_start_under_several_barriers_is_named_once():
     history = (start("given" + CONFIRM, 1.0), start(TABLE_START, 1.1))
     report = Report("ipopt", "converged", 2, 1, 50, 1e-9, 1e-9, 1.0, 0, 1.0, history)
     assert single_start_note(report).startswith(
-        "by a start given (a neighbouring optimum: another speed's or the other knee's) under "
-        "the monotone barrier from 1e-3 alone"
+        "by a given start (another problem's optimum, or an earlier stage's) under the "
+        "monotone barrier from 1e-3 alone"
     )
 
 

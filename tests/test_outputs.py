@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from biped import Robot
+from biped.errors import BipedError
 from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped_cli import main
@@ -340,6 +341,41 @@ def test_sweep_names_the_files_of_its_folder(tmp_path, capsys):
         f"sweep results in {out}: sweep.json, 1 gait file <knee>-<criterion>-<speed>.json, "
         ".independent/ (each point's first solve), paper-method/ (settings.json and 1 gait file)"
     )
+
+
+def test_a_gif_or_link_output_is_refused_before_any_work(tmp_path, monkeypatch, capsys):
+    """The GIF beside --video, a FIFO there, and an --out that is a symbolic link (to a file
+    or a device, as /dev/stdout) are refused before any work, naming the option."""
+    monkeypatch.chdir(tmp_path)
+    os.mkfifo("walk.gif")
+    argv = ["validate", "missing.json", "--video", "walk.mp4", "--gif"]
+    line = _refusal(capsys, main(argv))
+    assert "--gif 'walk.gif'" in line and "a device, a FIFO or a socket" in line, line
+    Path("file.json").write_text("{}")
+    os.symlink("file.json", "link.json")
+    argv = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "link.json"]
+    line = _refusal(capsys, main(argv))
+    assert "--out 'link.json' is a symbolic link" in line, line
+    assert Path("link.json").is_symlink() and Path("file.json").read_text() == "{}"
+
+
+def test_the_pipeline_s_design_takes_starts_with_the_paper_s_method():
+    """--method nelder-mead with --starts is refused, but not in a pipeline with --design,
+    whose design stage runs IPOPT from --starts."""
+    import argparse
+
+    from biped_cli.args import _Default, budget
+
+    def args(**given):
+        defaults = dict(starts=_Default(3), nelder_mead_starts=_Default(0))
+        defaults |= dict(restarts=_Default(1), evaluations=_Default(4000), seed=0)
+        return argparse.Namespace(**{**defaults, "method": "nelder-mead", **given})
+
+    with pytest.raises(BipedError, match="--starts 5"):
+        budget(args(starts=5))
+    assert budget(args(starts=5, design=True))["starts"] == 5
+    with pytest.raises(BipedError, match="--nelder-mead-starts 2"):
+        budget(args(nelder_mead_starts=2, design=True))
 
 
 def test_a_sweep_with_a_point_not_certified_exits_1(tmp_path, capsys):

@@ -825,7 +825,7 @@ def single_start_note(report: Report) -> str:
     return text
 
 
-GIVEN_NAME = "a start given (a neighbouring optimum: another speed's or the other knee's)"
+GIVEN_NAME = "a given start (another problem's optimum, or an earlier stage's)"
 
 
 def _named_starts(kinds) -> str:

@@ -2,11 +2,12 @@
 
 Every output of the project (gait files, reports, figures, MJCF models, recordings) is written
 to a temporary file in the destination's folder, flushed to disk, then renamed over the
-destination (``os.replace``, atomic on POSIX and Windows). A reader, or a run interrupted at
-any moment, sees the old file or the new one, never a part. The temporary file is named
-``.<name>.<random>.tmp``; it is removed on any exception, ``KeyboardInterrupt`` included. A
-process killed outright (SIGKILL, power loss) can leave one behind: ``clean_stale_temporaries``
-removes them before a run writes into the folder again.
+destination (``os.replace``, atomic on POSIX and Windows). A destination that a rename would
+destroy, a device, FIFO, socket or symbolic link, is refused (``refuse_special``). A reader,
+or a run interrupted at any moment, sees the old file or the new one, never a part. The
+temporary file is named ``.<name>.<random>.tmp``; it is removed on any exception,
+``KeyboardInterrupt`` included. A process killed outright (SIGKILL, power loss) can leave one
+behind: ``clean_stale_temporaries`` removes them before a run writes into the folder again.
 
 A set of files that belong together (the figures of a sweep, a page and its images) is written
 through ``atomic_set``: every file is written into a hidden staging folder first and moved into
@@ -89,12 +90,18 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
 
 
 def refuse_special(path: Path) -> None:
-    """Refuse a destination that is a device, a FIFO or a socket (``/dev/null``): a rename would
-    replace it by a regular file, and the system's ``/dev/null`` with it."""
+    """Refuse a destination that is a device, a FIFO or a socket (``/dev/null``), or a symbolic
+    link (``/dev/stdout``): a rename would replace it by a regular file, and the system's
+    ``/dev/null`` with it."""
     try:
-        mode = path.stat().st_mode
+        mode = path.lstat().st_mode
     except OSError:  # none yet (or unreadable: the rename says why)
         return
+    if stat.S_ISLNK(mode):
+        raise BipedError(
+            f"cannot write {str(path)!r}: it is a symbolic link; allowed a regular file or a new "
+            "path"
+        )
     if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
         raise BipedError(
             f"cannot write {str(path)!r}: it is a device, a FIFO or a socket; allowed a regular "
