@@ -314,3 +314,25 @@ def test_the_viewer_is_found_beside_this_python_when_not_on_path(monkeypatch, tm
     fake.write_text("#!/bin/sh\n")
     fake.chmod(0o755)
     assert viewer_executable() == str(fake)
+
+
+def test_spawn_starts_the_viewer_found_and_a_failed_start_is_a_warning(
+    recorded, monkeypatch, tmp_path
+):
+    """--spawn hands rerun the viewer ``viewer_executable`` found (beside this Python when
+    not on PATH); a viewer that cannot start is a ViewerWarning, the file written."""
+    import validate.record
+    from biped.errors import ViewerWarning
+
+    result, _, _ = recorded
+    asked = {}
+
+    def spawn(**kwargs):
+        asked.update(kwargs)
+        raise RuntimeError("no display")
+
+    monkeypatch.setattr(validate.record.rr, "spawn", spawn)
+    with pytest.warns(ViewerWarning, match="the viewer it started: no rerun viewer.*no display"):
+        path = validate.record.record(tmp_path / "spawned.rrd", result, spawn=True)
+    assert asked["executable_path"] == validate.record.viewer_executable()
+    assert path.is_file()
