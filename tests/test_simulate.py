@@ -225,6 +225,6 @@ def test_a_failed_forward_check_says_why_in_words():
     limp = Walker(with_torques(gait, np.zeros_like(gait.samples.torques)))
     check, _, _ = check_forward(limp, 3, energy=1.0)
     assert not check.passed
-    assert check.notes[0].startswith("not a walk of 3 steps: walked 0 of 3 steps, fell")
+    assert check.notes[0].startswith("not a walk of 3 steps: 0 of 3 steps within the limits, fell")
     check, _, _ = check_forward(Walker(gait), 2, energy=1.0)
     assert check.passed and not any(n.startswith("not a walk") for n in check.notes)

@@ -378,7 +378,7 @@ def walk_failures(figures: dict, steps: int) -> list[str]:
     """Why the walk of ``walk_figures`` is not a walk of ``steps`` steps (empty: it is)."""
     failures = []
     if figures["steps"] < steps:
-        failures.append(f"walked {figures['steps']} of {steps} steps")
+        failures.append(f"{figures['steps']} of {steps} steps within the limits")
     if figures["fell"]:
         failures.append("fell")
     if not figures["max_slip"] < MAX_SLIP:
