@@ -230,13 +230,14 @@ def speeds(text: str) -> np.ndarray:
 
 def check_output(path: str, option: str = "--out") -> None:
     """Fail before any work if ``path`` cannot become a file."""
+    from biped.runtime.files import special_kind
+
     target = Path(path)
-    if target.is_symlink():  # /dev/stdout: a rename would replace the link
-        raise BipedError(f"{option} {path!r} is a symbolic link: allowed a file path")
+    kind = special_kind(target)  # /dev/null, /dev/stdout: a rename would destroy it
+    if kind is not None:
+        raise BipedError(f"{option} {path!r} is {kind}: allowed a file path")
     if target.is_dir():
         raise BipedError(f"{option} {path!r} is a folder: allowed a file path")
-    if target.exists() and not target.is_file():  # /dev/null: a rename would replace it
-        raise BipedError(f"{option} {path!r} is a device, a FIFO or a socket: allowed a file path")
     check_folder(str(target.parent), option, of=path)
 
 
@@ -326,11 +327,12 @@ def add_budget(parser, sweep: bool = False):
     )
     add_options(
         parser,
-        ("--starts", starts, _Default(DEFAULT_STARTS), "N", "IPOPT's own starts (with --method "
-         f"ipopt, or a pipeline's --design), 1 to {MAX_STARTS}: first guesses of several step "
-         f"periods, then perturbations (default {DEFAULT_STARTS}); the table of optima's "
-         "starts come with them, and for the energy criterion take the place of the first "
-         f"{DEFAULT_STARTS} where the table covers the problem; {CERTIFIED_HELP}"),
+        ("--starts", starts, _Default(DEFAULT_STARTS), "N", "IPOPT's own starts"
+         + ("" if sweep else " (with --method ipopt, or a pipeline's --design)")
+         + f", 1 to {MAX_STARTS}: first guesses of several step periods, then perturbations "
+         f"(default {DEFAULT_STARTS}); the table of optima's starts come with them, and for "
+         f"the energy criterion take the place of the first {DEFAULT_STARTS} where the table "
+         f"covers the problem; {CERTIFIED_HELP}"),
         ("--seed", non_negative, 0, "N",
          "seed of the perturbed starts" + ("" if sweep else " and of Nelder-Mead")
          + " (default 0)"),

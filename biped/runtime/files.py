@@ -89,23 +89,28 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     _fsync_folder(path.parent)
 
 
-def refuse_special(path: Path) -> None:
-    """Refuse a destination that is a device, a FIFO or a socket (``/dev/null``), or a symbolic
-    link (``/dev/stdout``): a rename would replace it by a regular file, and the system's
-    ``/dev/null`` with it."""
+def special_kind(path: Path) -> str | None:
+    """What ``path`` is when a rename over it would destroy it: "a symbolic link"
+    (``/dev/stdout``; the rename replaces the link) or "a device, a FIFO or a socket"
+    (``/dev/null``); None when it is a regular file, a folder or nothing yet."""
     try:
         mode = path.lstat().st_mode
     except OSError:  # none yet (or unreadable: the rename says why)
-        return
+        return None
     if stat.S_ISLNK(mode):
-        raise BipedError(
-            f"cannot write {str(path)!r}: it is a symbolic link; allowed a regular file or a new "
-            "path"
-        )
+        return "a symbolic link"
     if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        return "a device, a FIFO or a socket"
+    return None
+
+
+def refuse_special(path: Path) -> None:
+    """Refuse a destination that a rename would destroy (``special_kind``): the system's
+    ``/dev/null`` was replaced by a regular file."""
+    kind = special_kind(path)
+    if kind is not None:
         raise BipedError(
-            f"cannot write {str(path)!r}: it is a device, a FIFO or a socket; allowed a regular "
-            "file or a new path"
+            f"cannot write {str(path)!r}: it is {kind}; allowed a regular file or a new path"
         )
 
 
