@@ -18,9 +18,11 @@ README sentences, which no command of the package makes.
         IPOPT iteration, the iterations and the values (the same path, a cheaper KKT solve?);
         --ipopt '{"print_timing_statistics": "yes", "print_level": 5, "max_iter": 40}': where
         an iteration's time goes
-    python benchmarks/resolve_point.py first-stage OUT
-        the default sweep's first stage alone (its own starts, no second stage) written to
-        OUT: its wall time, to set beside `biped sweep`'s
+    python benchmarks/resolve_point.py sweep OUT [--first-stage] [--ipopt JSON]
+        the default sweep (`biped sweep --paper-seeds 0`) written to OUT and timed: with
+        --first-stage its first stage alone (its own starts, no second stage), to set beside
+        the whole sweep's time; with --ipopt more IPOPT options for every solve
+        ('{"mumps_pivtol": 1e-8}'), its files to compare with compare_sweeps.py
 """
 
 import argparse
@@ -155,22 +157,48 @@ def mumps(repeats: int, ipopt: dict) -> None:
                 print(f"{name:21} {line}")
 
 
-def first_stage(out: Path) -> None:
+# More IPOPT options for every solve of ``sweep``, JSON: the sweep's workers are spawned and
+# import this file again (as __mp_main__), so they take them from the environment here.
+IPOPT_ENV = "RESOLVE_POINT_IPOPT"
+
+
+def _more_ipopt_options() -> None:
+    if os.environ.get(IPOPT_ENV):
+        from biped.optimization import solver
+
+        solver.IPOPT_OPTIONS.update(json.loads(os.environ[IPOPT_ENV]))
+
+
+_more_ipopt_options()
+
+
+def sweep(out: Path, first_stage: bool, ipopt: dict) -> None:
     import time
 
-    import biped.studies.sweep as sweep
+    import biped.studies.sweep as sweeps
     from biped_cli.main import main as biped_main
 
-    stages = sweep._stages
+    os.environ[IPOPT_ENV] = json.dumps(ipopt)
+    _more_ipopt_options()
+    stages = sweeps._stages
 
     def own_starts_only(*args):  # each stage without its final tasks, in the same order
-        own = sweep._solve_independent
+        own = sweeps._solve_independent
         return [[t for t in tasks if t.solve is own] for tasks in stages(*args)]
 
-    sweep._stages = own_starts_only
+    if first_stage:
+        sweeps._stages = own_starts_only
     began = time.perf_counter()
-    biped_main(["sweep", "--paper-seeds", "0", "--out", str(out)])  # exits 1: no final optima
-    print(f"the default sweep's first stage alone: {time.perf_counter() - began:.1f} s wall")
+    code = biped_main(["sweep", "--paper-seeds", "0", "--out", str(out)])  # 1 without finals
+    what = "first stage alone" if first_stage else "whole"
+    print(f"the default sweep, {what}: {time.perf_counter() - began:.1f} s wall (exit {code})")
+
+
+def _sweep_folder(text: str) -> Path:
+    folder = Path(text)
+    if not any(folder.glob("*-energy-*.json")):
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed a sweep folder with energy optima")
+    return folder
 
 
 def main() -> None:
@@ -183,11 +211,14 @@ def main() -> None:
     two = sub.add_parser("kernels")
     two.add_argument("folder", type=Path)
     two.add_argument("--kernels", nargs="+", default=["Haswell", "Sandybridge", "Nehalem"])
-    sub.add_parser("per-metre").add_argument("folder", type=Path)
+    sub.add_parser("per-metre").add_argument("folder", type=_sweep_folder)
     solves = sub.add_parser("mumps")
     solves.add_argument("--repeats", type=int, default=2)
     solves.add_argument("--ipopt", type=json.loads, default={}, help="more IPOPT options, JSON")
-    sub.add_parser("first-stage").add_argument("out", type=Path)
+    swept = sub.add_parser("sweep")
+    swept.add_argument("out", type=Path)
+    swept.add_argument("--first-stage", action="store_true", help="its first stage alone")
+    swept.add_argument("--ipopt", type=json.loads, default={}, help="more IPOPT options, JSON")
     args = parser.parse_args()
     if args.check == "other-knee":
         other_knee(args.folder, args.criterion, args.speed)
@@ -198,7 +229,7 @@ def main() -> None:
     elif args.check == "mumps":
         mumps(args.repeats, args.ipopt)
     else:
-        first_stage(args.out)
+        sweep(args.out, args.first_stage, args.ipopt)
 
 
 if __name__ == "__main__":
