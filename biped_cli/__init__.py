@@ -35,10 +35,10 @@ _handled = (
     "--multiprocessing-fork" not in sys.orig_argv
     and threading.current_thread() is threading.main_thread()
 )
+# Also where the shell had the program ignore Ctrl-C (a script's background job: ``biped sweep
+# &``): it stops at Ctrl-C as later (``biped.runtime.interrupts.taken_over``).
 _previous = {
-    number: signal.signal(number, _end_while_loading)
-    for number in _INTERRUPTS
-    if _handled and signal.getsignal(number) is not signal.SIG_IGN  # ignored stays ignored
+    number: signal.signal(number, _end_while_loading) for number in _INTERRUPTS if _handled
 }
 try:
     from biped_cli.main import build_parser, main

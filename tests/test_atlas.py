@@ -17,6 +17,7 @@ from biped.pages import atlas as pages
 from biped.records.gait_file import Gait
 from biped.studies import atlas
 from biped.studies.atlas import Cell, Difference
+from tests.background import PROMPTLY, numbers, stopped_twice_then_resumed
 
 ROBOT = biped.Robot.paper()
 
@@ -112,3 +113,20 @@ def test_a_resumed_atlas_runs_nothing_and_other_settings_are_refused(small):
     other = atlas.Settings(ROBOT, (0.3,), (0.0, 0.03), (0.0,), ("sthenic",), 1, 0, 1)
     with pytest.raises(biped.BipedError, match="atlas was made with clearances"):
         atlas.run_atlas(folder, other, jobs=1, stream=io.StringIO())
+
+
+def test_an_atlas_stopped_by_signals_while_its_workers_run_resumes_to_the_same(small, tmp_path):
+    """`biped atlas --jobs 2` as a script's background job, stopped while its workers solve by
+    Ctrl-C to its process group and then by SIGTERM, exits 130 then 143 within seconds with
+    one line, its workers ended; run again, it ends with the optima of an uninterrupted
+    atlas."""
+    folder, settings, _ = small
+    argv = ["atlas", "--speeds", "0.3", "--clearances", "0,0.02", "--criteria", "sthenic"]
+    argv += ["--starts", "1", "--no-walks", "--jobs", "2"]
+    stops = stopped_twice_then_resumed(argv, tmp_path / "atlas")
+    assert [stop.status for stop in stops] == [130, 143]
+    for stop, name in zip(stops, ("Ctrl-C", "SIGTERM"), strict=True):
+        assert stop.stderr.splitlines()[-1] == f"biped atlas: interrupted ({name})"
+        assert stop.seconds < PROMPTLY
+    optima = numbers(tmp_path / "atlas")
+    assert optima and optima == numbers(folder)

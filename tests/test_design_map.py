@@ -14,6 +14,7 @@ from biped.studies.design_map import (
     run_design_map,
     speed_summaries,
 )
+from tests.background import PROMPTLY, numbers, stopped_twice_then_resumed
 
 ROBOT = biped.Robot.paper()
 SPEED = 0.3
@@ -113,3 +114,18 @@ def test_every_optimization_line_gives_its_criterion_with_its_unit(small_map):
         line for line in (small_map.parent / "log.txt").read_text().splitlines() if "C = " in line
     ]
     assert lines and all("N²·m·s" in line.split("C = ")[1] for line in lines), lines
+
+
+def test_a_map_stopped_by_signals_while_its_workers_run_resumes_to_the_same(small_map, tmp_path):
+    """`biped design-map --jobs 2` as a script's background job, stopped while its workers
+    solve by Ctrl-C to its process group and then by SIGTERM, exits 130 then 143 within
+    seconds with one line, its workers ended; run again, it ends with the numbers of an
+    uninterrupted map."""
+    argv = ["design-map", "--speeds", str(SPEED), "--jobs", "2", "--starts", "1"]
+    argv += ["--r1", ",".join(map(str, GRID["r1"])), "--r2", ",".join(map(str, GRID["r2"]))]
+    stops = stopped_twice_then_resumed(argv, tmp_path / "map")
+    assert [stop.status for stop in stops] == [130, 143]
+    for stop, name in zip(stops, ("Ctrl-C", "SIGTERM"), strict=True):
+        assert stop.stderr.splitlines()[-1] == f"biped design-map: interrupted ({name})"
+        assert stop.seconds < PROMPTLY
+    assert numbers(tmp_path / "map") == numbers(small_map)

@@ -14,8 +14,10 @@ import pytest
 import biped
 from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver, solver_for
+from biped.runtime import runner
 from biped.runtime.interrupts import kept_interrupts
 from biped_cli import main
+from tests.background import PROMPTLY, stop_while_workers_run
 
 # CasADi's notice, in the pieces it writes.
 NOTICE = ("CasADi - ", "2026-01-01", ' WARNING("', "KeyboardInterruptException", '") [', "x.cpp]\n")
@@ -161,4 +163,25 @@ def test_biped_optimize_stops_at_a_signal_during_the_solve(
         timer.join()
     name = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}[signum]
     assert capsys.readouterr().err.splitlines()[-1] == f"biped optimize: interrupted ({name})"
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.skipif(runner.free_cores() < 2, reason="the starts are forked on 2 cores or more")
+@pytest.mark.parametrize(
+    "signum, to_group", [(signal.SIGINT, True), (signal.SIGINT, False), (signal.SIGTERM, False)]
+)
+def test_a_background_optimize_stops_while_its_starts_run_in_workers(signum, to_group, tmp_path):
+    """`biped optimize --criterion energy` started as a script's background job (Ctrl-C
+    ignored: it ran on to write its file and exit 0), signalled while its starts run in
+    forked worker processes: Ctrl-C to its process group as a terminal sends it, or to its
+    process alone, and SIGTERM, stop it and its workers within seconds, 130 / 143 and one
+    line, writing nothing."""
+    out = tmp_path / "gait.json"
+    argv = ["optimize", "--knee", "rolling", "--speed", "0.3", "--criterion", "energy"]
+    stopped = stop_while_workers_run([*argv, "--out", str(out)], signum, to_group)
+    name = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}[signum]
+    assert stopped.status == 128 + signum, stopped.stderr
+    assert stopped.stderr.splitlines()[-1] == f"biped optimize: interrupted ({name})"
+    assert "Traceback" not in stopped.stderr
+    assert stopped.seconds < PROMPTLY
     assert not list(tmp_path.iterdir())

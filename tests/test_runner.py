@@ -25,6 +25,7 @@ from biped.runtime import interrupts, runner
 from biped.runtime.files import atomic_write_text
 from biped.studies.sweep import INDEPENDENT, run_sweep, sweep_settings
 from biped_cli import main, progress
+from tests.background import PROGRAM, as_a_background_job
 
 SPEEDS = (0.275, 0.3)
 # A small sweep: one knee, one criterion, two speeds, one start (4 optimizations).
@@ -360,15 +361,7 @@ def test_sweep_progress_bar_on_a_terminal_only(local_sweep, tmp_path, monkeypatc
     assert re.fullmatch(r"sweep: 2/2 done \(100 %\), elapsed \d+ s", logged[1])
 
 
-# `biped` as its console script runs it (`python -m biped` loads the package first).
-PROGRAM = "import sys; from biped_cli import main; sys.exit(main())"
 SIGNALS = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
-
-
-def _ctrl_c_default():
-    """In the child: Ctrl-C as in a terminal, whatever this process inherited (a shell's
-    background job ignores it)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _lines(stream, into: queue.Queue):
@@ -378,9 +371,10 @@ def _lines(stream, into: queue.Queue):
 
 
 def test_signals_at_random_moments_leave_whole_files_and_resume_to_the_same(local_sweep, tmp_path):
-    """`biped sweep --jobs 2` stopped by real signals at seeded random moments (while it
-    loads, in either stage, while it sums up): Ctrl-C as a terminal sends it (to the whole
-    process group, workers included) and SIGTERM as `kill` does (to the program). Each stop
+    """`biped sweep --jobs 2`, started as a script's background job (Ctrl-C ignored), stopped
+    by real signals at seeded random moments (while it loads, in either stage, while it sums
+    up): Ctrl-C as a terminal sends it (to the whole process group, workers included) and
+    SIGTERM as `kill` does (to the program). Each stop
     exits 130 / 143 with one line and no traceback, leaves no temporary file, and the run
     that follows ends with every file of an uninterrupted sweep."""
     out = tmp_path / "sweep"
@@ -400,7 +394,7 @@ def test_signals_at_random_moments_leave_whole_files_and_resume_to_the_same(loca
             stderr=subprocess.PIPE,
             text=True,
             start_new_session=True,
-            preexec_fn=_ctrl_c_default,
+            preexec_fn=as_a_background_job,
         )
         lines: queue.Queue = queue.Queue()
         reader = threading.Thread(target=_lines, args=(process.stderr, lines), daemon=True)

@@ -9,6 +9,8 @@ and ends with the files of an uninterrupted run. Moment by moment:
 
 - loading (numpy, CasADi: a second or two): the program ends at once, nothing written yet
   (``biped_cli/__init__.py``: it must act before ``biped`` loads numpy);
+- a Ctrl-C the shell had the program ignore (a script's background job, ``biped sweep &``)
+  stops it all the same (``taken_over``);
 - a command, in the main thread: Ctrl-C raises ``KeyboardInterrupt``, SIGTERM ``Terminated``
   (one, ``command_interrupts``), so the same clean-up runs (``finally`` blocks, temporary
   files, worker pools); ``biped_cli.guard`` prints the line and exits with ``exit_status``;
@@ -67,17 +69,26 @@ def _main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
+def taken_over(handler) -> bool:
+    """Whether a command handles a signal whose handler is ``handler``: Python's own (Ctrl-C's
+    ``KeyboardInterrupt``), the system's default, or ignored. A POSIX shell starts a script's
+    background job (``biped sweep ... &``) with Ctrl-C ignored: the command stops at it all the
+    same, as ``kill -INT`` and a terminal's Ctrl-C to its process group mean it to. A handler
+    of the program's own (a library calling ``main``) is left in place."""
+    return handler in (signal.default_int_handler, signal.SIG_DFL, signal.SIG_IGN)
+
+
 @contextlib.contextmanager
 def command_interrupts() -> Iterator[None]:
     """Within the block, SIGTERM raises ``Terminated`` and Ctrl-C ``KeyboardInterrupt`` in the
-    main thread (elsewhere: no-op; a Ctrl-C ignored stays ignored), each remembered for
-    ``received_interrupt``."""
+    main thread (elsewhere: no-op), each remembered for ``received_interrupt``; a Ctrl-C the
+    shell had the command ignore is handled too (``taken_over``)."""
     if not _main_thread():
         yield
         return
     _received.clear()
     handled = [signal.SIGTERM]
-    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+    if taken_over(signal.getsignal(signal.SIGINT)):
         handled.append(signal.SIGINT)
     with _replaced({number: signal.getsignal(number) for number in handled}, _interrupt):
         yield
