@@ -229,7 +229,9 @@ def speeds(text: str) -> np.ndarray:
 
 
 def check_output(path: str, option: str = "--out") -> None:
-    """Fail before any work if ``path`` cannot become a file."""
+    """Fail before any work if ``path`` cannot become a file or another run writes it; it is
+    this command's until it ends (``biped.runtime.claims``)."""
+    from biped.runtime.claims import hold
     from biped.runtime.files import special_kind
 
     target = Path(path)
@@ -239,6 +241,26 @@ def check_output(path: str, option: str = "--out") -> None:
     if target.is_dir():
         raise BipedError(f"{option} {path!r} is a folder: allowed a file path")
     check_folder(str(target.parent), option, of=path)
+    hold(path, option)
+
+
+def claim_folder(path: str, option: str = "--out") -> None:
+    """Fail before any work if ``path`` cannot be (or become) a writable folder or another run
+    writes in it; it is this command's until it ends (``biped.runtime.claims``)."""
+    from biped.runtime.claims import hold
+
+    check_folder(path, option)
+    hold(path, option)
+
+
+def claim_outputs(folder: str, names: list, option: str = "--out") -> None:
+    """Claim the outputs named ``names`` in ``folder`` (each name standing for its files,
+    ``NAME.json``, ``NAME.png``) until the command ends: two runs may write other gaits'
+    outputs into one folder, not the same."""
+    from biped.runtime.claims import hold
+
+    for name in names:
+        hold(Path(folder) / str(name), option)
 
 
 def check_folder(path: str, option: str, of: str | None = None) -> None:

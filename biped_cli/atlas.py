@@ -62,7 +62,7 @@ def cmd_atlas(args) -> int:
             actuator_limits=args.actuator_limits,
         )
     )
-    types.check_folder(args.out, "--out")
+    types.claim_folder(args.out)
     atlas.ATLAS.check(args.out, settings.to_dict())
     if args.dask is not None:
         check_dask(args.dask)

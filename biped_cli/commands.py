@@ -16,7 +16,14 @@ from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped_cli import args as types
-from biped_cli.args import budget, check_folder, check_output, robot_of, safety
+from biped_cli.args import (
+    budget,
+    check_folder,
+    check_output,
+    claim_folder,
+    robot_of,
+    safety,
+)
 
 DEFAULT_SWEEP = "logs/sweep"
 DEFAULT_FIGURES = "logs/figures"
@@ -220,7 +227,7 @@ def cmd_sweep(args) -> int:
     )
 
     robot = robot_of(args)
-    check_folder(args.out, "--out")
+    claim_folder(args.out)
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
@@ -279,7 +286,7 @@ def cmd_figures(args) -> int:
     from biped.pages.figures import make_figures
     from biped.records import gait_file
 
-    check_folder(args.out, "--out")
+    claim_folder(args.out)
     takes = "--sweep a folder of the gait files that biped sweep writes"
     for gait in sorted(Path(args.sweep).glob("*-*.json")):  # each its parameters' gait
         gait_file.read_consistent(gait, takes)
@@ -532,7 +539,7 @@ def cmd_pipeline(args) -> int:
         check_speed(Biped(robot, knee), args.speed)
     for knee in args.knees:
         check_simulable(robot, knee, f"--robot {args.robot!r}" if args.robot else "robot")
-    check_folder(args.out, "--out")
+    claim_folder(args.out)  # its gait files, pages and recordings are named from it
     check_folder(args.recordings, "--recordings")
     pipeline = Pipeline(
         robot,

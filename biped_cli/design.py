@@ -179,7 +179,7 @@ def cmd_design_map(args) -> int:
 
     robot = types.robot_of(args)
     problem = design_problem(args, robot, float(args.speeds[0]))
-    types.check_folder(args.out, "--out")
+    types.claim_folder(args.out)
     for note in bound_notes(problem):
         print(note)
     if args.dask is not None:

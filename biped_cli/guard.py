@@ -27,6 +27,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from biped.errors import BipedError, BipedWarning
+from biped.runtime.claims import release_held
 from biped.runtime.interrupts import command_interrupts, exit_status, received_interrupt
 
 EXIT_OK = 0
@@ -64,6 +65,16 @@ def warnings_as_lines(say: Callable[[str], None]) -> Iterator[None]:
         warnings.showwarning = shown
 
 
+@contextlib.contextmanager
+def claims() -> Iterator[None]:
+    """The outputs a command claimed where it checked them (``biped.runtime.claims.hold``)
+    are released when it ends, however it ends."""
+    try:
+        yield
+    finally:
+        release_held()
+
+
 def one_line(text: str) -> str:
     """``text`` on one line: line breaks become spaces."""
     return " ".join(str(text).split("\n")).strip()
@@ -97,7 +108,7 @@ def run_guarded(name: str | Callable[[], str], run: Callable[[], int], debug: bo
         return EXIT_BAD_INPUT
 
     try:
-        with command_interrupts(), quiet_numerics(debug), warnings_as_lines(say):
+        with command_interrupts(), quiet_numerics(debug), warnings_as_lines(say), claims():
             return run()
     except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM (``Terminated``)
         status, signal_name = exit_status(interrupt)

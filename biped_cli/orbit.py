@@ -229,6 +229,7 @@ def cmd_orbit(args) -> int:
     gaits = read_gaits(args.gait, args.model)
     names = [output_name(path) for path in args.gait]
     types.distinct_outputs(names, "result")
+    types.claim_outputs(args.out, names)
     knob, values = args.vary if args.vary is not None else (None, [None])
 
     steps = Steps(angle=args.step, rate=args.step * RATE_STEP / STEP, phases=args.phases)

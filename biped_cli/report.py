@@ -14,7 +14,14 @@ import json
 from pathlib import Path
 
 from biped.errors import BipedError
-from biped_cli.args import add_command, add_folder, add_gaits, check_folder, distinct_outputs
+from biped_cli.args import (
+    add_command,
+    add_folder,
+    add_gaits,
+    check_folder,
+    claim_outputs,
+    distinct_outputs,
+)
 from biped_cli.commands import DEFAULT_RECORDINGS
 
 DEFAULT_REPORTS = "logs/reports"
@@ -102,6 +109,7 @@ def cmd_report(args) -> int:
             )
         )
     distinct_outputs([page.name for page in pages], "page", gaits="gait files")
+    claim_outputs(args.out, [page.name for page in pages])
     for written in write_pages(pages, args.out):
         print(f"wrote {written}")
     return 0

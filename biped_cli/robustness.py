@@ -198,6 +198,7 @@ def cmd_robustness(args) -> int:
     gaits = read_gaits(args.gait, args.model)
     names = [output_name(path) for path in args.gait]
     types.distinct_outputs(names, "map")
+    types.claim_outputs(args.out, names)
     out, failed, mapped = Path(args.out), [], {}
     with Progress(len(gaits) * (1 + len(robustness.LIMITS)), "robustness") as bar:
         for path, gait, name in zip(args.gait, gaits, names, strict=True):

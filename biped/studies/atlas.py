@@ -54,6 +54,7 @@ from biped.optimization.optimize import (
 )
 from biped.optimization.problem import GaitProblem, check_criterion, check_speed
 from biped.records import gait_file
+from biped.runtime.claims import claimed
 from biped.runtime.files import atomic_write_text, distinct_values
 from biped.studies import campaign
 from biped.studies.campaign import Task
@@ -368,18 +369,19 @@ def run_atlas(folder, settings: Settings, **where) -> Settings:
     """Every optimization of the atlas not yet in ``folder``; returns its settings.
     ``where``: ``jobs``, ``dask``, ``stream``, ``progress``, as ``campaign.Campaign.run``."""
     check_settings(settings)
-    folder = ATLAS.claim(folder, settings, *STAGES)
-    tasks = stages(folder, settings)
-    total = len(settings.cells()) * len(settings.criteria) * len(KNEES) * 4
-    total += len(settings.corners()) * len(settings.criteria) * len(KNEES)
-    remaining = sum(map(len, tasks))
-    plan = (
-        f"atlas: {total} optimizations of {len(settings.cells())} cells x "
-        f"{len(settings.criteria)} criteria x 2 knees in {folder} (own starts, final, finer "
-        f"grid, tighter tolerance, {RICHER_KNOTS} knots at the corners): "
-        f"{total - remaining} already done, {remaining} to run"
-    )
-    ATLAS.run(plan, tasks, lambda: summarize(folder, settings), **where)
+    with claimed(folder):  # one run at a time on the folder
+        folder = ATLAS.claim(folder, settings, *STAGES)
+        tasks = stages(folder, settings)
+        total = len(settings.cells()) * len(settings.criteria) * len(KNEES) * 4
+        total += len(settings.corners()) * len(settings.criteria) * len(KNEES)
+        remaining = sum(map(len, tasks))
+        plan = (
+            f"atlas: {total} optimizations of {len(settings.cells())} cells x "
+            f"{len(settings.criteria)} criteria x 2 knees in {folder} (own starts, final, finer "
+            f"grid, tighter tolerance, {RICHER_KNOTS} knots at the corners): "
+            f"{total - remaining} already done, {remaining} to run"
+        )
+        ATLAS.run(plan, tasks, lambda: summarize(folder, settings), **where)
     return settings
 
 

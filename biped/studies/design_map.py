@@ -49,6 +49,7 @@ from biped.optimization.design import (
 )
 from biped.optimization.optimize import DEFAULT_STARTS, optimize
 from biped.optimization.problem import VARIABLES
+from biped.runtime.claims import claimed
 from biped.runtime.files import atomic_path, atomic_write_text, distinct_values
 from biped.studies import campaign
 from biped.studies.campaign import Task
@@ -261,16 +262,17 @@ def run_design_map(
     r2 = radius_grid(robot, np.linspace(0.0, upper[1], DEFAULT_GRID) if r2 is None else r2, "r2")
     upper, seed, starts = tuple(upper), int(seed), int(starts)
     settings = MapSettings(robot, criterion, safety, tuple(speeds), r1, r2, upper, seed, starts)
-    folder = MAP.claim(folder, settings)  # checked before the folder is made
-    points = map_points(settings)
-    todo = [[p for p in stage if read_point(folder, p) is None] for stage in points]
-    stages = [[Task(solve_point, settings, p, str(folder)) for p in stage] for stage in todo]
-    total, remaining = sum(map(len, points)), sum(map(len, stages))
-    plan = (
-        f"design map: {total} optimizations in {folder}, {total - remaining} already done, "
-        f"{remaining} to run"
-    )
-    MAP.run(plan, stages, lambda: summarize(folder, settings), **where)
+    with claimed(folder):  # one run at a time on the folder
+        folder = MAP.claim(folder, settings)  # checked before the folder is made
+        points = map_points(settings)
+        todo = [[p for p in stage if read_point(folder, p) is None] for stage in points]
+        stages = [[Task(solve_point, settings, p, str(folder)) for p in stage] for stage in todo]
+        total, remaining = sum(map(len, points)), sum(map(len, stages))
+        plan = (
+            f"design map: {total} optimizations in {folder}, {total - remaining} already done, "
+            f"{remaining} to run"
+        )
+        MAP.run(plan, stages, lambda: summarize(folder, settings), **where)
     return settings
 
 

@@ -32,6 +32,7 @@ from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS
 from biped.optimization.problem import GaitProblem, check_speed
 from biped.records import gait_file
 from biped.records.provenance import version
+from biped.runtime.claims import claimed
 from biped.studies import campaign
 from biped.studies.campaign import Task
 
@@ -117,16 +118,17 @@ def run_paper_method(
     """The paper's Nelder-Mead from the seeds of ``settings`` (``paper_settings``) for every
     knee and criterion, into ``sweep_folder``/paper-method/ (runs already there are kept);
     returns the gait files. ``where`` they run: as ``campaign.Campaign.run`` says."""
-    folder = PAPER.claim(Path(sweep_folder) / FOLDER, settings)  # checked before it is made
-    speed, seeds = settings.speed, settings.seeds
-    runs = [Run(k, c, speed, s) for c in criteria for k in knees for s in range(seeds)]
-    todo = [Task(_solve, settings, r, str(folder)) for r in runs]
-    todo = [task for task in todo if not task.path.exists()]
-    plan = (
-        f"paper's method: {len(runs)} Nelder-Mead runs at {speed:.3f} m/s in {folder}: "
-        f"{len(runs) - len(todo)} already done, {len(todo)} to run"
-    )
-    PAPER.run(plan if todo else None, [todo], **where)
+    with claimed(Path(sweep_folder) / FOLDER):  # one run at a time on the folder
+        folder = PAPER.claim(Path(sweep_folder) / FOLDER, settings)  # checked before it is made
+        speed, seeds = settings.speed, settings.seeds
+        runs = [Run(k, c, speed, s) for c in criteria for k in knees for s in range(seeds)]
+        todo = [Task(_solve, settings, r, str(folder)) for r in runs]
+        todo = [task for task in todo if not task.path.exists()]
+        plan = (
+            f"paper's method: {len(runs)} Nelder-Mead runs at {speed:.3f} m/s in {folder}: "
+            f"{len(runs) - len(todo)} already done, {len(todo)} to run"
+        )
+        PAPER.run(plan if todo else None, [todo], **where)
     return [folder / r.filename() for r in runs]
 
 

@@ -56,6 +56,7 @@ from biped.optimization.optimize import (
 )
 from biped.optimization.problem import GaitProblem, check_speed
 from biped.records import gait_file
+from biped.runtime.claims import claimed
 from biped.studies import campaign
 from biped.studies.campaign import Task
 
@@ -210,13 +211,14 @@ def run_sweep(folder: Path, settings: Settings, knees=KNEES, criteria=CRITERIA, 
     as ``campaign.Campaign.run`` says."""
     if len(set(knees)) != len(knees) or len(set(criteria)) != len(criteria):
         raise BipedError(f"knees {list(knees)}, criteria {list(criteria)}: allowed each once")
-    folder = SWEEP.claim(folder, settings, INDEPENDENT)  # checked before anything is written
-    points = [Point(k, c, s) for c in criteria for k in knees for s in settings.speeds]
-    final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
-    saved = {p for p in points if _read_gait(folder / INDEPENDENT / p.filename(), p, settings)}
-    stages = _stages(folder, settings, points, final, knees, saved)
-    plan = _plan(folder, points, final, stages, saved)
-    SWEEP.run(plan, stages, lambda: summarize(folder, points, settings), **where)
+    with claimed(folder):  # one run at a time on the folder
+        folder = SWEEP.claim(folder, settings, INDEPENDENT)  # checked before anything is written
+        points = [Point(k, c, s) for c in criteria for k in knees for s in settings.speeds]
+        final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
+        saved = {p for p in points if _read_gait(folder / INDEPENDENT / p.filename(), p, settings)}
+        stages = _stages(folder, settings, points, final, knees, saved)
+        plan = _plan(folder, points, final, stages, saved)
+        SWEEP.run(plan, stages, lambda: summarize(folder, points, settings), **where)
     return points
 
 
