@@ -44,7 +44,9 @@ def cmd_atlas(args) -> int:
     with 3 interior knots: how the difference moves with a richer gait. Writes the optima,
     atlas.csv, atlas-<criterion>.png and atlas.md in --out; the optima at the corners and at
     the best pay-off are walked in MuJoCo (unless --no-walks) and atlas.md says which pass.
-    Run again to resume. Exits 0 when every optimum is certified, 1 otherwise."""
+    Run again to resume. Exits 0 when every final optimum is certified and every re-solve
+    measured what it is for, 1 otherwise (a re-solve that did not converge leaves its term
+    unknown: the run's last line and atlas.md say which and why)."""
     from biped.pages import atlas as pages
     from biped.runtime.runner import check_dask
     from biped.studies import atlas
@@ -77,7 +79,7 @@ def cmd_atlas(args) -> int:
         for cell in settings.cells()
         for k in ("revolute", "rolling")
     )
-    return 0 if certified else 1
+    return 0 if certified and not atlas.unmeasured(args.out, settings) else 1
 
 
 def _walks(folder, settings) -> list[str]:
@@ -129,7 +131,7 @@ def _best_payoff(folder, settings, criterion):
 
     found = []
     for cell in settings.cells():
-        diff, _ = difference(folder, criterion, cell)
+        diff, _ = difference(folder, settings, criterion, cell)
         if diff.distinguishable and diff.value < 0:
             found.append((diff.value, cell))
     return min(found, key=lambda pair: pair[0])[1] if found else None

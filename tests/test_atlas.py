@@ -3,6 +3,7 @@ difference no larger than its uncertainty is not distinguishable; a small atlas 
 CSV, figures and sentences from its numbers, resumes to the same files and refuses other
 settings."""
 
+import csv
 import io
 
 import numpy as np
@@ -102,7 +103,10 @@ def test_a_small_atlas_writes_its_table_figures_and_sentences(small):
         assert row.difference.richer is not None  # both cells are corners
     text = (folder / "atlas.md").read_text()
     best = min(table, key=lambda r: r.difference.value)
-    assert f"by {-best.difference.value:.2f}" in text
+    if best.difference.distinguishable:
+        assert f"by {-best.difference.value:.2f}" in text
+    else:  # named among the cells not told apart, or whose uncertainty is not measured
+        assert pages._where(best) in text
 
 
 def test_a_resumed_atlas_runs_nothing_and_other_settings_are_refused(small):
@@ -130,3 +134,66 @@ def test_an_atlas_stopped_by_signals_while_its_workers_run_resumes_to_the_same(s
         assert stop.seconds < PROMPTLY
     optima = numbers(tmp_path / "atlas")
     assert optima and optima == numbers(folder)
+
+
+def _stage_record(value: float, status: str = "converged") -> dict:
+    """A stage's record of an optimum of ``value`` (sthenic), as ``atlas._record`` keeps it."""
+    converged = status == "converged"
+    return {
+        "status": status,
+        "feasible": True,
+        "certified": converged,
+        "costs": {"sthenic": value},
+        "starts": 1,
+        "starts_at_best": 1 if converged else 0,
+        "next_optimum": 0.0,
+        "violations": "",
+        "seconds": 1.0,
+    }
+
+
+def _write_cell(folder, settings, values: dict) -> None:
+    """Records of the one cell of ``settings``: {(stage, knee): (value, status)}."""
+    import json
+
+    (cell,) = settings.cells()
+    for (stage, knee), (value, status) in values.items():
+        path = folder / atlas.Point(stage, knee, "sthenic", cell).filename()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(_stage_record(value, status)))
+
+
+def test_a_re_solve_that_did_not_converge_measures_nothing(tmp_path):
+    """A tighter tolerance's re-solve that ends at the acceptable level leaves its term and
+    the uncertainty unknown (empty in the CSV, never 0), the cell not distinguishable, and
+    the CSV, atlas.md and the run's summary say which re-solve and why."""
+    settings = atlas.Settings(ROBOT, (0.3,), (0.0,), (0.0,), ("sthenic",), 1, 0, 1)
+    acceptable = "Solved_To_Acceptable_Level"
+    values = {
+        ("final", "revolute"): (100.0, "converged"),
+        ("final", "rolling"): (90.0, "converged"),
+        ("fine", "revolute"): (100.1, "converged"),
+        ("fine", "rolling"): (90.0, "converged"),
+        ("tight", "revolute"): (100.0, acceptable),
+        ("tight", "rolling"): (90.0, "converged"),
+        ("richer", "revolute"): (99.0, "converged"),
+        ("richer", "rolling"): (88.0, "converged"),
+    }
+    _write_cell(tmp_path, settings, values)
+    (row,) = pages.rows(tmp_path, settings)
+    diff = row.difference
+    assert diff.value == pytest.approx(-10.0)
+    assert diff.tolerance is None and diff.uncertainty is None and not diff.distinguishable
+    assert diff.discretization == pytest.approx(100 * (90.0 / 100.1 - 1) + 10.0)
+    line = pages.csv_text([row], ROBOT.weight).splitlines()[1]
+    fields = next(csv.reader([line]))
+    assert fields[pages.COLUMNS.index("tolerance [%]")] == ""
+    assert fields[pages.COLUMNS.index("uncertainty [%]")] == ""
+    assert fields[pages.COLUMNS.index("distinguishable")] == "no"
+    why = fields[pages.COLUMNS.index("why empty")]
+    assert "tighter tolerance" in why and f"revolute NOT CONVERGED: {acceptable}" in why
+    text = pages.sentences(settings, [row])
+    assert "not measured" in text and acceptable in text
+    assert "less in 1 of 1" not in text
+    summary = atlas.summarize(tmp_path, settings)
+    assert "NOT MEASURED" in summary and "tighter tolerance" in summary and acceptable in summary

@@ -17,7 +17,15 @@ import numpy as np
 
 from biped.model.criteria import CRITERION_UNITS
 from biped.runtime.files import atomic_path, atomic_write_text
-from biped.studies.atlas import RICHER_KNOTS, Cell, Difference, Settings, difference, load
+from biped.studies.atlas import (
+    MEASURES,
+    RICHER_KNOTS,
+    Cell,
+    Difference,
+    Settings,
+    difference,
+    load,
+)
 
 CRITERION_NAMES = {
     "sthenic": "sthenic criterion C_Γ (squared torques per metre walked)",
@@ -42,7 +50,7 @@ def rows(folder, settings: Settings) -> list[Row]:
     found = []
     for criterion in settings.criteria:
         for cell in settings.cells():
-            diff, finals = difference(folder, criterion, cell)
+            diff, finals = difference(folder, settings, criterion, cell)
             found.append(Row(criterion, cell, diff, finals["revolute"], finals["rolling"]))
     return found
 
@@ -101,7 +109,7 @@ def csv_text(table: list[Row], weight: float) -> str:
             number(costs[0], 10),
             number(costs[1], 10),
             number(d.value, 6),
-            number(None if d.value is None else d.uncertainty, 3),
+            number(d.uncertainty, 3),
             "" if d.value is None else ("yes" if d.distinguishable else "no"),
             number(d.discretization, 3),
             number(d.tolerance, 3),
@@ -114,10 +122,22 @@ def csv_text(table: list[Row], weight: float) -> str:
                 )
                 for c in costs
             ),
-            f'"{d.why}"' if d.why else "",
+            _quoted(why_empty(d)),
         ]
         lines.append(",".join(cells))
     return "\n".join(lines) + "\n"
+
+
+def why_empty(d: Difference) -> str:
+    """Why a line's empty numbers are: no difference (a knee not certified), or each re-solve
+    of the cell that measured nothing (an unknown term leaves the uncertainty empty)."""
+    if d.why:
+        return d.why
+    return "; ".join(f"{what} not measured ({why})" for what, why in d.unmeasured)
+
+
+def _quoted(text: str) -> str:
+    return "" if not text else '"' + text.replace('"', '""') + '"'
 
 
 def figure(settings: Settings, table: list[Row], criterion: str):
@@ -137,8 +157,8 @@ def figure(settings: Settings, table: list[Row], criterion: str):
     fig.suptitle(
         f"{CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: "
         "(rolling − revolute) / revolute knee\n"
-        "blue: the rolling knee needs less; hatched: not distinguishable; x: no "
-        "certified optimum of both knees",
+        "blue: the rolling knee needs less; hatched: not distinguishable (±?: uncertainty not "
+        "measured); x: no certified optimum of both knees",
         fontsize=10,
     )
     return fig
@@ -174,8 +194,9 @@ def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> Non
 
 
 def _cell_label(ax, at: tuple[int, int], d: Difference, top: float) -> None:
-    """A cell's difference ± uncertainty (white on the darkest cells), hatched when not
-    distinguishable; a cross where a knee has no certified optimum."""
+    """A cell's difference ± uncertainty (white on the darkest cells; ±? where it is not
+    measured), hatched when not distinguishable; a cross where a knee has no certified
+    optimum."""
     from matplotlib.patches import Rectangle
 
     x, y = at
@@ -183,10 +204,11 @@ def _cell_label(ax, at: tuple[int, int], d: Difference, top: float) -> None:
         ax.plot(x, y, "kx", markersize=10)
         return
     dark = abs(d.value) > 0.6 * top
+    spread = "?" if d.uncertainty is None else f"{d.uncertainty:.1f}"
     ax.text(
         x,
         y,
-        f"{d.value:+.1f}\n±{d.uncertainty:.1f}",
+        f"{d.value:+.1f}\n±{spread}",
         ha="center",
         va="center",
         fontsize=6.5,
@@ -197,22 +219,42 @@ def _cell_label(ax, at: tuple[int, int], d: Difference, top: float) -> None:
 
 
 def _curves_panel(ax, settings: Settings, rows_: list[Row]) -> None:
-    """The differences over speed, one curve per clearance, with their error bars."""
+    """The differences over speed, one curve per clearance, with their error bars; an open
+    marker without a bar where the uncertainty is not measured."""
+    unknown = False
     for k, clearance in enumerate(settings.clearances):
         picked = [
             r for r in rows_ if r.cell.clearance == clearance and r.difference.value is not None
         ]
         if not picked:
             continue
-        ax.errorbar(
+        ax.plot(
             [r.cell.speed for r in picked],
             [r.difference.value for r in picked],
-            yerr=[r.difference.uncertainty for r in picked],
-            fmt="o-",
-            capsize=3,
+            "-",
             color=f"C{k}",
             label=f"clearance {100 * clearance:g} cm",
         )
+        measured = [r for r in picked if r.difference.uncertainty is not None]
+        ax.errorbar(
+            [r.cell.speed for r in measured],
+            [r.difference.value for r in measured],
+            yerr=[r.difference.uncertainty for r in measured],
+            fmt="o",
+            capsize=3,
+            color=f"C{k}",
+        )
+        blind = [r for r in picked if r.difference.uncertainty is None]
+        unknown = unknown or bool(blind)
+        ax.plot(
+            [r.cell.speed for r in blind],
+            [r.difference.value for r in blind],
+            "o",
+            color=f"C{k}",
+            fillstyle="none",
+        )
+    if unknown:
+        ax.plot([], [], "o", color="0.4", fillstyle="none", label="uncertainty not measured")
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_xlabel("speed [m/s]")
     ax.set_ylabel("(rolling − revolute) / revolute [%]")
@@ -262,7 +304,10 @@ def _criterion_sentences(mine: list[Row]) -> list[str]:
         return ["No cell has certified optima of both knees."]
     less = [r for r in done if r.difference.distinguishable and r.difference.value < 0]
     more = [r for r in done if r.difference.distinguishable and r.difference.value > 0]
-    blind = [r for r in done if not r.difference.distinguishable]
+    blind = [
+        r for r in done if not r.difference.distinguishable and r.difference.uncertainty is not None
+    ]
+    unknown = [r for r in done if r.difference.uncertainty is None]
     if less:
         best = min(less, key=lambda r: r.difference.value)
         lines.append(
@@ -285,6 +330,14 @@ def _criterion_sentences(mine: list[Row]) -> list[str]:
             + (" ..." if len(blind) > 6 else "")
             + "."
         )
+    if unknown:
+        lines.append(
+            f"- The uncertainty of {len(unknown)} cells is not measured, so they are not "
+            "distinguishable until it is: "
+            + "; ".join(f"{_where(r)} ({_uncertainty_unmeasured(r)})" for r in unknown[:6])
+            + (" ..." if len(unknown) > 6 else "")
+            + "."
+        )
     empty = [r for r in mine if r.difference.value is None]
     if empty:
         lines.append(
@@ -301,6 +354,13 @@ def _criterion_sentences(mine: list[Row]) -> list[str]:
             f"cells the difference moves by {min(moves):+.2f} to {max(moves):+.2f} points."
         )
     return lines
+
+
+def _uncertainty_unmeasured(row: Row) -> str:
+    """Which terms of a row's uncertainty are not measured, and why."""
+    richer = MEASURES["richer"]
+    found = [(what, why) for what, why in row.difference.unmeasured if what != richer]
+    return "; ".join(f"{what} not measured: {why}" for what, why in found)
 
 
 def write(folder, out=None, walks=()) -> list[Path]:

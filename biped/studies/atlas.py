@@ -18,7 +18,9 @@ grid (``biped.optimization.comparison.relative_change``). Its uncertainty (``Dif
 what moves it: the finer grid's difference less the cell's, the tighter tolerance's less
 the cell's, and the spread of the starts (for a knee whose best value one start alone reached,
 the distance to the next optimum the starts reached). A difference no larger than its
-uncertainty is not distinguishable. A point whose solver did not converge, or whose optimum
+uncertainty is not distinguishable. A re-solve that did not converge measures nothing: its
+term is unknown, never 0, and the difference not distinguishable until it is measured, with
+why (``Difference.unmeasured``). A point whose solver did not converge, or whose optimum
 is infeasible, leaves its cell empty, with why.
 """
 
@@ -411,79 +413,121 @@ def summarize(folder, settings: Settings) -> str:
     note = (
         f"; {len(seconds)} optimizations, median {np.median(seconds):.2f} s each" if seconds else ""
     )
-    return campaign.tally(finals, why_not, counted, note, most=8)
+    text = campaign.tally(finals, why_not, counted, note, most=8)
+    missing = unmeasured(folder, settings)
+    if missing:
+        text += f"; NOT MEASURED by {len(missing)} re-solves: " + ", ".join(missing[:8])
+        text += " ..." if len(missing) > 8 else ""
+    return text
+
+
+def unmeasured(folder, settings: Settings) -> list[str]:
+    """Each re-solve of a cell with a difference that measured nothing, and why, a line each
+    (``Difference.unmeasured``: the finer grid's or the tighter tolerance's leave the cell's
+    uncertainty unknown)."""
+    lines = []
+    for criterion in settings.criteria:
+        for cell in settings.cells():
+            diff, _ = difference(folder, settings, criterion, cell)
+            lines += [f"{criterion} {cell.name()} {what} ({why})" for what, why in diff.unmeasured]
+    return lines
+
+
+# What each re-solve of a cell measures, in words.
+MEASURES = {
+    "fine": "finer grid",
+    "tight": "tighter tolerance",
+    "richer": f"{RICHER_KNOTS} knots",
+}
 
 
 @dataclass(frozen=True)
 class Difference:
     """The knees compared in one cell for one criterion [%], with what moves the difference.
 
+    A term that was not measured (a re-solve that did not converge) is None, never 0: the
+    uncertainty is then unknown and the difference not distinguishable until it is measured.
+
     Attributes:
         value: (rolling − revolute) / revolute on the check grid [%], None without both.
-        discretization: the finer grid's difference less ``value`` [%].
-        tolerance: the tighter tolerance's less ``value`` [%].
+        discretization: the finer grid's difference less ``value`` [%], None if not measured.
+        tolerance: the tighter tolerance's less ``value`` [%], None if not measured.
         starts: the spread of the starts [%]: √ of the squared distances to the next optimum
-            of each knee whose best one start alone reached.
+            of each knee whose best one start alone reached; None without ``value``.
         richer: the difference with the richer family (corner cells) [%], else None.
         why: why there is no difference (a knee not certified), else "".
+        unmeasured: (re-solve, why) of each re-solve asked of the cell that gave no
+            difference (``MEASURES``' words: a knee's optimum missing or not certified).
     """
 
     value: float | None
-    discretization: float
-    tolerance: float
-    starts: float
+    discretization: float | None
+    tolerance: float | None
+    starts: float | None
     richer: float | None
     why: str
+    unmeasured: tuple = ()
 
     @property
-    def uncertainty(self) -> float:
-        """[%] The sum of the three."""
+    def uncertainty(self) -> float | None:
+        """[%] The sum of the three; None (unknown) while one of them is not measured."""
+        terms = (self.discretization, self.tolerance, self.starts)
+        if any(term is None for term in terms):
+            return None
         return abs(self.discretization) + abs(self.tolerance) + self.starts
 
     @property
     def distinguishable(self) -> bool:
-        return self.value is not None and abs(self.value) > self.uncertainty
+        """Larger than its uncertainty, which is measured."""
+        uncertainty = self.uncertainty
+        return self.value is not None and uncertainty is not None and abs(self.value) > uncertainty
 
 
-def difference(folder, criterion: str, cell: Cell) -> tuple[Difference, dict]:
+def _not_certified(contents: dict) -> str:
+    """Why the knees' records of one stage give no difference ("" when both are certified)."""
+    reasons = []
+    for knee in KNEES:
+        content = contents[knee]
+        if content is None:
+            reasons.append(f"{knee} missing")
+        elif not content["certified"]:
+            why = campaign.failure(content["status"], content["feasible"])
+            detail = f": {content['violations']}" if content["violations"] else ""
+            reasons.append(f"{knee} {why}{detail}")
+    return "; ".join(reasons)
+
+
+def difference(folder, settings: Settings, criterion: str, cell: Cell) -> tuple[Difference, dict]:
     """The cell's ``Difference`` for ``criterion`` and each knee's final record."""
     records = {
         stage: {k: read(folder, Point(stage, k, criterion, cell)) for k in KNEES}
         for stage in STAGES
     }
     finals = records["final"]
-    bad = [k for k in KNEES if finals[k] is None or not finals[k]["certified"]]
-    if bad:
-        reasons = []
-        for knee in bad:
-            content = finals[knee]
-            if content is None:
-                reasons.append(f"{knee} missing")
-            else:
-                why = campaign.failure(content["status"], content["feasible"])
-                detail = f": {content['violations']}" if content["violations"] else ""
-                reasons.append(f"{knee} {why}{detail}")
-        return Difference(None, 0.0, 0.0, 0.0, None, "; ".join(reasons)), finals
+    why = _not_certified(finals)
+    if why:
+        return Difference(None, None, None, None, None, why), finals
 
     def change(stage):
         contents = records[stage]
-        if any(c is None or not c["certified"] for c in contents.values()):
-            return None
         return relative_change(
             contents["rolling"]["costs"][criterion], contents["revolute"]["costs"][criterion]
         )
 
     value = change("final")
-    moved = {stage: change(stage) for stage in ("fine", "tight", "richer")}
+    asked = ("fine", "tight") + (("richer",) if cell in settings.corners() else ())
+    missing = {stage: _not_certified(records[stage]) for stage in asked}
+    moved = {stage: None if missing[stage] else change(stage) for stage in asked}
     spread = 100 * math.sqrt(sum(finals[k]["next_optimum"] ** 2 for k in KNEES))
     return (
         Difference(
             value=value,
-            discretization=0.0 if moved["fine"] is None else moved["fine"] - value,
-            tolerance=0.0 if moved["tight"] is None else moved["tight"] - value,
+            discretization=None if moved["fine"] is None else moved["fine"] - value,
+            tolerance=None if moved["tight"] is None else moved["tight"] - value,
             starts=spread,
-            richer=moved["richer"],
+            richer=moved.get("richer"),
             why="",
+            unmeasured=tuple((MEASURES[s], why) for s, why in missing.items() if why),
         ),
         finals,
     )
