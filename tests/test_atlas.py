@@ -197,3 +197,46 @@ def test_a_re_solve_that_did_not_converge_measures_nothing(tmp_path):
     assert "less in 1 of 1" not in text
     summary = atlas.summarize(tmp_path, settings)
     assert "NOT MEASURED" in summary and "tighter tolerance" in summary and acceptable in summary
+
+
+def _drawn_figure(speeds, clearances, criterion):
+    """The atlas figure of a table of made-up differences, drawn, and its renderer."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    settings = atlas.Settings(ROBOT, speeds, clearances, (0.0,), (criterion,), 1, 0, 1)
+    table = [
+        pages.Row(criterion, cell, Difference(-1.0 - k, 0.1, 0.0, 0.1, None, ""), None, None)
+        for k, cell in enumerate(settings.cells())
+    ]
+    figure = pages.figure(settings, table, criterion)
+    renderer = FigureCanvasAgg(figure).get_renderer()
+    figure.draw(renderer)
+    return figure, renderer
+
+
+@pytest.mark.parametrize(
+    "speeds, clearances", [((0.2,), (0.0, 0.03)), (atlas.DEFAULT_SPEEDS, atlas.DEFAULT_CLEARANCES)]
+)
+def test_the_atlas_figure_is_readable(speeds, clearances):
+    """Whatever the criterion and grid: no literal underscore outside mathtext, the speed
+    ticks of the curves apart, every cell's label 8 pt or larger, the legend off the
+    curves."""
+    import re
+
+    from matplotlib.text import Text
+
+    for criterion in pages.CRITERION_NAMES:
+        figure, renderer = _drawn_figure(speeds, clearances, criterion)
+        for text in figure.findobj(Text):
+            assert "_" not in re.sub(r"\$[^$]*\$", "", text.get_text()), text.get_text()
+    (curves,) = [ax for ax in figure.axes if "bars" in ax.get_title()]
+    (grid,) = [ax for ax in figure.axes if "cells" in ax.get_title()]
+    low, high = curves.get_xlim()
+    ticks = [t for t in curves.get_xticklabels() if t.get_text()]
+    ticks = [t for t in ticks if low <= t.get_position()[0] <= high]
+    boxes = sorted((t.get_window_extent(renderer) for t in ticks), key=lambda b: b.x0)
+    apart = [a.x1 < b.x0 for a, b in zip(boxes[:-1], boxes[1:], strict=True)]
+    assert boxes and all(apart), [t.get_text() for t in ticks]
+    assert grid.texts and min(t.get_fontsize() for t in grid.texts) >= 8.0
+    legend = curves.get_legend().get_window_extent(renderer)
+    assert not legend.overlaps(curves.get_window_extent(renderer))

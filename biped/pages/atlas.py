@@ -33,6 +33,27 @@ CRITERION_NAMES = {
     "energy-per-metre": "energy per metre walked C_E / S",
     "electrical": "electrical energy per metre walked E / S (the motors', no regeneration)",
 }
+# The same in a figure's title, the subscripts as subscripts (mathtext).
+FIGURE_NAMES = {
+    "sthenic": r"sthenic criterion $C_\Gamma$ (squared torques per metre walked)",
+    "energy": r"energy criterion $C_E$ (per step)",
+    "energy-per-metre": r"energy per metre walked $C_E\,/\,S$",
+    "electrical": r"electrical energy per metre walked $E\,/\,S$ (the motors', no regeneration)",
+}
+# A map's cell: its width at least [in], and its label's font [pt] from the first size (the
+# least readable) up to the second, as the cell allows.
+CELL_WIDTH = 0.45
+CELL_FONT = (8.0, 14.0)
+# A map panel's plot area at least [in] (width, height) and what its labels, colour bar and
+# titles take beside it.
+MAP_AREA = (3.6, 3.2)
+MAP_MARGINS = (1.6, 1.4)
+# The curves' panel with its legend beside it [in].
+CURVES_WIDTH = 7.4
+# The curves' speed axis: a tick at each speed for at most this many speeds, else
+# matplotlib's; one speed in a span of this much either side of it [m/s].
+SPEED_TICKS = 12
+ONE_SPEED_SPAN = 0.05
 
 
 @dataclass(frozen=True)
@@ -145,17 +166,21 @@ def figure(settings: Settings, table: list[Row], criterion: str):
     from matplotlib.figure import Figure
 
     bends = settings.knee_bends
-    fig = Figure(figsize=(5.2 * len(bends) + 5.6, 4.6), layout="constrained")
+    width, height = _map_area(settings)
+    fig = Figure(
+        figsize=((width + MAP_MARGINS[0]) * len(bends) + CURVES_WIDTH, height + MAP_MARGINS[1]),
+        layout="constrained",
+    )
     axes = fig.subplots(1, len(bends) + 1, squeeze=False)[0]
     mine = [r for r in table if r.criterion == criterion]
     values = [r.difference.value for r in mine if r.difference.value is not None]
     top = max([abs(v) for v in values], default=1.0) or 1.0
     for ax, bend in zip(axes[:-1], bends, strict=True):
         _map_panel(fig, ax, settings, [r for r in mine if r.cell.knee_bend == bend], top)
-        ax.set_title(f"{_bend_words(bend)}; cells: difference ± uncertainty [%]", fontsize=9)
+        ax.set_title(f"{_bend_words(bend)}\ncells: difference ± uncertainty [%]", fontsize=9)
     _curves_panel(axes[-1], settings, [r for r in mine if r.cell.knee_bend == bends[0]])
     fig.suptitle(
-        f"{CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: "
+        f"{FIGURE_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: "
         "(rolling − revolute) / revolute knee\n"
         "blue: the rolling knee needs less; hatched: not distinguishable (±?: uncertainty not "
         "measured); x: no certified optimum of both knees",
@@ -183,9 +208,10 @@ def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> Non
         aspect="auto",
         extent=(-0.5, len(speeds) - 0.5, -0.5, len(clearances) - 0.5),
     )
+    font = cell_font(settings)
     for r in rows_:
         at = (speeds.index(r.cell.speed), clearances.index(r.cell.clearance))
-        _cell_label(ax, at, r.difference, top)
+        _cell_label(ax, at, r.difference, top, font)
     ax.set_xticks(range(len(speeds)), [f"{s:g}" for s in speeds])
     ax.set_yticks(range(len(clearances)), [f"{100 * c:g}" for c in clearances])
     ax.set_xlabel("speed [m/s]")
@@ -193,7 +219,21 @@ def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> Non
     fig.colorbar(image, ax=ax, label="rolling vs revolute [%]")
 
 
-def _cell_label(ax, at: tuple[int, int], d: Difference, top: float) -> None:
+def _map_area(settings: Settings) -> tuple[float, float]:
+    """[in] (width, height) of a map panel's plot area: ``MAP_AREA``, wider for many speeds
+    (``CELL_WIDTH`` each)."""
+    return max(MAP_AREA[0], CELL_WIDTH * len(settings.speeds)), MAP_AREA[1]
+
+
+def cell_font(settings: Settings) -> float:
+    """[pt] The font of a map cell's two lines of label: as large as the cell holds (about
+    4 characters wide, 2.5 lines high), within ``CELL_FONT``."""
+    width, height = _map_area(settings)
+    cell = (72 * width / len(settings.speeds), 72 * height / len(settings.clearances))
+    return float(np.clip(min(cell[0] / 3.6, cell[1] / 3.0), *CELL_FONT))
+
+
+def _cell_label(ax, at: tuple[int, int], d: Difference, top: float, font: float) -> None:
     """A cell's difference ± uncertainty (white on the darkest cells; ±? where it is not
     measured), hatched when not distinguishable; a cross where a knee has no certified
     optimum."""
@@ -211,7 +251,7 @@ def _cell_label(ax, at: tuple[int, int], d: Difference, top: float) -> None:
         f"{d.value:+.1f}\n±{spread}",
         ha="center",
         va="center",
-        fontsize=6.5,
+        fontsize=font,
         color="white" if dark else "black",
     )
     if not d.distinguishable:
@@ -220,7 +260,7 @@ def _cell_label(ax, at: tuple[int, int], d: Difference, top: float) -> None:
 
 def _curves_panel(ax, settings: Settings, rows_: list[Row]) -> None:
     """The differences over speed, one curve per clearance, with their error bars; an open
-    marker without a bar where the uncertainty is not measured."""
+    marker without a bar where the uncertainty is not measured; the legend beside the plot."""
     unknown = False
     for k, clearance in enumerate(settings.clearances):
         picked = [
@@ -228,13 +268,8 @@ def _curves_panel(ax, settings: Settings, rows_: list[Row]) -> None:
         ]
         if not picked:
             continue
-        ax.plot(
-            [r.cell.speed for r in picked],
-            [r.difference.value for r in picked],
-            "-",
-            color=f"C{k}",
-            label=f"clearance {100 * clearance:g} cm",
-        )
+        ax.plot([r.cell.speed for r in picked], [r.difference.value for r in picked], color=f"C{k}")
+        ax.plot([], [], "o-", color=f"C{k}", label=f"clearance {100 * clearance:g} cm")
         measured = [r for r in picked if r.difference.uncertainty is not None]
         ax.errorbar(
             [r.cell.speed for r in measured],
@@ -256,10 +291,24 @@ def _curves_panel(ax, settings: Settings, rows_: list[Row]) -> None:
     if unknown:
         ax.plot([], [], "o", color="0.4", fillstyle="none", label="uncertainty not measured")
     ax.axhline(0.0, color="k", lw=0.8)
+    _speed_axis(ax, settings.speeds)
     ax.set_xlabel("speed [m/s]")
     ax.set_ylabel("(rolling − revolute) / revolute [%]")
-    ax.set_title(f"{_bend_words(settings.knee_bends[0])}; bars: uncertainty", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.set_title(f"{_bend_words(settings.knee_bends[0])}\nbars: uncertainty [%]", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the curves
+
+
+def _speed_axis(ax, speeds) -> None:
+    """A tick at each speed, unless there are more than ``SPEED_TICKS`` or two lie closer
+    than a ``SPEED_TICKS``-th of the span (then matplotlib's); one speed in a span of
+    ``ONE_SPEED_SPAN`` either side."""
+    speeds = sorted(speeds)
+    span = speeds[-1] - speeds[0]
+    if len(speeds) == 1:
+        ax.set_xlim(speeds[0] - ONE_SPEED_SPAN, speeds[0] + ONE_SPEED_SPAN)
+    gaps = np.diff(speeds)
+    if len(speeds) <= SPEED_TICKS and (len(speeds) == 1 or gaps.min() >= span / SPEED_TICKS):
+        ax.set_xticks(speeds, [f"{s:g}" for s in speeds])
 
 
 def _bend_words(bend: float) -> str:
