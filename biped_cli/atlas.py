@@ -69,7 +69,7 @@ def cmd_atlas(args) -> int:
     if args.dask is not None:
         check_dask(args.dask)
     atlas.run_atlas(args.out, settings, **types.campaign(args, "atlas"))
-    walks = [] if args.no_walks else _walks(args.out, settings)
+    walks = None if args.no_walks else _walks(args.out, settings)
     for path in pages.write(args.out, walks=walks):
         print(f"wrote {path}")
     certified = all(

@@ -152,11 +152,10 @@ def _stage_record(value: float, status: str = "converged") -> dict:
     }
 
 
-def _write_cell(folder, settings, values: dict) -> None:
-    """Records of the one cell of ``settings``: {(stage, knee): (value, status)}."""
+def _write_cell(folder, cell, values: dict) -> None:
+    """Records of ``cell``: {(stage, knee): (value, status)}."""
     import json
 
-    (cell,) = settings.cells()
     for (stage, knee), (value, status) in values.items():
         path = folder / atlas.Point(stage, knee, "sthenic", cell).filename()
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -179,7 +178,7 @@ def test_a_re_solve_that_did_not_converge_measures_nothing(tmp_path):
         ("richer", "revolute"): (99.0, "converged"),
         ("richer", "rolling"): (88.0, "converged"),
     }
-    _write_cell(tmp_path, settings, values)
+    _write_cell(tmp_path, settings.cells()[0], values)
     (row,) = pages.rows(tmp_path, settings)
     diff = row.difference
     assert diff.value == pytest.approx(-10.0)
@@ -240,3 +239,34 @@ def test_the_atlas_figure_is_readable(speeds, clearances):
     assert grid.texts and min(t.get_fontsize() for t in grid.texts) >= 8.0
     legend = curves.get_legend().get_window_extent(renderer)
     assert not legend.overlaps(curves.get_window_extent(renderer))
+
+
+def test_atlas_md_says_what_each_number_compares_for_one_speed(tmp_path):
+    """One speed, two clearances, the richer gait measured at one corner and not at the
+    other: atlas.md counts in the singular where there is one (no range of one value), says
+    what the richer gait's move compares, why the other corner has none (as the CSV's 'why
+    empty' does), and that the optima were not walked."""
+    settings = atlas.Settings(ROBOT, (0.2,), (0.0, 0.03), (0.0,), ("sthenic",), 1, 0, 1)
+    acceptable = "Solved_To_Acceptable_Level"
+    for cell, richer in zip(settings.cells(), ("converged", acceptable), strict=True):
+        values = {
+            (stage, knee): (value, "converged")
+            for stage in ("final", "fine", "tight")
+            for knee, value in (("revolute", 100.0), ("rolling", 80.0))
+        }
+        values |= {("richer", "revolute"): (50.0, richer), ("richer", "rolling"): (38.0, richer)}
+        _write_cell(tmp_path, cell, values)
+    table = pages.rows(tmp_path, settings)
+    text = pages.sentences(settings, table)
+    assert "over 1 speed (0.2 m/s), 2 swing-foot clearances (0 and 3 cm)" in text
+    assert "a least stance-knee bend of 0 rad" in text
+    assert "1 speeds" not in text and "0.2-0.2" not in text and "1 corner cells" not in text
+    assert "at 1 corner cell (0.2 m/s, clearance 0 cm) the difference moves by -4.00 " in text
+    assert "percentage points (its value with 3 knots less the paper's spline's)" in text
+    missing = f"0.2 m/s, clearance 3 cm (revolute NOT CONVERGED: {acceptable}; rolling"
+    assert missing in text
+    assert "Not walked" in text and "--no-walks" in text
+    lines = list(csv.reader(pages.csv_text(table, ROBOT.weight).splitlines()))
+    why = lines[2][pages.COLUMNS.index("why empty")]
+    assert lines[2][pages.COLUMNS.index("difference with 3 knots [%]")] == ""
+    assert why.startswith("3 knots not measured") and acceptable in why

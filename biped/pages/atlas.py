@@ -318,26 +318,56 @@ def _bend_words(bend: float) -> str:
     return f"stance knee bent {bend:g} rad at least"
 
 
-def sentences(settings: Settings, table: list[Row], walks=()) -> str:
-    """``atlas.md``: what the numbers say, criterion by criterion, computed from them."""
+def sentences(settings: Settings, table: list[Row], walks=None) -> str:
+    """``atlas.md``: what the numbers say, criterion by criterion, computed from them;
+    ``walks``: a line per optimum walked in MuJoCo, None when none was asked to walk."""
     lines = ["# Where the rolling knee pays off", ""]
+    clearances = [100 * c for c in settings.clearances]
+    bends = settings.knee_bends
     lines.append(
         f"Optimal gaits of both knees (Table 1 robot unless the record says otherwise) over "
-        f"{len(settings.speeds)} speeds ({settings.speeds[0]:g}-{settings.speeds[-1]:g} m/s), "
-        f"{len(settings.clearances)} swing-foot clearances "
-        f"({', '.join(f'{100 * c:g}' for c in settings.clearances)} cm) and least stance-knee "
-        f"bends of {', '.join(f'{b:g}' for b in settings.knee_bends)} rad. Each difference is "
+        f"{_count(len(settings.speeds), 'speed')} ({_span(settings.speeds, 'm/s')}), "
+        f"{_count(len(clearances), 'swing-foot clearance')} ({_span(clearances, 'cm')}) and "
+        + ("a least stance-knee bend" if len(bends) == 1 else "least stance-knee bends")
+        + f" of {_span(bends, 'rad')}. Each difference is "
         "(rolling − revolute) / revolute on the check grid, with its uncertainty: the finer "
         "grid's change, the tighter tolerance's and the spread of the starts; a difference "
         "no larger than it is not distinguishable."
     )
     for criterion in settings.criteria:
         lines += ["", f"## {CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]", ""]
-        lines += _criterion_sentences([r for r in table if r.criterion == criterion])
-    if walks:
-        lines += ["", "## Do the optima walk?", ""]
-        lines += [f"- {line}" for line in walks]
+        mine = [r for r in table if r.criterion == criterion]
+        lines += _criterion_sentences(mine) + _richer_sentences(mine)
+    lines += ["", "## Do the optima walk?", ""]
+    if walks is None:
+        lines.append(
+            "Not walked: the atlas was written without walking its optima in MuJoCo "
+            "(`biped atlas --no-walks`); `biped validate GAIT.json` walks any of its gait files."
+        )
+    elif not walks:
+        lines.append("No optimum walked: no corner or best pay-off has a gait file.")
+    lines += [f"- {line}" for line in walks or ()]
     return "\n".join(lines) + "\n"
+
+
+def _count(count: int, noun: str) -> str:
+    """ "1 cell", "2 cells"."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"
+
+
+def _span(values, unit: str) -> str:
+    """Values with their unit: "0.2 m/s", "0 and 3 cm", "0.2-1 m/s" for more than three."""
+    words = [f"{v:g}" for v in values]
+    if len(words) > 3:
+        return f"{words[0]}-{words[-1]} {unit}"
+    if len(words) > 1:
+        return f"{', '.join(words[:-1])} and {words[-1]} {unit}"
+    return f"{words[0]} {unit}"
+
+
+def _listed(items: list, describe, most: int = 6) -> str:
+    """The first ``most`` items, ``describe(item)`` each, "; " between, "..." for the rest."""
+    return "; ".join(map(describe, items[:most])) + (" ..." if len(items) > most else "")
 
 
 def _where(row: Row) -> str:
@@ -347,60 +377,79 @@ def _where(row: Row) -> str:
 
 
 def _criterion_sentences(mine: list[Row]) -> list[str]:
+    """Where the rolling knee needs less, more, where the knees cannot be told apart, where
+    that is not known, and the empty cells, each with why."""
     done = [r for r in mine if r.difference.value is not None]
-    lines = []
     if not done:
         return ["No cell has certified optima of both knees."]
+    lines = []
     less = [r for r in done if r.difference.distinguishable and r.difference.value < 0]
     more = [r for r in done if r.difference.distinguishable and r.difference.value > 0]
-    blind = [
-        r for r in done if not r.difference.distinguishable and r.difference.uncertainty is not None
-    ]
     unknown = [r for r in done if r.difference.uncertainty is None]
+    blind = [r for r in done if not r.difference.distinguishable and r not in unknown]
     if less:
         best = min(less, key=lambda r: r.difference.value)
         lines.append(
-            f"- The rolling knee needs less in {len(less)} of {len(done)} cells, by "
+            f"- The rolling knee needs less in {len(less)} of {_count(len(done), 'cell')}, by "
             f"{-best.difference.value:.2f} ± {best.difference.uncertainty:.2f} % at most "
             f"({_where(best)})."
         )
     else:
-        lines.append(f"- The rolling knee needs distinguishably less in none of {len(done)} cells.")
+        lines.append(
+            f"- The rolling knee needs distinguishably less in none of {_count(len(done), 'cell')}."
+        )
     if more:
         worst = max(more, key=lambda r: r.difference.value)
         lines.append(
-            f"- It needs more in {len(more)} cells, by {worst.difference.value:.2f} ± "
+            f"- It needs more in {_count(len(more), 'cell')}, by {worst.difference.value:.2f} ± "
             f"{worst.difference.uncertainty:.2f} % at most ({_where(worst)})."
         )
     if blind:
         lines.append(
-            f"- The knees cannot be told apart in {len(blind)} cells (the difference no larger "
-            f"than its uncertainty): {', '.join(_where(r) for r in blind[:6])}"
-            + (" ..." if len(blind) > 6 else "")
-            + "."
+            f"- The knees cannot be told apart in {_count(len(blind), 'cell')} (the difference "
+            f"no larger than its uncertainty): {_listed(blind, _where)}."
         )
     if unknown:
         lines.append(
-            f"- The uncertainty of {len(unknown)} cells is not measured, so they are not "
-            "distinguishable until it is: "
-            + "; ".join(f"{_where(r)} ({_uncertainty_unmeasured(r)})" for r in unknown[:6])
-            + (" ..." if len(unknown) > 6 else "")
+            f"- {_count(len(unknown), 'cell')} not distinguishable until "
+            + ("its" if len(unknown) == 1 else "their")
+            + " uncertainty is measured: "
+            + _listed(unknown, lambda r: f"{_where(r)} ({_uncertainty_unmeasured(r)})")
             + "."
         )
     empty = [r for r in mine if r.difference.value is None]
     if empty:
         lines.append(
-            f"- {len(empty)} cells have no certified optimum of both knees: "
-            + "; ".join(f"{_where(r)} ({r.difference.why})" for r in empty[:6])
-            + (" ..." if len(empty) > 6 else "")
+            f"- {_count(len(empty), 'cell')} "
+            + ("has" if len(empty) == 1 else "have")
+            + " no certified optimum of both knees: "
+            + _listed(empty, lambda r: f"{_where(r)} ({r.difference.why})")
             + "."
         )
-    richer = [r for r in done if r.difference.richer is not None]
-    if richer:
-        moves = [r.difference.richer - r.difference.value for r in richer]
+    return lines
+
+
+def _richer_sentences(mine: list[Row]) -> list[str]:
+    """How far the difference moves with the richer gait at the corner cells (its value with
+    ``RICHER_KNOTS`` knots less the paper's spline's), and where it is not measured, why."""
+    lines, words = [], f"the richer gait ({RICHER_KNOTS} interior knots)"
+    moved = [r for r in mine if r.difference.value is not None and r.difference.richer is not None]
+    if moved:
+        moves = [r.difference.richer - r.difference.value for r in moved]
+        span = f"{moves[0]:+.2f}" if len(moves) == 1 else f"{min(moves):+.2f} to {max(moves):+.2f}"
         lines.append(
-            f"- With the richer gait ({RICHER_KNOTS} interior knots) at {len(richer)} corner "
-            f"cells the difference moves by {min(moves):+.2f} to {max(moves):+.2f} points."
+            f"- With {words} at {_count(len(moved), 'corner cell')} ({_listed(moved, _where)}) "
+            f"the difference moves by {span} percentage points (its value with {RICHER_KNOTS} "
+            "knots less the paper's spline's)."
+        )
+    richer = MEASURES["richer"]
+    missing = [(r, why) for r in mine for what, why in r.difference.unmeasured if what == richer]
+    if missing:
+        lines.append(
+            f"- With {words} the difference is not measured at "
+            f"{_count(len(missing), 'corner cell')}: "
+            + _listed(missing, lambda found: f"{_where(found[0])} ({found[1]})")
+            + "."
         )
     return lines
 
@@ -412,9 +461,10 @@ def _uncertainty_unmeasured(row: Row) -> str:
     return "; ".join(f"{what} not measured: {why}" for what, why in found)
 
 
-def write(folder, out=None, walks=()) -> list[Path]:
+def write(folder, out=None, walks=None) -> list[Path]:
     """``atlas.csv``, ``atlas-<criterion>.png`` and ``atlas.md`` of the atlas in ``folder``, in
-    ``out`` (default the folder); ``walks``: lines saying which optima walk in MuJoCo."""
+    ``out`` (default the folder); ``walks``: lines saying which optima walk in MuJoCo, None
+    when none was asked to walk."""
     settings = load(folder)
     out = Path(folder if out is None else out)
     out.mkdir(parents=True, exist_ok=True)
