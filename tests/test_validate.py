@@ -142,8 +142,9 @@ def heavy_gait(tmp_path_factory):
 def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_path, capsys):
     """A gait made for a trunk 10 % heavier, played on the committed Table 1 model (--model):
     its torques are not those of that robot's motion, and the replay of its steps fails at
-    the joints that carry the trunk, beside inverse dynamics; on the model of its own robot
-    (the default) the same replay passes."""
+    the joints that carry the trunk, its note giving the share the servos add to each,
+    beside inverse dynamics; on the model of its own robot (the default) the same replay
+    passes."""
     from validate.mjcf import FOLDER
 
     rrd = str(tmp_path / "heavy.rrd")
@@ -157,6 +158,11 @@ def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_pa
     assert not table_1["model"]["passed"] and "trunk_mass" in table_1["model"]["notes"][0]
     stance = [table_1["feedforward"][f"feedback_share_stance_{j}"] for j in ("knee", "hip")]
     assert min(stance) > 0.1
+    (note,) = table_1["feedforward"]["notes"]  # what MuJoCo's replay measured, not a bad file
+    for joint in ("knee", "hip"):
+        share = table_1["feedforward"][f"feedback_share_stance_{joint}"]
+        assert f"{100 * share:.1f} % of stance_{joint}'s" in note, note
+    assert "servos" in note and "not its motion" not in note
     _, out, _ = _run(args, capsys)
     own = json.loads(out)
     assert own["feedforward"]["passed"] and own["inverse_dynamics"]["passed"]

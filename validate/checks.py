@@ -202,11 +202,15 @@ def check_feedforward(spec: mujoco.MjSpec, biped: Biped, samples: GaitSamples) -
     figures |= {f"torque_rms_{joint}": float(v) for joint, v in zip(JOINTS, torques, strict=True)}
     passed = bool(shares.max() < FEEDFORWARD_SHARE)
     notes = []
-    if not passed:
-        worst = [j for j, v in zip(JOINTS, shares, strict=True) if v >= FEEDFORWARD_SHARE]
+    if not passed:  # the file's torques alone do not make its motion in MuJoCo
+        worst = [
+            f"{100 * v:.1f} % of {joint}'s"
+            for joint, v in zip(JOINTS, shares, strict=True)
+            if v >= FEEDFORWARD_SHARE
+        ]
         notes.append(
-            "the file's torques are not its motion's at " + ", ".join(worst) + " (servo share "
-            f">= {FEEDFORWARD_SHARE:g})"
+            "replayed in MuJoCo, the gait's torques need the servos to follow its motion: they "
+            f"add {', '.join(worst)} torque (allowed < {100 * FEEDFORWARD_SHARE:g} % each)"
         )
     shown = ("max_feedback_share",) + tuple(f"feedback_share_{joint}" for joint in JOINTS)
     return Check("feedforward", passed, figures, notes, shown=shown)
