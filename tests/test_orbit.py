@@ -242,3 +242,56 @@ def test_a_map_that_keeps_the_flow_is_told_by_its_gain():
         m = o.multipliers(mean + noise, basis, steps)
         removed = m.flow_gain < o.MARGIN_SPREADS * m.flow_noise
         assert removed == (kept == 0.0), (kept, m.flow_gain, m.flow_noise)
+
+
+def _knob_content(crossing: bool) -> dict:
+    """A study over kp 0, 1, 2 as `biped orbit --vary kp 0:2:3` gives one: no orbit at 0,
+    stable at 1 and 2; with ``crossing``, unstable at 0.5, ρ crossing 1 before 1."""
+    stable = [
+        {"verdict": "stable", "spectral_radius": rho, "spectral_radius_spread": spread}
+        for rho, spread in ((0.760, 0.093), (0.212, 0.034))
+    ]
+    values, orbits = [0.0, 1.0, 2.0], [{"verdict": "unstable"}, *stable]
+    boundaries = [{"between": [0.0, 1.0], "radius_crosses_1_at": None}]
+    if crossing:
+        values.insert(1, 0.5)
+        orbits.insert(
+            1, {"verdict": "unstable", "spectral_radius": 1.35, "spectral_radius_spread": 0.05}
+        )
+        boundaries = [{"between": [0.5, 1.0], "radius_crosses_1_at": 0.8}]
+    return {"values": values, "orbits": orbits, "boundaries": boundaries, "scales": "KP"}
+
+
+@pytest.mark.parametrize("crossing", [False, True])
+def test_the_knob_figure_draws_what_it_measured_and_names_what_it_draws(crossing):
+    """ρ against a gain: no cross on ρ's scale (a value without an orbit has no ρ: it lies
+    in a strip of its own, without a scale), the legend off every panel, a band where the
+    verdict changes, the dotted line named only where ρ crosses 1, every bar whole."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from biped.pages.orbit_figures import knob_figure
+
+    content = _knob_content(crossing)
+    figure = knob_figure(content, "a study")
+    renderer = FigureCanvasAgg(figure).get_renderer()
+    figure.draw(renderer)
+    (ax,) = [a for a in figure.axes if a.get_ylabel().startswith("spectral radius")]
+    (strip,) = [a for a in figure.axes if a is not ax]
+
+    def crosses(panel):
+        return [line for line in panel.lines if line.get_marker() == "x" and len(line.get_xdata())]
+
+    assert not crosses(ax) and len(crosses(strip)) == 1 and not len(strip.get_yticks())
+    (legend,) = figure.legends
+    box = legend.get_window_extent(renderer)
+    assert not any(box.overlaps(panel.get_window_extent(renderer)) for panel in figure.axes)
+    labels = [text.get_text() for text in legend.get_texts()]
+    assert "verdict changes between these scales" in labels
+    dotted = [line for line in ax.lines if line.get_linestyle() == ":"]
+    assert len(dotted) == int(crossing)
+    assert any("crosses 1" in label for label in labels) == crossing
+    titles = [figure.get_suptitle()] + [panel.get_title() for panel in figure.axes]
+    assert not any("dotted" in title for title in titles)
+    found = [orbit for orbit in content["orbits"] if "spectral_radius" in orbit]
+    top = max(orbit["spectral_radius"] + 2 * orbit["spectral_radius_spread"] for orbit in found)
+    assert ax.get_ylim()[1] >= top  # every bar whole, none clipped to the top

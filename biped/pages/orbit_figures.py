@@ -4,7 +4,8 @@
     multipliers_figure   the Floquet multipliers in the complex plane with the unit circle,
                          the spectral radius and its uncertainty as circles
     knob_figure          ρ against a scale of one controller gain, its uncertainty, the
-                         values whose walk falls, where ρ crosses 1
+                         values without an orbit apart, where the verdict changes and
+                         where ρ crosses 1
     speeds_figure        ρ of both knees against the walking speed, and their difference
 """
 
@@ -80,38 +81,55 @@ def multipliers_figure(orbit: dict, title: str) -> Figure:
 
 
 def knob_figure(content: dict, title: str) -> Figure:
-    """ρ against the knob's values of a study's content (``validate.orbit_study.content``)."""
-    figure = Figure(figsize=(7.0, 4.4), layout="constrained")
-    ax = figure.subplots()
-    values = np.array(content["values"], float)
-    top = 1.6
-    for value, orbit in zip(values, content["orbits"], strict=True):
+    """ρ against the knob's values of a study's content (``validate.orbit_study.content``):
+    each orbit's ρ with its bar; the values without an orbit in a strip above, off ρ's scale
+    (nothing measured there); a band between two values where the verdict changes, dotted
+    where ρ crosses 1 in it; the legend below, off the data, naming only what is drawn."""
+    figure = Figure(figsize=(7.0, 5.2), layout="constrained")
+    strip, ax = figure.subplots(2, 1, sharex=True, height_ratios=(1.0, 6.0))
+    values, orbits = np.array(content["values"], float), content["orbits"]
+    found = [(v, o) for v, o in zip(values, orbits, strict=True) if "spectral_radius" in o]
+    for value, orbit in found:
+        rho, bar = orbit["spectral_radius"], SPREADS * orbit["spectral_radius_spread"]
         colour = VERDICT_COLOURS.get(orbit["verdict"], "0.5")
-        if "spectral_radius" not in orbit:
-            ax.plot([value], [top], color=colour, **FALLS, clip_on=False)
-            continue
-        rho, spread = orbit["spectral_radius"], orbit["spectral_radius_spread"]
-        ax.errorbar(
-            [value], [min(rho, top)], yerr=[[SPREADS * spread], [SPREADS * spread]], fmt="o",
-            color=colour, capsize=3,
-        )  # fmt: skip
-    for boundary in content["boundaries"]:
-        if boundary["radius_crosses_1_at"] is not None:
-            ax.axvline(boundary["radius_crosses_1_at"], color="0.4", linestyle=":")
-    ax.axhline(1.0, color="k", linewidth=1.2)
-    for verdict, colour in VERDICT_COLOURS.items():
-        ax.plot([], [], "o", color=colour, label=verdict)
-    ax.plot([], [], color="0.5", label="falls: no orbit (unstable)", **FALLS)
-    ax.set_ylim(0.0, top + 0.05)
+        ax.errorbar([value], [rho], yerr=[[bar], [bar]], fmt="o", color=colour, capsize=3)
+    fell = [v for v, o in zip(values, orbits, strict=True) if "spectral_radius" not in o]
+    strip.plot(fell, [0.5] * len(fell), color=VERDICT_COLOURS["unstable"], **FALLS)
+    for verdict in sorted({o["verdict"] for _, o in found}, key=list(VERDICT_COLOURS).index):
+        ax.plot([], [], "o", color=VERDICT_COLOURS[verdict], label=f"ρ: {verdict}")
+    if fell:
+        ax.plot([], [], color=VERDICT_COLOURS["unstable"], label="no orbit: unstable", **FALLS)
+    _boundaries(ax, strip, content["boundaries"])
+    ax.axhline(1.0, color="k", linewidth=1.2, label="ρ = 1")
+    tops = [o["spectral_radius"] + SPREADS * o["spectral_radius_spread"] for _, o in found]
+    ax.set_ylim(0.0, 1.08 * max([1.2, *tops]))
+    strip.set_ylim(0.0, 1.0)
+    strip.set_yticks([])
+    strip.set_ylabel("no\norbit", rotation=0, ha="right", va="center", fontsize=8)
+    strip.tick_params(labelbottom=False)
     ax.set_xlabel(f"scale of {content['scales']} [1]")
     ax.set_ylabel("spectral radius ρ [1]")
-    ax.legend(fontsize=7, loc="lower right", ncols=2)
-    ax.set_title(
-        f"{title}\nρ of the walk's return map, bars ± {SPREADS:g} spreads (the landing's noise); "
-        "dotted: ρ crosses 1",
+    figure.legend(loc="outside lower center", ncols=3, fontsize=7)
+    figure.suptitle(
+        f"{title}\nρ of the walk's return map, bars: ± {SPREADS:g} spreads (the landing's "
+        "noise); above: the scales without an orbit (no ρ)",
         fontsize=9,
     )
     return figure
+
+
+def _boundaries(ax, strip, boundaries: list[dict]) -> None:
+    """Each boundary of a knob's study: a grey band between its two values (on both
+    panels), and a dotted line where ρ crosses 1 (where both have an orbit)."""
+    for k, boundary in enumerate(boundaries):
+        a, b = boundary["between"]
+        label = "verdict changes between these scales" if k == 0 else None
+        for panel in (ax, strip):
+            panel.axvspan(a, b, color="0.9", zorder=0, label=label if panel is ax else None)
+    crossings = [b["radius_crosses_1_at"] for b in boundaries]
+    for k, at in enumerate(x for x in crossings if x is not None):
+        label = "ρ crosses 1 (linear between the two)" if k == 0 else None
+        ax.axvline(at, color="0.3", linestyle=":", label=label)
 
 
 def speeds_figure(rows: list[dict], title: str) -> Figure:
