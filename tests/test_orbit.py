@@ -244,6 +244,16 @@ def test_a_map_that_keeps_the_flow_is_told_by_its_gain():
         assert removed == (kept == 0.0), (kept, m.flow_gain, m.flow_noise)
 
 
+def test_a_complex_pair_is_written_out_not_with_plus_minus():
+    """The slowest mode of a complex pair names both multipliers: "±" is a spread in every
+    line beside it (ρ ± spread)."""
+    pair = np.array([0.006 + 0.212j, 0.006 - 0.212j, 0.1 + 0.0j])
+    multipliers = o.Multipliers(pair, np.zeros((12, 3), complex), 0.0, 0.034)
+    result = o.Orbit(o.NOMINAL, o.Steps(), 0.0, period_ratio=1.0, multipliers=multipliers)
+    note = o.notes(result)[0]
+    assert "0.006 + 0.212i and 0.006 - 0.212i" in note and "±" not in note, note
+
+
 def _knob_content(crossing: bool) -> dict:
     """A study over kp 0, 1, 2 as `biped orbit --vary kp 0:2:3` gives one: no orbit at 0,
     stable at 1 and 2; with ``crossing``, unstable at 0.5, ρ crossing 1 before 1."""

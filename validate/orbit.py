@@ -528,14 +528,18 @@ def notes(result: Orbit) -> list[str]:
         return [f"{result.failure} (an orbit that cannot be found is unstable)"]
     m = result.multipliers
     slowest = m.values[0]
-    if abs(slowest.imag) > 1e-12:
-        kind = f"{slowest.real:.3f} ± {abs(slowest.imag):.3f}i (oscillating over steps)"
+    if abs(slowest.imag) > 1e-12:  # the pair written out: "±" is a spread elsewhere
+        re, im = slowest.real, abs(slowest.imag)
+        mode = (
+            f"slowest multipliers {re:.3f} + {im:.3f}i and {re:.3f} - {im:.3f}i (a complex "
+            "pair: oscillating over steps)"
+        )
     elif slowest.real < 0:
-        kind = f"{slowest.real:.3f} (a flip: errors alternate from step to step)"
+        mode = f"slowest multiplier {slowest.real:.3f} (a flip: errors alternate from step to step)"
     else:
-        kind = f"{slowest.real:.3f} (errors keep their sign)"
+        mode = f"slowest multiplier {slowest.real:.3f} (errors keep their sign)"
     said = [
-        f"slowest multiplier {kind}",
+        mode,
         f"ρ + {MARGIN_SPREADS:g} spreads = {m.upper:.3f}",
     ]
     verdict = result.verdict
