@@ -3,6 +3,7 @@ settings like a sweep, figures and summary from the files."""
 
 import json
 
+import numpy as np
 import pytest
 
 import biped
@@ -129,3 +130,67 @@ def test_a_map_stopped_by_signals_while_its_workers_run_resumes_to_the_same(smal
         assert stop.stderr.splitlines()[-1] == f"biped design-map: interrupted ({name})"
         assert stop.seconds < PROMPTLY
     assert numbers(tmp_path / "map") == numbers(small_map)
+
+
+def _made_up_map(r1, r2, grid_value, table1: float, revolute: float = 30.0):
+    """Settings and results of a map at 0.3 m/s whose every optimization is certified:
+    ``grid_value(r1, r2)`` on the grid, ``table1`` at the Table 1 radii, no joint optimum."""
+    from biped.model.criteria import PAPER_SAFETY
+    from biped.optimization.design import radius_limits
+    from biped.studies.design_map import MapSettings
+
+    upper = tuple(radius_limits(ROBOT))
+    settings = MapSettings(ROBOT, "sthenic", PAPER_SAFETY, (SPEED,), r1, r2, upper, 0, 1)
+    results = {
+        MapPoint("grid", SPEED, (a, b)): {"certified": True, "value": grid_value(a, b)}
+        for a in r1
+        for b in r2
+    }
+    results[MapPoint("table1", SPEED)] = {"certified": True, "value": table1}
+    results[MapPoint("revolute", SPEED)] = {"certified": True, "value": revolute}
+    return settings, results
+
+
+def test_a_coarse_map_puts_the_table_1_radii_on_their_measured_side():
+    """On a 2 x 2 grid whose far corner costs more than the revolute knee, the Table 1 radii
+    measured below it: the map's colour at the Table 1 radii holds their measured value (the
+    map is linear between every measured point), so they lie on the side of the revolute
+    knee's contour that the summary gives them."""
+    from matplotlib.contour import ContourSet
+    from matplotlib.path import Path
+
+    from biped.studies.design_map import map_figure
+
+    def grid_value(a, b):  # the hinges on the axes cost what the revolute knee does
+        return 30.0 + (0.5 if a > 0 and b > 0 else 0.0)
+
+    settings, results = _made_up_map((0.0, 0.08), (0.0, 0.08), grid_value, table1=29.8)
+    (summary,) = speed_summaries(settings, results)
+    assert summary.gain(summary.table1) < 0
+    figure = map_figure(settings, summary, results)
+    (ax,) = [ax for ax in figure.axes if ax.get_xlabel().startswith("r1")]
+    (filled,) = [c for c in ax.collections if isinstance(c, ContourSet) and c.filled]
+    near = 100 * np.array(settings.problem(SPEED).reference_radii) + 0.01  # [cm] off its vertex
+    bands = [
+        (low, high)
+        for path, low, high in zip(
+            filled.get_paths(), filled.levels[:-1], filled.levels[1:], strict=True
+        )
+        if sum(Path(ring).contains_point(near) for ring in path.to_polygons()) % 2
+    ]
+    assert len(bands) == 1 and bands[0][1] <= summary.revolute, bands
+
+
+def test_a_map_of_one_radius_each_says_why_it_is_empty():
+    """A 1 x 1 grid has no map to draw: the figure says so and why, and gives each certified
+    point's value and its change against the revolute knee."""
+    from biped.studies.design_map import map_figure
+
+    settings, results = _made_up_map((0.08,), (0.08,), lambda a, b: 29.0, table1=29.8)
+    (summary,) = speed_summaries(settings, results)
+    figure = map_figure(settings, summary, results)
+    (ax,) = [ax for ax in figure.axes if ax.get_xlabel().startswith("r1")]
+    assert "no map" in ax.get_title() and "2 or more of each" in ax.get_title()
+    labels = [text.get_text() for text in ax.texts]
+    assert any(label.startswith("29 N²·m·s (-3.33 % vs revolute)") for label in labels), labels
+    assert any(label.startswith("29.8 N²·m·s (-0.67 % vs revolute)") for label in labels)
