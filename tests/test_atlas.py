@@ -218,8 +218,8 @@ def _drawn_figure(speeds, clearances, criterion):
 )
 def test_the_atlas_figure_is_readable(speeds, clearances):
     """Whatever the criterion and grid: no literal underscore outside mathtext, the speed
-    ticks of the curves apart, every cell's label 8 pt or larger, the legend off the
-    curves."""
+    ticks of the curves apart, every cell's label 8 pt or larger on a box of its own (over
+    the hatching), the legend off the curves."""
     import re
 
     from matplotlib.text import Text
@@ -237,6 +237,7 @@ def test_the_atlas_figure_is_readable(speeds, clearances):
     apart = [a.x1 < b.x0 for a, b in zip(boxes[:-1], boxes[1:], strict=True)]
     assert boxes and all(apart), [t.get_text() for t in ticks]
     assert grid.texts and min(t.get_fontsize() for t in grid.texts) >= 8.0
+    assert all(t.get_bbox_patch() is not None for t in grid.texts)  # over any hatching
     legend = curves.get_legend().get_window_extent(renderer)
     assert not legend.overlaps(curves.get_window_extent(renderer))
 

@@ -48,6 +48,8 @@ CELL_FONT = (8.0, 14.0)
 # titles take beside it.
 MAP_AREA = (3.6, 3.2)
 MAP_MARGINS = (1.6, 1.4)
+# The maps' colours: blue where the rolling knee needs less.
+CMAP = "RdBu_r"
 # The curves' panel with its legend beside it [in].
 CURVES_WIDTH = 7.4
 # The curves' speed axis: a tick at each speed for at most this many speeds, else
@@ -202,7 +204,7 @@ def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> Non
     image = ax.imshow(
         grid,
         origin="lower",
-        cmap="RdBu_r",
+        cmap=CMAP,
         vmin=-top,
         vmax=top,
         aspect="auto",
@@ -235,8 +237,9 @@ def cell_font(settings: Settings) -> float:
 
 def _cell_label(ax, at: tuple[int, int], d: Difference, top: float, font: float) -> None:
     """A cell's difference ± uncertainty (white on the darkest cells; ±? where it is not
-    measured), hatched when not distinguishable; a cross where a knee has no certified
-    optimum."""
+    measured), hatched when not distinguishable, the label on the cell's own colour over
+    the hatching; a cross where a knee has no certified optimum."""
+    from matplotlib import colormaps
     from matplotlib.patches import Rectangle
 
     x, y = at
@@ -253,6 +256,7 @@ def _cell_label(ax, at: tuple[int, int], d: Difference, top: float, font: float)
         va="center",
         fontsize=font,
         color="white" if dark else "black",
+        bbox=dict(boxstyle="square,pad=0.15", lw=0, fc=colormaps[CMAP](0.5 + d.value / top / 2)),
     )
     if not d.distinguishable:
         ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, fill=False, hatch="//", lw=0, ec="0.55"))
