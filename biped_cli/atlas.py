@@ -39,7 +39,7 @@ def cmd_atlas(args) -> int:
     """Certified optimal gaits of both knees over a grid of speed x swing-foot clearance (x a
     least stance-knee bend), for each criterion asked; each difference between the knees,
     (rolling − revolute) / revolute, with its uncertainty: the change on a grid of twice the
-    samples, at a hundred times tighter tolerance and the spread of the starts; a difference
+    samples, at ten times tighter tolerance and the spread of the starts; a difference
     no larger than it is not distinguishable. At the corner cells the gait is also optimized
     with 3 interior knots: how the difference moves with a richer gait. Writes the optima,
     atlas.csv, atlas-<criterion>.png and atlas.md in --out; the optima at the corners and at

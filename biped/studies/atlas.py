@@ -9,7 +9,7 @@ optimum of the paper's spline, in the campaign's stages (``biped.studies.campaig
 2. ``final``: again from the ``own`` optima of the neighbouring cells (speed and clearance)
    and of the other knee; the best of both is the point's answer, written as a gait file;
 3. ``fine``, ``tight``, ``richer``: the final optimum re-solved with twice the samples per
-   piece (the discretization), to a hundred times tighter tolerance (the solver's), and, at
+   piece (the discretization), to ten times tighter tolerance (the solver's), and, at
    the corner cells, in the family of 3 interior knots (``biped.model.gait``), which holds the
    paper's spline: how much the difference moves when the gait is richer.
 
