@@ -598,28 +598,35 @@ def test_solver_that_does_not_converge_fails_loudly(tmp_path, monkeypatch, capsy
         solver._solver.cache_clear()
 
 
+# Every walkable constraint asked, with a clearance (``biped.model.walkable``).
+WALKING = Safety(clearance=0.02, landing_speed=0.3, friction=0.6, joint_margin=0.05, hip_progress=0.2)
+
+
 @pytest.mark.parametrize(
-    "knee, criterion, radii, knots",
+    "knee, criterion, radii, knots, safety",
     [
-        ("revolute", "sthenic", None, 1),
-        ("rolling", "energy", None, 1),
-        ("rolling", "sthenic", "design", 1),
-        ("rolling", "energy", None, 3),
+        ("revolute", "sthenic", None, 1, Safety(clearance=0.02)),
+        ("rolling", "energy", None, 1, Safety(clearance=0.02)),
+        ("rolling", "sthenic", "design", 1, Safety(clearance=0.02)),
+        ("rolling", "energy", None, 3, Safety(clearance=0.02)),
+        ("revolute", "energy", None, 1, WALKING),
+        ("rolling", "sthenic", "design", 3, WALKING),
     ],
 )
-def test_derivatives_built_sample_by_sample_are_casadis(knee, criterion, radii, knots):
+def test_derivatives_built_sample_by_sample_are_casadis(knee, criterion, radii, knots, safety):
     """The derivatives IPOPT uses (built per sample and chained through the head,
     ``biped.optimization.derivatives``): the Hessian of the Lagrangian and the constraints'
     Jacobian equal CasADi's own of the whole NLP to 1e-12 at random variables and
-    multipliers, with a clearance margin, a design's radii and the energy criterion's slacks,
-    the Jacobian's sparsity holding every nonzero of CasADi's (the objective's gradient,
-    CasADi's own, dense as IPOPT reads it); another robot's differ."""
+    multipliers, with a clearance margin (kept between the samples too), a design's radii,
+    the energy criterion's slacks and the walkable constraints (the landing's and the
+    impact's on the head), the Jacobian's sparsity holding every nonzero of CasADi's (the
+    objective's gradient, CasADi's own, dense as IPOPT reads it); another robot's differ."""
     from biped.optimization.derivatives import dense, full_hessian
     from biped.optimization.solver import Solver
 
     model = biped.Biped(UNEQUAL, knee)
     bounds_ = ((0.001, 0.001), (0.15, 0.2)) if radii else None
-    solver = Solver(model, criterion, Safety(clearance=0.02), 6, bounds_, knots)
+    solver = Solver(model, criterion, safety, 6, bounds_, knots)
     oracle = solver.nlp.oracle()
     x, p = oracle.sx_in(0), oracle.sx_in(1)
     f, g = oracle.call([x, p])[:2]
@@ -643,7 +650,7 @@ def test_derivatives_built_sample_by_sample_are_casadis(knee, criterion, radii, 
     assert np.all(pattern[jacobian != 0] == 1)
     assert solver.gradient.sparsity_out(1).is_dense()  # IPOPT reads it as a dense vector
     heavier = dataclasses.replace(UNEQUAL, trunk_mass=1.1 * UNEQUAL.trunk_mass)
-    other = Solver(biped.Biped(heavier, knee), criterion, Safety(clearance=0.02), 6, bounds_, knots)
+    other = Solver(biped.Biped(heavier, knee), criterion, safety, 6, bounds_, knots)
     wrong = dense(other.hessian(xs, 0.3, 1.7, lam_g))  # another robot's: told apart
     assert np.abs(wrong - expected).max() > 1e-6 * np.abs(expected).max()
     wrong = dense(other.jacobian(xs, 0.3)[1])

@@ -43,7 +43,7 @@ from pathlib import Path
 
 from biped.model.kinematics import check_knee
 from biped.model.robot import FOOT_FRICTION as SLIDING_FRICTION
-from biped.model.robot import SOLE_EDGES, Robot
+from biped.model.robot import JOINT_STOPS, SOLE_EDGES, Robot
 from biped.runtime.files import atomic_write_text
 
 SIDES = ("left", "right")
@@ -102,9 +102,9 @@ IMPRATIO_HARD = 50.0
 # optimal gaits of 0.15-0.45 m/s stay far inside every range (hip -0.17 to 0.22, knee
 # -0.18 to 0, ankle -0.15 to 0.19 rad), their walks too: they play as without limits. A
 # rolling knee's two hinges share the range as they share the flexion (r1 / l and r2 / l).
-HIP_RANGE = (-0.5, 2.0)  # extension 29°, flexion 115°
-KNEE_RANGE = (-2.4, 0.05)  # flexion 138°, 3° past straight
-ANKLE_RANGE = (-0.8, 0.6)  # plantar flexion 46°, dorsiflexion 34°
+HIP_RANGE = JOINT_STOPS["hip"]  # extension 29°, flexion 115°
+KNEE_RANGE = JOINT_STOPS["knee"]  # flexion 138°, 3° past straight
+ANKLE_RANGE = JOINT_STOPS["ankle"]  # plantar flexion 46°, dorsiflexion 34°
 # The stops are as stiff as the contacts (a stop hit by a falling robot gives by a few
 # hundredths of a radian; at MuJoCo's default, 0.02 s, by 0.13 rad).
 LIMIT_SOLREF = "0.004 1"

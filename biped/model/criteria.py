@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model import walkable
 from biped.model.actuators import LIMITS, Actuators, Drive, drive, limit_margins
 from biped.model.dynamics import JOINTS, Biped, zmp_from
 from biped.model.gait import Step, breakpoints, piece_grid, sample
@@ -81,26 +82,47 @@ FOOT_MARGIN_RAMP = 0.1  # fraction of the step
 ACTUATOR_MARGIN = 0.01
 
 
+def foot_margin(t_n) -> np.ndarray:
+    """δ of Ψ6, Ψ7 (the swing heel's and toe's) at the normalised times ``t_n``."""
+    t_n = np.asarray(t_n, dtype=float)
+    ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / FOOT_MARGIN_RAMP, 0.0, 1.0)
+    return MARGINS[5] * ramp
+
+
 @functools.cache
 def margin_profile(samples_per_half: int, knots: int = 1) -> np.ndarray:
     """δ (N, 7) on the time grid of ``biped.model.gait.sample``."""
     t_n = np.concatenate(piece_grid(samples_per_half, knots))
-    ramp = np.clip(np.minimum(t_n, 1.0 - t_n) / FOOT_MARGIN_RAMP, 0.0, 1.0)
     profile = np.tile(MARGINS, (len(t_n), 1))
-    profile[:, 5:] *= ramp[:, None]
+    profile[:, 5:] = foot_margin(t_n)[:, None]
     profile.setflags(write=False)
     return profile
 
 
-# The swing foot's required clearance (``Safety.clearance``, 0 in the paper) ramps up over
-# this fraction of the step at each end, where the foot leaves and reaches the ground.
-CLEARANCE_RAMP = 0.3
-CLEARANCE_DELAY = 0.03
+# The swing sole's clearance (``Safety.clearance`` C, 0 in the paper) is an envelope over the
+# step (``clearance_envelope``): nothing in the lift-off and touchdown windows (a fraction W
+# of the step at each end, ``Safety.clearance_window``), at least ``CLEARANCE_FLOOR`` of C
+# from them on, rising linearly to the whole of C at ``CLEARANCE_FULL`` of the step from
+# each end (30 % to 70 % of it). A full clearance from 10 % of the step is often infeasible
+# (at 0.2 m/s with 3 cm); the optima keep a third of it from there.
+CLEARANCE_WINDOW = 0.1  # W by default [T]
+CLEARANCE_FULL = 0.3  # [T]
+CLEARANCE_FLOOR = 1.0 / 3.0
+MAX_CLEARANCE_WINDOW = 0.45  # [T]: the swing between the windows at least a tenth of the step
 # Largest safety margins accepted [m].
 MAX_CLEARANCE = 0.2
 MAX_ZMP_MARGIN = 0.05
 # Largest least bend of the stance knee asked [rad].
 MAX_KNEE_BEND = 1.0
+# Ranges of the walkable constraints' settings (``biped.model.walkable``): the landing speed
+# [m/s], the friction coefficient, the joints' margin to their stops [rad], the hip's least
+# forward speed as a share of the walking speed.
+MAX_LANDING_SPEED = 10.0
+FRICTION_RANGE = (0.05, 2.0)
+MAX_JOINT_MARGIN = 0.5
+MAX_HIP_PROGRESS = 1.0
+# The walkable constraints' settings that may be None (not asked).
+OPTIONAL = ("landing_speed", "friction", "joint_margin", "hip_progress")
 
 
 @dataclass(frozen=True)
@@ -109,61 +131,117 @@ class Safety:
     engine's contact model and tracking errors. ``Safety()`` is the paper's problem.
 
     Attributes:
-        clearance: [m] height the swing foot keeps off the ground away from the ends of the
-            step (``clearance_profile``); Ψ6, Ψ7 become the heights above it.
+        clearance: [m] height the swing sole keeps off the ground between its lift-off and
+            touchdown windows (``clearance_envelope``), on the check grid's every sample;
+            Ψ6, Ψ7 become the heights above it.
         zmp_margin: [m] distance the ZMP keeps inside the sole's heel and toe (Ψ2, Ψ3).
         knee_bend: [rad] least flexion of the stance knee over the step (Ψ4 becomes the
             flexion beyond it): the two knee kinematics differ only where the knee bends.
         actuator_limits: every joint's torque, speed and voltage within its motor's
             (``biped.model.actuators.limit_margins``) at every sample: a gait the motors
             cannot follow is not feasible.
+        clearance_window: [T] the lift-off and touchdown windows of the clearance, a
+            fraction of the step at each end.
+        landing_speed: [m/s] largest speed of the swing sole at touchdown (0: a landing
+            without impact); None: unbounded (the paper's).
+        friction: μ, the stance foot's |F_x| <= μ F_z at every sample and the landing's
+            impulse within the same cone; None: unbounded.
+        joint_margin: [rad] least distance of every hip and ankle to its stops
+            (``biped.model.robot.JOINT_STOPS``); None: the stops are not constrained.
+        hip_progress: the hip's least forward speed, a share of the walking speed; None:
+            not constrained.
     """
 
     clearance: float = field(default=0.0, metadata={"unit": "m"})
     zmp_margin: float = field(default=0.0, metadata={"unit": "m"})
     knee_bend: float = field(default=0.0, metadata={"unit": "rad"})
     actuator_limits: bool = field(default=False, metadata={"unit": None})
+    clearance_window: float = field(default=CLEARANCE_WINDOW, metadata={"unit": "T"})
+    landing_speed: float | None = field(default=None, metadata={"unit": "m/s"})
+    friction: float | None = field(default=None, metadata={"unit": "1"})
+    joint_margin: float | None = field(default=None, metadata={"unit": "rad"})
+    hip_progress: float | None = field(default=None, metadata={"unit": "1"})
 
     def __post_init__(self):
         if not isinstance(self.actuator_limits, bool):
             raise BipedError(f"actuator_limits = {self.actuator_limits!r}: allowed true or false")
         limits = (
-            ("clearance", MAX_CLEARANCE, "m"),
-            ("zmp_margin", MAX_ZMP_MARGIN, "m"),
-            ("knee_bend", MAX_KNEE_BEND, "rad"),
+            ("clearance", 0.0, MAX_CLEARANCE, "m"),
+            ("zmp_margin", 0.0, MAX_ZMP_MARGIN, "m"),
+            ("knee_bend", 0.0, MAX_KNEE_BEND, "rad"),
+            ("clearance_window", 0.0, MAX_CLEARANCE_WINDOW, "T"),
+            ("landing_speed", 0.0, MAX_LANDING_SPEED, "m/s"),
+            ("friction", *FRICTION_RANGE, ""),
+            ("joint_margin", 0.0, MAX_JOINT_MARGIN, "rad"),
+            ("hip_progress", 0.0, MAX_HIP_PROGRESS, "of the walking speed"),
         )
-        for name, high, unit in limits:
+        for name, low, high, unit in limits:
             value = getattr(self, name)
+            if value is None and name in OPTIONAL:
+                continue
+            allowed = f"{low:g} to {high:g} {unit}".rstrip()
             if isinstance(value, bool) or not isinstance(value, (int, float)):
-                what = "metres" if unit == "m" else "radians"
-                raise BipedError(f"{name} = {value!r}: allowed a number of {what}")
-            if not (math.isfinite(value) and 0.0 <= value <= high):
-                raise BipedError(f"{name} = {value!r} {unit}: allowed 0 to {high} {unit}")
+                raise BipedError(f"{name} = {value!r}: allowed a number {allowed}")
+            if not (math.isfinite(value) and low <= value <= high):
+                raise BipedError(f"{f'{name} = {value!r} {unit}'.rstrip()}: allowed {allowed}")
             object.__setattr__(self, name, float(value))
+
+    @property
+    def walkable(self) -> tuple:
+        """The walkable constraints asked (``biped.model.walkable``), by name, in the order of
+        the solver's rows: "landing", "impact_friction", "friction", "joint_stops",
+        "progress"."""
+        asked = []
+        if self.landing_speed is not None:
+            asked.append("landing")
+        if self.friction is not None:
+            asked += ["impact_friction", "friction"]
+        if self.joint_margin is not None:
+            asked.append("joint_stops")
+        if self.hip_progress is not None:
+            asked.append("progress")
+        return tuple(asked)
 
 
 PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
+_LEFT_OUT = {
+    "knee_bend": 0.0,
+    "actuator_limits": False,
+    "clearance_window": CLEARANCE_WINDOW,
+    **dict.fromkeys(OPTIONAL),
+}
 
 
 def safety_dict(safety: Safety) -> dict:
-    """The margins as a file writes them: a least knee bend and the actuator limits only
-    when asked (a file of the paper's problem is as it was before they existed)."""
+    """The margins as a file writes them: those beyond the clearance and the ZMP margin only
+    when asked (``_LEFT_OUT``)."""
     values = dataclasses.asdict(safety)
-    if not values["knee_bend"]:
-        del values["knee_bend"]
-    if not values["actuator_limits"]:
-        del values["actuator_limits"]
+    for name, default in _LEFT_OUT.items():
+        if values[name] == default and type(values[name]) is type(default):
+            del values[name]
     return values
 
 
+def clearance_envelope(t_n, clearance: float, window: float = CLEARANCE_WINDOW) -> np.ndarray:
+    """Least height [m] of the swing sole at the normalised times ``t_n``: 0 within ``window``
+    of either end of the step, else ``CLEARANCE_FLOOR`` of ``clearance`` rising linearly to
+    all of it at ``CLEARANCE_FULL`` of the step from the nearer end."""
+    end = np.minimum(np.asarray(t_n, dtype=float), 1.0 - np.asarray(t_n, dtype=float))
+    if window < CLEARANCE_FULL:
+        rise = np.clip((end - window) / (CLEARANCE_FULL - window), 0.0, 1.0)
+    else:
+        rise = np.ones_like(end)
+    share = CLEARANCE_FLOOR + (1.0 - CLEARANCE_FLOOR) * rise
+    return np.where(end >= window, clearance * share, 0.0)
+
+
 @functools.cache
-def clearance_profile(samples_per_half: int, clearance: float, knots: int = 1) -> np.ndarray:
-    """Required height (N,) [m] of the swing heel and toe: none for the first and last
-    ``CLEARANCE_DELAY`` of the step (lift-off and touchdown), then ``clearance`` reached
-    linearly at ``CLEARANCE_RAMP``."""
+def clearance_profile(
+    samples_per_half: int, clearance: float, knots: int = 1, window: float = CLEARANCE_WINDOW
+) -> np.ndarray:
+    """``clearance_envelope`` (N,) [m] on the time grid of ``biped.model.gait.sample``."""
     t_n = np.concatenate(piece_grid(samples_per_half, knots))
-    x = (np.minimum(t_n, 1.0 - t_n) - CLEARANCE_DELAY) / (CLEARANCE_RAMP - CLEARANCE_DELAY)
-    profile = clearance * np.clip(x, 0.0, 1.0)
+    profile = clearance_envelope(t_n, clearance, window)
     profile.setflags(write=False)
     return profile
 
@@ -220,6 +298,9 @@ class StepEvaluation:
     # Under ``Safety.actuator_limits``: the margins of ``limit_margins`` (N, 6, 6): sample,
     # limit (``LIMITS`` each twice, − then +), joint; else None.
     actuator_margins: np.ndarray | None = None
+    # The margins of the walkable constraints asked (``biped.model.walkable.step_margins``),
+    # by name, in each one's unit: once a step (k,) or at each sample (N, k).
+    walkable: dict = field(default_factory=dict)
 
     @functools.cached_property
     def drive(self) -> Drive:
@@ -270,6 +351,9 @@ class StepEvaluation:
         limits also each joint's limit exceeded ("swing_knee max_speed": its margin, a share
         of the limit)."""
         found = {name: float(w) for name, w in zip(CONSTRAINTS, self.worst, strict=True) if w < 0.0}
+        for name, margins in self.walkable.items():
+            if margins.min() < 0.0:
+                found[name] = float(margins.min())
         if self.actuator_margins is not None:
             worst = self.actuator_margins.min(axis=0).reshape(len(LIMITS), 2, -1).min(axis=1)
             for limit, row in zip(LIMITS, worst, strict=True):
@@ -338,7 +422,9 @@ def evaluate_step(
     feet_z = feet[..., 1]
     knots = step.knots
     if safety.clearance:
-        feet_z = feet_z - clearance_profile(samples_per_half, safety.clearance, knots)[:, None]
+        window = safety.clearance_window
+        required = clearance_profile(samples_per_half, safety.clearance, knots, window)
+        feet_z = feet_z - required[:, None]
     psi = constraints(robot, q, torques, wrench, feet_z)
     psi[:, 1:3] -= safety.zmp_margin
     if safety.knee_bend:
@@ -352,6 +438,8 @@ def evaluate_step(
     actuators, accels = robot.drive_actuators, model.joint_angles(qdd)
     limits = None
     penalty = penalty_rate(seen, checked)
+    walk = walkable.step_margins(model, step, q, qd, wrench, safety, solver=margins)
+    penalty = penalty + _walkable_penalty(walk, step.period)
     if safety.actuator_limits:
         constants = actuators.constants()
         voltage = drive(constants, torques, rates, accels).voltage
@@ -375,4 +463,17 @@ def evaluate_step(
         actuators=actuators,
         weights=weights,
         actuator_margins=limits,
+        walkable=walk,
     )
+
+
+def _walkable_penalty(margins: dict, period: float) -> np.ndarray | float:
+    """The penalty rate of the walkable constraints' ``margins`` (``penalty_rate``, each in
+    its solver's scale), per sample; a once-a-step margin's spread over the step (the
+    penalised criteria of the paper's method, ``biped.optimization.penalty``)."""
+    rate = 0.0
+    for name, values in margins.items():
+        scaled = np.atleast_2d(values / walkable.SCALES[name])
+        term = penalty_rate(scaled, True)
+        rate = rate + (term.sum() / period if values.ndim == 1 else term)
+    return rate

@@ -211,7 +211,8 @@ class Solver:
     def _objective_and_constraints(self, graph: StepGraph, criterion: str, y):
         """The NLP's variables x, objective and constraints, on the graph's symbols (the
         samples' quantities, the head; ``StepGraph.on_symbols``) and the slacks."""
-        period, hip_height = graph.head_symbol[graph.period_index], graph.head_symbol[-1]
+        period = graph.head_symbol[graph.period_index]
+        hip_height = graph.head_symbol[graph.hip_height_index]
         constraints = ca.vertcat(graph.on_symbols["constraints"], hip_height)
         if criterion == "sthenic":
             self.slacks = 0

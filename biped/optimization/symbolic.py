@@ -26,17 +26,19 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from biped.model import walkable
 from biped.model.actuators import LIMITS, drive, limit_margins
 from biped.model.criteria import (
     ACTUATOR_MARGIN,
     CONSTRAINTS,
     checked_mask,
+    clearance_envelope,
     clearance_profile,
     margin_profile,
     simpson_weights,
 )
 from biped.model.dynamics import JOINT_MATRIX, Biped
-from biped.model.gait import FREE_SWAP, hermite, spline_basis
+from biped.model.gait import FREE_SWAP, hermite, piece_grid, spline_basis
 from biped.model.kinematics import (
     BODY_DIRECTIONS,
     LEG_SWAP,
@@ -53,8 +55,11 @@ from biped.model.kinematics import (
     ZH,
     point_table,
 )
-from biped.optimization.problem import MIN_HIP_HEIGHT, index, variable_names
+from biped.optimization.problem import CHECK_SAMPLES, MIN_HIP_HEIGHT, index, variable_names
 
+# [m] What the solver keeps above the clearance at the check grid's samples between its own:
+# the check's rounding (the solver meets its constraints to 1e-9 of their scale).
+BETWEEN_SAMPLES_MARGIN = 1e-6
 # Constraints are divided by these in the solvers so that all are of order one
 # [N, m, m, rad, rad, m, m].
 CONSTRAINT_SCALES = np.array([1000.0, 0.1, 0.1, 1.0, 1.0, 0.1, 0.1])
@@ -178,6 +183,20 @@ def _torques_and_wrench(c: _Constants, qdd, phid, phidd, s, co):
     g1 = tau[Q1] + g2 - work[0]
     cy = tau[QP1] + g1
     return ca.vertcat(g1, g2, g3, g4, g5, g6), ca.vertcat(fx, fz, cy)
+
+
+def _sole_heights(c: _Constants, angles):
+    """Heights (n, 2) [m] of the swing heel and toe at the free angles ``angles`` (n, 6),
+    the stance foot flat and fixed (``sample_function``'s Ψ6, Ψ7 without the margins)."""
+    rows = []
+    zero = ca.SX.zeros(angles.shape[0], 1)
+    phi = ca.horzcat(zero, angles) @ c.phi.T  # (n, K) the directions' angles
+    s, co = ca.sin(phi), ca.cos(phi)
+    hip = c.hp + co @ c.ankle  # z_H (n, 1)
+    for name in ("swing_heel", "swing_toe"):
+        a, b = c.point(name)
+        rows.append(hip - co @ a + s @ b)
+    return ca.horzcat(*rows)
 
 
 def _mass_matrix(c: _Constants, q):
@@ -391,6 +410,7 @@ class StepGraph:
         d_inv_jt = ca.solve(mass, jac.T)
         gram = jac @ d_inv_jt
         self.impulse = -ca.solve(gram, jac @ qd_end)
+        self.touchdown = (jac @ qd_end)[:2]  # the swing ankle's (vx, vz): every sole point's
         qd_plus = qd_end + d_inv_jt @ self.impulse
         start_rates = ca.vertcat(*[qd_plus[LEG_SWAP[i]] for i in range(1, 7)])
         return end_angles, end_rates, start_rates
@@ -427,9 +447,22 @@ class StepGraph:
         maps it to each sample's inputs, the ``sample`` function, and the samples'
         ``QUANTITIES`` as a symbol (``quantities``) and as expressions (``flat``)."""
         radii = [self.radii] if self.design else []
-        self.head = ca.vertcat(ca.vec(coefficients), self.period, *radii, self.hip_height)
+        # The landing's quantities join the head only where a constraint asks for them (the
+        # paper's problem keeps its graph).
+        walkable = self.safety.walkable
+        events = [("touchdown", self.touchdown, "landing" in walkable)]
+        events.append(("impulse", self.impulse, "impact_friction" in walkable))
         self.period_index = coefficients.numel()
+        self.hip_height_index = self.period_index + 1 + len(radii) * 2
+        parts, self.head_slices, at = [], {}, self.hip_height_index + 1
+        for name, value, asked in events:
+            if asked:
+                parts.append(value)
+                self.head_slices[name] = slice(at, at + value.shape[0])
+                at += value.shape[0]
+        self.head = ca.vertcat(ca.vec(coefficients), self.period, *radii, self.hip_height, *parts)
         self.head_symbol = ca.SX.sym("head", self.head.shape[0])
+        self._constants = c
         self.sample = sample_function(c, self.model.robot, self.safety, self.radii, self.motors)
         self.basis = _sample_basis(
             self.samples_per_half, self.knots, self.head.shape[0], self.design
@@ -464,7 +497,10 @@ class StepGraph:
         power = self.rows("power")
         psi = self.rows("psi")
         if self.safety.clearance:
-            required = ca.DM(clearance_profile(samples, self.safety.clearance, knots)).T
+            profile = clearance_profile(
+                samples, self.safety.clearance, knots, self.safety.clearance_window
+            )
+            required = ca.DM(profile).T
             psi = ca.vertcat(psi[:5, :], psi[5:, :] - ca.repmat(required, 2, 1))
         n = psi.shape[1]
         margins = ca.DM(margin_profile(samples, knots)).T
@@ -484,6 +520,9 @@ class StepGraph:
             }
         if self.safety.actuator_limits:
             constraints += self._actuator_limits()
+        constraints += self._walkable()
+        if self.safety.clearance:
+            constraints += self._clearance_between_samples()
         return {
             **named,
             **motors,
@@ -512,6 +551,75 @@ class StepGraph:
             f"actuator {names[i // 6]}" for _ in limits for i in range(per_sample)
         ]
         return [ca.vertcat(*limits)]
+
+    def _walkable(self) -> list:
+        """The walkable constraints ``safety`` asks (``biped.model.walkable``, the formulas of
+        the numeric check with the solver's margins), each divided by its scale: the
+        landing's and the impact's once, the others at every sample, sample-major; their
+        names join ``constraint_names``."""
+        safety, rows = self.safety, []
+        head = self.head_symbol
+        per_sample = {}
+        if "landing" in safety.walkable:
+            touchdown = head[self.head_slices["touchdown"]]
+            margins = walkable.landing_margins(touchdown, safety.landing_speed, True)
+            rows.append(("landing", margins))
+        if "impact_friction" in safety.walkable:
+            impulse = head[self.head_slices["impulse"]]
+            margins = walkable.impact_friction_margins(impulse, safety.friction, True)
+            rows.append(("impact_friction", margins))
+            wrench = self.rows("wrench")
+            per_sample["friction"] = walkable.friction_margins(
+                wrench[0, :], wrench[1, :], safety.friction, True
+            )
+        if "joint_stops" in safety.walkable:
+            theta = ca.DM(JOINT_MATRIX) @ self.rows("q")
+            theta = [theta[i, :] for i in range(6)]
+            per_sample["joint_stops"] = walkable.joint_stop_margins(
+                theta, safety.joint_margin, True
+            )
+        if "progress" in safety.walkable:
+            hip_rate = self.rows("qd")[XH, :]
+            per_sample["progress"] = walkable.progress_margins(
+                hip_rate, safety.hip_progress, self.speed, True
+            )
+        constraints = []
+        for name, margins in rows:
+            constraints += [m / walkable.SCALES[name] for m in margins]
+            self.constraint_names += [name] * len(margins)
+        for name, margins in per_sample.items():
+            stacked = ca.vertcat(*margins) / walkable.SCALES[name]  # (k, N)
+            constraints.append(ca.vec(stacked))  # sample-major
+            self.constraint_names += [name] * stacked.numel()
+        return constraints
+
+    def _clearance_between_samples(self) -> list:
+        """The swing heel's and toe's clearance (``clearance_envelope``) at every sample of
+        the check grid between the solver's, within the swing (the envelope above 0), less
+        ``BETWEEN_SAMPLES_MARGIN``: on the solver's samples alone the sole may dip below it
+        between them (δ of Ψ6, Ψ7 is 1 mm there, ramping from 0 at the step's ends).
+        Functions of the head's spline coefficients (the sole's height at a time is a
+        function of the angles alone)."""
+        knots, safety = self.knots, self.safety
+        t_check, (values, _, _) = spline_basis(CHECK_SAMPLES[knots], knots)
+        t_solver = np.concatenate(piece_grid(self.samples_per_half, knots))
+        required = clearance_envelope(t_check, safety.clearance, safety.clearance_window)
+        taken = [
+            j
+            for j, t in enumerate(t_check)
+            if required[j] > 0.0 and np.min(np.abs(t_solver - t)) > 1e-12
+        ]
+        coefficients = ca.reshape(self.head_symbol[: self.period_index], self.period_index // 6, 6)
+        angles = ca.DM(values[taken, :]) @ coefficients  # (n, 6)
+        heights = _sole_heights(self._constants, angles)  # (n, 2): heel, toe
+        if self.design:  # the radii as the head holds them
+            at = self.period_index + 1
+            heights = ca.substitute(heights, self.radii, self.head_symbol[at : at + 2])
+        floor = required[taken] + BETWEEN_SAMPLES_MARGIN
+        scale = CONSTRAINT_SCALES[CONSTRAINTS.index("swing_heel")]
+        margins = (heights - ca.repmat(ca.DM(floor), 1, 2)) / scale
+        self.constraint_names += ["swing_heel"] * len(taken) + ["swing_toe"] * len(taken)
+        return [ca.vec(margins)]
 
     @property
     def inputs(self) -> list:

@@ -38,6 +38,7 @@ from biped.model.criteria import (
     CONSTRAINTS,
     CRITERIA,
     CRITERION_UNITS,
+    PAPER_SAFETY,
     Safety,
     evaluate_step,
     safety_dict,
@@ -450,15 +451,16 @@ class Gait:
 
     @staticmethod
     def units(
-        criterion: str, knots: int = 1, knee_bend: bool = False, actuators: bool = False
+        criterion: str, knots: int = 1, safety: Safety = PAPER_SAFETY, actuators: bool = False
     ) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion`` in the family of
-        ``knots`` interior knots, with a least knee bend if ``knee_bend``, with the robot's
-        actuators if ``actuators`` (a robot file's, not the default set), from the fields'
-        declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
+        ``knots`` interior knots, under the margins ``safety`` (the paper's by default), with
+        the robot's actuators if ``actuators`` (a robot file's, not the default set), from the
+        fields' declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
         units = declared_units(Gait, "", criterion)
-        if not knee_bend:  # the paper's knees: the file does not write it
-            del units["safety.knee_bend"]
+        written = safety_dict(safety)  # a setting left at its default is not written
+        for name in [f.name for f in dataclasses.fields(Safety) if f.name not in written]:
+            units.pop(f"safety.{name}", None)
         if actuators:
             for kind in KINDS:
                 for name, unit in ACTUATOR_UNITS.items():
@@ -476,10 +478,7 @@ class Gait:
 
     def _units(self) -> dict:
         return self.units(
-            self.criterion,
-            self.knots,
-            bool(self.safety.knee_bend),
-            self.robot.actuators is not None,
+            self.criterion, self.knots, self.safety, self.robot.actuators is not None
         )
 
     def to_dict(self) -> dict:

@@ -1,0 +1,187 @@
+"""The walkable constraints (``biped.model.walkable``): the solver's graph and the check compute
+one formula; each binds where it should (the paper's optimum breaks it, the constrained
+optimum keeps it on the check grid, active, at a higher cost); a landing at speed 0 has no
+impact; the clearance envelope is kept at every sample of the check grid."""
+
+import dataclasses
+import functools
+
+import numpy as np
+import pytest
+
+import biped
+from biped.model import walkable
+from biped.model.criteria import (
+    CLEARANCE_FLOOR,
+    CLEARANCE_FULL,
+    PAPER_SAFETY,
+    Safety,
+    clearance_envelope,
+    evaluate_step,
+)
+from biped.model.gait import build_step
+from biped.model.robot import JOINT_STOPS
+from biped.optimization.optimize import optimize
+from biped.optimization.problem import GaitProblem
+from biped.optimization.symbolic import StepGraph
+
+ROBOT = biped.Robot.paper()
+SPEED = 0.3
+
+
+@functools.cache
+def optimum(knee: str = "rolling", safety: Safety = PAPER_SAFETY):
+    """The certified optimum of the sthenic criterion at 0.3 m/s under ``safety``."""
+    problem = GaitProblem(biped.Biped(ROBOT, knee), SPEED, safety=safety)
+    found = optimize(problem, starts=3)
+    assert found.certified, found.report.status
+    return problem, found
+
+
+def _step(problem, found):
+    return build_step(problem.model, problem.speed, problem.to_parameters(found.variables))
+
+
+def test_the_solver_and_the_check_compute_one_formula():
+    """At seeded random gaits, the solver's rows of every walkable constraint (its graph,
+    scaled, with its margins) equal the numeric check's (``step_margins(solver=True)``) on
+    the solver's samples to 1e-9 of their scale; with another friction coefficient they
+    differ."""
+    safety = Safety(landing_speed=0.3, friction=0.6, joint_margin=0.05, hip_progress=0.2)
+    model = biped.Biped(ROBOT, "rolling")
+    problem = GaitProblem(model, SPEED, safety=safety)
+    graph = StepGraph(model, problem.samples_per_half, safety)
+    constraints = graph.function()
+    names = np.array(graph.constraint_names)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        z = problem.first_guess(rng.uniform(0.4, 0.8)) + 0.02 * rng.standard_normal(21)
+        rows = np.asarray(constraints(z, SPEED)[8]).ravel()
+        step = build_step(model, SPEED, problem.to_parameters(z))
+        numeric = evaluate_step(
+            model, step, problem.samples_per_half, margins=True, safety=safety
+        ).walkable
+        assert set(numeric) == set(safety.walkable)
+        for name, margins in numeric.items():
+            expected = margins.ravel() / walkable.SCALES[name]  # sample-major
+            np.testing.assert_allclose(rows[names == name], expected, rtol=0, atol=1e-9)
+    other = dataclasses.replace(safety, friction=0.5)
+    numeric = evaluate_step(model, step, problem.samples_per_half, True, other).walkable
+    expected = numeric["friction"].ravel() / walkable.SCALES["friction"]
+    assert np.abs(rows[names == "friction"] - expected).max() > 1e-3
+
+
+# A setting of each constraint that the paper's optimum at 0.3 m/s (rolling knee) breaks: its
+# sole lands at 0.90 m/s, its impulse has |Ix| / Iz = 0.30, its hips come within 0.36 rad of
+# their stops, its hip slows to 0.60 V.
+BINDING = {
+    "landing": Safety(landing_speed=0.3),
+    "impact_friction": Safety(friction=0.25),
+    "joint_stops": Safety(joint_margin=0.4),
+    "progress": Safety(hip_progress=0.7),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BINDING))
+def test_each_walkable_constraint_binds_where_it_should(name):
+    """The paper's optimum breaks the setting (infeasible under it, naming the constraint);
+    the optimum under it is certified, keeps it at every sample of the check grid, holds it
+    active (its tightest margin within 1 % of the constraint's scale) and costs more."""
+    safety = BINDING[name]
+    paper_problem, paper = optimum()
+    model = paper_problem.model
+    evaluation = evaluate_step(model, _step(paper_problem, paper), 100, safety=safety)
+    assert name in evaluation.violations()
+    problem, found = optimum(safety=safety)
+    margins = found.evaluation.walkable[name]
+    assert found.feasible and margins.min() >= 0.0
+    assert margins.min() < 0.01 * walkable.SCALES[name]
+    assert found.value > paper.value * 1.01
+
+
+def _impact_loss(problem, found) -> float:
+    """[J] The kinetic energy the landing destroys, ½ (q̇⁻ − q̇⁺)ᵀ D (q̇⁻ − q̇⁺) (Carnot: the
+    kinetic energy before less after)."""
+    q, before = _step(problem, found).end
+    after, _ = problem.model.impact(q, before)
+    mass = problem.model.mass_matrix(q)
+    lost = 0.5 * (before - after) @ mass @ (before - after)
+    assert lost == pytest.approx(0.5 * (before @ mass @ before - after @ mass @ after), rel=1e-9)
+    return lost
+
+
+def test_a_landing_bound_is_the_soles_largest_speed():
+    """Under a landing speed of 0.3 m/s the sole touches down at 0.3 m/s at most (at 0.90
+    m/s without), and the landing destroys less kinetic energy (0.77 J, 1.24 J without,
+    though its impulse is larger: the sole comes down more vertically, against the whole
+    robot's weight)."""
+    paper_problem, paper = optimum()
+    problem, found = optimum(safety=BINDING["landing"])
+    velocities = [
+        walkable.touchdown_velocity(p.model, *_step(p, f).end)
+        for p, f in ((paper_problem, paper), (problem, found))
+    ]
+    speeds = np.linalg.norm(velocities, axis=1)
+    assert speeds[0] > 0.85 and speeds[1] <= 0.3 + walkable.LANDING_TOLERANCE
+    assert _impact_loss(problem, found) < 0.7 * _impact_loss(paper_problem, paper)
+
+
+def test_a_landing_at_speed_zero_has_no_impact():
+    """An impactless landing (landing speed 0): the sole touches down at rest (1 μm/s), the
+    impulse vanishes and the impact map leaves the velocities as they are."""
+    problem, found = optimum(safety=Safety(landing_speed=0.0))
+    step = _step(problem, found)
+    velocity = walkable.touchdown_velocity(problem.model, *step.end)
+    assert np.linalg.norm(velocity) <= walkable.LANDING_TOLERANCE
+    assert np.abs(step.impulse).max() < 1e-4
+    qd_plus, _ = problem.model.impact(*step.end)
+    assert np.abs(qd_plus - step.end[1]).max() < 1e-4
+
+
+def test_friction_holds_the_stance_foot_and_the_impulse_in_the_cone():
+    """Under μ = 0.25 the impact's |Ix| <= μ Iz (0.30 Iz without) and |Fx| <= μ Fz at every
+    sample of the check grid."""
+    problem, found = optimum(safety=BINDING["impact_friction"])
+    step = _step(problem, found)
+    assert abs(step.impulse[0]) <= 0.25 * step.impulse[1] + 1e-12
+    wrench = found.evaluation.wrench
+    assert np.all(np.abs(wrench[:, 0]) <= 0.25 * wrench[:, 1])
+
+
+def test_joint_stops_are_in_the_mjcfs_convention():
+    """The constrained joints' margins are their distances to the MJCF's stops, each joint's
+    angle its child's less its parent's: minus the paper's θ (a standing robot's joints at
+    0 are each |stop| from the stops)."""
+    theta = np.zeros((6, 1))
+    margins = np.array(walkable.joint_stop_margins(theta, 0.0)).ravel()
+    kinds = [kind for kind in walkable.STOPPED.values() for _ in range(2)]
+    expected = [abs(JOINT_STOPS[kind][i % 2]) for i, kind in enumerate(kinds)]
+    np.testing.assert_allclose(margins, expected)
+    theta[5] = -0.7  # the swing ankle's child − parent is +0.7, past its 0.6 stop
+    margins = np.array(walkable.joint_stop_margins(theta, 0.0)).ravel()
+    assert margins[7] == pytest.approx(-0.1)
+
+
+def test_the_clearance_envelope():
+    """Nothing within the windows; a third of the clearance at the window's edge, rising to
+    all of it at 30 % of the step from each end; all of it outside windows of 30 % or more."""
+    t = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.8, 0.95, 1.0])
+    found = clearance_envelope(t, 0.03, 0.1)
+    mid = CLEARANCE_FLOOR + (1 - CLEARANCE_FLOOR) * (0.2 - 0.1) / (CLEARANCE_FULL - 0.1)
+    expected = 0.03 * np.array([0, 0, CLEARANCE_FLOOR, mid, 1, 1, 1, mid, 0, 0])
+    np.testing.assert_allclose(found, expected, atol=1e-15)
+    np.testing.assert_allclose(clearance_envelope(t, 0.03, 0.35)[4:6], [0.0, 0.03])
+
+
+def test_the_clearance_is_kept_at_every_check_sample():
+    """With 3 cm at 0.3 m/s the swing sole keeps the envelope at each of the check grid's
+    samples (the solver constrains those between its own), and none of the optimum's
+    samples inside the windows is required to."""
+    problem, found = optimum(safety=Safety(clearance=0.03))
+    psi = found.evaluation.constraints[:, 5:]
+    assert np.nanmin(psi) >= 0.0
+    paper_problem, paper = optimum()
+    kept = evaluate_step(
+        paper_problem.model, _step(paper_problem, paper), 100, safety=Safety(clearance=0.03)
+    )
+    assert "swing_heel" in kept.violations() or "swing_toe" in kept.violations()
