@@ -99,6 +99,34 @@ def _scale_row(field, row, factor):
             lambda g: g["impact"].update(consistent=not g["impact"]["consistent"]),
             "impact.consistent",
         ),
+        (
+            lambda g: g["knee_loads"]["normal"][60].__setitem__(
+                1, g["knee_loads"]["normal"][60][1] - 1.0
+            ),
+            "knee_loads.normal do not belong to the parameters (off by 1 N)",
+        ),
+        (
+            lambda g: g["knee_loads"].update(
+                tangential=[[-x for x in r] for r in g["knee_loads"]["tangential"]]
+            ),
+            "knee_loads.tangential do not belong to the parameters",
+        ),
+        (
+            lambda g: g["knee_loads"].update(max_tension=[0.0, 0.0]),
+            "knee_loads.max_tension do not belong to the parameters",
+        ),
+        (
+            lambda g: g["knee_loads"].update(max_slip_ratio=[0.01, 0.01]),
+            "knee_loads.max_slip_ratio has None where its parameters give a number",
+        ),
+        (
+            lambda g: g["knee_loads"].update(needs_ligaments=False),
+            "knee_loads.needs_ligaments = False, its parameters give true",
+        ),
+        (
+            lambda g: g["knee_loads"].pop("max_compression"),
+            "knee_loads.max_compression is not the (2,) numbers it should be",
+        ),
     ],
     ids=[
         "sthenic halved",
@@ -112,6 +140,12 @@ def _scale_row(field, row, factor):
         "feasible flipped",
         "impulse doubled",
         "impact consistency flipped",
+        "swing knee's normal force -1 N",
+        "tangential forces reversed",
+        "no tension",
+        "a ratio for a knee never compressed",
+        "no ligaments",
+        "largest compression missing",
     ],
 )
 def test_an_edited_field_is_named(content, tmp_path, change, needle):

@@ -211,3 +211,14 @@ def test_a_gait_file_of_format_2_without_actuators_reads_with_the_set_of_its_tim
     old["format"] = gait_file.FORMAT
     message = refusal(gait_file.read_consistent, gait_file.write_json(tmp_path / "new.json", old))
     assert "inconsistent: costs.electrical = " in message
+
+
+def test_a_gait_file_written_before_the_knee_loads_reads_without_them(content, tmp_path):
+    """The knee loads came after format 3's files (an added block, as the electrical figures):
+    a file without them reads, consistent, with none (null when written back)."""
+    old = json.loads(json.dumps(content))
+    del old["knee_loads"]
+    old["units"] = {k: v for k, v in old["units"].items() if not k.startswith("knee_loads.")}
+    gait = gait_file.read_consistent(gait_file.write_json(tmp_path / "old.json", old))
+    assert gait.knee_loads is None and old["format"] == gait_file.FORMAT
+    assert gait.to_dict()["knee_loads"] is None

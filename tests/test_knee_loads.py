@@ -130,3 +130,31 @@ def test_batches_of_any_shape_are_the_samples_one_by_one(model):
     np.testing.assert_array_equal(square.normal.reshape(16, 2), flat.normal)
     one = knee_forces(model, q[5], qd[5], qdd[5])
     np.testing.assert_allclose(one.tangential, flat.tangential[5], rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_a_gait_records_its_knee_loads_and_the_ligaments_they_need(knee):
+    """The gait's record holds the loads of its samples on the check grid, the largest
+    tension and compression of each knee, its largest |T| / N where compressed (None: never),
+    and whether it needs ligaments: the rolling knee's swing knee pulls (N < 0), which the
+    revolute knee's pin carries; in stance the knee is pressed by the body's weight."""
+    from biped.records.gait_file import Gait
+    from tests.conftest import small_optimum
+
+    gait = Gait.from_optimum(small_optimum(knee), ROBOT)
+    record, samples = gait.knee_loads, gait.samples
+    loads = knee_forces(gait.biped, samples.q, samples.qd, samples.qdd, samples.wrench)
+    np.testing.assert_array_equal(record.normal, loads.normal)
+    np.testing.assert_array_equal(record.tangential, loads.tangential)
+    normal = np.asarray(record.normal)
+    np.testing.assert_array_equal(record.max_tension, np.maximum(-normal.min(0), 0.0))
+    np.testing.assert_array_equal(record.max_compression, np.maximum(normal.max(0), 0.0))
+    assert normal.shape == (len(samples.t), 2)
+    assert record.max_tension[0] == 0.0 and record.max_compression[1] == 0.0  # this gait's
+    assert 0.5 * ROBOT.weight < record.max_compression[0] < 1.5 * ROBOT.weight
+    assert record.max_tension[1] > 30.0
+    pressed = normal[:, 0] > 0.0
+    ratio = np.abs(np.asarray(record.tangential)[pressed, 0]) / normal[pressed, 0]
+    assert record.max_slip_ratio == [ratio.max(), None]
+    assert record.needs_ligaments is (knee == "rolling")
+    assert Gait.units("sthenic")["knee_loads.max_tension"] == "N"

@@ -1,17 +1,19 @@
 """Gait files: one optimal gait as a ``Gait`` record, written as JSON atomically (SI units,
 the paper's coordinate order; ground at z = 0, stance ankle at x = 0), read back with checks.
 
-``Gait`` and its inner records (``Costs``, ``Constraints``, ``Impact``, ``Optimizer``,
-``Samples``) are declared once, each field with its unit as metadata: the file holds their
-fields in their order, ``format`` first and ``units`` (``Gait.units``: the unit of every
-number, see ``biped.model.units``) before ``samples``. ``costs`` are on the check grid of 202
-samples per step (what the comparisons, tables and figures use); ``optimizer.value`` is the
-criterion on the solver's 52 samples per step, which ranked the starts. ``constraints`` hold
-the worst Ψ_i on the samples less the safety margins (>= 0 when met); ``impact.consistent``:
-Iz > 0 and the trailing foot lifts (the flat-foot impact model holds); ``provenance``: what
-produced the file (``biped.records.provenance``). The samples run from t = 0 to t = T
-inclusive on both spline pieces; t = T/2 appears twice, left and right limits, because the
-accelerations (and torques) jump at the knot.
+``Gait`` and its inner records (``Costs``, ``Constraints``, ``Impact``, ``Electrical``,
+``KneeLoads``, ``Optimizer``, ``Samples``) are declared once, each field with its unit as
+metadata: the file holds their fields in their order, ``format`` first and ``units``
+(``Gait.units``: the unit of every number, see ``biped.model.units``) before ``samples``.
+``costs`` are on the check grid of 202 samples per step (what the comparisons, tables and
+figures use); ``optimizer.value`` is the criterion on the solver's 52 samples per step, which
+ranked the starts. ``constraints`` hold the worst Ψ_i on the samples less the safety margins
+(>= 0 when met); ``impact.consistent``: Iz > 0 and the trailing foot lifts (the flat-foot
+impact model holds); ``knee_loads``: the force of the thigh on the lower leg through each knee
+on the check grid, along and across the rolling knee's line of centres, and the ligament load
+it needs; ``provenance``: what produced the file (``biped.records.provenance``). The samples
+run from t = 0 to t = T inclusive on both spline pieces; t = T/2 appears twice, left and right
+limits, because the accelerations (and torques) jump at the knot.
 
 ``Gait.read`` checks the format and names the bad field; with ``consistent=True`` it also
 recomputes what the parameters determine (``Gait.check_consistency``) and refuses a file
@@ -47,6 +49,7 @@ from biped.model.dynamics import JOINTS, Biped
 from biped.model.gait import PARAMETERS, build_step, check_knots, parameter_names
 from biped.model.impact import trailing_foot_lift
 from biped.model.kinematics import COORDINATES, KNEES
+from biped.model.knee_loads import KNEE_SIDES, knee_forces
 from biped.model.robot import Robot
 from biped.model.units import (
     CONSTRAINT_UNITS,
@@ -74,6 +77,8 @@ FORMAT = "biped-gait/3"
 # Earlier formats read: a file of format 2 whose robot names no actuators was computed with
 # the default set of its time (``Actuators.legacy``), which it is read with.
 EARLIER_FORMATS = ("biped-gait/2",)
+# A block added to a format (``electrical``, ``knee_loads``) changes none of its other figures
+# and leaves the format as it is: a file written before the block reads with None there.
 READ_FORMATS = (FORMAT, *EARLIER_FORMATS)
 # Shortest step a gait file may hold [m]: shorter is no walk (a speed near 0).
 MIN_STEP_LENGTH = 1e-3
@@ -260,6 +265,51 @@ class Electrical(_Record):
         )
 
 
+# The knees of ``KneeLoads``: the stance leg's, in stance, and the swing leg's, in swing (each
+# leg's knee through its stance, resp. its swing, over the two steps of a stride).
+KNEE_COLUMNS = tuple(f"{side}_knee" for side in KNEE_SIDES)
+
+
+def _per_knee(unit: str, label: str):
+    """A field of ``KneeLoads`` per knee (``KNEE_COLUMNS``): its unit and what it is."""
+    return unit_field(unit, KNEE_COLUMNS, metadata={"label": label})
+
+
+@dataclass(frozen=True, eq=False)
+class KneeLoads(_Record):
+    """The force of the thigh on the lower leg through each knee on the check grid
+    (``biped.model.knee_loads``), one column per knee (``KNEE_COLUMNS``): its normal part N
+    along the rolling knee's line of centres, from the thigh's circle's centre C2 to the
+    shank's C1 (the revolute knee's shank, knee to ankle), > 0 compression, < 0 tension, and
+    its tangential part T across it. Two surfaces in contact carry no tension: a rolling knee
+    with N < 0 anywhere needs ligaments, which carry the largest tension; a revolute knee's
+    pin carries it. |T| / N where N > 0 is the friction coefficient rolling without slip
+    needs (None: a knee never compressed)."""
+
+    normal: list = _per_knee("N", "normal force N along the line of centres (> 0 compression)")
+    tangential: list = _per_knee("N", "tangential force T across the line of centres")
+    max_tension: list = _per_knee("N", "largest tension max(-N), the ligament load needed")
+    max_compression: list = _per_knee("N", "largest compression max(N)")
+    max_slip_ratio: list = _per_knee(PURE, "largest |T| / N where N > 0")
+    needs_ligaments: bool  # a rolling knee in tension (N < 0) at some sample
+
+    @classmethod
+    def of(cls, model: Biped, evaluation) -> KneeLoads:
+        """The knee loads of a step's evaluation on the check grid (with its ground wrench)."""
+        ev = evaluation
+        loads = knee_forces(model, ev.q, ev.qd, ev.qdd, ev.wrench)
+        ratio = np.max(np.nan_to_num(loads.slip_ratio, nan=-1.0), axis=0)
+        tension = loads.tension.max(axis=0)
+        return cls(
+            normal=loads.normal.tolist(),
+            tangential=loads.tangential.tolist(),
+            max_tension=tension.tolist(),
+            max_compression=loads.compression.max(axis=0).tolist(),
+            max_slip_ratio=[float(r) if r >= 0.0 else None for r in ratio],
+            needs_ligaments=bool(sum(model.radii) > 0.0 and tension.max() > 0.0),
+        )
+
+
 # The worst Ψ_i of each constraint on the check grid less its safety margin (>= 0 when met),
 # by name (``biped.model.criteria.CONSTRAINTS``).
 Constraints = dataclasses.make_dataclass(
@@ -336,6 +386,7 @@ class Gait:
     constraints: Constraints | None = unit_field(Constraints)  # None: a file without them
     impact: Impact | None = unit_field(Impact)  # None: a file without it
     electrical: Electrical | None = unit_field(Electrical)  # None: a file without it
+    knee_loads: KneeLoads | None = unit_field(KneeLoads)  # None: a file without them
     optimizer: Optimizer = unit_field(Optimizer)
     provenance: dict
     samples: Samples = unit_field(Samples)
@@ -444,6 +495,7 @@ class Gait:
                 ("constraints", Constraints),
                 ("impact", Impact),
                 ("electrical", Electrical),
+                ("knee_loads", KneeLoads),
             )
         }
         parsed = {"safety": safety, "robot": robot, "optimizer": optimizer, "knots": knots}
@@ -554,6 +606,8 @@ class Gait:
             _check_impact(self.impact, expected["impact"], bad)
         if self.electrical is not None:  # a file written before the actuators has none
             _check_group(self.electrical, "electrical", expected["electrical"], units, bad)
+        if self.knee_loads is not None:  # a file written before the knee loads has none
+            _check_knee_loads(self.knee_loads, expected["knee_loads"], units, bad)
 
 
 def _robot(content: dict) -> Robot:
@@ -577,6 +631,7 @@ def _derived(model: Biped, step, evaluation) -> dict:
         ),
         "impact": Impact.of(model, step),
         "electrical": Electrical.of(model, step, evaluation),
+        "knee_loads": KneeLoads.of(model, evaluation),
         "samples": Samples(
             **{f.name: getattr(evaluation, f.name) for f in dataclasses.fields(Samples)}
         ),
@@ -789,6 +844,32 @@ def _check_group(stored, group: str, expected, units: dict, bad) -> None:
             raise bad(
                 f"{path} = {value!r}{_shown(units, path)}, its parameters give "
                 f"{wanted!r}{_shown(units, path)}"
+            )
+
+
+def _check_knee_loads(stored: KneeLoads, expected: KneeLoads, units: dict, bad) -> None:
+    """The knee loads against the parameters': each figure a knee's (a ratio None where the
+    knee is never compressed), ``needs_ligaments`` last."""
+    for name, wanted in expected.to_dict().items():
+        path, value = f"knee_loads.{name}", getattr(stored, name)
+        if name == "needs_ligaments":
+            if value is not wanted:
+                raise bad(f"{path} = {value!r}, its parameters give {str(wanted).lower()}")
+            continue
+        wanted_array = np.array(wanted, dtype=float)  # None: NaN
+        try:
+            found = np.array(value, dtype=float)
+        except (TypeError, ValueError):
+            found = None
+        if found is None or found.shape != wanted_array.shape:
+            raise bad(f"{path} is not the {wanted_array.shape} numbers it should be")
+        missing = np.isnan(found)  # where a ratio is None (an infinity differs by inf)
+        if not np.array_equal(missing, np.isnan(wanted_array)):
+            raise bad(f"{path} has None where its parameters give a number, or the reverse")
+        off = _mismatch(np.where(missing, 0.0, found), np.nan_to_num(wanted_array))
+        if off:
+            raise bad(
+                f"{path} do not belong to the parameters (off by {off[1]:.3g}{_shown(units, path)})"
             )
 
 
