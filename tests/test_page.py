@@ -246,3 +246,30 @@ def test_the_table_gives_each_constraint_where_it_binds(optimal_page):
         assert rows[name].ratio == pytest.approx(np.nanmin(psi[held, i] / delta[held, i]))
     for name in ("swing_heel", "swing_toe"):
         assert 0.1 < rows[name].at < 0.9 and rows[name].ratio == pytest.approx(1.0, abs=0.02)
+
+
+def test_page_gives_the_ligament_load_each_knee_needs(optimal_page):
+    """The rolling knee's page says the gait needs ligaments and how much, in N, for each knee
+    (stance, swing): the file's largest tensions; the swing knee pulls about 40 N."""
+    gait, text, _ = optimal_page
+    stance, swing = gait.knee_loads.max_tension
+    assert gait.knee_loads.needs_ligaments and 35.0 < swing < 50.0
+    assert "## Knee loads: the ligaments each knee needs" in text
+    assert f"This gait needs ligaments: {stance:.4g} N in the stance knee (in stance), " in text
+    assert f"{swing:.4g} N in the swing knee (in swing)" in text
+    assert "| knee | ligament load needed [N] | largest tension [N] |" in text
+    assert f"| swing knee, in swing | {swing:.4g} | {swing:.4g} | 0 | never compressed |" in text
+
+
+def test_a_revolute_knee_needs_no_ligament_and_an_old_file_no_section():
+    """The revolute knee's pin carries the tension: its page says no ligament is needed; a
+    file written before the knee loads has no such section."""
+    import dataclasses
+
+    from biped.pages.page import knee_lines
+
+    gait = Gait.from_optimum(small_optimum("revolute"), Robot.paper())
+    text = "\n".join(knee_lines(gait))
+    assert "the pin carries tension, so no ligament is needed" in text
+    assert f"| swing knee, in swing | none (a pin) | {gait.knee_loads.max_tension[1]:.4g} |" in text
+    assert knee_lines(dataclasses.replace(gait, knee_loads=None)) == []

@@ -9,11 +9,12 @@
 The page gives the gait's parameters by name with their units, its criteria, the tightest
 margin of each constraint (which sample of the step, and how far above the solver's margin δ),
 where a constraint dips below δ between the solver's samples (an inset on its panel), the
-jumps of the torques and ground reaction at the mid-step knot (marked on their panels),
-the verdict and figures of its validation in MuJoCo when a report is given, and links to the
-recording and the video. ``write_pages`` writes pages as a set, all or none
-(``biped.runtime.files.atomic_set``). The constraints are computed again from the gait's parameters
-on the grid the optimiser checks feasibility on (``CHECK_SAMPLES``).
+jumps of the torques and ground reaction at the mid-step knot (marked on their panels), the
+ligament load each knee needs (the rolling knee's surfaces carry no tension), the verdict and
+figures of its validation in MuJoCo when a report is given, and links to the recording and the
+video. ``write_pages`` writes pages as a set, all or none (``biped.runtime.files.atomic_set``).
+The constraints are computed again from the gait's parameters on the grid the optimiser checks
+feasibility on (``CHECK_SAMPLES``).
 """
 
 from __future__ import annotations
@@ -541,6 +542,7 @@ def markdown(page: Page, folder: Path) -> str:
         optimised = " (optimised)" if name == gait.criterion else ""
         lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
     lines += drive_lines(gait)
+    lines += knee_lines(gait)
     lines += _constraint_lines(gait)
     lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [
@@ -614,6 +616,55 @@ def drive_lines(gait: Gait) -> list[str]:
         unit = f.metadata["unit"]
         lines += [f"| {f.metadata['label']} | {getattr(electrical, f.name):.5g} | {unit} |"]
     return lines
+
+
+def knee_lines(gait: Gait) -> list[str]:
+    """The knee loads (``KneeLoads``; none for a file written before them): for the designer,
+    the ligament load each knee needs, in stance and in swing, with its largest compression
+    and the friction its rolling needs where compressed."""
+    loads = gait.knee_loads
+    if loads is None:
+        return []
+    rolling = sum(gait.biped.radii) > 0.0
+    lines = ["", "## Knee loads: the ligaments each knee needs", "", _knee_sentence(gait), ""]
+    lines += [
+        "| knee | ligament load needed [N] | largest tension [N] | largest compression [N] | "
+        "largest \\|T\\| / N where compressed |",
+        "|---|---|---|---|---|",
+    ]
+    for k, side in enumerate(("stance", "swing")):
+        tension, ratio = loads.max_tension[k], loads.max_slip_ratio[k]
+        lines += [
+            f"| {side} knee, in {side} | {f'{tension:.4g}' if rolling else 'none (a pin)'} | "
+            f"{tension:.4g} | {loads.max_compression[k]:.4g} | "
+            f"{'never compressed' if ratio is None else f'{ratio:.3g}'} |"
+        ]
+    return lines
+
+
+def _knee_sentence(gait: Gait) -> str:
+    """What the knee loads are and the verdict: whether the gait needs ligaments, how much."""
+    loads = gait.knee_loads
+    if sum(gait.biped.radii) == 0.0:
+        return (
+            "The force of the thigh on the lower leg through each knee's pin "
+            "(`biped.model.knee_loads`), along the shank (N, > 0 compression, < 0 tension) "
+            "and across it (T): the pin carries tension, so no ligament is needed."
+        )
+    what = (
+        "The force of the thigh on the lower leg through each knee (`biped.model.knee_loads`), "
+        "along the line of the rolling circles' centres (N: > 0 presses the surfaces "
+        "together, < 0 pulls them apart) and across it (T, what keeps them rolling without "
+        "slip). Two surfaces in contact carry no tension: where N < 0, ligaments (straps or "
+        "crossed cables) must hold the knee together."
+    )
+    if not loads.needs_ligaments:
+        return f"{what} This gait never pulls a knee apart: it needs no ligament."
+    stance, swing = loads.max_tension
+    return (
+        f"{what} This gait needs ligaments: {stance:.4g} N in the stance knee (in stance), "
+        f"{swing:.4g} N in the swing knee (in swing); each knee goes through both every stride."
+    )
 
 
 def _validation_lines(page: Page, folder: Path) -> list[str]:
