@@ -61,3 +61,23 @@ def test_impact_map_agrees_with_mujoco(model):
         mj_qd_plus, mj_impulse = mujoco_impact(mj, model, q[k], qd[k])
         np.testing.assert_allclose(mj_qd_plus, mapped.qpos(qd_plus[k]), atol=1e-9)
         np.testing.assert_allclose(mj_impulse, impulse[k], atol=1e-9)
+
+
+@pytest.mark.parametrize("stance", ["left", "right"])
+def test_knee_forces_agree_with_mujoco_on_random_motions(model, stance):
+    """The force of the thigh on the lower leg through each knee is MuJoCo's (``cfrc_int`` of
+    the body below the knee, the ground's force from its own inverse dynamics) to 1e-9 N, and
+    so are its parts along and across the axes taken from MuJoCo's joints."""
+    from biped.model.knee_loads import knee_forces
+    from validate.crosscheck import mujoco_knee_forces
+
+    q, qd, qdd = random_state(model, seed=45, n=30)
+    expected = knee_forces(model, q, qd, qdd)
+    exact = load_model(model, exact=True)
+    wrench = mujoco_inverse_dynamics(exact, model, q, qd, qdd, stance).wrench
+    found = mujoco_knee_forces(exact, model, q, qd, qdd, wrench, stance)
+    assert np.abs(expected.force).max() > 100.0
+    np.testing.assert_allclose(found.force, expected.force, atol=1e-9)
+    np.testing.assert_allclose(found.axis, expected.axis, atol=1e-12)
+    np.testing.assert_allclose(found.normal, expected.normal, atol=1e-9)
+    np.testing.assert_allclose(found.tangential, expected.tangential, atol=1e-9)

@@ -227,6 +227,8 @@ def test_model_errors_are_fail_lines(gait_path, tmp_path, capsys):
         assert (
             lines["inverse_dynamics"].startswith("  FAIL") and inverse in lines["inverse_dynamics"]
         )
+        if model == missing:  # no knee force without the knee's inverse dynamics
+            assert lines["knee_loads"].startswith("  FAIL") and inverse in lines["knee_loads"]
 
 
 def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
@@ -329,3 +331,40 @@ def test_a_gait_under_other_gravity_passes_on_its_own_model(knee):
     model = checks.check_model(table_1, biped)
     assert not model.passed and model.notes[-1].startswith("gravity: 9.81 m/s² in the model")
     assert not checks.check_inverse_dynamics(table_1, biped, samples).passed
+
+
+@pytest.mark.parametrize("knee", ["revolute", "rolling"])
+def test_the_knee_loads_check_fails_a_wrong_radius_or_lower_leg_mass(table_1_models, knee):
+    """The gait file's knee loads are MuJoCo's on the Table 1 model (to 1e-6 N, rounding
+    measured); loads computed for a shank 10 % heavier, or for r1 = r2 = 0.04 m, fail on it,
+    as the file's loads fail on the MJCF of r1 = r2 = 0.04 m (the revolute knee has no
+    radii: it passes there)."""
+    import dataclasses
+
+    from biped import Biped
+    from biped.model.knee_loads import knee_forces
+    from tests.conftest import gait_of
+    from validate.checks import check_knee_loads
+    from validate.model import compile_spec, model_spec
+    from validate.samples import GaitSamples
+
+    gait = gait_of(small_optimum(knee))
+    samples = GaitSamples.from_gait(gait)
+    table_1 = table_1_models[knee]
+    check = check_knee_loads(table_1, gait.biped, samples, gait.knee_loads)
+    assert check.passed and check.figures["max_knee_normal_error"] < 1e-9, check.line()
+    assert check.figures["max_swing_knee_tension"] > 30.0
+    paper = Robot.paper()
+    small = dataclasses.replace(paper, r1=0.04, r2=0.04)
+    for robot in (dataclasses.replace(paper, shank_mass=1.1 * paper.shank_mass), small):
+        loads = knee_forces(Biped(robot, knee), samples.q, samples.qd, samples.qdd)
+        wrong = check_knee_loads(table_1, gait.biped, samples, loads)
+        assert wrong.passed is (knee == "revolute" and robot is small), wrong.line()
+    other = compile_spec(model_spec(Biped(small, knee)))
+    wrong = check_knee_loads(other, gait.biped, samples, gait.knee_loads)
+    assert wrong.passed is (knee == "revolute"), wrong.line()
+    if knee == "rolling":
+        assert wrong.figures["max_knee_normal_error"] > 0.01, wrong.line()
+    assert check_knee_loads(table_1, gait.biped, samples).notes == [
+        "the gait file has no knee_loads: computed from its samples"
+    ]

@@ -6,6 +6,10 @@ model             the MJCF is the gait's robot: the rolling knee's equalities an
                   with both values); its mass beside the gait's
 inverse_dynamics  the file's Γ, F_e, ZMP against MuJoCo's dynamics of the model along the
                   file's motion (1e-6)
+knee_loads        MuJoCo's force of the thigh on the lower leg through each knee (its
+                  ``cfrc_int``) along the file's motion against the file's knee loads, normal
+                  and tangential, both knees (1e-6 N: two exact rigid models, the knee
+                  equalities' softness out of the inverse dynamics; 5e-13 N measured)
 impact            the file's start velocities and impulse against MuJoCo's impact map
                   (mass matrix and foot Jacobian) applied to the file's end state (1e-6)
 feedforward       each step replayed against the clock with the file's torques
@@ -34,10 +38,16 @@ import numpy as np
 
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import ZH
+from biped.model.knee_loads import KNEE_SIDES, knee_forces
 from biped.model.units import PURE
 from biped.records.gait_file import Gait
 from validate import contact
-from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
+from validate.crosscheck import (
+    mujoco_impact,
+    mujoco_inverse_dynamics,
+    mujoco_knee_forces,
+    rigid_copy,
+)
 from validate.mapping import mapping, other
 from validate.mjcf import SIDES
 from validate.model import ModelError, model_problems
@@ -165,6 +175,37 @@ def check_inverse_dynamics(model: mujoco.MjModel, biped: Biped, samples: GaitSam
         figures["max_knee_coupling"] = float(np.abs(result.coupling).max())
     passed = max(figures["max_torque_error"], figures["max_wrench_error"]) < EXACT
     return Check("inverse_dynamics", passed and figures["max_zmp_error"] < EXACT, figures)
+
+
+def check_knee_loads(
+    model: mujoco.MjModel, biped: Biped, samples: GaitSamples, loads=None
+) -> Check:
+    """MuJoCo's force through each knee along the file's motion (``mujoco_knee_forces``, its
+    own ground wrench) against the analytical one, ``loads`` (the gait file's ``knee_loads``,
+    or any record with ``normal`` and ``tangential`` (N, 2); None: computed from the samples
+    with ``biped``), normal and tangential, both knees, to ``EXACT`` [N]: along a given motion
+    both are exact rigid-body models of the same robot (the rigid copy: no armature, massless
+    knee links), and the equalities' softness, which a walk feels, plays no part."""
+    name = "knee_loads"
+    exact = rigid_copy(model)
+    try:
+        wrench = mujoco_inverse_dynamics(exact, biped, samples.q, samples.qd, samples.qdd).wrench
+    except ModelError as error:
+        return _model_failure(name, error)
+    found = mujoco_knee_forces(exact, biped, samples.q, samples.qd, samples.qdd, wrench)
+    notes = []
+    if loads is None:
+        loads = knee_forces(biped, samples.q, samples.qd, samples.qdd, samples.wrench)
+        notes.append("the gait file has no knee_loads: computed from its samples")
+    errors = {
+        part: np.abs(getattr(found, part) - np.asarray(getattr(loads, part), dtype=float))
+        for part in ("normal", "tangential")
+    }
+    figures = {f"max_knee_{part}_error": float(e.max()) for part, e in errors.items()}
+    for k, side in enumerate(KNEE_SIDES):  # MuJoCo's
+        figures[f"max_{side}_knee_tension"] = float(np.maximum(-found.normal[:, k], 0.0).max())
+    passed = max(figures["max_knee_normal_error"], figures["max_knee_tangential_error"]) < EXACT
+    return Check(name, passed, figures, notes)
 
 
 def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait: Gait) -> Check:

@@ -13,6 +13,13 @@ revolute knee, 11 x 11 for the rolling knee), so u, λ = [Fx, Fz, Cy] and μ fol
 and are compared with the analytical Γ and F_e. Both are exact rigid-body models of the same
 robot, so they agree to rounding.
 
+Knee forces. The force the thigh exerts on the lower leg through a knee is the translational
+part of MuJoCo's ``cfrc_int`` of the body below the knee (the rolling knee's link, whose
+subtree is link, shank and foot; the revolute knee's shank), world frame, which
+``mj_rnePostConstraint`` computes from the accelerations by the same recursion, with the
+ground's force from the inverse dynamics applied to the stance foot. The motors' torques and
+the knee equalities' forces act about the hinges: they do not enter its translational part.
+
 The MJCF carries two things the analytical model does not: armature on the rolling-knee
 hinges (it enters MuJoCo's joint-space mass matrix, though not ``mj_rne``'s body recursion)
 and a near-massless knee link. The cross-check zeroes both in a copy of the model;
@@ -28,7 +35,7 @@ import mujoco
 import numpy as np
 
 from biped.model.dynamics import Biped
-from validate.mapping import Mapping, mapping
+from validate.mapping import Mapping, mapping, other
 from validate.mjcf import SIDES, robot_xml
 from validate.model import JOINT_ORDER, ModelError
 
@@ -135,6 +142,65 @@ def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, sta
     hp = biped.robot.ankle_height
     zmp = (torques[:, 0] - hp * wrench[:, 0]) / wrench[:, 1]
     return InverseDynamics(torques, wrench, zmp, coupling)
+
+
+@dataclass
+class KneeForces:
+    """MuJoCo's force of the thigh on the lower leg through each knee, stance then swing."""
+
+    force: np.ndarray  # (N, 2, 2) [N]: knee, (x, z)
+    axis: np.ndarray  # (N, 2, 2): knee, the unit vector e from MuJoCo's joints (x, z)
+
+    @property
+    def normal(self) -> np.ndarray:
+        """N = F · e (N, 2) [N]: > 0 compression."""
+        return (self.force * self.axis).sum(-1)
+
+    @property
+    def tangential(self) -> np.ndarray:
+        """T = F · e' (N, 2) [N], e' = e turned +90° in the x-z plane."""
+        across = np.stack([-self.axis[..., 1], self.axis[..., 0]], axis=-1)
+        return (self.force * across).sum(-1)
+
+
+def _knee_bodies(model: mujoco.MjModel, side: str) -> tuple[int, int, int]:
+    """The body below a knee whose subtree is the lower leg (the rolling knee's link, else the
+    shank), and the joints whose anchors span its axis e: knee_upper → knee_lower (C2 → C1),
+    else knee → ankle."""
+    if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"{side}_knee_link") >= 0:
+        ends = (f"{side}_knee_upper", f"{side}_knee_lower")
+        return model.body(f"{side}_knee_link").id, *(model.joint(n).id for n in ends)
+    ends = (f"{side}_knee", f"{side}_ankle")
+    return model.body(f"{side}_shank").id, *(model.joint(n).id for n in ends)
+
+
+def mujoco_knee_forces(
+    model: mujoco.MjModel, biped: Biped, q, qd, qdd, wrench, stance="left"
+) -> KneeForces:
+    """The force the thigh exerts on the lower leg's subtree (the translational part of
+    ``cfrc_int``, world frame, after ``mj_rnePostConstraint``) along a motion, the ground's
+    force (Fx, Fz) of ``wrench`` (N, 3) applied to the stance foot (``xfrc_applied``; where
+    it acts changes only the rotational part) and no other constraint force, and each knee's
+    axis from MuJoCo's joint anchors."""
+    mapped = mapping(model, stance, biped.radii)
+    data = mujoco.MjData(model)
+    knees = [_knee_bodies(model, side) for side in (stance, other(stance))]
+    foot = model.body(f"{stance}_foot").id
+    qpos, qvel, qacc = (mapped.qpos(x) for x in (q, qd, qdd))
+    force, axis = np.zeros((len(qpos), 2, 2)), np.zeros((len(qpos), 2, 2))
+    for k in range(len(qpos)):
+        data.qpos[:], data.qvel[:], data.qacc[:] = qpos[k], qvel[k], qacc[k]
+        mujoco.mj_fwdPosition(model, data)
+        mujoco.mj_fwdVelocity(model, data)
+        data.efc_force[:] = 0.0
+        data.xfrc_applied[:] = 0.0
+        data.xfrc_applied[foot, [0, 2]] = wrench[k][:2]
+        mujoco.mj_rnePostConstraint(model, data)
+        for j, (body, start, end) in enumerate(knees):
+            force[k, j] = data.cfrc_int[body, [3, 5]]
+            vector = (data.xanchor[end] - data.xanchor[start])[[0, 2]]
+            axis[k, j] = vector / np.linalg.norm(vector)
+    return KneeForces(force, axis)
 
 
 def knee_link_effect(biped: Biped, q, qd, qdd, stance="left") -> float:

@@ -111,6 +111,12 @@ FIGURE_UNITS = {
         "max_zmp_error": "m",
         "max_knee_coupling": "N·m",
     },
+    "knee_loads": {
+        "max_knee_normal_error": "N",
+        "max_knee_tangential_error": "N",
+        "max_stance_knee_tension": "N",
+        "max_swing_knee_tension": "N",
+    },
     "impact": {
         "max_velocity_error": "m/s, rad/s",
         "max_impulse_error": "N·s, N·m·s",

@@ -62,6 +62,7 @@ def validate(
     results = [
         c.check_model(robot_model, biped),
         c.check_inverse_dynamics(robot_model, biped, samples),
+        c.check_knee_loads(robot_model, biped, samples, gait.knee_loads),
         c.check_impact(robot_model, biped, samples, gait),
         c.check_feedforward(spec, biped, samples),
     ]
