@@ -79,10 +79,11 @@ def links(gait_path: Path, validation: dict | None) -> list:
 
 def cmd_report(args) -> int:
     """Write one Markdown page per gait file into --out, with its figures: the parameters by
-    name, the criteria and the tightest margin of each constraint (where in the step), the
-    torques, angles, ground reaction and constraints over the step; the verdict and figures
-    of its validation in MuJoCo when <gait>.report.json lies beside it; links to its recording
-    and video. All pages are written, or none.
+    name, the criteria, the ligament load each knee needs (N, in stance and in swing) and the
+    tightest margin of each constraint (where in the step), the torques, angles, ground
+    reaction and constraints over the step; the verdict and figures of its validation in
+    MuJoCo when <gait>.report.json lies beside it; links to its recording and video. All pages
+    are written, or none.
     """
     from biped.pages.page import Page, write_pages
     from biped.records import gait_file
