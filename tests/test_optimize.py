@@ -599,7 +599,9 @@ def test_solver_that_does_not_converge_fails_loudly(tmp_path, monkeypatch, capsy
 
 
 # Every walkable constraint asked, with a clearance (``biped.model.walkable``).
-WALKING = Safety(clearance=0.02, landing_speed=0.3, friction=0.6, joint_margin=0.05, hip_progress=0.2)
+WALKING = Safety(
+    clearance=0.02, landing_speed=0.3, friction=0.6, joint_margin=0.05, hip_progress=0.2
+)
 
 
 @pytest.mark.parametrize(

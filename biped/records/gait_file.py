@@ -529,9 +529,7 @@ class Gait:
         return units
 
     def _units(self) -> dict:
-        return self.units(
-            self.criterion, self.knots, self.safety, self.robot.actuators is not None
-        )
+        return self.units(self.criterion, self.knots, self.safety, self.robot.actuators is not None)
 
     def to_dict(self) -> dict:
         """The JSON-ready content of the gait's file."""
