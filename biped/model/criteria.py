@@ -204,6 +204,17 @@ class Safety:
 
 
 PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
+# The walkable preset (``--walkable``): the margins at which MuJoCo's walk of the optimal gaits
+# follows the model (``validate.margins_study``: the servos add at most a fifth of the joint
+# torque, MuJoCo spends within 5 % of the model's energy per step, every check passes).
+WALKABLE = Safety(
+    clearance=0.01,
+    zmp_margin=0.01,
+    landing_speed=0.3,
+    friction=0.6,
+    joint_margin=0.05,
+    hip_progress=0.2,
+)
 _LEFT_OUT = {
     "knee_bend": 0.0,
     "actuator_limits": False,

@@ -1,0 +1,222 @@
+"""How closely MuJoCo's walk follows the model as the walkable constraints tighten: the study
+that chose the walkable preset (``biped.model.criteria.WALKABLE``).
+
+For each operating point (knee, speed, clearance) and each setting of one knob (the sole's
+largest landing speed, or the swing clearance), the certified sthenic optimum under that
+setting is validated in MuJoCo (``validate.validation.validate``, every check), and two
+figures of its 20-step walk are kept: the servos' share of the joint torque
+(``forward.feedback_share``: what the controller had to add to the gait's own torques) and
+the energy per step MuJoCo spends against the model's (``forward.energy_per_step`` over
+``analytic_energy_per_step``, less 1). The preset takes the loosest setting at which every
+point's walk passes every check with both figures within their targets (``TARGETS``).
+
+    python -m validate.margins_study [--knob landing|clearance] [--out logs/margins] [--jobs N]
+
+writes ``<knob>.json`` (one row per optimum, atomically) and ``<knob>.png`` (both figures
+against the knob, a line per point, the targets dashed), and prints the rows.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from biped.errors import BipedError
+from biped.model.criteria import Safety
+from biped.runtime.files import atomic_write_text
+
+# What the walk of a gait that a robot walks as computed must show (the issue's numbers):
+# the servos add at most a fifth of the joint torque, MuJoCo spends within 5 % of the model's
+# energy per step.
+TARGETS = {"feedback_share": 0.20, "energy_error": 0.05}
+# The operating points: the paper's (0.3 m/s), a slow step over a 3 cm obstacle (two families
+# of gaits there), a fast one.
+POINTS = ((0.3, 0.0), (0.2, 0.03), (0.6, 0.01))
+KNEES = ("revolute", "rolling")
+# The knobs' settings, loosest first (None: unbounded, the paper's), and the other walkable
+# constraints held meanwhile.
+KNOBS = {
+    "landing": {"values": (None, 0.6, 0.45, 0.3, 0.2, 0.1), "unit": "m/s"},
+    "clearance": {"values": (0.0, 0.005, 0.01, 0.02), "unit": "m"},
+}
+STARTS = 5
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One optimum of the study: the point and the knob's value."""
+
+    knob: str
+    knee: str
+    speed: float  # [m/s]
+    clearance: float  # [m]
+    value: float | None  # the knob's setting, in its unit; None: unbounded
+    held: Safety  # the other walkable constraints
+
+    def safety(self) -> Safety:
+        if self.knob == "landing":
+            return dataclasses.replace(
+                self.held, clearance=self.clearance, landing_speed=self.value
+            )
+        return dataclasses.replace(self.held, clearance=self.value)
+
+
+def measure(setting: Setting) -> dict:
+    """The optimum of ``setting`` and its walk's figures (a row of the study)."""
+    import biped
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
+    from biped.records.gait_file import Gait
+    from validate.validation import as_json, validate
+
+    robot = biped.Robot.paper()
+    problem = GaitProblem(biped.Biped(robot, setting.knee), setting.speed, safety=setting.safety())
+    optimum = optimize(problem, starts=STARTS)
+    row = {**dataclasses.asdict(setting), "held": None, "certified": bool(optimum.certified)}
+    row["criterion"] = float(optimum.value)
+    if not optimum.certified:
+        return {**row, "passed": False, "feedback_share": None, "energy_error": None}
+    report = as_json(validate(Gait.from_optimum(optimum, robot)).checks)
+    forward = report["forward"]
+    modelled = forward["analytic_energy_per_step"]
+    return {
+        **row,
+        "passed": report["passed"],
+        "failed": [
+            name for name, check in report.items() if name != "passed" and not check["passed"]
+        ],
+        "feedback_share": forward["feedback_share"],
+        "energy_error": forward["energy_per_step"] / modelled - 1.0,
+        "touchdown_speed": report["impact"]["landing_speed"],
+        "swing_clearance": forward["swing_clearance"],
+    }
+
+
+def settings(knob: str, held: Safety) -> list[Setting]:
+    if knob not in KNOBS:
+        raise BipedError(f"knob = {knob!r}: allowed {', '.join(KNOBS)}")
+    return [
+        Setting(knob, knee, speed, clearance, value, held)
+        for speed, clearance in POINTS
+        for knee in KNEES
+        for value in KNOBS[knob]["values"]
+    ]
+
+
+def chosen(rows: list[dict], knob: str):
+    """The loosest setting at which every point walks with both figures within ``TARGETS``
+    (None if none does)."""
+    for value in KNOBS[knob]["values"]:
+        at = [r for r in rows if r["value"] == value]
+        if at and all(_meets(r) for r in at):
+            return value
+    return None
+
+
+def _meets(row: dict) -> bool:
+    return bool(
+        row["passed"]
+        and row["feedback_share"] <= TARGETS["feedback_share"]
+        and abs(row["energy_error"]) <= TARGETS["energy_error"]
+    )
+
+
+def figure(rows: list[dict], knob: str):
+    """Both figures against the knob, a line per point and knee, the targets dashed and the
+    chosen setting marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    values = KNOBS[knob]["values"]
+    unit = KNOBS[knob]["unit"]
+    # Unbounded drawn left of the others (a landing bound: the loosest is the largest).
+    positions = {v: i for i, v in enumerate(values)}
+    labels = ["none" if v is None else f"{v:g}" for v in values]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
+    panels = (
+        ("feedback_share", "servos' share of the joint torque", 1.0),
+        ("energy_error", "MuJoCo's energy per step / model's − 1 [%]", 100.0),
+    )
+    for ax, (name, title, scale) in zip(axes, panels, strict=True):
+        for (speed, clearance), style in zip(POINTS, ("o-", "s--", "^:"), strict=True):
+            for knee, colour in zip(KNEES, ("tab:orange", "tab:blue"), strict=True):
+                line = [
+                    r
+                    for r in rows
+                    if (r["speed"], r["clearance"], r["knee"]) == (speed, clearance, knee)
+                ]
+                xs = [positions[r["value"]] for r in line if r[name] is not None]
+                ys = [scale * r[name] for r in line if r[name] is not None]
+                ax.plot(
+                    xs,
+                    ys,
+                    style,
+                    color=colour,
+                    label=f"{knee}, {speed:g} m/s, {100 * clearance:g} cm",
+                )
+        target = scale * TARGETS[name]
+        ax.axhline(target, color="k", ls="--", lw=0.8)
+        if name == "energy_error":
+            ax.axhline(-target, color="k", ls="--", lw=0.8)
+        best = chosen(rows, knob)
+        if best is not None:
+            ax.axvline(positions[best], color="tab:green", lw=6, alpha=0.2)
+        ax.set_xticks(range(len(values)), labels)
+        what = "largest landing speed of the sole" if knob == "landing" else "swing clearance"
+        ax.set_xlabel(f"{what} [{unit}]")
+        ax.set_title(title)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, loc="upper right")
+    fig.suptitle(
+        "MuJoCo's 20-step walk of each sthenic optimum (dashed: the targets; green: the preset)"
+    )
+    return fig
+
+
+def main(argv=None) -> int:
+    from biped.pages.figures import DPI
+    from biped.runtime.runner import run_tasks
+
+    parser = argparse.ArgumentParser(
+        prog="python -m validate.margins_study", description=__doc__.split("\n\n")[0]
+    )
+    parser.add_argument("--knob", choices=tuple(KNOBS), default="landing")
+    parser.add_argument("--out", default="logs/margins")
+    parser.add_argument("--jobs", type=int, default=None)
+    args = parser.parse_args(argv)
+    from biped.model.criteria import WALKABLE
+
+    held = (
+        WALKABLE if args.knob == "clearance" else dataclasses.replace(WALKABLE, landing_speed=None)
+    )
+    rows = list(run_tasks(measure, settings(args.knob, held), jobs=args.jobs, stream=None))
+    rows.sort(key=lambda r: (r["speed"], r["knee"], -1 if r["value"] is None else -r["value"]))
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    record = {
+        "knob": args.knob,
+        "targets": TARGETS,
+        "chosen": chosen(rows, args.knob),
+        "rows": rows,
+    }
+    atomic_write_text(out / f"{args.knob}.json", json.dumps(record, indent=1))
+    figure(rows, args.knob).savefig(out / f"{args.knob}.png", dpi=DPI)
+    for r in rows:
+        print(
+            f"{r['knee']:8} {r['speed']:.2f} m/s {100 * r['clearance']:g} cm  {args.knob} "
+            f"{r['value']}: C = {r['criterion']:.4g}, passed {r['passed']}, share "
+            f"{r['feedback_share']}, energy error {r['energy_error']}"
+        )
+    written = ", ".join(str(out / f"{args.knob}.{suffix}") for suffix in ("json", "png"))
+    print(f"chosen: {record['chosen']}; wrote {written}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
