@@ -27,10 +27,12 @@ NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2, and
-    negative numbers read as values (``NEGATIVE_NUMBER``)."""
+    """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2,
+    negative numbers read as values (``NEGATIVE_NUMBER``), and no abbreviated option:
+    ``--start 2`` is refused, not read as ``--starts 2``."""
 
     def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
 

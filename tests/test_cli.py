@@ -256,6 +256,9 @@ OPTIMIZE = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "x.json"
         (["atlas", "--starts", "101"], ["--starts", "'101'", "1 to 100"]),
         (["figures", "--sweep", "/nonexistent"], ["'/nonexistent' does not exist", "allowed"]),
         (["figures", "--sweep", "README.md"], ["'README.md' is a file", "allowed a folder"]),
+        # an abbreviated option is not read as the option it begins
+        ([*OPTIMIZE, "--start", "2"], ["unrecognized arguments: --start 2"]),
+        (["sweep", "--speed", "0.3"], ["unrecognized arguments: --speed 0.3"]),
     ],
 )
 def test_refused_values_are_named_with_what_is_allowed(capsys, argv, needles):
