@@ -197,14 +197,18 @@ def speed(text: str) -> float:
 
 
 def number_list(text: str, name: str, limit: int, unit: str) -> np.ndarray:
-    """'START:STOP:COUNT' (COUNT from 1 to ``limit``) or 'V1,V2,...' as an array; ``name``
-    and ``unit`` name them in the message of a malformed one."""
+    """'START:STOP:COUNT' (COUNT from 1 to ``limit``, START <= STOP) or 'V1,V2,...' as an
+    array; ``name`` and ``unit`` name them in the message of a malformed one."""
     try:
         if ":" in text:
             start, stop, count = text.split(":")
             if not 1 <= int(count) <= limit:
                 raise argparse.ArgumentTypeError(
                     f"{name} = {text!r}: COUNT = {count}, allowed 1 to {limit}"
+                )
+            if float(start) > float(stop):  # a range runs upward: a typo, not a descent
+                raise argparse.ArgumentTypeError(
+                    f"{name} = {text!r}: START {start} > STOP {stop}, allowed START <= STOP"
                 )
             return np.linspace(float(start), float(stop), int(count))
         return np.array([float(v) for v in text.split(",")])

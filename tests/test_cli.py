@@ -259,6 +259,9 @@ OPTIMIZE = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "x.json"
         # an abbreviated option is not read as the option it begins
         ([*OPTIMIZE, "--start", "2"], ["unrecognized arguments: --start 2"]),
         (["sweep", "--speed", "0.3"], ["unrecognized arguments: --speed 0.3"]),
+        # a range that runs downward is a typo, not a descent
+        (["sweep", "--speeds", "0.3:0.2:2"], ["'0.3:0.2:2'", "START 0.3 > STOP 0.2", "allowed"]),
+        (["design-map", "--r1", "0.05:0.01:3"], ["'0.05:0.01:3'", "allowed START <= STOP"]),
     ],
 )
 def test_refused_values_are_named_with_what_is_allowed(capsys, argv, needles):
