@@ -574,7 +574,7 @@ def add_pipeline(commands) -> None:
     pipe.add_argument(
         "--no-video",
         action="store_true",
-        help="skip the videos of the walks (<recordings>/<gait>.mp4)",
+        help="skip the videos of the walks (<recordings>/<gait>.mp4; an earlier run's is removed)",
     )
     types.add_budget(pipe)
     types.add_robot(pipe)

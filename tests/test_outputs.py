@@ -421,3 +421,32 @@ def test_a_file_output_that_is_a_fifo_is_refused_before_any_work(
     line = _refusal(capsys, main([*command, "--out", "pipe"]))
     assert "--out 'pipe'" in line and "a device, a FIFO or a socket" in line, line
     assert stat.S_ISFIFO(Path("pipe").stat().st_mode)
+
+
+def test_a_pipeline_without_video_removes_the_earlier_runs_video(tmp_path, monkeypatch):
+    """--no-video leaves no earlier run's video beside the new recording of the same gait."""
+    from types import SimpleNamespace
+
+    from biped.model.criteria import PAPER_SAFETY
+    from validate import workflows
+
+    def validated(gait, rrd, *, steps, video, source):
+        assert video is None
+        Path(rrd).write_bytes(b"a recording")
+        result = SimpleNamespace(checks=[], passed=True)
+        return result, {"recording": str(rrd)}
+
+    monkeypatch.setattr(workflows, "validate_and_record", validated)
+    recordings = tmp_path / "recordings"
+    recordings.mkdir()
+    earlier = recordings / f"{NAME}.mp4"
+    earlier.write_bytes(b"an earlier run's video")
+    pipeline = workflows.Pipeline(
+        Robot.paper(), 0.3, ("rolling",), "sthenic", PAPER_SAFETY, 1, tmp_path, recordings,
+        {}, video=False,
+    )  # fmt: skip
+    said = []
+    gait = Gait.from_optimum(small_optimum("rolling"), Robot.paper())
+    pipeline.validated("rolling", gait.write(tmp_path / f"{NAME}.json"), gait, said.append)
+    assert not earlier.exists() and (recordings / f"{NAME}.rrd").exists()
+    assert any(str(earlier) in line and "removed" in line for line in said)

@@ -109,6 +109,10 @@ class Pipeline:
         name = gait_path.stem
         say(f"[{label}] validating {self.steps} steps in MuJoCo...")
         video = self.recordings / f"{name}.mp4" if self.video else None
+        stale = self.recordings / f"{name}.mp4"
+        if video is None and stale.is_file():  # an earlier run's, beside the new recording
+            stale.unlink()
+            say(f"[{label}] removed {stale}, an earlier run's video (no video this run)")
         rrd = self.recordings / f"{name}.rrd"
         result, report = validate_and_record(
             gait, rrd, steps=self.steps, video=video, source=gait_path
