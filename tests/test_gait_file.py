@@ -2,6 +2,8 @@
 
 import dataclasses
 import json
+import tempfile
+from pathlib import Path
 
 import pytest
 
@@ -138,6 +140,38 @@ def _other_files() -> dict:
             "point": design_map._point_dict(point),
             "certified": True,
         },
+        **_more_other_files(),
+    }
+
+
+def _more_other_files() -> dict:
+    """The atlas's records, the table of optima, the catalog, an orbit study and a
+    recording's owner record, as their writers make them, by what the refusal must call
+    them."""
+    from importlib import resources
+
+    from biped.studies import atlas
+    from validate import orbit_study
+    from validate.outputs import claim
+
+    def shipped(package, name):
+        return json.loads(resources.files(package).joinpath(name).read_text())
+
+    optimum = small_optimum("rolling")
+    gait = Gait.from_optimum(optimum, Robot.paper())
+    settings = atlas.Settings(
+        Robot.paper(), (0.3,), (0.0,), (0.0,), ("sthenic",), 1, 0, 1
+    ).to_dict()
+    with tempfile.TemporaryDirectory() as folder:
+        source = gait.write(Path(folder) / "g.json")
+        owner = json.loads(claim(Path(folder) / "g.rrd", source).read_text())
+    return {
+        "an atlas's record": settings,
+        "one optimization of an atlas": atlas._record(optimum, 1.0),
+        "a table of optima": shipped("biped.optimization", "optima.json"),
+        "a catalog of actuators": shipped("biped.model", "catalog.json"),
+        "an orbit study": orbit_study.content("g.json", gait, None, [None], [{"verdict": "x"}]),
+        "a recording's owner record": owner,
     }
 
 
@@ -222,3 +256,20 @@ def test_a_gait_file_written_before_the_knee_loads_reads_without_them(content, t
     gait = gait_file.read_consistent(gait_file.write_json(tmp_path / "old.json", old))
     assert gait.knee_loads is None and old["format"] == gait_file.FORMAT
     assert gait.to_dict()["knee_loads"] is None
+
+
+@pytest.mark.parametrize(
+    "command, kind",
+    [("orbit", "a table of optima"), ("robustness", "one optimization of an atlas")],
+)
+def test_orbit_and_robustness_name_a_file_of_another_kind(command, kind, tmp_path, capsys):
+    """`biped orbit` and `biped robustness` given the table of optima or an atlas's record
+    exit 2 with one line naming what it is, never calling it corrupt."""
+    from biped_cli import main
+
+    path = tmp_path / "other.json"
+    path.write_text(json.dumps(_other_files()[kind]))
+    assert main([command, str(path), "--out", str(tmp_path / "out")]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and f"{str(path)!r} is {kind} (which biped " in error
+    assert "corrupt" not in error and not (tmp_path / "out").exists()

@@ -95,7 +95,27 @@ OTHER_FORMATS = {
         "the record of the paper's method's runs (which biped sweep --paper-seeds writes, as "
         "paper-method/settings.json)"
     ),
+    "biped-atlas/": "an atlas's record (which biped atlas writes, as atlas.json)",
+    "biped-optima-table/": (
+        "a table of optima (which biped table writes; the package ships one, "
+        "biped/optimization/optima.json)"
+    ),
+    "biped-actuator-catalog/": "a catalog of actuators (which biped size --catalog reads)",
 }
+# The project's other JSON files without a "format", by the keys that only they hold.
+OTHER_KEYS = (
+    ({"nominal", "limits", "ranges"}, "a robustness map (which biped robustness writes)"),
+    ({"orbits", "knob", "boundaries"}, "an orbit study (which biped orbit writes)"),
+    (
+        {"status", "certified", "next_optimum", "variables"},
+        "one optimization of an atlas (which biped atlas writes)",
+    ),
+)
+# A recording's owner record (``validate.outputs``) holds these keys and no other.
+OWNER_RECORD = (
+    {"gait", "sha256"},
+    "a recording's owner record (which biped validate and biped pipeline write beside it)",
+)
 # Consistency: the derived fields of a gait file against those recomputed from its parameters.
 # A file keeps every bit of its numbers (JSON), so only the rounding of another CPU or numpy
 # build (1e-13 of a field's size or so) may separate them; an edited figure differs by far
@@ -679,8 +699,11 @@ def other_kind(content) -> str | None:
     for prefix, kind in OTHER_FORMATS.items():
         if isinstance(found, str) and found.startswith(prefix):
             return kind
-    if {"nominal", "limits", "ranges"} <= content.keys():
-        return "a robustness map (which biped robustness writes)"
+    for keys, kind in OTHER_KEYS:
+        if keys <= content.keys():
+            return kind
+    if content.keys() == OWNER_RECORD[0]:
+        return OWNER_RECORD[1]
     if _validation_report(content):
         return "a validation report (which biped validate --json and biped pipeline write)"
     if content and all(_validation_report(value) for value in content.values()):
