@@ -407,10 +407,37 @@ def add_robot(parser) -> None:
 
 
 def robot_of(args):
-    """The robot of ``--robot`` (Table 1 without it)."""
+    """The robot of ``--robot`` (Table 1 without it); another of the project's files is
+    refused, named (``not_a_robot_file``)."""
     from biped.model.robot import Robot
 
-    return Robot.paper() if args.robot is None else Robot.from_file(args.robot)
+    if args.robot is None:
+        return Robot.paper()
+    not_a_robot_file(args.robot)
+    return Robot.from_file(args.robot)
+
+
+def not_a_robot_file(path: str) -> None:
+    """Refuse a JSON file of another kind of the project's (a gait file, a table of optima)
+    given as a robot file, naming its kind, not the first field a robot lacks."""
+    import json
+
+    from biped.records.gait_file import other_kind
+
+    if Path(path).suffix.lower() != ".json":
+        return
+    try:
+        content = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return  # Robot.from_file says what is wrong with it
+    found = content.get("format") if isinstance(content, dict) else None
+    gait = isinstance(found, str) and found.startswith("biped-gait/")
+    kind = "a gait file (its 'robot' object is one)" if gait else other_kind(content)
+    if kind is not None:
+        raise BipedError(
+            f"--robot {path!r} is {kind}, not a robot file: allowed a .json or .toml file of "
+            "the robot's fields (r1 = 0.08 alone is one)"
+        )
 
 
 def add_steps(parser) -> None:

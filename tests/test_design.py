@@ -384,3 +384,18 @@ def test_a_design_against_a_bound_is_said_and_validated(tmp_path, capsys):
             assert f"note: {name} at its lower bound 0.001 m" in out
     rrd = tmp_path / "design.rrd"
     assert main(["validate", str(path), "--steps", "2", "--rrd", str(rrd)]) == 0
+
+
+def test_a_gait_file_given_as_the_robot_is_named(tmp_path, capsys):
+    """A gait file (or another of the project's files) given as --robot: one line naming its
+    kind, not the first of its fields a robot lacks, exit 2."""
+    from biped_cli import main
+    from tests.conftest import gait_of, small_optimum
+
+    gait = gait_of(small_optimum("rolling")).write(tmp_path / "g.json")
+    for command in (["design"], ["optimize", "--knee", "rolling"]):
+        argv = [*command, "--robot", str(gait), "--speed", "0.3", "--out", str(tmp_path / "o")]
+        assert main(argv) == 2
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert len(lines) == 1 and f"--robot {str(gait)!r} is a gait file" in lines[0]
+        assert "not a robot file: allowed" in lines[0] and "constraints" not in lines[0]
