@@ -99,13 +99,33 @@ def _upper(args, robot) -> tuple:
     return tuple(upper)
 
 
+def _check_own_radii(args, robot, upper: tuple) -> None:
+    """Refuse a robot whose own radii, the rolling knee every design is compared with, lie
+    beyond the design's bounds: compared at the bound instead, the row would not be the
+    robot's knee."""
+    from biped.optimization.design import MIN_RADIUS, RADII, radius_limits
+
+    source = f"--robot {args.robot!r}" if args.robot else "Table 1's robot"
+    radii = zip(RADII, (robot.r1, robot.r2), upper, radius_limits(robot), strict=True)
+    for name, value, high, limit in radii:
+        if not MIN_RADIUS <= value <= high:
+            wider = high < value <= limit and hasattr(args, f"max_{name}")
+            option = f" or --max-{name} {value:g}" if wider else ""
+            raise BipedError(
+                f"{source}: its own {name} = {value:g} m lies beyond the design's bounds "
+                f"{MIN_RADIUS:g} to {high:.4g} m, so its knee cannot be compared: allowed a "
+                f"robot whose radii lie within them{option}"
+            )
+
+
 def design_problem(args, robot, speed):
-    """The knee design of the command line at ``speed`` (``biped.optimization.design``)."""
+    """The knee design of the command line at ``speed`` (``biped.optimization.design``); a
+    robot whose own radii lie beyond its bounds is refused (``_check_own_radii``)."""
     from biped.optimization.design import DesignProblem
 
-    return DesignProblem(
-        robot, speed, args.criterion, types.safety(args), upper=_upper(args, robot)
-    )
+    upper = _upper(args, robot)
+    _check_own_radii(args, robot, upper)
+    return DesignProblem(robot, speed, args.criterion, types.safety(args), upper=upper)
 
 
 def cmd_design(args) -> int:

@@ -386,6 +386,35 @@ def test_a_design_against_a_bound_is_said_and_validated(tmp_path, capsys):
     assert main(["validate", str(path), "--steps", "2", "--rrd", str(rrd)]) == 0
 
 
+@pytest.mark.parametrize(
+    "robot, argv, needles",
+    [
+        ("shank_com = 0.03\n", ["design"], ["its own r1 = 0.05 m", "bounds 0.001 to 0.03 m"]),
+        ("r2 = 0.0\n", ["design-map", "--speeds", "0.3"], ["its own r2 = 0 m", "to 0.2362 m"]),
+        ("", ["design", "--max-r1", "0.03"], ["r1 = 0.05 m", "or --max-r1 0.05"]),
+        ("shank_com = 0.03\n", ["pipeline", "--design"], ["its own r1 = 0.05 m"]),
+    ],
+)
+def test_a_robot_whose_radii_lie_beyond_the_designs_bounds_is_refused(
+    tmp_path, capsys, robot, argv, needles
+):
+    """A robot whose own radii lie beyond the design's bounds is refused in one line naming
+    the radius, its bounds and what is allowed, exit 2: never compared at the bound as if
+    those were its radii."""
+    from biped_cli import main
+
+    path = tmp_path / "robot.toml"
+    path.write_text(robot)
+    given = ["--robot", str(path)] if robot else []
+    speed = [] if argv[0] == "design-map" else ["--speed", "0.3"]
+    out = str(tmp_path / ("d.json" if argv[0] == "design" else "out"))
+    assert main([*argv, *given, *speed, "--out", out]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and all(n in lines[0] for n in needles), lines
+    assert "allowed a robot whose radii lie within them" in lines[0]
+    assert not list(tmp_path.glob("d.json")) and not (tmp_path / "out").exists()
+
+
 def test_a_gait_file_given_as_the_robot_is_named(tmp_path, capsys):
     """A gait file (or another of the project's files) given as --robot: one line naming its
     kind, not the first of its fields a robot lacks, exit 2."""
