@@ -299,6 +299,34 @@ def test_a_viewer_that_does_not_take_the_stream_is_a_warning_the_file_written(
     assert len(rerun.chunk.RrdReader(path).stream().to_chunks()) > 0
 
 
+def test_connect_where_nothing_listens_warns_without_rerun_s_waits(recorded, monkeypatch, tmp_path):
+    """--connect to an address where nothing listens: the warning comes within the probe's
+    wait, the stream never opened (rerun's own connection, flush and disconnect wait 5 s
+    and more each), the file written whole."""
+    import socket
+    import time
+
+    import validate.record
+    from biped.errors import ViewerWarning
+
+    result, _, _ = recorded
+    with socket.socket() as probe:  # a port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    url = f"rerun+http://127.0.0.1:{port}/proxy"
+
+    def opened(*args, **kwargs):
+        pytest.fail("a stream opened to an address where nothing listens")
+
+    monkeypatch.setattr(rerun.RecordingStream, "connect_grpc", opened)
+    with pytest.warns(ViewerWarning, match="nothing listens at that address"):
+        path = validate.record.record(tmp_path / "live.rrd", result, connect=url)
+    assert len(rerun.chunk.RrdReader(path).stream().to_chunks()) > 0
+    began = time.perf_counter()
+    assert validate.record._unreachable(url) is not None
+    assert time.perf_counter() - began < validate.record.PROBE_TIMEOUT + 0.5
+
+
 def test_the_viewer_is_found_beside_this_python_when_not_on_path(monkeypatch, tmp_path):
     """Without the virtual environment's folder on PATH (not activated), --spawn starts the
     viewer installed beside the running Python; with neither, rerun's own search."""

@@ -41,9 +41,11 @@ than their plots and is a key in words beside them (``torque_key``).
 from __future__ import annotations
 
 import shutil
+import socket
 import sys
 import warnings
 from pathlib import Path
+from urllib.parse import urlsplit
 
 import mujoco
 import numpy as np
@@ -69,6 +71,9 @@ VIEWER = "rerun"
 DEFAULT_VIEWER = "rerun+http://127.0.0.1:9876/proxy"
 # Longest wait [s] for a viewer (--spawn, --connect) to take the recording.
 VIEWER_TIMEOUT = 10.0
+# Longest wait [s] for --connect's address to accept a connection before streaming: where
+# nothing listens, rerun's own connection waits 5 s, its flush more and its disconnect 5 s.
+PROBE_TIMEOUT = 2.0
 # Series colours, the same in every plot (RGB), and line widths [UI points]: the gait's
 # widest, so that it shows around the series drawn over it where they run together.
 ANALYTIC_COLOR = (80, 140, 230)
@@ -399,6 +404,11 @@ def _stream(log_all, layout, recording_id: str, path: Path, spawn: bool, connect
     at ``connect``: a viewer that does not answer delays the command by at most
     ``VIEWER_TIMEOUT`` and never the file; it is a ``ViewerWarning``, the checks' results
     stand."""
+    where = "the viewer it started" if spawn else f"--connect {connect or DEFAULT_VIEWER!r}"
+    refused = None if spawn else _unreachable(connect or DEFAULT_VIEWER)
+    if refused is not None:  # nothing listens there: said at once, not after rerun's waits
+        _viewer_warning(where, f"nothing listens at that address: {refused}", path)
+        return
     live = rr.RecordingStream(APPLICATION, recording_id=recording_id)
     try:
         if spawn:
@@ -408,15 +418,32 @@ def _stream(log_all, layout, recording_id: str, path: Path, spawn: bool, connect
         log_all(live)
         live.flush(timeout_sec=VIEWER_TIMEOUT)
     except RuntimeError as error:  # rerun's way to say no viewer took it
-        where = "the viewer it started" if spawn else f"--connect {connect or DEFAULT_VIEWER!r}"
-        message = (
-            f"{where}: no rerun viewer took the recording ({error}); it is written to "
-            f"{str(path)!r}: open it with '{viewer_executable() or VIEWER} {path}'"
-        )
-        warnings.warn(ViewerWarning(message), stacklevel=3)
+        _viewer_warning(where, str(error), path)
     finally:
         live.disconnect()
         del live
+
+
+def _viewer_warning(where: str, why: str, path: Path) -> None:
+    """The ``ViewerWarning`` of a recording no viewer took: where it went, why, the file."""
+    message = (
+        f"{where}: no rerun viewer took the recording ({why}); it is written to "
+        f"{str(path)!r}: open it with '{viewer_executable() or VIEWER} {path}'"
+    )
+    warnings.warn(ViewerWarning(message), stacklevel=4)
+
+
+def _unreachable(url: str) -> str | None:
+    """Why nothing accepts a connection at the host and port of a viewer's ``url`` within
+    ``PROBE_TIMEOUT`` (the error), or None where something does or the URL names no port."""
+    parts = urlsplit(url)
+    if parts.hostname is None or parts.port is None:
+        return None
+    try:
+        with socket.create_connection((parts.hostname, parts.port), timeout=PROBE_TIMEOUT):
+            return None
+    except OSError as error:
+        return error.strerror or str(error) or type(error).__name__
 
 
 def viewer_executable() -> str | None:
