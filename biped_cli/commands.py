@@ -307,10 +307,13 @@ def add_figures(commands) -> None:
 
 
 def cmd_table(args) -> int:
-    """The table of optima over speed that starts every optimization (one more start: the
-    optima at the neighbouring speeds, interpolated), from a sweep's certified final optima,
-    as JSON. The package ships one, made by 'biped sweep && biped table --out
-    biped/optimization/optima.json'."""
+    """A table of optima over speed, as the one that starts every optimization (one more
+    start: the optima at the neighbouring speeds, interpolated), from a sweep's certified
+    final optima, as JSON. No command takes it as an option: every optimization reads the
+    installed package's table, biped/optimization/optima.json of the package (this command
+    prints where it is: of the source tree only with 'pip install -e .'); a table written
+    elsewhere starts optimizations once it is copied there."""
+    from biped.optimization.table import SHIPPED
     from biped.records.gait_file import write_json
     from biped.studies.sweep import optima_table
 
@@ -319,13 +322,21 @@ def cmd_table(args) -> int:
     counts = ", ".join(
         f"{len(s['speeds'])} {s['knee']} {s['criterion']}" for s in content["series"]
     )
-    print(f"wrote {write_json(args.out, content)} ({counts} optima)")
+    path = write_json(args.out, content)
+    print(f"wrote {path} ({counts} optima)")
+    if path.resolve() == SHIPPED.resolve():
+        print(f"optimizations start from it from now on: it is the package's table, {SHIPPED}")
+    else:
+        print(
+            f"optimizations read the package's table, {SHIPPED}, not this file: copy it "
+            "there to start them from it"
+        )
     return 0
 
 
 def add_table(commands) -> None:
     table = types.add_command(
-        commands, "table", "table of optima that starts optimizations", cmd_table
+        commands, "table", "a table of optima like the one that starts optimizations", cmd_table
     )
     table.add_argument(
         "--sweep",
@@ -338,7 +349,9 @@ def add_table(commands) -> None:
         "--out",
         default="logs/optima.json",
         metavar="FILE",
-        help=f"the table written (JSON), {types.FOLDERS_CREATED} (default %(default)s)",
+        help=f"the table written (JSON), {types.FOLDERS_CREATED} (default %(default)s); "
+        "optimizations read the package's table alone (printed), so this file starts them "
+        "once copied there",
     )
 
 

@@ -156,3 +156,22 @@ def test_the_energy_criterion_replaces_its_first_guesses_by_the_table_where_it_c
     ]
     assert "near" in barriers_of(covered)
     assert "near" not in barriers_of(_problem("revolute", 0.3, "energy-per-metre"))
+
+
+def test_biped_table_says_which_table_optimizations_read(tmp_path, monkeypatch, capsys):
+    """`biped table --out FILE` says that optimizations read the installed package's table,
+    naming its path, and not FILE; written there, it says that file starts them."""
+    from biped.studies import sweep
+    from biped_cli import main
+
+    series = {("rolling", "energy"): [(0.3, np.full(21, 1.0))]}
+    content = table.content(series, ROBOT, PAPER_SAFETY, "a test")
+    monkeypatch.setattr(sweep, "optima_table", lambda folder: content)
+    out = tmp_path / "optima.json"
+    assert main(["table", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"optimizations read the package's table, {table.SHIPPED}, not this file" in printed
+    monkeypatch.setattr(table, "SHIPPED", out)
+    assert main(["table", "--out", str(out)]) == 0
+    assert f"it is the package's table, {out}" in capsys.readouterr().out
+    assert json.loads(out.read_text()) == content

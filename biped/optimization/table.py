@@ -2,12 +2,15 @@
 
 ``optima.json`` beside this module holds, for each knee and criterion of one robot and safety
 (the paper's by default), the solvers' variables (``biped.optimization.problem.VARIABLES``) of
-the certified optima of a sweep at its speeds. ``biped table`` writes it from a sweep's
-folder (``from_sweep``); the shipped file is made by
+the certified optima of a sweep at its speeds. ``biped table`` writes one from a sweep's
+folder (``biped.studies.sweep.optima_table``); the shipped file is made in the source
+tree by
 
     biped sweep && biped table --out biped/optimization/optima.json
 
-(from an earlier version's sweep, its ``source`` says). It stays fixed: made again from
+(from an earlier version's sweep, its ``source`` says). Every optimization reads the
+installed package's file (``SHIPPED``), no other: the source tree's only under an editable
+install, which ``biped table`` says when it writes elsewhere. It stays fixed: made again from
 today's sweep, the starts move, and with them some of the energy criterion's optima among
 its close local minima.
 
