@@ -38,8 +38,15 @@ def test_report_has_the_documented_figures(report):
     """JSON with the inverse-dynamics errors, steps, fall and slip; exit 0 iff all pass."""
     code, content, _ = report
     assert content["inverse_dynamics"]["max_torque_error"] < 1e-6
-    assert content["inverse_dynamics"]["max_wrench_error"] < 1e-6
-    assert content["impact"]["max_velocity_error"] < 1e-6
+    for check, name, unit in (
+        ("inverse_dynamics", "max_force_error", "N"),
+        ("inverse_dynamics", "max_moment_error", "N·m"),
+        ("impact", "max_linear_velocity_error", "m/s"),
+        ("impact", "max_angular_velocity_error", "rad/s"),
+        ("impact", "max_force_impulse_error", "N·s"),
+        ("impact", "max_moment_impulse_error", "N·m·s"),
+    ):  # one figure, one unit: an error of quantities of two units is two figures
+        assert content[check][name] < 1e-6 and content["units"][f"{check}.{name}"] == unit
     forward = content["forward"]
     for key in (
         "steps",

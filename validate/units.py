@@ -1,9 +1,9 @@
 """Units of the validation report's figures (``validate.validation``), for its ``units`` map.
 
 Paths and notation as in ``biped.model.units``: ``"forward.max_slip": "m"``. "weight" is a
-fraction of the robot's weight, "S" of the gait's step length; a figure that is the largest of
-several quantities of different units names them all ("N, N·m": the largest of the errors
-of Fx, Fz [N] and Cy [N·m]).
+fraction of the robot's weight, "S" of the gait's step length. One figure has one unit: the
+largest error of quantities of different units is one figure per unit (``max_force_error``
+of Fx, Fz [N] and ``max_moment_error`` of Cy [N·m]).
 """
 
 from __future__ import annotations
@@ -107,7 +107,8 @@ FIGURE_UNITS = {
     "model": {"mass_difference": "kg", "problems": PURE},
     "inverse_dynamics": {
         "max_torque_error": "N·m",
-        "max_wrench_error": "N, N·m",
+        "max_force_error": "N",  # of Fx, Fz
+        "max_moment_error": "N·m",  # of Cy
         "max_zmp_error": "m",
         "max_knee_coupling": "N·m",
     },
@@ -118,8 +119,10 @@ FIGURE_UNITS = {
         "max_swing_knee_tension": "N",
     },
     "impact": {
-        "max_velocity_error": "m/s, rad/s",
-        "max_impulse_error": "N·s, N·m·s",
+        "max_linear_velocity_error": "m/s",  # of the slide joints' rates
+        "max_angular_velocity_error": "rad/s",  # of the hinges'
+        "max_force_impulse_error": "N·s",  # of Ix, Iz
+        "max_moment_impulse_error": "N·m·s",  # of Iy
         "normal_impulse": "N·s",
         "landing_speed": "m/s",
     },

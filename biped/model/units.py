@@ -10,12 +10,13 @@ field to its unit::
 
 A path goes through objects by key, and ``[]`` stands for every element of a list of objects.
 A unit is a string in the notation the project prints (``N·m``, ``rad/s²``), ``"1"`` for a pure
-number (a count, a ratio) and ``"T"`` for a fraction of the gait's period; a list holds one
-unit per column of an array whose columns differ. A unit may be followed by what the number is,
-in parentheses, where the key alone would mislead: ``optimizer.value`` is the criterion on the
-solver's samples, which ranks the starts, where ``costs`` hold it on the check grid, which the
-comparisons use (``biped.optimization.comparison``). Only numbers (and null, a figure that could
-not be measured) have units; texts, booleans and ``provenance`` have none.
+number (a count, a ratio) and ``"T"`` for a fraction of the gait's period (``is_unit``): a
+unit, never prose, and one number has one unit; a list holds one unit per column of an array
+whose columns differ. What a number is goes with its record's documentation, not its unit:
+``optimizer.value`` is the criterion on the solver's samples, which ranks the starts, where
+``costs`` hold it on the check grid, which the comparisons use (``biped.optimization.comparison``).
+Only numbers (and null, a figure that could not be measured) have units; texts, booleans and
+``provenance`` have none.
 
 A record declares the unit of each of its fields beside it (``unit_field``), and its map
 follows from the declarations (``declared_units``): the gait file's ``Gait`` and its inner
@@ -25,14 +26,46 @@ records, the optimizer's ``Report``, a walk's figures (``validate.units``).
 from __future__ import annotations
 
 import dataclasses
+import re
 
 from biped.model.criteria import CONSTRAINTS
 from biped.model.kinematics import ANGLES, COORDINATES
 
 PURE = "1"  # a count or a ratio
 PERIOD = "T"  # a fraction of the gait's period
+# The units that are a fraction of one of the gait's or the robot's own figures: of the
+# period T, of the step length S, of the robot's weight m g.
+FRACTIONS = (PERIOD, "S", "weight")
+# SI symbols a unit is made of (a product with "·", a quotient with "/", powers ² and ³).
+SYMBOLS = ("m", "s", "kg", "N", "J", "W", "A", "V", "Ω", "rad", "Hz")
+_FACTOR = f"(?:{'|'.join(SYMBOLS)})[²³]?"
+_UNIT = re.compile(rf"{_FACTOR}(?:[·/]{_FACTOR})*")
 # Fields without units: what produced the file, and the map itself.
 SKIPPED = ("provenance", "units")
+
+
+def is_unit(text) -> bool:
+    """Whether ``text`` is one unit: ``PURE``, one of ``FRACTIONS``, or SI symbols
+    (``SYMBOLS``) multiplied and divided ("N²·m·s", "rad/s²"), nothing else."""
+    return isinstance(text, str) and (
+        text == PURE or text in FRACTIONS or _UNIT.fullmatch(text) is not None
+    )
+
+
+def unit_text(unit) -> str:
+    """A unit as a page prints it: a string as it is; one per column as runs of columns
+    ("rad (1-6), rad/s (7-12)"), or the one unit all columns share."""
+    if isinstance(unit, str):
+        return unit
+    runs: list[list] = []
+    for column, each in enumerate(unit, start=1):
+        if runs and runs[-1][0] == each:
+            runs[-1][2] = column
+        else:
+            runs.append([each, column, column])
+    if len(runs) == 1:
+        return str(runs[0][0])
+    return ", ".join(f"{u} ({a})" if a == b else f"{u} ({a}-{b})" for u, a, b in runs)
 
 
 def numeric_paths(content: dict, skip=SKIPPED) -> list[str]:

@@ -37,7 +37,6 @@ from biped.model.criteria import CRITERION_UNITS, WORK_CRITERIA, StepEvaluation,
 from biped.model.gait import Step, build_step
 from biped.model.units import PURE, unit_field
 from biped.optimization import table
-from biped.optimization.comparison import CHECKED_VALUE, SOLVER_VALUE
 from biped.optimization.penalty import EVALUATIONS_PER_RUN, MAX_RESTARTS, nelder_mead
 from biped.optimization.problem import (  # noqa: F401 (re-exported)
     CHECK_SAMPLES,
@@ -66,12 +65,9 @@ PERTURBATION = 1.0
 AGREEMENT = 1e-6
 
 
-def _solver_value(criterion: str) -> str:
-    return f"{CRITERION_UNITS[criterion]} ({SOLVER_VALUE})"
-
-
-def _best_value(criterion: str) -> str:
-    return f"{CRITERION_UNITS[criterion]} ({SOLVER_VALUE}; costs.{criterion} is {CHECKED_VALUE})"
+def _criterion_unit(criterion: str) -> str:
+    """The unit of a value of ``criterion`` (what the value is: ``SOLVER_VALUE``)."""
+    return CRITERION_UNITS[criterion]
 
 
 @dataclass(frozen=True)
@@ -79,7 +75,7 @@ class Start:
     """One start of the solver and where it ended."""
 
     kind: str  # "first guess", "perturbed", "nelder-mead", "given"
-    value: float = unit_field(_solver_value)  # criterion reached (solver's samples)
+    value: float = unit_field(_criterion_unit)  # criterion reached (SOLVER_VALUE)
     status: str  # solver status
     iterations: int = unit_field(PURE)
 
@@ -97,12 +93,14 @@ class Report:
     starts: int = unit_field(PURE)
     starts_at_best: int = unit_field(PURE)
     iterations: int = unit_field(PURE)  # the best start's
-    # the largest violation of a constraint or bound at the best point
-    constraint_violation: float = unit_field("1 (the solver's scaled constraints)")
-    dual_infeasibility: float = unit_field("1 (IPOPT's measure)")  # NaN for Nelder-Mead
+    # the largest violation of a constraint or bound at the best point, of the solver's
+    # scaled constraints
+    constraint_violation: float = unit_field(PURE)
+    dual_infeasibility: float = unit_field(PURE)  # IPOPT's measure; NaN for Nelder-Mead
     seconds: float = unit_field("s")  # wall time of all starts
     seed: int = unit_field(PURE)  # of the perturbed starts and of Nelder-Mead's restarts
-    value: float = unit_field(_best_value, default=float("nan"))  # on the solver's samples
+    # SOLVER_VALUE; costs.<criterion> of a gait file is CHECKED_VALUE
+    value: float = unit_field(_criterion_unit, default=float("nan"))
     history: tuple = unit_field([Start], default_factory=tuple)  # every start
 
     @property

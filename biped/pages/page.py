@@ -33,7 +33,7 @@ from biped.model.actuators import Actuators
 from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
 from biped.model.gait import breakpoints, build_step, parameter_names, piece_grid
-from biped.model.units import CONSTRAINT_UNITS, parameter_unit
+from biped.model.units import CONSTRAINT_UNITS, parameter_unit, unit_text
 from biped.optimization.problem import CHECK_SAMPLES, SOLVER_SAMPLES
 from biped.pages.figures import (
     ANGLE_PANELS,
@@ -682,7 +682,8 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
         lines += ["| figure | value | unit |", "|---|---|---|"]
         for name, value in figures.items():
             if name not in ("passed", "notes"):
-                lines += [f"| {name} | {_number(value)} | {units.get(f'{check}.{name}', '')} |"]
+                unit = unit_text(units.get(f"{check}.{name}", ""))
+                lines += [f"| {name} | {_number(value)} | {unit} |"]
         lines += [""]
         notes = figures.get("notes") or []
         if notes:  # sentences, one a line (a list of two figures is a range: "low to high")
