@@ -105,3 +105,14 @@ def refusal(read, path) -> str:
     message = str(error.value)
     assert str(path) in message and "\n" not in message
     return message
+
+
+def designed_gait():
+    """A designed gait in memory (``Gait.from_design``): the comparison of the small optima,
+    the rolling knee's as the design at Table 1's radii."""
+    from biped.optimization.design import Comparison, Design, DesignProblem
+    from biped.records.gait_file import Gait
+
+    problem = DesignProblem(biped.Robot.paper(), 0.3)
+    rolling, revolute = small_optimum("rolling"), small_optimum("revolute")
+    return Gait.from_design(Comparison(problem, revolute, rolling, Design(problem, rolling)))

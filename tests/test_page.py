@@ -273,3 +273,22 @@ def test_a_revolute_knee_needs_no_ligament_and_an_old_file_no_section():
     assert "the pin carries tension, so no ligament is needed" in text
     assert f"| swing knee, in swing | none (a pin) | {gait.knee_loads.max_tension[1]:.4g} |" in text
     assert knee_lines(dataclasses.replace(gait, knee_loads=None)) == []
+
+
+def test_a_designed_knees_page_states_its_radii_and_what_it_was_compared_with(tmp_path):
+    """The page of a designed knee's gait states r1 and r2 with their bounds, the knees it
+    was compared with and the changes; every rolling knee's page states its radii."""
+    from biped.pages.page import Page, markdown
+    from tests.conftest import designed_gait
+
+    gait = designed_gait()
+    text = markdown(Page("design", tmp_path / "design.json", gait), tmp_path)
+    assert "| knee radii r1 / r2 | 0.05 / 0.05 | m |" in text
+    assert "## Knee design" in text
+    assert (
+        "| r1 | 0.05 | 0.001 | 0.1811 | m |" in text
+        and "| r2 | 0.05 | 0.001 | 0.2362 | m |" in text
+    )
+    for knee in ("| revolute | - | - |", "| rolling, Table 1 radii | 0.05 | 0.05 |"):
+        assert knee in text
+    assert "- design vs revolute: " in text

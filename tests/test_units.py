@@ -160,3 +160,20 @@ def test_a_page_prints_units_per_column_as_units_never_a_list():
     lines = _validation_lines(Page("p", Path("g.json"), gait, report), Path("."))
     row = next(line for line in lines if line.startswith("| fixed_point |"))
     assert row.endswith("| rad (1-6), rad/s (7-12) |") and "[" not in row
+
+
+def test_every_number_of_a_designed_gait_file_has_a_unit(tmp_path):
+    """A designed knee's gait file (biped design) gives a unit to every number of its
+    ``design`` block too: the radii and their bounds [m], the knees compared, the changes."""
+    from biped.model.units import is_unit
+    from tests.conftest import designed_gait
+
+    path = designed_gait().write(tmp_path / "design.json")
+    content = json.loads(path.read_text())
+    units = content["units"]
+    assert missing(content, units) == [] and set(units) == set(numeric_paths(content))
+    assert units["design.radii.r1"] == units["design.upper.r2"] == "m"
+    assert units["design.compared[].energy"] == "J"
+    assert units["design.gains_percent.design_vs_revolute"] == "%"
+    assert all(is_unit(unit) for unit in units.values() if isinstance(unit, str))
+    assert Gait.read(path, consistent=True).design == content["design"]

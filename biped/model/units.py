@@ -32,6 +32,7 @@ from biped.model.criteria import CONSTRAINTS
 from biped.model.kinematics import ANGLES, COORDINATES
 
 PURE = "1"  # a count or a ratio
+PERCENT = "%"  # a ratio in hundredths (a change, ``biped.optimization.comparison``)
 PERIOD = "T"  # a fraction of the gait's period
 # The units that are a fraction of one of the gait's or the robot's own figures: of the
 # period T, of the step length S, of the robot's weight m g.
@@ -45,10 +46,10 @@ SKIPPED = ("provenance", "units")
 
 
 def is_unit(text) -> bool:
-    """Whether ``text`` is one unit: ``PURE``, one of ``FRACTIONS``, or SI symbols
-    (``SYMBOLS``) multiplied and divided ("N²·m·s", "rad/s²"), nothing else."""
+    """Whether ``text`` is one unit: ``PURE``, ``PERCENT``, one of ``FRACTIONS``, or SI
+    symbols (``SYMBOLS``) multiplied and divided ("N²·m·s", "rad/s²"), nothing else."""
     return isinstance(text, str) and (
-        text == PURE or text in FRACTIONS or _UNIT.fullmatch(text) is not None
+        text in (PURE, PERCENT, *FRACTIONS) or _UNIT.fullmatch(text) is not None
     )
 
 

@@ -61,6 +61,8 @@ from biped.optimization.problem import GaitProblem, check_criterion, check_speed
 from biped.optimization.solver import Solver
 
 RADII = ("r1", "r2")
+# The changes of a comparison (``Comparison.gains``), by name.
+GAINS = ("design_vs_revolute", "design_vs_table1", "table1_vs_revolute")
 # [m] Lower bound of a designed knee radius: the smallest length of a robot
 # (``biped.model.robot.LENGTH_MIN``); at 0 the rolling knee is the revolute knee (module docstring).
 MIN_RADIUS = LENGTH_MIN
@@ -379,11 +381,8 @@ class Comparison:
         needs less): the design against the revolute knee and against the Table 1 radii, the
         Table 1 radii against the revolute knee."""
         design, revolute, reference = self.design.value, self.revolute.value, self.reference.value
-        return {
-            "design_vs_revolute": relative_change(design, revolute),
-            "design_vs_table1": relative_change(design, reference),
-            "table1_vs_revolute": relative_change(reference, revolute),
-        }
+        changes = ((design, revolute), (design, reference), (reference, revolute))
+        return {name: relative_change(*pair) for name, pair in zip(GAINS, changes, strict=True)}
 
     def table(self) -> str:
         """The three knees in a text table: radii, both criteria of the gait optimal for

@@ -34,6 +34,7 @@ from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
 from biped.model.gait import breakpoints, build_step, parameter_names, piece_grid
 from biped.model.units import CONSTRAINT_UNITS, parameter_unit, unit_text
+from biped.optimization.design import GAINS, RADII
 from biped.optimization.problem import CHECK_SAMPLES, SOLVER_SAMPLES
 from biped.pages.figures import (
     ANGLE_PANELS,
@@ -532,6 +533,12 @@ def markdown(page: Page, folder: Path) -> str:
         f"| ZMP margin asked (beyond the paper's) | {safety.zmp_margin:g} | m |",
         f"| optimiser | {report.method}: {report.status}, "
         f"{report.starts_at_best} of {report.starts} starts at the best | |",
+        *(
+            [f"| knee radii r1 / r2 | {gait.robot.r1:.4g} / {gait.robot.r2:.4g} | m |"]
+            if gait.knee == "rolling"
+            else []
+        ),
+        *design_lines(gait),
         "",
         "## Criteria",
         "",
@@ -558,6 +565,51 @@ def markdown(page: Page, folder: Path) -> str:
     if page.validation is not None:
         lines += _validation_lines(page, folder)
     return "\n".join(lines) + "\n"
+
+
+def design_lines(gait: Gait) -> list[str]:
+    """The section of a designed knee (``biped design``: the file's ``design``): its radii
+    within their bounds, the knees it was compared with and the changes; none for a gait of
+    given radii."""
+    design = gait.design
+    if not isinstance(design, dict):
+        return []
+    at = design.get("at_bounds") or []
+    lines = [
+        "",
+        "## Knee design",
+        "",
+        "The rolling knee's radii optimised with the gait (`biped design`)"
+        + (f": {', '.join(at)}." if at else ", inside their bounds."),
+        "",
+        "| radius | value | lower bound | upper bound | unit |",
+        "|---|---|---|---|---|",
+    ]
+    for name in RADII:
+        values = [(design.get(key) or {}).get(name) for key in ("radii", "lower", "upper")]
+        lines += [f"| {name} | {' | '.join(map(_number, values))} | m |"]
+    lines += [
+        "",
+        "| knee compared | r1 [m] | r2 [m] | sthenic [N²·m·s] | energy [J] | certified |",
+        "|---|---|---|---|---|---|",
+    ]
+    for knee in design.get("compared") or []:
+        radii = knee.get("radii") or {}
+        values = [radii.get(name, "-") for name in RADII] + [
+            knee.get("sthenic"),
+            knee.get("energy"),
+        ]
+        shown = " | ".join(v if isinstance(v, str) else _number(v) for v in values)
+        lines += [f"| {knee.get('knee')} | {shown} | {_number(knee.get('certified'))} |"]
+    gains = design.get("gains_percent") or {}
+    lines += [
+        "",
+        f"Changes of the {gait.criterion} criterion, (first − second) / second; negative: the "
+        "first needs less:",
+        "",
+    ]
+    lines += [f"- {name.replace('_', ' ')}: {_number(gains.get(name))} %" for name in GAINS]
+    return lines
 
 
 def _constraint_lines(gait: Gait) -> list[str]:

@@ -53,6 +53,7 @@ from biped.model.knee_loads import KNEE_SIDES, knee_forces
 from biped.model.robot import Robot
 from biped.model.units import (
     CONSTRAINT_UNITS,
+    PERCENT,
     PURE,
     declared_units,
     parameter_unit,
@@ -60,6 +61,7 @@ from biped.model.units import (
     robot_unit,
     unit_field,
 )
+from biped.optimization.design import GAINS, RADII
 from biped.optimization.optimize import Optimum, Report
 from biped.optimization.problem import (
     CHECK_SAMPLES,
@@ -125,6 +127,16 @@ CONSISTENCY_RTOL = 1e-9
 
 
 RATES = per_coordinate("rad/s", "m/s")
+# Units of a designed knee's block, ``design`` (``biped.optimization.design.Comparison``): the
+# radii and their bounds, each knee compared (the revolute knee's radii null), the changes.
+DESIGN_UNITS = {
+    **{f"design.{group}.{name}": "m" for group in ("radii", "lower", "upper") for name in RADII},
+    "design.compared[].radii": "m",
+    **{f"design.compared[].radii.{name}": "m" for name in RADII},
+    "design.compared[].sthenic": CRITERION_UNITS["sthenic"],
+    "design.compared[].energy": CRITERION_UNITS["energy"],
+    **{f"design.gains_percent.{name}": PERCENT for name in GAINS},
+}
 
 
 @dataclass(frozen=True, eq=False)
@@ -523,16 +535,23 @@ class Gait:
 
     @staticmethod
     def units(
-        criterion: str, knots: int = 1, safety: Safety = PAPER_SAFETY, actuators: bool = False
+        criterion: str,
+        knots: int = 1,
+        safety: Safety = PAPER_SAFETY,
+        actuators: bool = False,
+        design: bool = False,
     ) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion`` in the family of
         ``knots`` interior knots, under the margins ``safety`` (the paper's by default), with
-        the robot's actuators if ``actuators`` (a robot file's, not the default set), from the
-        fields' declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
+        the robot's actuators if ``actuators`` (a robot file's, not the default set), with a
+        designed knee's block if ``design`` (``DESIGN_UNITS``), from the fields' declarations:
+        ``{"costs.sthenic": "N²·m·s", ...}``."""
         units = declared_units(Gait, "", criterion)
         written = safety_dict(safety)  # a setting left at its default is not written
         for name in [f.name for f in dataclasses.fields(Safety) if f.name not in written]:
             units.pop(f"safety.{name}", None)
+        if design:
+            units.update(DESIGN_UNITS)
         if actuators:
             for kind in KINDS:
                 for name, unit in ACTUATOR_UNITS.items():
@@ -549,7 +568,13 @@ class Gait:
         return units
 
     def _units(self) -> dict:
-        return self.units(self.criterion, self.knots, self.safety, self.robot.actuators is not None)
+        return self.units(
+            self.criterion,
+            self.knots,
+            self.safety,
+            self.robot.actuators is not None,
+            self.design is not None,
+        )
 
     def to_dict(self) -> dict:
         """The JSON-ready content of the gait's file."""
