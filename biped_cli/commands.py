@@ -388,19 +388,24 @@ def cmd_validate(args) -> int:
     same walk at half and twice the servo stiffness; the walk's orbit stable (the spectral
     radius of its return map from step to step, plus two of its spreads, below 1: biped
     orbit, validate/orbit.py). Prints a table per gait (or JSON with
-    --json) and writes a rerun recording per gait (--spawn, --connect: also to a viewer) and,
+    --json) and writes a rerun recording per gait (--spawn, --connect: also to a viewer), the
+    report as JSON beside it (<recording>.report.json, which biped report reads) and,
     with --video, the video of the walk; exits 0 only when every check of every gait passes,
     1 otherwise. A gait file whose samples, costs, constraints or feasibility are not those
     of its parameters is refused before any work (exit 2, naming the field).
     """
     import json
 
+    from biped.records.gait_file import write_json
     from biped_cli.progress import Progress
+    from validate.outputs import report_path
     from validate.workflows import validate_and_record
 
     gif = _check_video(args)
     gaits = read_gaits(args.gait, args.model)
     recordings = _recordings(args)
+    for rrd in recordings:
+        check_output(str(report_path(rrd)), "--rrd")
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:
         for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
@@ -417,10 +422,12 @@ def cmd_validate(args) -> int:
                     source=path,
                     model=args.model,
                 )
+            written = write_json(report_path(rrd), {**reports[path], "gait": path})
             passed += result.passed
             bar.clear()
             if not args.json:
                 _print_validation(path, gait, result, reports[path])
+                print(f"report {written} (biped report {path} reads it)", flush=True)
             bar.advance()
     if args.json:
         print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))

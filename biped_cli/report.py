@@ -2,8 +2,9 @@
 
 The page (``biped.pages.page``) is named from the gait file's path as its recording is
 (``validate.outputs``). Its validation is the report beside the gait file,
-``<gait>.report.json`` (``biped pipeline`` writes it; ``biped validate GAIT.json --json >
-GAIT.report.json`` too); its links are the recording and videos that report names, or the
+``<gait>.report.json`` (``biped pipeline`` writes it), else the one ``biped validate`` writes
+beside the gait's default recording, when that recording is the gait's as it is now; its
+links are the recording and videos that report names, or the
 recording ``biped validate`` writes by default, each only if it exists and was made from this
 gait file as it is now.
 """
@@ -33,9 +34,23 @@ def validation_path(gait_path: str | Path) -> Path:
     return gait_path.with_name(f"{gait_path.stem}.report.json")
 
 
-def read_validation(path: Path) -> dict | None:
+def validation_file(gait_path: str | Path) -> Path | None:
+    """A gait file's validation report: the one beside it (``validation_path``, the
+    pipeline's), else the one ``biped validate`` writes beside the gait's default recording
+    when that recording was made from the gait file as it is now; None without either."""
+    from validate.outputs import belongs_to, output_name, report_path
+
+    beside = validation_path(gait_path)
+    if beside.exists():
+        return beside
+    recording = Path(DEFAULT_RECORDINGS) / f"{output_name(gait_path)}.rrd"
+    found = report_path(recording)
+    return found if found.exists() and belongs_to(recording, gait_path) else None
+
+
+def read_validation(path: Path | None) -> dict | None:
     """A validation report's content, None if there is none; BipedError if it is not one."""
-    if not path.exists():
+    if path is None or not path.exists():
         return None
     try:
         content = json.loads(path.read_text(encoding="utf-8"))
@@ -82,8 +97,9 @@ def cmd_report(args) -> int:
     name, the criteria, the ligament load each knee needs (N, in stance and in swing) and the
     tightest margin of each constraint (where in the step), the torques, angles, ground
     reaction and constraints over the step; the verdict and figures of its validation in
-    MuJoCo when <gait>.report.json lies beside it; links to its recording and video. All pages
-    are written, or none.
+    MuJoCo when <gait>.report.json lies beside it (biped pipeline's) or beside its recording
+    (biped validate's, if the recording is of the gait as it is now); links to its recording
+    and video. All pages are written, or none.
     """
     from biped.pages.page import Page, write_pages
     from biped.records import gait_file
@@ -93,8 +109,8 @@ def cmd_report(args) -> int:
     pages = []
     for path in args.gait:  # every input read and checked before any work
         gait = gait_file.read_consistent(path)  # its figures its parameters'
-        validation_file = validation_path(path)
-        validation = read_validation(validation_file)
+        found = validation_file(path)
+        validation = read_validation(found)
         if validation is not None and not isinstance(validation.get("units"), dict):
             from validate.units import report_units  # a report from before the units map
 
@@ -105,7 +121,7 @@ def cmd_report(args) -> int:
                 source=Path(path),
                 gait=gait,
                 validation=validation,
-                validation_source=validation_file if validation is not None else None,
+                validation_source=found if validation is not None else None,
                 links=links(Path(path), validation),
             )
         )

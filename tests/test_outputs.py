@@ -450,3 +450,22 @@ def test_a_pipeline_without_video_removes_the_earlier_runs_video(tmp_path, monke
     pipeline.validated("rolling", gait.write(tmp_path / f"{NAME}.json"), gait, said.append)
     assert not earlier.exists() and (recordings / f"{NAME}.rrd").exists()
     assert any(str(earlier) in line and "removed" in line for line in said)
+
+
+def test_report_reads_the_validation_biped_validate_wrote(gaits, capsys):
+    """After 'biped validate X.json', 'biped report X.json' shows that validation (the
+    report validate writes beside its recording), and no longer once X.json changes."""
+    gait = gaits["sweep"]
+    assert main(["validate", str(gait), "--steps", "1"]) in (0, 1)
+    written = Path("logs/recordings") / f"sweep-{NAME}.report.json"
+    assert f"report {written}" in capsys.readouterr().out
+    assert json.loads(written.read_text())["gait"] == str(gait)
+    assert main(["report", str(gait), "--out", "pages"]) == 0
+    page = (Path("pages") / f"sweep-{NAME}.md").read_text()
+    assert "Validation in MuJoCo: **" in page and "Not validated" not in page
+    assert f"Report [`{written}`]" in page
+    content = json.loads(gait.read_text())
+    content["provenance"]["command"] = "edited"  # another file: the validation is not its
+    gait.write_text(json.dumps(content))
+    assert main(["report", str(gait), "--out", "pages"]) == 0
+    assert "Not validated in MuJoCo" in (Path("pages") / f"sweep-{NAME}.md").read_text()

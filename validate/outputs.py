@@ -3,7 +3,8 @@
 A gait file's recording, video and page are named from the gait file's own path, its folder
 and its name (``logs/sweep/rolling-sthenic-0.300.json`` -> ``sweep-rolling-sthenic-0.300``),
 so gait files of the same name in two folders do not share them. Beside each recording, its
-owner record ``<recording>.source.json`` names the gait file it was made from (absolute path)
+validation report ``<recording's stem>.report.json`` (``report_path``) and its owner record
+``<recording>.source.json``, which names the gait file it was made from (absolute path)
 and the SHA-256 of that file's content; a recording owned by another gait file is never
 overwritten (``check_owner``), and a page links a recording only if it is its gait's.
 
@@ -31,6 +32,13 @@ def output_name(gait_path: str | Path) -> str:
     """The name of a gait file's outputs: '<folder>-<name>' of its absolute path."""
     path = Path(gait_path).resolve()
     return f"{path.parent.name}-{path.stem}" if path.parent.name else path.stem
+
+
+def report_path(recording: str | Path) -> Path:
+    """The validation report ``biped validate`` writes beside a recording:
+    ``<recording's stem>.report.json``."""
+    recording = Path(recording)
+    return recording.with_name(f"{recording.stem}.report.json")
 
 
 def owner_path(recording: str | Path) -> Path:

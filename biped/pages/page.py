@@ -516,7 +516,10 @@ def markdown(page: Page, folder: Path) -> str:
         verdict = "PASS" if page.validation.get("passed") else "FAIL"
         lines += [f"Validation in MuJoCo: **{verdict}** (below)."]
     else:
-        lines += ["Not validated in MuJoCo: no validation report beside the gait file."]
+        lines += [
+            "Not validated in MuJoCo: no validation report beside the gait file nor beside "
+            "its recording (`biped validate` writes one there)."
+        ]
     lines += [""]
     for link in page.links:
         note = f" ({link.note})" if link.note else ""
