@@ -74,6 +74,11 @@ def cmd_size(args) -> int:
 
     catalog = load_catalog(args.catalog)
     gaits = [(path, gait_file.read_consistent(path)) for path in args.gait]  # all read first
+    for path, gait in gaits:
+        why = uncertified(gait)
+        if why is not None:  # as biped optimize warns: its actuators may be another optimum's
+            more = "more --starts may find a better one, which other actuators may drive"
+            print(f"warning: {path}: its optimum is {why}; {more}", file=sys.stderr)
     totals, status = [], 0
     for path, gait in gaits:
         print(
@@ -114,6 +119,21 @@ def cmd_size(args) -> int:
     return status
 
 
+def uncertified(gait) -> str | None:
+    """Why a gait file's optimum is not certified, or reached by a single start only
+    (``biped.optimization.comparison``); None if it is certified and confirmed."""
+    from biped.optimization.comparison import SINGLE_START
+
+    report = gait.optimizer
+    if not report.converged:
+        return f"not certified: the solver did not converge ({report.status})"
+    if not gait.feasible:
+        return "not certified: infeasible on the check grid"
+    if report.method == "ipopt" and not report.confirmed:
+        return f"{SINGLE_START} ({report.starts_at_best} of {report.starts} starts)"
+    return None
+
+
 def _electrical(gait) -> str:
     value = gait.costs.electrical
     return "electrical not recorded" if value is None else f"{value:.4f} J/m"
@@ -139,9 +159,11 @@ def _knee_differences(totals) -> list[str]:
             rolling.costs.electrical or float("nan"), revolute.costs.electrical or float("nan")
         )
         mass = relative_change(mass_r or float("nan"), mass_v or float("nan"))
+        flagged = [f"{g.knee}: {uncertified(g)}" for g in (rolling, revolute) if uncertified(g)]
         lines.append(
             f"  rolling vs revolute, {criterion} optima at {speed:.3f} m/s: electrical energy "
             f"{energy:+.2f} %, actuator mass {mass:+.2f} % ({DIFFERENCE})"
+            + (f"; not a certified comparison ({'; '.join(flagged)})" if flagged else "")
         )
     return lines
 

@@ -250,3 +250,31 @@ def test_bad_catalog_is_one_line_exit_2(gait_path, tmp_path, capsys, content, ne
     assert main(["size", str(gait_path), "--catalog", str(path)]) == 2
     err = capsys.readouterr().err.strip()
     assert needle in err and str(path) in err and "\n" not in err
+
+
+def test_size_warns_of_a_single_start_optimum_and_its_comparison(tmp_path, capsys):
+    """A gait whose optimum one start alone reached: a warning on stderr naming the file and
+    --starts, as biped optimize gives, and the knees' comparison says it is not certified;
+    of two confirmed optima, neither."""
+    import dataclasses
+
+    gaits = {knee: gait_of(optimal_gait(knee)) for knee in ("rolling", "revolute")}
+    assert all(g.optimizer.starts_at_best >= 2 for g in gaits.values())
+    paths = [g.write(tmp_path / f"{knee}.json") for knee, g in gaits.items()]
+    assert main(["size", *map(str, paths)]) == 0
+    out, err = capsys.readouterr()
+    assert "warning" not in err and "not a certified comparison" not in out
+    rolling = gaits["rolling"]
+    single = dataclasses.replace(
+        rolling, optimizer=dataclasses.replace(rolling.optimizer, starts_at_best=1)
+    )
+    single.write(paths[0])
+    assert main(["size", *map(str, paths)]) == 0
+    out, err = capsys.readouterr()
+    assert f"warning: {paths[0]}: its optimum is reached by a single start" in err
+    assert "more --starts" in err and str(paths[1]) not in err
+    [line] = [line for line in out.splitlines() if line.startswith("  rolling vs revolute")]
+    assert line.endswith(
+        "; not a certified comparison (rolling: reached by a single start (1 of "
+        f"{rolling.optimizer.starts} starts))"
+    )
