@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import biped
-from biped.optimization.optimize import CONFIRM, MONOTONE, apart_from_table
+from biped.optimization.optimize import CONFIRM, MONOTONE, apart_from_table, optimize
 from biped.optimization.problem import GaitProblem
 from biped.optimization.table import OTHER_KNEE_START
 from biped.pages.figures import LABELS, make_figures
@@ -226,13 +226,18 @@ def test_figures_and_table(sweep, tmp_path):
         best[knee] = min(gaits, key=lambda g: g.costs.sthenic)
     difference = 100 * (best["rolling"].costs.sthenic / best["revolute"].costs.sthenic - 1)
     assert f"| -17.0 % | {difference:+.1f} % |" in table
-    assert f"| 0.27 | {best['revolute'].speed:.3f} |" in table
+    speed = best["revolute"].speed  # at an end of the sweep's grid: said so
+    end = {SPEEDS[0]: " (the slowest of the sweep)", SPEEDS[-1]: " (the fastest of the sweep)"}
+    assert f"| 0.27 | {speed:.3f}{end.get(speed, '')} |" in table
     gaits = [gait_file.read(p) for p in folder.glob("*-*.json")]
     confirmed = sum(g.optimizer.starts_at_best >= 2 for g in gaits)
     assert f"{confirmed} of 8 optima were reached by at least two starts" in table
     # the motors' energy per metre of the optima, from the gait files
-    least = f"{best['revolute'].costs.electrical:.2f} / {best['rolling'].costs.electrical:.2f}"
-    assert f"of the least sthenic optimum, revolute / rolling [J/m] | | {least} |" in table
+    least = [best[knee].costs.electrical for knee in ("revolute", "rolling")]
+    shown = f"{least[0]:.4g} / {least[1]:.4g} ({100 * (least[1] / least[0] - 1):+.1f} %)"
+    assert (
+        f"of the least sthenic optimum, revolute / rolling (rolling vs revolute) [J/m] | | {shown} |"
+    ) in table
     electrical = {
         (g.knee, round(g.speed, 6)): g.costs.electrical for g in gaits if g.criterion == "sthenic"
     }
@@ -608,3 +613,53 @@ def test_a_resume_with_other_speeds_is_refused_naming_the_speeds(tmp_path, capsy
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "speeds = [0.25, 0.3]" in err[0] and "[0.25, 0.35]" in err[0], err
     assert sorted(tmp_path.rglob("*")) == before
+
+
+def _series(speeds, swapped=False):
+    """Sthenic optima of both knees at ``speeds``, in memory, as read_sweep gives them;
+    ``swapped``: each gait labelled with the other speed's (a criterion that rises as the
+    speed falls)."""
+    from tests.conftest import gait_of
+
+    gaits = {}
+    for knee in biped.KNEES:
+        found = []
+        for speed in speeds:
+            problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), speed)
+            found.append(gait_of(optimize(problem, starts=1)))
+        if swapped:
+            found = [
+                dataclasses.replace(g, speed=v) for g, v in zip(found, speeds[::-1], strict=True)
+            ]
+        gaits[(knee, "sthenic")] = sorted(found, key=lambda g: g.speed)
+    return gaits
+
+
+def test_comparison_of_one_speed_claims_no_trend_and_shows_the_difference():
+    """From one speed: no mean over '1 speeds', no trend over speed, no located minimum; a
+    least value of each knee to four digits with their difference; the stance-knee flexion
+    says which knee is which."""
+    from biped.pages.figures import comparison_table
+
+    series = _series((0.3,))
+    table = comparison_table(series)
+    assert "1 speeds" not in table and "the one speed both knees have" in table
+    assert "falls" not in table and "keeps falling" not in table
+    assert "no minimum located" in table
+    values = {k: series[(k, "sthenic")][0].costs.sthenic for k in biped.KNEES}
+    difference = 100 * (values["rolling"] / values["revolute"] - 1)
+    pair = f"{values['revolute']:.4g} / {values['rolling']:.4g} ({difference:+.1f} %)"
+    assert f"(rolling vs revolute) [N²·m·s per metre walked] | | {pair} |" in table
+    assert "q2 - q1, sthenic optimum near 0.3 m/s, revolute / rolling [rad]" in table
+
+
+def test_comparison_claims_a_fall_to_the_slowest_speed_only_where_the_data_falls():
+    """Over two speeds, 'falls at every step' only where each knee's sthenic criterion
+    rises with the speed; where it does not, no word of the slowest speed."""
+    from biped.pages.figures import comparison_table
+
+    series = _series((0.25, 0.3))
+    rising = all(np.all(np.diff([g.costs.sthenic for g in gaits]) > 0) for gaits in series.values())
+    assert rising  # the sthenic optima per metre fall with the speed here
+    assert "falls at every step of the sweep" in comparison_table(series)
+    assert "slowest speed" not in comparison_table(_series((0.25, 0.3), swapped=True))

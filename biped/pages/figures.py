@@ -471,6 +471,31 @@ def _percent(value: float) -> str:
     return f"{value:+.1f} %"
 
 
+def _pair(revolute: float, rolling: float) -> str:
+    """'0.7812 / 0.7781 (-0.4 %)': both knees' values to four digits and their difference,
+    which values rounded alike would hide."""
+    return f"{revolute:.4g} / {rolling:.4g} ({_percent(relative_change(rolling, revolute))})"
+
+
+def _over(speeds) -> str:
+    """Where a difference of the knees is taken: the mean over the speeds both knees have,
+    or the one speed."""
+    if len(speeds) == 1:
+        return f"at {speeds[0]:.3f} m/s, the one speed both knees have"
+    return f"mean over the {len(speeds)} speeds both knees have"
+
+
+def _grid_place(speed: float, series) -> str:
+    """What a least value's speed is on the sweep's grid: its one speed or an end of it
+    (where the minimum may lie beyond), else nothing."""
+    speeds = sorted({round(g.speed, 6) for gaits in series.values() for g in gaits})
+    if len(speeds) == 1:
+        return " (the sweep's one speed: no minimum located)"
+    if round(speed, 6) in (speeds[0], speeds[-1]):
+        return f" (the {'slowest' if round(speed, 6) == speeds[0] else 'fastest'} of the sweep)"
+    return ""
+
+
 def _criterion_rows(series, criterion) -> list[str]:
     """The table's rows of one criterion compared (both knees have certified optima)."""
     unit = CRITERION_UNITS[criterion]
@@ -483,19 +508,17 @@ def _criterion_rows(series, criterion) -> list[str]:
     rows = [
         f"| {criterion} criterion, rolling vs revolute, at each knee's best speed "
         f"| {paper} | {_percent(relative_change(best['rolling'], best['revolute']))} |",
-        f"| {criterion} criterion, rolling vs revolute, mean over the {len(speeds)} speeds "
-        f"both knees have | | {mean} |",
+        f"| {criterion} criterion, rolling vs revolute, {_over(speeds)} | | {mean} |",
     ]
     if criterion == "sthenic":
         rows += [
             f"| speed of minimum sthenic criterion, {knee} [m/s] "
-            f"| {PAPER['best_speed'][knee]} | {speed[knee]:.3f} |"
+            f"| {PAPER['best_speed'][knee]} | {speed[knee]:.3f}{_grid_place(speed[knee], series)} |"
             for knee in KNEES
         ]
     rows.append(
-        f"| minimum {criterion} criterion, revolute / rolling [{unit} {per}] | | "
-        f"{best['revolute']:.{1 if criterion == 'sthenic' else 2}f} / "
-        f"{best['rolling']:.{1 if criterion == 'sthenic' else 2}f} |"
+        f"| minimum {criterion} criterion, revolute / rolling (rolling vs revolute) "
+        f"[{unit} {per}] | | {_pair(best['revolute'], best['rolling'])} |"
     )
     return rows + _electrical_rows(series, criterion)
 
@@ -512,12 +535,13 @@ def _electrical_rows(series, criterion) -> list[str]:
     }
     speeds, differences = difference_curve(series, criterion, "electrical")
     unit = CRITERION_UNITS["electrical"]
+    electrical = {knee: least[knee].costs.electrical for knee in KNEES}
     return [
         f"| electrical energy per metre, no regeneration, of the least {criterion} optimum, "
-        f"revolute / rolling [{unit}] | | {least['revolute'].costs.electrical:.2f} / "
-        f"{least['rolling'].costs.electrical:.2f} |",
-        f"| electrical energy per metre of the {criterion} optima, rolling vs revolute, mean "
-        f"over the {len(speeds)} speeds both knees have | | {_mean_difference(differences)} |",
+        f"revolute / rolling (rolling vs revolute) [{unit}] | | "
+        f"{_pair(electrical['revolute'], electrical['rolling'])} |",
+        f"| electrical energy per metre of the {criterion} optima, rolling vs revolute, "
+        f"{_over(speeds)} | | {_mean_difference(differences)} |",
     ]
 
 
@@ -536,8 +560,8 @@ def _detail_rows(series) -> tuple[list[str], dict]:
         knee: float(np.max(g.samples.q[:, 3] - g.samples.q[:, 2])) for knee, g in detail.items()
     }
     rows = [
-        f"| largest stance-knee flexion q2 - q1, sthenic optimum near {DETAIL_SPEED} m/s [rad] "
-        f"| | {flexion['revolute']:.3f} / {flexion['rolling']:.3f} |",
+        f"| largest stance-knee flexion q2 - q1, sthenic optimum near {DETAIL_SPEED} m/s, "
+        f"revolute / rolling [rad] | | {flexion['revolute']:.3f} / {flexion['rolling']:.3f} |",
         *(
             f"| period / step length of that gait, {knee} [s / m] | | "
             f"{detail[knee].period:.3f} / {detail[knee].step_length:.3f} |"
@@ -612,22 +636,33 @@ def _explanations(flexion, series, criteria) -> list[str]:
             "  knee-link angle equals the segment angles when it is straight), so the two",
             "  robots walk almost alike.",
         ]
-    speeds = sorted({g.speed for gaits in series.values() for g in gaits})
-    best = min(_minimum(series, knee, "sthenic")[0] for knee in KNEES)
-    if best <= speeds[0]:
+    lines += _slowest_lines(series)
+    if len({round(g.speed, 6) for gaits in series.values() for g in gaits}) > 1:
+        per_step = {knee: _minimum_per_step(series, knee) for knee in KNEES}
         lines += [
-            "- The sthenic criterion per metre keeps falling as the speed decreases: its",
-            "  minimum is at the slowest speed of the sweep.",
+            "- Under the other reading of d in eq. (30), C_Γ per step (∫ΓᵀΓ dt, no 2/d), the",
+            f"  minimum is at {per_step['revolute']:.3f} m/s (revolute) and "
+            f"{per_step['rolling']:.3f} m/s (rolling).",
         ]
-    per_step = {knee: _minimum_per_step(series, knee) for knee in KNEES}
-    lines += [
-        "- Under the other reading of d in eq. (30), C_Γ per step (∫ΓᵀΓ dt, no 2/d), the",
-        f"  minimum is at {per_step['revolute']:.3f} m/s (revolute) and "
-        f"{per_step['rolling']:.3f} m/s (rolling).",
-    ]
     if "energy" in criteria:
         lines += _bullet(f"- Fig. 8, middle: {OTHER_NOTES['energy']}")
     return [*lines, ""]
+
+
+def _slowest_lines(series) -> list[str]:
+    """Where the sthenic optima are least at the sweep's slowest speed: that it falls all
+    the way down to it only where each knee's falls at every step of the grid; nothing from
+    one speed, where there is no trend."""
+    curves = [_curve(series, knee, "sthenic", "sthenic") for knee in KNEES]
+    speeds = sorted({float(v) for v, _ in curves for v in v})
+    if len(speeds) < 2 or any(int(np.argmin(c)) != 0 for _, c in curves):
+        return []
+    if all(len(c) > 1 and np.all(np.diff(c) > 0) for _, c in curves):
+        return [
+            "- The sthenic criterion per metre falls at every step of the sweep as the speed",
+            "  decreases: its minimum is at the slowest speed of the sweep, and may lie below.",
+        ]
+    return ["- The sthenic criterion per metre is least at the slowest speed of the sweep."]
 
 
 def _minimum_per_step(series, knee) -> float:
