@@ -128,8 +128,7 @@ class Pipeline:
 def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool:
     """Run the pipeline (``Pipeline``), printing with ``say``; whether every gait is feasible
     and passes every check."""
-    from biped.model.criteria import CRITERIA
-    from biped.optimization.comparison import DIFFERENCE, relative_change
+    from biped.optimization.knees import compare_knees, knee_lines
 
     passed, optima, written = True, {}, {}
     for knee in pipeline.knees:
@@ -144,15 +143,11 @@ def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool
         passed = passed and knee_passed
     if pipeline.design is not None:
         passed = _design_stage(pipeline, optima, say) and passed
-    costs = {knee: optima[knee].costs() for knee in written}
-    if len(costs) == 2:
-        revolute, rolling = costs["revolute"], costs["rolling"]
-        changes = ", ".join(
-            f"{criterion} {relative_change(rolling[criterion], revolute[criterion]):+.1f} %"
-            for criterion in (*CRITERIA, "electrical")
-        )
-        gaits = f"{pipeline.criterion}-optimal gaits"
-        say(f"rolling vs revolute knee, {gaits}: {changes} ({DIFFERENCE})")
+    if len(written) == 2:  # both knees' optima certified: each cost, its uncertainty, verdict
+        say("[knees] re-solving both optima on a finer grid and more tightly...")
+        differences = compare_knees({knee: optima[knee] for knee in written})
+        for line in knee_lines(differences, pipeline.speed, pipeline.criterion):
+            say(line)
     for knee, lines in written.items():  # every file written, once
         for line in lines:
             say(f"{knee:9} {line}")

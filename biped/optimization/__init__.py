@@ -5,7 +5,8 @@ from the model's own constants (``symbolic``) and its derivatives sample by samp
 the multistart optimizer (``optimize``) with the shipped table of optima among its starts
 (``table``), the knee radii designed with the gait (``design``), and the words and sign with
 which optima are compared (``comparison``: a difference between knees, "certified", the two
-grids of a criterion).
+grids of a criterion), and the two knees' optima compared, each difference with what moves it
+and a verdict (``knees``).
 
 May import: ``biped.model``, ``biped.runtime``, ``biped.errors``, numpy, scipy, casadi.
 """

@@ -805,6 +805,21 @@ def confirm(problem: GaitProblem, optimum: Optimum, given=(), jobs: int | None =
     return best_of(problem, [optimum, found], None if lower else optimum)
 
 
+def next_optimum(report: Report) -> float | None:
+    """Where one start alone reached the best value of ``report``: the relative distance
+    from it to the next optimum its other converged starts reached (the spread of the
+    starts), None where none of them converged; 0 where at least two starts reached it."""
+    if report.starts_at_best >= 2:
+        return 0.0
+    best = report.value
+    above = [
+        s.value
+        for s in report.history
+        if s.status in CONVERGED and np.isfinite(s.value) and s.value > best * (1 + AGREEMENT)
+    ]
+    return min(above) / best - 1.0 if above else None
+
+
 def single_start_note(report: Report) -> str:
     """Why the best value of ``report`` counts one start: the start that reached it, and the
     next optimum the starts reached, how far above and by how many starts ("by the optima
