@@ -363,22 +363,23 @@ def test_bounds_that_move_the_robots_own_radii_say_so():
 
 
 def test_a_design_against_a_bound_is_said_and_validated(tmp_path, capsys):
-    """'biped design --robot R.toml' with shank_com = 0.03 m: it says that the Table 1 r1 was
-    moved to its bound, its optimum lies at the radii's lower bound of 1 mm (said, where r = 0
+    """'biped design --robot R.toml' with shank_com = 0.03 m and r1 = 0.03 m (its own radii
+    within the bounds): its optimum lies at the radii's lower bound of 1 mm (said, where r = 0
     would be the revolute knee) and 'biped validate' plays the file it writes."""
     from biped.optimization.design import MIN_RADIUS
     from biped.records import gait_file
     from biped_cli import main
 
     robot, path = tmp_path / "R.toml", tmp_path / "design.json"
-    robot.write_text("shank_com = 0.03\n")
+    robot.write_text("shank_com = 0.03\nr1 = 0.03\n")
     argv = ["design", "--robot", str(robot), "--speed", "0.3", "--starts", "1", "--out", str(path)]
     assert main(argv) == 0
     out = capsys.readouterr().out
-    assert "note: the robot's own r1 = 0.05 m lies beyond its upper bound 0.03 m" in out
+    assert "lies beyond" not in out
     gait = gait_file.read(path)
     radii = gait.design["radii"]
-    assert min(radii.values()) >= MIN_RADIUS and gait.design["reference_moved"]
+    assert min(radii.values()) >= MIN_RADIUS and not gait.design["reference_moved"]
+    assert any(value == MIN_RADIUS for value in radii.values())
     for name, value in radii.items():
         if value == MIN_RADIUS:
             assert f"note: {name} at its lower bound 0.001 m" in out
