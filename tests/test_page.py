@@ -291,4 +291,6 @@ def test_a_designed_knees_page_states_its_radii_and_what_it_was_compared_with(tm
     )
     for knee in ("| revolute | - | - |", "| rolling, Table 1 radii | 0.05 | 0.05 |"):
         assert knee in text
-    assert "- design vs revolute: " in text
+    gains = gait.design["gains_percent"]
+    assert f"- optimal radii vs revolute: {gains['design_vs_revolute']:+.2f} %" in text
+    assert f"- Table 1 radii vs revolute: {gains['table1_vs_revolute']:+.2f} %" in text

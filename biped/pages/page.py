@@ -570,6 +570,10 @@ def markdown(page: Page, folder: Path) -> str:
     return "\n".join(lines) + "\n"
 
 
+# The knees of a design's changes (``biped.optimization.design.GAINS``), as its table names them.
+GAIN_WORDS = {"design": "optimal radii", "table1": "Table 1 radii", "revolute": "revolute"}
+
+
 def design_lines(gait: Gait) -> list[str]:
     """The section of a designed knee (``biped design``: the file's ``design``): its radii
     within their bounds, the knees it was compared with and the changes; none for a gait of
@@ -611,7 +615,11 @@ def design_lines(gait: Gait) -> list[str]:
         "first needs less:",
         "",
     ]
-    lines += [f"- {name.replace('_', ' ')}: {_number(gains.get(name))} %" for name in GAINS]
+    for name in GAINS:
+        first, second = (GAIN_WORDS[part] for part in name.split("_vs_"))
+        value = gains.get(name)
+        shown = f"{value:+.2f} %" if isinstance(value, (int, float)) else "n/a"
+        lines += [f"- {first} vs {second}: {shown}"]
     return lines
 
 
