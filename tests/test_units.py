@@ -1,6 +1,7 @@
 """The units map of gait files: a unit for every number, every column of a mixed array, and
 the robot's fields in the units its own documentation states."""
 
+import dataclasses
 import inspect
 import json
 import re
@@ -101,14 +102,15 @@ def test_printed_check_lines_carry_the_units_of_their_figures():
 
 def _all_units() -> dict:
     """Every unit the project's files declare, by where (a per-column list: each column)."""
-    from biped.model.criteria import ALL_CRITERIA
+    from biped.model.criteria import ALL_CRITERIA, WALKABLE
     from validate import robustness
     from validate.units import FIGURE_UNITS
 
     declared = {}
     for criterion in ALL_CRITERIA:
         for knots in (1, 3):
-            units = Gait.units(criterion, knots, knee_bend=True, actuators=True)
+            every = dataclasses.replace(WALKABLE, knee_bend=0.1, actuator_limits=True)
+            units = Gait.units(criterion, knots, every, actuators=True, design=True)
             declared.update({f"gait {criterion} {knots}: {k}": v for k, v in units.items()})
     for check, figures in FIGURE_UNITS.items():
         declared.update({f"report: {check}.{k}": v for k, v in figures.items()})
