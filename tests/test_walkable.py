@@ -185,3 +185,18 @@ def test_the_clearance_is_kept_at_every_check_sample():
         paper_problem.model, _step(paper_problem, paper), 100, safety=Safety(clearance=0.03)
     )
     assert "swing_heel" in kept.violations() or "swing_toe" in kept.violations()
+
+
+def test_a_landing_bound_as_a_share_of_the_walking_speed():
+    """``landing_share`` s bounds the sole's landing speed at s V: at 0.3 m/s a share of 1 is
+    the bound 0.3 m/s (the same optimum to 1e-9); at 0.6 m/s it is 0.6 m/s. Both at once
+    are refused."""
+    _, by_speed = optimum(safety=BINDING["landing"])
+    _, by_share = optimum(safety=Safety(landing_share=1.0))
+    assert by_share.value == pytest.approx(by_speed.value, rel=1e-9)
+    problem = GaitProblem(biped.Biped(ROBOT, "rolling"), 0.6, safety=Safety(landing_share=1.0))
+    found = optimize(problem, starts=1)
+    velocity = walkable.touchdown_velocity(problem.model, *_step(problem, found).end)
+    assert 0.55 < np.linalg.norm(velocity) <= 0.6 + walkable.LANDING_TOLERANCE
+    with pytest.raises(biped.BipedError, match="allowed one of the two"):
+        Safety(landing_speed=0.3, landing_share=1.0)

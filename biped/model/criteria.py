@@ -118,11 +118,12 @@ MAX_KNEE_BEND = 1.0
 # [m/s], the friction coefficient, the joints' margin to their stops [rad], the hip's least
 # forward speed as a share of the walking speed.
 MAX_LANDING_SPEED = 10.0
+MAX_LANDING_SHARE = 5.0
 FRICTION_RANGE = (0.05, 2.0)
 MAX_JOINT_MARGIN = 0.5
 MAX_HIP_PROGRESS = 1.0
 # The walkable constraints' settings that may be None (not asked).
-OPTIONAL = ("landing_speed", "friction", "joint_margin", "hip_progress")
+OPTIONAL = ("landing_speed", "landing_share", "friction", "joint_margin", "hip_progress")
 
 
 @dataclass(frozen=True)
@@ -144,6 +145,8 @@ class Safety:
             fraction of the step at each end.
         landing_speed: [m/s] largest speed of the swing sole at touchdown (0: a landing
             without impact); None: unbounded (the paper's).
+        landing_share: the same bound as a share of the walking speed V (the sole lands at
+            ``landing_share`` V at most); one of the two at most.
         friction: μ, the stance foot's |F_x| <= μ F_z at every sample and the landing's
             impulse within the same cone; None: unbounded.
         joint_margin: [rad] least distance of every hip and ankle to its stops
@@ -158,6 +161,7 @@ class Safety:
     actuator_limits: bool = field(default=False, metadata={"unit": None})
     clearance_window: float = field(default=CLEARANCE_WINDOW, metadata={"unit": "T"})
     landing_speed: float | None = field(default=None, metadata={"unit": "m/s"})
+    landing_share: float | None = field(default=None, metadata={"unit": "1"})
     friction: float | None = field(default=None, metadata={"unit": "1"})
     joint_margin: float | None = field(default=None, metadata={"unit": "rad"})
     hip_progress: float | None = field(default=None, metadata={"unit": "1"})
@@ -171,6 +175,7 @@ class Safety:
             ("knee_bend", 0.0, MAX_KNEE_BEND, "rad"),
             ("clearance_window", 0.0, MAX_CLEARANCE_WINDOW, "T"),
             ("landing_speed", 0.0, MAX_LANDING_SPEED, "m/s"),
+            ("landing_share", 0.0, MAX_LANDING_SHARE, "of the walking speed"),
             ("friction", *FRICTION_RANGE, ""),
             ("joint_margin", 0.0, MAX_JOINT_MARGIN, "rad"),
             ("hip_progress", 0.0, MAX_HIP_PROGRESS, "of the walking speed"),
@@ -185,6 +190,11 @@ class Safety:
             if not (math.isfinite(value) and low <= value <= high):
                 raise BipedError(f"{f'{name} = {value!r} {unit}'.rstrip()}: allowed {allowed}")
             object.__setattr__(self, name, float(value))
+        if self.landing_speed is not None and self.landing_share is not None:
+            raise BipedError(
+                f"landing_speed = {self.landing_speed!r} m/s and landing_share = "
+                f"{self.landing_share!r}: allowed one of the two"
+            )
 
     @property
     def walkable(self) -> tuple:
@@ -192,7 +202,7 @@ class Safety:
         the solver's rows: "landing", "impact_friction", "friction", "joint_stops",
         "progress"."""
         asked = []
-        if self.landing_speed is not None:
+        if self.landing_speed is not None or self.landing_share is not None:
             asked.append("landing")
         if self.friction is not None:
             asked += ["impact_friction", "friction"]
@@ -210,7 +220,7 @@ PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
 WALKABLE = Safety(
     clearance=0.01,
     zmp_margin=0.01,
-    landing_speed=0.3,
+    landing_share=0.75,
     friction=0.6,
     joint_margin=0.05,
     hip_progress=0.2,

@@ -4,12 +4,12 @@ margin >= 0 when met, written once for numbers and for CasADi's symbols (only su
 products of their arguments), so that the numeric check and the solver's graph
 (``biped.optimization.symbolic``) compute one formula.
 
-- landing (``Safety.landing_speed`` L): the swing sole's speed at touchdown at most L. At
-  touchdown the landing foot is flat and does not turn (its angle's rate is 0 by the gait's
-  construction), so every point of the sole moves as the ankle. The speed is bounded through
-  a regular octagon inscribed in the disc |v| <= L: |v · n_k| <= L cos(π/8) for the four
-  directions n_k = (cos kπ/4, sin kπ/4) (linear in v, well posed at L = 0, an impactless
-  landing, where the paper's impact map is then a no-op);
+- landing (``Safety.landing_speed`` L, or ``landing_share`` s with L = s V): the swing
+  sole's speed at touchdown at most L. At touchdown the landing foot is flat and does not
+  turn (its angle's rate is 0 by the gait's construction), so every point of the sole moves
+  as the ankle. The speed is bounded through a regular octagon inscribed in the disc |v| <=
+  L: |v · n_k| <= L cos(π/8) for the four directions n_k = (cos kπ/4, sin kπ/4) (linear in v,
+  well posed at L = 0, an impactless landing, where the paper's impact map is then a no-op);
 - impact friction (``Safety.friction`` μ): the landing's impulse within the friction cone,
   |I_x| <= μ I_z;
 - friction: the stance foot's |F_x| <= μ F_z at every sample;
@@ -99,6 +99,14 @@ def progress_margins(hip_rate, share: float, speed, solver: bool = False) -> lis
     return [hip_rate - least]
 
 
+def landing_bound(safety, speed):
+    """[m/s] The sole's largest landing speed ``safety`` asks at walking speed ``speed`` V (a
+    number or a symbol): ``landing_speed``, or ``landing_share`` V."""
+    if safety.landing_speed is not None:
+        return safety.landing_speed
+    return safety.landing_share * speed
+
+
 def touchdown_velocity(model, q, qd) -> np.ndarray:
     """(vx, vz) [m/s] of the swing ankle at the end of the step (the state before the impact),
     the velocity of every point of the landing sole (it does not turn then)."""
@@ -111,9 +119,11 @@ def step_margins(model, step, q, qd, wrench, safety, solver: bool = False) -> di
     others (N, k) at each sample of ``q``, ``qd`` (N, 9) and ``wrench`` (N, 3). ``solver``:
     with the margins the solver keeps inside them."""
     found = {}
-    if safety.landing_speed is not None:
+    speed = step.step_length / step.period
+    if "landing" in safety.walkable:
         velocity = touchdown_velocity(model, *step.end)
-        found["landing"] = np.array(landing_margins(velocity, safety.landing_speed, solver))
+        bound = landing_bound(safety, speed)
+        found["landing"] = np.array(landing_margins(velocity, bound, solver))
     if safety.friction is not None:
         found["impact_friction"] = np.array(
             impact_friction_margins(step.impulse, safety.friction, solver)
@@ -127,7 +137,6 @@ def step_margins(model, step, q, qd, wrench, safety, solver: bool = False) -> di
         )
     if safety.hip_progress is not None:
         hip_rate = qd[:, XH]
-        speed = step.step_length / step.period
         found["progress"] = np.stack(
             progress_margins(hip_rate, safety.hip_progress, speed, solver), axis=-1
         )

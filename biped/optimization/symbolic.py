@@ -562,7 +562,8 @@ class StepGraph:
         per_sample = {}
         if "landing" in safety.walkable:
             touchdown = head[self.head_slices["touchdown"]]
-            margins = walkable.landing_margins(touchdown, safety.landing_speed, True)
+            bound = walkable.landing_bound(safety, self.speed)
+            margins = walkable.landing_margins(touchdown, bound, True)
             rows.append(("landing", margins))
         if "impact_friction" in safety.walkable:
             impulse = head[self.head_slices["impulse"]]
