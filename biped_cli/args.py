@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import tempfile
 from pathlib import Path
 
@@ -14,9 +15,17 @@ from biped.errors import BipedError
 from biped.model.criteria import (
     ALL_CRITERIA,
     CRITERIA,
+    FRICTION_RANGE,
     MAX_CLEARANCE,
+    MAX_CLEARANCE_WINDOW,
+    MAX_HIP_PROGRESS,
+    MAX_JOINT_MARGIN,
     MAX_KNEE_BEND,
+    MAX_LANDING_SHARE,
+    MAX_LANDING_SPEED,
     MAX_ZMP_MARGIN,
+    PAPER_SAFETY,
+    WALKABLE,
     Safety,
 )
 from biped.model.dynamics import Biped
@@ -38,6 +47,15 @@ ROBOT_HELP = (
 ACTUATOR_LIMITS_HELP = (
     "every joint's torque, speed and voltage within its motor's peak torque, top speed and "
     "supply voltage at every sample: a gait the motors cannot follow is not feasible"
+)
+_W = WALKABLE
+WALKABLE_HELP = (
+    "the walkable preset: margins at which MuJoCo's walk of the optimal gaits follows the "
+    f"model (the sole lands at {_W.landing_share:g} times the walking speed at most, "
+    f"friction {_W.friction:g}, clearance {_W.clearance:g} m, ZMP {_W.zmp_margin:g} m inside "
+    f"the sole, hips and ankles {_W.joint_margin:g} rad from their stops, the hip at "
+    f"{_W.hip_progress:g} of the walking speed at least; validate/margins_study.py chose "
+    "them); an option given replaces the preset's value"
 )
 SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower steps are mm long)"
 # Most speeds of a sweep: each is an optimisation per knee and criterion.
@@ -325,14 +343,35 @@ def budget(args) -> dict:
     }
 
 
+# The options of ``add_safety`` that set a field of ``Safety`` of the same name, each left at
+# the preset's value (the paper's, or ``--walkable``'s) unless given.
+SAFETY_OPTIONS = (
+    "clearance",
+    "zmp_margin",
+    "knee_bend",
+    "clearance_window",
+    "landing_speed",
+    "landing_share",
+    "friction",
+    "joint_margin",
+    "hip_progress",
+)
+
+
 def safety(args) -> Safety:
-    """The safety margins given on the command line."""
-    return Safety(
-        clearance=args.clearance,
-        zmp_margin=args.zmp_margin,
-        knee_bend=args.knee_bend,
-        actuator_limits=getattr(args, "actuator_limits", False),
-    )
+    """The safety margins given on the command line: those of ``--walkable`` (``WALKABLE``) or
+    the paper's, each replaced by the option given; a landing speed given replaces the
+    preset's landing share (one of the two)."""
+    preset = WALKABLE if getattr(args, "walkable", False) else PAPER_SAFETY
+    given_ = {
+        name: getattr(args, name) for name in SAFETY_OPTIONS if getattr(args, name) is not None
+    }
+    if "landing_speed" in given_ and "landing_share" not in given_:
+        given_["landing_share"] = None
+    if "landing_share" in given_ and "landing_speed" not in given_:
+        given_["landing_speed"] = None
+    actuators = getattr(args, "actuator_limits", False) or preset.actuator_limits
+    return dataclasses.replace(preset, **given_, actuator_limits=actuators)
 
 
 def add_budget(parser, sweep: bool = False):
@@ -386,17 +425,40 @@ def add_options(parser, *options) -> None:
 
 
 def add_safety(parser) -> None:
-    """``--clearance`` and ``--zmp-margin``: the safety margins of the optimal gait
-    (``safety(args)``)."""
+    """The safety margins and walkable constraints of the optimal gait (``safety(args)``):
+    each option's default is the paper's, or ``--walkable``'s."""
+    walkable = WALKABLE
+    parser.add_argument("--walkable", action="store_true", help=WALKABLE_HELP)
     add_options(
         parser,
-        ("--clearance", clearance, 0.0, "M", "[m] height the swing foot must keep off the "
-         "ground away from the ends of the step (default 0, the paper's z >= 0)"),
-        ("--zmp-margin", zmp_margin, 0.0, "M",
-         "[m] distance the ZMP must keep inside the sole's heel and toe (default 0)"),
-        ("--knee-bend", knee_bend, 0.0, "RAD",
+        ("--clearance", clearance, None, "M", "[m] height the swing sole keeps off the ground "
+         "between its lift-off and touchdown windows (--clearance-window): a third of it from "
+         "the windows on, all of it from 30 %% to 70 %% of the step, at every sample of the "
+         f"check grid (default 0, the paper's z >= 0; --walkable: {walkable.clearance:g})"),
+        ("--clearance-window", clearance_window, None, "F", "the lift-off and touchdown "
+         "windows of the clearance, a fraction of the step at each end, 0 to "
+         f"{MAX_CLEARANCE_WINDOW:g} (default {walkable.clearance_window:g})"),
+        ("--zmp-margin", zmp_margin, None, "M", "[m] distance the ZMP must keep inside the "
+         f"sole's heel and toe (default 0; --walkable: {walkable.zmp_margin:g})"),
+        ("--knee-bend", knee_bend, None, "RAD",
          f"[rad] least flexion of the stance knee over the step, 0 to {MAX_KNEE_BEND} "
          "(default 0, the paper's knee not inverted)"),
+        ("--landing-speed", landing_speed, None, "M", "[m/s] largest speed of the swing sole "
+         f"at touchdown, 0 to {MAX_LANDING_SPEED:g} (0: a landing without impact; default "
+         "unbounded, the paper's)"),
+        ("--landing-share", landing_share, None, "S", "the same bound as a share of the walking "
+         f"speed: the sole lands at S times it at most, 0 to {MAX_LANDING_SHARE:g} (default "
+         f"unbounded; --walkable: {walkable.landing_share:g}); one of the two"),
+        ("--friction", friction, None, "MU", "friction coefficient the stance foot needs at "
+         f"most, |Fx| <= MU Fz at every sample and for the landing's impulse, "
+         f"{FRICTION_RANGE[0]:g} to {FRICTION_RANGE[1]:g} (default unbounded; --walkable: "
+         f"{walkable.friction:g}; the MuJoCo floor's is 1)"),
+        ("--joint-margin", joint_margin, None, "RAD", "[rad] least distance of every hip and "
+         f"ankle to its stop (the MJCF's joint ranges), 0 to {MAX_JOINT_MARGIN:g} (default "
+         f"none; --walkable: {walkable.joint_margin:g})"),
+        ("--hip-progress", hip_progress, None, "P", "the hip's least forward speed, a share "
+         f"of the walking speed, 0 to {MAX_HIP_PROGRESS:g} (default none; --walkable: "
+         f"{walkable.hip_progress:g})"),
     )  # fmt: skip
     parser.add_argument("--actuator-limits", action="store_true", help=ACTUATOR_LIMITS_HELP)
 
@@ -502,11 +564,13 @@ def _read(text: str, kind, otherwise):
         return otherwise
 
 
-def margin(name: str, high: float, unit: str = "m"):
+def margin(name: str, high: float, unit: str = "m", low: float = 0.0):
     def parse(text: str) -> float:
         value = _read(text, float, float("nan"))
-        if not (0.0 <= value <= high):
-            raise argparse.ArgumentTypeError(f"{name} = {text!r} {unit}: allowed 0 to {high}")
+        if not (low <= value <= high):
+            raise argparse.ArgumentTypeError(
+                f"{f'{name} = {text!r} {unit}'.rstrip()}: allowed {low:g} to {high:g}"
+            )
         return value
 
     return parse
@@ -515,6 +579,12 @@ def margin(name: str, high: float, unit: str = "m"):
 clearance = margin("clearance", MAX_CLEARANCE)
 zmp_margin = margin("zmp margin", MAX_ZMP_MARGIN)
 knee_bend = margin("knee bend", MAX_KNEE_BEND, "rad")
+clearance_window = margin("clearance window", MAX_CLEARANCE_WINDOW, "of the step")
+landing_speed = margin("landing speed", MAX_LANDING_SPEED, "m/s")
+landing_share = margin("landing share", MAX_LANDING_SHARE, "of the walking speed")
+friction = margin("friction", FRICTION_RANGE[1], "", low=FRICTION_RANGE[0])
+joint_margin = margin("joint margin", MAX_JOINT_MARGIN, "rad")
+hip_progress = margin("hip progress", MAX_HIP_PROGRESS, "of the walking speed")
 
 
 def bounded(low: int, high: int | None = None):

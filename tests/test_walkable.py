@@ -200,3 +200,67 @@ def test_a_landing_bound_as_a_share_of_the_walking_speed():
     assert 0.55 < np.linalg.norm(velocity) <= 0.6 + walkable.LANDING_TOLERANCE
     with pytest.raises(biped.BipedError, match="allowed one of the two"):
         Safety(landing_speed=0.3, landing_share=1.0)
+
+
+def test_a_gait_file_gives_the_landing_and_the_tightest_margins(tmp_path):
+    """A gait file gives the sole's touchdown velocity and speed, the landing's friction
+    ratio and, for the walkable constraints its margins ask, their tightest margins with
+    units; an edited one is refused by name; a file written before them reads. A landing at
+    rest is a consistent impact (no impulse to push)."""
+    import json
+
+    from biped.records import gait_file
+    from biped.records.gait_file import Gait
+
+    safety = Safety(landing_speed=0.3, friction=0.6, joint_margin=0.05, hip_progress=0.2)
+    problem, found = optimum(safety=safety)
+    path = Gait.from_optimum(found, ROBOT).write(tmp_path / "walkable.json")
+    content = json.loads(path.read_text())
+    impact, walk = content["impact"], content["walkability"]
+    assert impact["touchdown_speed"] == pytest.approx(np.hypot(*impact["touchdown_velocity"]))
+    assert impact["touchdown_speed"] <= 0.3 + walkable.LANDING_TOLERANCE
+    assert set(walk) == {"friction_needed", "joint_stop_distance", "least_hip_speed"} | set(
+        safety.walkable
+    )
+    assert content["units"]["walkability.landing"] == "m/s"
+    assert content["units"]["walkability.friction"] == "N"
+    assert walk["landing"] >= 0.0 and walk["landing"] < 0.01
+    gait_file.read_consistent(path)
+    edited = {**content, "impact": {**impact, "touchdown_speed": 0.1}}
+    with pytest.raises(biped.BipedError, match="impact.touchdown_speed"):
+        gait_file.read_consistent(gait_file.write_json(tmp_path / "edited.json", edited))
+    old = {k: v for k, v in content.items() if k != "walkability"}
+    old["impact"] = {
+        k: v for k, v in impact.items() if k not in ("touchdown_velocity", "touchdown_speed")
+    }
+    old["impact"].pop("friction_needed")
+    gait = gait_file.read_consistent(gait_file.write_json(tmp_path / "old.json", old))
+    assert gait.walkability is None and gait.impact.touchdown_speed is None
+    _, at_rest = optimum(safety=Safety(landing_speed=0.0))
+    impact = Gait.from_optimum(at_rest, ROBOT).impact
+    assert impact.consistent and impact.touchdown_speed <= walkable.LANDING_TOLERANCE
+
+
+def test_the_command_lines_walkable_preset_and_its_options():
+    """``--walkable`` gives the preset (``WALKABLE``); an option given replaces its value (a
+    landing speed the preset's landing share); without it, the paper's problem; a value out
+    of range is one line naming it, exit 2."""
+    from biped.model.criteria import WALKABLE
+    from biped_cli import build_parser, main
+    from biped_cli.args import safety
+
+    def parsed(*options):
+        argv = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "g.json", *options]
+        return safety(build_parser().parse_args(argv))
+
+    assert parsed() == PAPER_SAFETY
+    assert parsed("--walkable") == WALKABLE
+    assert parsed("--walkable", "--friction", "0.8") == dataclasses.replace(WALKABLE, friction=0.8)
+    assert parsed("--walkable", "--landing-speed", "0.3") == dataclasses.replace(
+        WALKABLE, landing_speed=0.3, landing_share=None
+    )
+    assert parsed("--landing-share", "1", "--clearance-window", "0.2") == Safety(
+        landing_share=1.0, clearance_window=0.2
+    )
+    for option, value in (("--friction", "5"), ("--landing-share", "-1"), ("--hip-progress", "x")):
+        assert main(["optimize", "--knee", "rolling", "--speed", "0.3", option, value]) == 2

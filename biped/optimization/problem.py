@@ -151,6 +151,25 @@ def check_criterion(criterion: str) -> str:
     return criterion
 
 
+def walkable_description(safety: Safety) -> str:
+    """The walkable constraints ``safety`` asks, as a problem's line says them ("" for
+    none)."""
+    parts = []
+    if safety.landing_speed is not None:
+        parts.append(f"landing at {safety.landing_speed:g} m/s at most")
+    if safety.landing_share is not None:
+        parts.append(f"landing at {safety.landing_share:g} V at most")
+    if safety.friction is not None:
+        parts.append(f"friction {safety.friction:g}")
+    if safety.joint_margin is not None:
+        parts.append(f"joints {safety.joint_margin:g} rad from their stops")
+    if safety.hip_progress is not None:
+        parts.append(f"hip at {safety.hip_progress:g} V at least")
+    if safety.clearance and safety.clearance_window != PAPER_SAFETY.clearance_window:
+        parts.append(f"clearance windows {safety.clearance_window:g} T")
+    return "".join(f", {part}" for part in parts)
+
+
 @dataclass(frozen=True)
 class GaitProblem:
     """Minimise ``criterion`` over the gaits of ``model`` at ``speed``.
@@ -209,6 +228,7 @@ class GaitProblem:
                 margins += f", stance knee bent {self.safety.knee_bend:g} rad at least"
             if self.safety.actuator_limits:
                 margins += ", within the actuators' limits"
+            margins += walkable_description(self.safety)
         family = f", {self.knots} knots" if self.knots != 1 else ""
         return (
             f"{self.knee} knee, {self.criterion} criterion, {self.speed:.3f} m/s{margins}{family}"

@@ -553,6 +553,7 @@ def markdown(page: Page, folder: Path) -> str:
         lines += [f"| {label}{optimised} | {value:.5g} | {unit} |"]
     lines += drive_lines(gait)
     lines += knee_lines(gait)
+    lines += walk_lines(gait)
     lines += _constraint_lines(gait)
     lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [
@@ -678,6 +679,37 @@ def drive_lines(gait: Gait) -> list[str]:
     for f in totals:
         unit = f.metadata["unit"]
         lines += [f"| {f.metadata['label']} | {getattr(electrical, f.name):.5g} | {unit} |"]
+    return lines
+
+
+def walk_lines(gait: Gait) -> list[str]:
+    """What walking the gait asks of the robot (``Impact``'s touchdown, ``Walkability``;
+    none for a file written before them): the sole's landing, the friction the stance foot
+    and the landing need, the joints' distance to their stops, the hip's least speed, and
+    the tightest margin of each walkable constraint the gait was optimised under."""
+    impact, walk = gait.impact, gait.walkability
+    if walk is None or impact is None or impact.touchdown_speed is None:
+        return []
+    vx, vz = impact.touchdown_velocity
+    landing = "unknown" if impact.friction_needed is None else f"{impact.friction_needed:.3g}"
+    stops = f"{walk.joint_stop_distance:.3g}"
+    bar = "\\|"  # a literal | in a Markdown table
+    rows = [
+        ("the sole's speed at touchdown", f"{impact.touchdown_speed:.3g}", "m/s"),
+        ("its velocity (forward, up)", f"{vx:.3g}, {vz:.3g}", "m/s"),
+        (f"the landing's impulse, {bar}Ix{bar} / Iz", landing, "1"),
+        (f"the stance foot's largest {bar}Fx{bar} / Fz", f"{walk.friction_needed:.3g}", "1"),
+        ("a hip's or ankle's least distance to its stop", stops, "rad"),
+        ("the hip's least forward speed", f"{walk.least_hip_speed:.3g}", "m/s"),
+    ]
+    lines = ["", "## Landing and walkability", "", "| figure | value | unit |", "|---|---|---|"]
+    lines += [f"| {what} | {value} | {unit} |" for what, value, unit in rows]
+    asked = [f for f in dataclasses.fields(walk) if f.metadata.get("optional")]
+    asked = [(f, getattr(walk, f.name)) for f in asked if getattr(walk, f.name) is not None]
+    if asked:
+        lines += ["", "Tightest margins of the walkable constraints it was optimised under:", ""]
+        lines += ["| constraint | tightest margin | unit |", "|---|---|---|"]
+        lines += [f"| {f.metadata['label']} | {v:.3g} | {f.metadata['unit']} |" for f, v in asked]
     return lines
 
 

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model import walkable
 from biped.model.actuators import KINDS, Actuators
 from biped.model.actuators import UNITS as ACTUATOR_UNITS
 from biped.model.criteria import (
@@ -48,7 +49,7 @@ from biped.model.criteria import (
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.gait import PARAMETERS, build_step, check_knots, parameter_names
 from biped.model.impact import trailing_foot_lift
-from biped.model.kinematics import COORDINATES, KNEES
+from biped.model.kinematics import COORDINATES, KNEES, XH
 from biped.model.knee_loads import KNEE_SIDES, knee_forces
 from biped.model.robot import Robot
 from biped.model.units import (
@@ -354,29 +355,97 @@ Constraints = dataclasses.make_dataclass(
 )
 
 
+def _margin(unit, label: str):
+    """A field of ``Walkability``: the tightest margin of one walkable constraint, written
+    only where the gait's ``safety`` asks for the constraint."""
+    return unit_field(unit, metadata={"label": label, "optional": True}, default=None)
+
+
+def _added(unit, label: str):
+    """A field added to a record after format 3's first files: a file written before has
+    none (read, and left so; ``_Record.to_dict`` leaves it out)."""
+    return unit_field(unit, metadata={"label": label, "optional": True}, default=None)
+
+
 @dataclass(frozen=True, eq=False)
 class Impact(_Record):
     """The flat-foot impact that ends the step (eqs. 21-24): the impulse on the landing foot
     [Fx, Fz, Cy], the trailing foot's lift velocities (heel, toe), whether the flat-foot model
-    holds (Iz > 0 and the trailing foot lifts), the velocities just before and after it."""
+    holds (Iz > 0 and the trailing foot lifts, or no impact: the sole lands at rest), the
+    velocities just before and after it; the sole's velocity (vx, vz) and speed at touchdown
+    (every point of the flat, not turning sole moves as the ankle,
+    ``biped.model.walkable.touchdown_velocity``) and the impulse's |Ix| / Iz, the friction
+    the landing needs."""
 
     impulse: list = unit_field(["N·s", "N·s", "N·m·s"])
     trailing_foot_lift: list = unit_field("m/s")
     consistent: bool
     qd_minus: list = unit_field(RATES)
     qd_plus: list = unit_field(RATES)
+    touchdown_velocity: list | None = _added("m/s", "the sole's velocity at touchdown")
+    touchdown_speed: float | None = _added("m/s", "the sole's speed at touchdown")
+    friction_needed: float | None = _added(PURE, "the landing's |Ix| / Iz")
 
     @classmethod
     def of(cls, model: Biped, step) -> Impact:
         """The impact at the end of a gait's step."""
         qd_plus, _ = model.impact(*step.end)
         lift = trailing_foot_lift(model, step.end[0], qd_plus)
+        velocity = walkable.touchdown_velocity(model, *step.end)
+        speed = float(np.linalg.norm(velocity))
+        pushed = step.impulse[1] > 0 and np.all(lift >= 0)
+        tolerance = walkable.LANDING_TOLERANCE
+        at_rest = bool(speed <= tolerance and np.all(lift >= -tolerance))
         return cls(
             impulse=step.impulse.tolist(),
             trailing_foot_lift=lift.tolist(),
-            consistent=bool(step.impulse[1] > 0 and np.all(lift >= 0)),
+            consistent=bool(pushed or at_rest),
             qd_minus=step.end[1].tolist(),
             qd_plus=step.start[1].tolist(),
+            touchdown_velocity=velocity.tolist(),
+            touchdown_speed=speed,
+            friction_needed=_landing_friction(step.impulse, at_rest),
+        )
+
+
+def _landing_friction(impulse, at_rest: bool) -> float | None:
+    """|Ix| / Iz of the landing's impulse: the friction it needs; 0 for a landing at rest
+    (no impulse), None (unknown) for an impulse that pulls the sole (Iz <= 0)."""
+    if impulse[1] > 0:
+        return float(abs(impulse[0]) / impulse[1])
+    return 0.0 if at_rest else None
+
+
+@dataclass(frozen=True, eq=False)
+class Walkability(_Record):
+    """What walking the gait asks of the floor, the joints and the hip, on the check grid
+    (``biped.model.walkable``): the stance foot's largest |Fx| / Fz, the least distance of a hip
+    or ankle to its stop (``biped.model.robot.JOINT_STOPS``), the hip's least forward speed;
+    and the tightest margin of each walkable constraint the gait's ``safety`` asks (>= 0 when
+    met; None where not asked), each in its unit."""
+
+    friction_needed: float = unit_field(PURE, metadata={"label": "the stance foot's |Fx| / Fz"})
+    joint_stop_distance: float = unit_field(
+        "rad", metadata={"label": "a hip's or an ankle's least distance to its stop"}
+    )
+    least_hip_speed: float = unit_field("m/s", metadata={"label": "the hip's least speed"})
+    landing: float | None = _margin("m/s", "landing speed")
+    impact_friction: float | None = _margin("N·s", "the landing's friction cone")
+    friction: float | None = _margin("N", "the stance foot's friction cone")
+    joint_stops: float | None = _margin("rad", "the joints' stops")
+    progress: float | None = _margin("m/s", "the hip's least speed")
+
+    @classmethod
+    def of(cls, model: Biped, evaluation) -> Walkability:
+        """The figures of a gait's evaluation on the check grid."""
+        wrench = evaluation.wrench
+        distances = walkable.joint_stop_margins(model.joint_angles(evaluation.q).T, 0.0)
+        margins = {name: float(m.min()) for name, m in evaluation.walkable.items()}
+        return cls(
+            friction_needed=float(np.max(np.abs(wrench[:, 0]) / wrench[:, 1])),
+            joint_stop_distance=float(np.min(distances)),
+            least_hip_speed=float(evaluation.qd[:, XH].min()),
+            **margins,
         )
 
 
@@ -417,6 +486,7 @@ class Gait:
     parameters: dict = unit_field({name: parameter_unit(name) for name in PARAMETERS})
     constraints: Constraints | None = unit_field(Constraints)  # None: a file without them
     impact: Impact | None = unit_field(Impact)  # None: a file without it
+    walkability: Walkability | None = unit_field(Walkability)  # None: a file without it
     electrical: Electrical | None = unit_field(Electrical)  # None: a file without it
     knee_loads: KneeLoads | None = unit_field(KneeLoads)  # None: a file without them
     optimizer: Optimizer = unit_field(Optimizer)
@@ -526,6 +596,7 @@ class Gait:
                 ("costs", Costs),
                 ("constraints", Constraints),
                 ("impact", Impact),
+                ("walkability", Walkability),
                 ("electrical", Electrical),
                 ("knee_loads", KneeLoads),
             )
@@ -550,6 +621,9 @@ class Gait:
         written = safety_dict(safety)  # a setting left at its default is not written
         for name in [f.name for f in dataclasses.fields(Safety) if f.name not in written]:
             units.pop(f"safety.{name}", None)
+        for name in walkable.SCALES:  # the margins of the walkable constraints asked only
+            if name not in safety.walkable:
+                units.pop(f"walkability.{name}", None)
         if design:
             units.update(DESIGN_UNITS)
         if actuators:
@@ -568,13 +642,19 @@ class Gait:
         return units
 
     def _units(self) -> dict:
-        return self.units(
+        units = self.units(
             self.criterion,
             self.knots,
             self.safety,
             self.robot.actuators is not None,
             self.design is not None,
         )
+        for group in ("impact", "walkability"):  # a figure not written has no unit
+            record = getattr(self, group)
+            for f in dataclasses.fields(record) if record is not None else ():
+                if getattr(record, f.name) is None:
+                    units.pop(f"{group}.{f.name}", None)
+        return units
 
     def to_dict(self) -> dict:
         """The JSON-ready content of the gait's file."""
@@ -647,6 +727,8 @@ class Gait:
             )
         if self.impact is not None:
             _check_impact(self.impact, expected["impact"], bad)
+        if self.walkability is not None:  # a file written before the walkable constraints
+            _check_group(self.walkability, "walkability", expected["walkability"], units, bad)
         if self.electrical is not None:  # a file written before the actuators has none
             _check_group(self.electrical, "electrical", expected["electrical"], units, bad)
         if self.knee_loads is not None:  # a file written before the knee loads has none
@@ -673,6 +755,7 @@ def _derived(model: Biped, step, evaluation) -> dict:
             **dict(zip(CONSTRAINTS, map(float, evaluation.worst), strict=True))
         ),
         "impact": Impact.of(model, step),
+        "walkability": Walkability.of(model, evaluation),
         "electrical": Electrical.of(model, step, evaluation),
         "knee_loads": KneeLoads.of(model, evaluation),
         "samples": Samples(
@@ -920,11 +1003,17 @@ def _check_knee_loads(stored: KneeLoads, expected: KneeLoads, units: dict, bad) 
 
 
 def _check_impact(impact: Impact, expected: Impact, bad) -> None:
-    """The impact record against the parameters' (its ``consistent`` flag last)."""
-    for name in ("impulse", "qd_minus", "qd_plus", "trailing_foot_lift"):
+    """The impact record against the parameters' (its ``consistent`` flag last; a figure
+    added since the file was written, absent from it, is not checked)."""
+    added = ("touchdown_velocity", "touchdown_speed", "friction_needed")
+    for name in ("impulse", "qd_minus", "qd_plus", "trailing_foot_lift", *added):
         path, value, wanted = f"impact.{name}", getattr(impact, name), getattr(expected, name)
+        if name in added and value is None and impact.touchdown_speed is None:
+            continue
         try:
-            if value is None:
+            if value is None or wanted is None:
+                if value is None and wanted is None:
+                    continue
                 raise TypeError(name)
             found = _mismatch(value, wanted)
         except (TypeError, ValueError):
