@@ -233,12 +233,14 @@ _LEFT_OUT = {
 }
 
 
-def safety_dict(safety: Safety) -> dict:
+def safety_dict(safety: Safety, kept: tuple = ()) -> dict:
     """The margins as a file writes them: those beyond the clearance and the ZMP margin only
-    when asked (``_LEFT_OUT``)."""
+    when asked (``_LEFT_OUT``), but for those ``kept`` (a campaign's record keeps the knee
+    bend, which it wrote before the others existed)."""
     values = dataclasses.asdict(safety)
     for name, default in _LEFT_OUT.items():
-        if values[name] == default and type(values[name]) is type(default):
+        at_default = values[name] == default and type(values[name]) is type(default)
+        if at_default and name not in kept:
             del values[name]
     return values
 

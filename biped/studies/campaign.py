@@ -24,7 +24,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import Safety
+from biped.model.criteria import Safety, safety_dict
 from biped.model.gait import KNOTS
 from biped.model.robot import Robot
 from biped.optimization import table
@@ -67,10 +67,8 @@ class Settings:
             value = getattr(self, field.name)
             if isinstance(value, Robot):
                 value = value.to_dict()
-            elif isinstance(value, Safety):  # the actuator limits only when asked
-                value = dataclasses.asdict(value)
-                if not value["actuator_limits"]:
-                    del value["actuator_limits"]
+            elif isinstance(value, Safety):  # what is asked (as the records before)
+                value = safety_dict(value, kept=("knee_bend",))
             content[field.name] = list(value) if isinstance(value, tuple) else value
         return {**content, **self.stamp()}
 
