@@ -2,7 +2,8 @@
 that chose the walkable preset (``biped.model.criteria.WALKABLE``).
 
 For each operating point (knee, speed, clearance) and each setting of one knob (the sole's
-largest landing speed, or the swing clearance), the certified sthenic optimum under that
+largest landing speed as a share of the walking speed, the swing clearance, or the ZMP's
+margin inside the sole), the certified sthenic optimum under that
 setting is validated in MuJoCo (``validate.validation.validate``, every check), and two
 figures of its 20-step walk are kept: the servos' share of the joint torque
 (``forward.feedback_share``: what the controller had to add to the gait's own torques) and
@@ -10,7 +11,7 @@ the energy per step MuJoCo spends against the model's (``forward.energy_per_step
 ``analytic_energy_per_step``, less 1). The preset takes the loosest setting at which every
 point's walk passes every check with both figures within their targets (``TARGETS``).
 
-    python -m validate.margins_study [--knob landing|clearance] [--out logs/margins] [--jobs N]
+    python -m validate.margins_study [--knob landing|clearance|zmp] [--out logs/margins] [--jobs N]
 
 writes ``<knob>.json`` (one row per optimum, atomically) and ``<knob>.png`` (both figures
 against the knob, a line per point, the targets dashed), and prints the rows.
@@ -42,6 +43,7 @@ KNEES = ("revolute", "rolling")
 KNOBS = {
     "landing": {"values": (None, 2.0, 1.5, 1.0, 0.75, 0.5, 0.35), "unit": "× walking speed"},
     "clearance": {"values": (0.0, 0.005, 0.01, 0.02), "unit": "m"},
+    "zmp": {"values": (0.0, 0.005, 0.01, 0.02), "unit": "m"},
 }
 STARTS = 5
 
@@ -62,6 +64,8 @@ class Setting:
             return dataclasses.replace(
                 self.held, clearance=self.clearance, landing_share=self.value
             )
+        if self.knob == "zmp":
+            return dataclasses.replace(self.held, clearance=self.clearance, zmp_margin=self.value)
         return dataclasses.replace(self.held, clearance=self.value)
 
 
@@ -107,11 +111,22 @@ def settings(knob: str, held: Safety) -> list[Setting]:
     ]
 
 
+def _point(row: dict) -> tuple:
+    return row["knee"], row["speed"], row["clearance"]
+
+
+def never_walking(rows: list[dict]) -> list[tuple]:
+    """The points (knee, speed, clearance) whose optimum meets the targets at no setting."""
+    points = sorted({_point(r) for r in rows})
+    return [p for p in points if not any(_meets(r) for r in rows if _point(r) == p)]
+
+
 def chosen(rows: list[dict], knob: str):
-    """The loosest setting at which every point walks with both figures within ``TARGETS``
-    (None if none does)."""
+    """The loosest setting at which every point that meets the targets at some setting meets
+    them (``never_walking`` told apart), None if there is none."""
+    left_out = set(never_walking(rows))
     for value in KNOBS[knob]["values"]:
-        at = [r for r in rows if r["value"] == value]
+        at = [r for r in rows if r["value"] == value and _point(r) not in left_out]
         if at and all(_meets(r) for r in at):
             return value
     return None
@@ -175,7 +190,11 @@ def figure(rows: list[dict], knob: str):
         if best is not None:
             ax.axvline(positions[best], color="tab:green", lw=6, alpha=0.2)
         ax.set_xticks(range(len(values)), labels)
-        what = "the sole's largest landing speed" if knob == "landing" else "swing clearance"
+        what = {
+            "landing": "the sole's largest landing speed",
+            "clearance": "swing clearance",
+            "zmp": "the ZMP's margin inside the sole",
+        }[knob]
         ax.set_xlabel(f"{what} [{unit}]")
         ax.set_title(title)
         ax.grid(alpha=0.3)
@@ -200,9 +219,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     from biped.model.criteria import WALKABLE
 
-    held = (
-        WALKABLE if args.knob == "clearance" else dataclasses.replace(WALKABLE, landing_share=None)
-    )
+    # The preset held but for the knob (a landing share unbounded while it is varied).
+    held = dataclasses.replace(WALKABLE, landing_share=None) if args.knob == "landing" else WALKABLE
     rows = list(run_tasks(measure, settings(args.knob, held), jobs=args.jobs, stream=None))
     rows.sort(key=lambda r: (r["speed"], r["knee"], -1 if r["value"] is None else -r["value"]))
     out = Path(args.out)
@@ -211,6 +229,7 @@ def main(argv=None) -> int:
         "knob": args.knob,
         "targets": TARGETS,
         "chosen": chosen(rows, args.knob),
+        "never_walking": never_walking(rows),
         "rows": rows,
     }
     atomic_write_text(out / f"{args.knob}.json", json.dumps(record, indent=1))
@@ -222,7 +241,9 @@ def main(argv=None) -> int:
             f"{r['feedback_share']}, energy error {r['energy_error']}"
         )
     written = ", ".join(str(out / f"{args.knob}.{suffix}") for suffix in ("json", "png"))
-    print(f"chosen: {record['chosen']}; wrote {written}")
+    never = ", ".join(f"{k} {v:g} m/s {100 * c:g} cm" for k, v, c in record["never_walking"])
+    print(f"chosen: {record['chosen']} (meeting the targets at no setting: {never or 'none'})")
+    print(f"wrote {written}")
     return 0
 
 
