@@ -124,6 +124,10 @@ def test_a_flip_beyond_the_unit_circle_fails_the_check():
     assert result.multipliers.values[0].real < -1.0 and result.radius >= 1.0
     assert result.verdict == "unstable"
     assert "unstable" in o.notes(result)[-1]
+    check = o.orbit_check(result)
+    assert not check.passed and check.causes == ["unstable orbit"]
+    assert check.line().startswith("FAIL  orbit             [unstable orbit] ")
+    assert "an error may grow from step to step" in check.line()
 
 
 def test_a_gain_the_robustness_map_says_falls_has_no_orbit():

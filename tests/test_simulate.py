@@ -9,7 +9,14 @@ import pytest
 from biped.model.kinematics import ZH
 from tests.conftest import gait_of, optimal_gait, small_optimum, with_torques
 from validate import contact
-from validate.checks import MAX_FOOT_TILT, MAX_SLIP, scuff_notes, walk_figures, walks
+from validate.checks import (
+    MAX_FOOT_TILT,
+    MAX_SLIP,
+    scuff_notes,
+    walk_causes,
+    walk_figures,
+    walks,
+)
 from validate.model import model_spec
 from validate.simulate import FALLEN, RESYNC, Push, Walker, WalkSettings
 
@@ -86,7 +93,8 @@ def test_fall_ends_the_simulation():
     assert len(sim.landed) <= 2 and not sim.landed[-1]
     assert sim.hip_height()[-1] == pytest.approx(FALLEN * walker.samples.q[0, ZH], abs=0.01)
     figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
-    assert figures["fell"] and figures["steps"] == 0
+    assert figures["fell"] and figures["steps"] == 0 and not figures["stalled"]
+    assert walk_causes(figures, 3)[0] == "fell"
 
 
 def test_flipped_torques_roll_the_stance_foot():
@@ -102,6 +110,7 @@ def test_flipped_torques_roll_the_stance_foot():
     assert sim.hip_height()[sim.step_slices()[0]].min() > 0.85  # [m] not fallen
     figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
     assert figures["max_foot_tilt"] > MAX_FOOT_TILT and not walks(figures, 2)
+    assert "tilted" in walk_causes(figures, 2) and "fell" not in walk_causes(figures, 2)
 
 
 def test_a_scuff_fails_the_walk_with_its_duration_and_depth():
@@ -124,7 +133,7 @@ def test_a_scuff_fails_the_walk_with_its_duration_and_depth():
     figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
     assert figures["scuff_steps"] >= 1 and 1 in contact.scuffs(sim, walker.period).steps
     assert figures["scuff_duration"] > 0.0 and figures["scuff_depth"] >= 0.0
-    assert not walks(figures, 4)
+    assert not walks(figures, 4) and "scuffed" in walk_causes(figures, 4)
     assert "scuffed" in scuff_notes(sim, walker.period, figures, 4)[0]
     clean = Walker(gait).walk(4)
     assert walks(walk_figures(walker.biped, walker.samples, clean, 1.0), 4)
@@ -137,6 +146,10 @@ def test_low_friction_slips():
     sim = walker.walk(6, WalkSettings(friction=0.05))
     figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
     assert figures["max_slip"] > 10 * MAX_SLIP and figures["steps"] == 0
+    assert "slipped" in walk_causes(figures, 6)
+    assert figures["max_slip_share"] == pytest.approx(
+        figures["max_slip"] / walker.samples.step_length
+    )
 
 
 def test_push_gives_its_impulse():
@@ -152,10 +165,12 @@ def test_push_gives_its_impulse():
         assert np.sign(change) == np.sign(impulse) and abs(change) > 0.01  # [m/s]
 
 
-def test_shuffling_is_a_fall():
+def test_shuffling_does_not_advance():
     """Landings that do not carry the hip forward by half a step length are not steps: a walk
-    whose hip is held in place from its second step (a robot shuffling) walked one step and
-    fell."""
+    whose hip is held in place from its second step (a robot shuffling) walked one step, did
+    not advance and did not fall (the hip stays up)."""
+    from validate.checks import walk_causes
+
     walker = Walker(gait_of(small_optimum("revolute")))
     sim = walker.walk(4)
     held = sim.step_slices()[1].start
@@ -164,7 +179,8 @@ def test_shuffling_is_a_fall():
     qpos[held:, column] = qpos[held, column]
     sim.qpos = qpos
     figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
-    assert figures["steps"] == 1 and figures["fell"]
+    assert figures["steps"] == 1 and figures["stalled"] and not figures["fell"]
+    assert walk_causes(figures, 4) == ["did not advance"]
 
 
 def test_phase_follows_the_hip():
@@ -209,22 +225,33 @@ def test_an_unstable_walk_counts_its_warnings_and_writes_no_log(tmp_path, monkey
     walker = Walker(gait_of(small_optimum("revolute")))
     sim = walker.walk(1, WalkSettings(kp_scale=1e4))
     assert sim.warnings > 0
-    assert not walks(walk_figures(walker.biped, walker.samples, sim, 1.0), 1)
+    figures = walk_figures(walker.biped, walker.samples, sim, 1.0)
+    assert not walks(figures, 1) and "MuJoCo warning" in walk_causes(figures, 1)
     assert list(tmp_path.iterdir()) == []
     assert capfd.readouterr() == ("", "")
     assert mujoco.get_mju_user_warning() is before
 
 
 def test_a_failed_forward_check_says_why_in_words():
-    """Zero torques: the forward check fails, and its first note says why (the steps walked
-    and the fall), so a line that gives only the notes (the atlas's) names the reason; the
-    optimal gait's check passes with no such note."""
+    """Zero torques, the servos alone holding the joints: the forward check fails, its causes
+    first on its line and its first note saying why in words (the steps walked, then each
+    cause on its physical scale), so a line that gives only the notes (the atlas's) names the
+    reason: the stance foot slides (mm, a share of the step) and rolls onto its edge (mm off
+    the floor), the swing foot drags (ms, mm deep), no step lands, the hip stays up; the optimal gait's check passes with no such
+    note and no cause."""
     from validate.checks import check_forward
 
     gait = gait_of(small_optimum("revolute"))
     limp = Walker(with_torques(gait, np.zeros_like(gait.samples.torques)))
     check, _, _ = check_forward(limp, 3, energy=1.0)
-    assert not check.passed
-    assert check.notes[0].startswith("not a walk of 3 steps: 0 of 3 steps within the limits, fell")
+    causes = ["scuffed", "slipped", "tilted", "did not advance"]
+    assert not check.passed and check.causes == causes
+    assert check.line().startswith(f"FAIL  forward           [{', '.join(causes)}] ")
+    first = check.notes[0]
+    assert first.startswith("not a walk of 3 steps: 0 of 3 steps within the limits, "), first
+    assert "mm off the floor (allowed < 0.01 rad: 2.6 mm at the far end of the 25.8 cm" in first
+    assert "swing foot scuffed the floor" in first and "mm deep" in first
+    assert "% of the 0.183 m step (allowed < 1 mm, 0.55 %)" in first
     check, _, _ = check_forward(Walker(gait), 2, energy=1.0)
-    assert check.passed and not any(n.startswith("not a walk") for n in check.notes)
+    assert check.passed and check.causes == []
+    assert not any(n.startswith("not a walk") for n in check.notes)

@@ -163,13 +163,18 @@ def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_pa
     assert not table_1["feedforward"]["passed"] and not table_1["inverse_dynamics"]["passed"]
     assert table_1["model"]["mass_difference"] == pytest.approx(-0.1 * Robot.paper().trunk_mass)
     assert not table_1["model"]["passed"] and "trunk_mass" in table_1["model"]["notes"][0]
-    stance = [table_1["feedforward"][f"feedback_share_stance_{j}"] for j in ("knee", "hip")]
+    replay = table_1["feedforward"]
+    stance = [replay[f"feedback_share_stance_{j}"] for j in ("knee", "hip")]
     assert min(stance) > 0.1
-    (note,) = table_1["feedforward"]["notes"]  # what MuJoCo's replay measured, not a bad file
-    for joint in ("knee", "hip"):
-        share = table_1["feedforward"][f"feedback_share_stance_{joint}"]
-        assert f"{100 * share:.1f} % of stance_{joint}'s" in note, note
+    assert replay["causes"] == ["servo share"] and table_1["model"]["causes"] == ["model mismatch"]
+    (note,) = replay["notes"]  # what MuJoCo's replay measured, not a bad file
+    for joint in ("knee", "hip"):  # each servo's torque against the robot's torque scale
+        torque, ratio = (replay[f"{f}_stance_{joint}"] for f in ("feedback_rms", "feedback_ratio"))
+        assert ratio == pytest.approx(torque / replay["torque_scale"]) and ratio > 0.1
+        assert f"{torque:.3g} N·m at stance_{joint} ({100 * ratio:.2g} %)" in note, note
+    assert f"of the robot's torque scale {replay['torque_scale']:.3g} N·m" in note
     assert "servos" in note and "not its motion" not in note
+    assert table_1["units"]["feedforward.torque_scale"] == "N·m"
     _, out, _ = _run(args, capsys)
     own = json.loads(out)
     assert own["feedforward"]["passed"] and own["inverse_dynamics"]["passed"]
@@ -230,7 +235,8 @@ def test_model_errors_are_fail_lines(gait_path, tmp_path, capsys):
             for line in out.splitlines()
             if line[:4].strip() and "  " in line[:2]
         }
-        assert lines["model"].startswith("  FAIL") and reason in lines["model"]
+        assert lines["model"].startswith("  FAIL  model             [model mismatch] ")
+        assert reason in lines["model"]
         assert (
             lines["inverse_dynamics"].startswith("  FAIL") and inverse in lines["inverse_dynamics"]
         )
@@ -239,14 +245,19 @@ def test_model_errors_are_fail_lines(gait_path, tmp_path, capsys):
 
 
 def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
-    """Each check is an object with ``passed`` and ``notes``; every number has its unit."""
+    """Each check is an object with ``passed``, ``notes`` and ``causes`` (none when it passes,
+    else words of ``CAUSES``); every number has its unit."""
     from biped.model.units import missing
+    from validate.checks import CAUSES
 
     code, content, _ = report
     for name in ("model", "inverse_dynamics", "impact", "feedforward", "forward", "gains"):
         assert isinstance(content[name]["passed"], bool), name
         assert isinstance(content[name]["notes"], list), name
+        causes = content[name]["causes"]  # why it fails, in the fixed words; none if it passes
+        assert set(causes) <= set(CAUSES) and bool(causes) is not content[name]["passed"]
     assert missing(content, content["units"]) == []
+    assert content["units"]["forward.max_slip_share"] == "S"
 
 
 ROBOT_FIELDS = [f.name for f in Robot.body_fields()]  # in their order (the actuators: no MJCF)

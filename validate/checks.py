@@ -1,31 +1,41 @@
-"""The checks of a gait file against MuJoCo, each a ``Check``: a verdict, figures and notes.
+"""The checks of a gait file against MuJoCo, each a ``Check``: a verdict, figures, notes and,
+when it fails, its causes in words of ``CAUSES``. Each tolerance is stated on a physical
+scale beside its constant, and a failing check's note gives the figure on that scale.
 
 model             the MJCF is the gait's robot: the rolling knee's equalities and their
                   ratio r2 / r1, and every field of ``biped.Robot`` the MJCF holds
                   (``validate.model.parameter_differences``: the first that differs named
-                  with both values); its mass beside the gait's
+                  with both values); its mass beside the gait's ("model mismatch")
 inverse_dynamics  the file's Γ, F_e, ZMP against MuJoCo's dynamics of the model along the
-                  file's motion (1e-6)
+                  file's motion (``EXACT``; "model mismatch")
 knee_loads        MuJoCo's force of the thigh on the lower leg through each knee (its
                   ``cfrc_int``) along the file's motion against the file's knee loads, normal
-                  and tangential, both knees (1e-6 N: two exact rigid models, the knee
-                  equalities' softness out of the inverse dynamics; 5e-13 N measured)
+                  and tangential, both knees (``EXACT`` N: two exact rigid models, the knee
+                  equalities' softness out of the inverse dynamics; 5e-13 N measured;
+                  "model mismatch")
 impact            the file's start velocities and impulse against MuJoCo's impact map
-                  (mass matrix and foot Jacobian) applied to the file's end state (1e-6)
+                  (mass matrix and foot Jacobian) applied to the file's end state (``EXACT``;
+                  "model mismatch")
 feedforward       each step replayed against the clock with the file's torques
-                  (``validate.replay``): the share of each joint's torque its servo had to
-                  add, below ``FEEDFORWARD_SHARE`` for every joint
+                  (``validate.replay``): the torque each joint's servo had to add, RMS over
+                  the step, below ``SERVO_SHARE`` of the robot's torque scale (the largest
+                  RMS torque of its joints) for every joint ("servo share"); each joint's
+                  share of its own torque reported beside it
 forward           the file walked in MuJoCo with contact (``validate.simulate``): every step
                   lands and advances the hip by ``STEP_ADVANCE`` of the step length at
-                  least, no fall, no slip of the stance foot (``MAX_SLIP``), the stance foot
-                  flat (tilt below ``MAX_FOOT_TILT``), no scuff of the swing foot before its
-                  landing window, no MuJoCo warning; ground reaction, centre of pressure,
-                  velocity jump at touchdown, feedback, energy, clearance and the
+                  least ("did not advance"), no fall ("fell"), no slip of the stance foot
+                  (``MAX_SLIP``, also as a share of the step: "slipped"), the stance foot
+                  flat (tilt below ``MAX_FOOT_TILT``, its sole's far end within 2.6 mm of the
+                  floor: "tilted"), no scuff of the swing foot before its landing window
+                  ("scuffed"), no MuJoCo warning ("MuJoCo warning"); ground reaction, centre
+                  of pressure, velocity jump at touchdown, feedback, energy, clearance, the
                   rolling-knee equality reported beside the gait's
 gains             the same walk at kp × ``GAIN_SCALES``: the range of gains it walks over
+                  (the causes of the walks that fail)
 
 A model the harness cannot use as the gait's robot (``validate.model.ModelError``: a rolling
-knee without its equalities) fails the checks that need it, with the reason as a note.
+knee without its equalities) fails the checks that need it, with the reason as a note
+("model mismatch"). The orbit check (``validate.orbit``) fails as "unstable orbit".
 """
 
 from __future__ import annotations
@@ -56,23 +66,38 @@ from validate.samples import GaitSamples
 from validate.simulate import KP, Simulation, Walker, WalkSettings, reference_along
 from validate.units import FIGURE_UNITS, WalkFigures
 
-# Agreement of two exact rigid-body models of one robot.
+# Agreement of two exact rigid-body models of one robot, in each figure's unit (N·m, N, m,
+# m/s, rad/s, N·s): a millionth of the torques (1-10 N·m), of the weight (687 N) and of the
+# sole (0.26 m) of the gaits it compares; two models of one robot agree to rounding (1e-13
+# measured), a robot 5 % off in any field of Table 1 differs by 1e-3 or more.
 EXACT = 1e-6
-# Largest share of a joint's torque its servo may add in the replay (``validate.replay``):
-# the optimal gaits need 0.025 at most, a joint 20 % off 0.09 or more.
-FEEDFORWARD_SHARE = 0.05
-MAX_SLIP = 1e-3  # [m] stance-foot travel during its stance, after the landing settles
+# Largest torque a joint's servo may add in the replay (``validate.replay``), RMS over the
+# step, as a share of the robot's torque scale: the largest RMS torque of its joints over
+# that step (a stance hip's or ankle's: 1.7 N·m for the optimal gaits at 0.3 m/s, 7.3 N·m at
+# 0.6 m/s). Judged against that scale, not against each joint's own torque: a swing ankle
+# carrying 0.12 N·m needs 0.015 N·m of servo torque for the millisecond after its torque
+# jumps at the mid-step knot, 12 % of its own torque but 0.6 % of the scale. Measured
+# (``tests/test_wrong_models.py``): the correct gaits of both knees at 0.2-0.6 m/s, walkable
+# or with 2-3 cm of clearance, need 0.0064 at most (that swing ankle; 0.0021 the optimal
+# gaits at 0.3 m/s); the Table 1 gaits on a model 10 % off need 0.017 (r1) to 0.67 (the
+# trunk's centre of mass), 0.05 (a thigh's inertia), 0.47 (the trunk's mass).
+SERVO_SHARE = 0.01
+# Stance-foot travel during its stance, after the landing settles [m]: 0.56 % of the 0.18 m
+# step of the optimal gaits at 0.3 m/s (0.12 mm measured), a tenth of the 1 cm the hip's
+# advance is read to.
+MAX_SLIP = 1e-3
 # Largest tilt [rad] of the stance foot: a loaded sole on the soft floor tilts by a
-# fraction of a milliradian; 0.01 rad lifts the far end of a 26 cm sole by 2.6 mm.
+# fraction of a milliradian; 0.01 rad lifts the far end of the 25.8 cm sole by 2.6 mm.
 MAX_FOOT_TILT = 0.01
-# Fall: hip lower than this fraction of its planned minimum, or trunk beyond this angle.
+# Fall: hip lower than this fraction of its planned minimum (8.9 cm below the 0.89 m of the
+# optimal gaits), or trunk beyond this angle (29°).
 HIP_DROP = 0.9
 TRUNK_LIMIT = 0.5  # [rad]
 # A step counts only if the hip advances by this fraction of the step length in it (a robot
 # shuffling in place makes short "steps" that land).
 STEP_ADVANCE = 0.5
 # Fraction of a step after touchdown left out of the comparisons with the gait: MuJoCo's
-# soft landing takes that long to settle.
+# soft landing takes that long to settle (59 ms at 0.3 m/s).
 LANDING = 0.1
 # Time after a landing's first contact at which its velocity jump is read [s].
 JUMP_WINDOW = 0.02
@@ -81,6 +106,18 @@ JUMP_WINDOW = 0.02
 SCUFF_MARGIN = 1e-3
 # Scales of the servos' stiffness KP (the damping stays) of the gains check.
 GAIN_SCALES = (0.5, 2.0)
+# Why a check fails, in words: every failing check names its causes among these (``Check``).
+CAUSES = (
+    "fell",  # the hip dropped or the trunk tipped over
+    "scuffed",  # the swing foot touched the floor before its landing
+    "slipped",  # the stance foot slid
+    "tilted",  # the stance foot rolled onto an edge of its sole
+    "unstable orbit",  # the walk's return map is not shown to shrink an error
+    "servo share",  # the gait's torques alone do not make its motion
+    "model mismatch",  # the model is not the gait's robot, or its dynamics not the gait's
+    "MuJoCo warning",  # the simulator warned (an unstable integration)
+    "did not advance",  # a step did not land, or landed without carrying the hip forward
+)
 
 
 @dataclass
@@ -93,6 +130,7 @@ class Check:
         figures: name -> value (numbers, booleans, [low, high] pairs; NaN: not measured).
         notes: sentences that go with the verdict.
         shown: the figures ``line`` prints (None: all).
+        causes: why it fails, among ``CAUSES`` (empty when it passes).
     """
 
     name: str
@@ -100,13 +138,21 @@ class Check:
     figures: dict
     notes: list = field(default_factory=list)
     shown: tuple | None = None
+    causes: list = field(default_factory=list)
+
+    def __post_init__(self):
+        unknown = [cause for cause in self.causes if cause not in CAUSES]
+        if unknown:
+            raise ValueError(f"cause {unknown[0]!r} of check {self.name}: allowed {CAUSES}")
 
     def line(self) -> str:
+        """PASS or FAIL, the name, the causes first, the figures shown with units, notes."""
         names = self.figures if self.shown is None else self.shown
         values = ", ".join(
             f"{k} {_fmt(self.figures[k])}{_unit(self.name, k)}" for k in names if k in self.figures
         )
-        text = f"{'PASS' if self.passed else 'FAIL'}  {self.name:17} {values}".rstrip()
+        causes = f"[{', '.join(self.causes)}] " if self.causes else ""
+        text = f"{'PASS' if self.passed else 'FAIL'}  {self.name:17} {causes}{values}".rstrip()
         if not self.notes:
             return text
         return f"{text}{'; ' if values else '  '}{'; '.join(self.notes)}"
@@ -141,13 +187,41 @@ def _ratio(a: float, b: float) -> float:
     return a / b if b != 0 else float("nan")
 
 
+def _peak(values) -> float:
+    """Largest magnitude; NaN for no values."""
+    return float(np.abs(values).max()) if np.size(values) else float("nan")
+
+
 def _median(values) -> float:
     """Median; NaN for no values (a walk too short to measure)."""
     return float(np.median(values)) if np.size(values) else float("nan")
 
 
 def _model_failure(name: str, error: Exception) -> Check:
-    return Check(name, False, {}, notes=[f"model error: {error}"])
+    return Check(name, False, {}, notes=[f"model error: {error}"], causes=[MISMATCH])
+
+
+MISMATCH = "model mismatch"
+
+
+def _exact_verdict(name: str, figures: dict, what: str, scales: dict, notes=None) -> Check:
+    """A check of two exact models (``EXACT``): passed when every figure of ``scales`` is
+    below it; else a note giving the largest of each against its physical scale
+    (name -> (scale, what it is)), cause "model mismatch"."""
+    notes = list(notes or [])
+    passed = all(figures[key] < EXACT for key in scales)
+    if not passed:
+        said = []
+        for key, (scale, of) in scales.items():
+            unit = _unit(name, key)
+            share = f", {100 * figures[key] / scale:.2g} % of {of}" if scale > 0 else ""
+            said.append(f"{key} {figures[key]:.3g}{unit}{share}")
+        notes.insert(
+            0,
+            f"{what}: {'; '.join(said)} (allowed < {EXACT:g} in each unit: two models of one "
+            "robot agree to rounding)",
+        )
+    return Check(name, passed, figures, notes, causes=[] if passed else [MISMATCH])
 
 
 def check_model(model: mujoco.MjModel, biped: Biped) -> Check:
@@ -156,7 +230,7 @@ def check_model(model: mujoco.MjModel, biped: Biped) -> Check:
     trunk = model.body("trunk").id
     mass = float(model.body_subtreemass[trunk])
     figures = {"mass_difference": mass - biped.robot.total_mass, "problems": len(problems)}
-    return Check("model", not problems, figures, notes=problems)
+    return Check("model", not problems, figures, notes=problems, causes=[MISMATCH] * bool(problems))
 
 
 def check_inverse_dynamics(model: mujoco.MjModel, biped: Biped, samples: GaitSamples) -> Check:
@@ -176,8 +250,15 @@ def check_inverse_dynamics(model: mujoco.MjModel, biped: Biped, samples: GaitSam
     }
     if result.coupling.size:
         figures["max_knee_coupling"] = float(np.abs(result.coupling).max())
-    errors = ("max_torque_error", "max_force_error", "max_moment_error", "max_zmp_error")
-    return Check("inverse_dynamics", max(figures[name] for name in errors) < EXACT, figures)
+    weight = biped.robot.weight
+    scales = {
+        "max_torque_error": (_peak(samples.torques), "the largest joint torque"),
+        "max_force_error": (weight, "the weight"),
+        "max_moment_error": (_peak(samples.wrench[:, 2]), "the largest ground moment"),
+        "max_zmp_error": (biped.robot.foot_length, "the sole"),
+    }
+    what = "MuJoCo's inverse dynamics of the model are not the gait file's"
+    return _exact_verdict("inverse_dynamics", figures, what, scales)
 
 
 def check_knee_loads(
@@ -207,8 +288,10 @@ def check_knee_loads(
     figures = {f"max_knee_{part}_error": float(e.max()) for part, e in errors.items()}
     for k, side in enumerate(KNEE_SIDES):  # MuJoCo's
         figures[f"max_{side}_knee_tension"] = float(np.maximum(-found.normal[:, k], 0.0).max())
-    passed = max(figures["max_knee_normal_error"], figures["max_knee_tangential_error"]) < EXACT
-    return Check(name, passed, figures, notes)
+    weight = biped.robot.weight
+    scales = {f"max_knee_{part}_error": (weight, "the weight") for part in ("normal", "tangential")}
+    what = "MuJoCo's force through the knees is not the gait file's"
+    return _exact_verdict(name, figures, what, scales, notes)
 
 
 def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait: Gait) -> Check:
@@ -234,35 +317,66 @@ def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait
         figures["max_moment_impulse_error"] = float(error[2])
     else:
         notes.append("the gait file has no impact.impulse to compare")
-    errors = [v for k, v in figures.items() if k.endswith("_error")]
-    return Check("impact", max(errors) < EXACT and impulse is not None, figures, notes)
+    start_rates = np.abs(start)
+    scales = {
+        "max_linear_velocity_error": (_peak(start_rates[slide]), "the largest hip speed"),
+        "max_angular_velocity_error": (_peak(start_rates[~slide]), "the largest joint rate"),
+    }
+    if impulse is not None:
+        size = float(np.linalg.norm(mj_impulse[:2]))
+        scales["max_force_impulse_error"] = (size, "the impulse")
+        scales["max_moment_impulse_error"] = (abs(float(mj_impulse[2])), "its moment")
+    what = "MuJoCo's impact map is not the gait file's"
+    check = _exact_verdict("impact", figures, what, scales, notes)
+    if impulse is None:  # nothing to compare the impulse with: not shown to be MuJoCo's
+        check.passed, check.causes = False, [MISMATCH]
+    return check
 
 
 def check_feedforward(spec: mujoco.MjSpec, biped: Biped, samples: GaitSamples) -> Check:
-    """Both stance sides replayed; each joint's worst share (``validate.replay``)."""
+    """Both stance sides replayed (``validate.replay``): each joint's servo torque, RMS over
+    the step, against the robot's torque scale (the largest RMS torque of its joints over
+    the step), below ``SERVO_SHARE`` at every joint; each joint's share of its own torque
+    reported beside it."""
     model = replay_model(spec, biped.knee)
     replays = [replay_step(model, samples, biped, stance) for stance in SIDES]
     shares = np.max([r.shares() for r in replays], axis=0)
     feedback = np.max([r.feedback_rms() for r in replays], axis=0)
     torques = np.max([r.torque_rms() for r in replays], axis=0)
-    figures = {"max_feedback_share": float(shares.max())}
-    for name, values in (("feedback_share", shares), ("feedback_rms", feedback)):
+    scale = float(torques.max())
+    ratios = feedback / scale if scale > 0 else np.full(len(JOINTS), np.nan)
+    figures = {
+        "max_feedback_ratio": float(ratios.max()),
+        "torque_scale": scale,
+        "max_feedback_share": float(shares.max()),
+    }
+    per_joint = (
+        ("feedback_ratio", ratios),
+        ("feedback_share", shares),
+        ("feedback_rms", feedback),
+        ("torque_rms", torques),
+    )
+    for name, values in per_joint:
         figures |= {f"{name}_{joint}": float(v) for joint, v in zip(JOINTS, values, strict=True)}
-    figures |= {f"torque_rms_{joint}": float(v) for joint, v in zip(JOINTS, torques, strict=True)}
-    passed = bool(shares.max() < FEEDFORWARD_SHARE)
+    passed = bool(ratios.max() < SERVO_SHARE)  # NaN (no torque to compare with) fails
     notes = []
-    if not passed:  # the file's torques alone do not make its motion in MuJoCo
+    if not scale > 0:
+        notes.append("no joint carries torque in the replay: no scale to judge the servos by")
+    elif not passed:  # the file's torques alone do not make its motion in MuJoCo
         worst = [
-            f"{100 * v:.1f} % of {joint}'s"
-            for joint, v in zip(JOINTS, shares, strict=True)
-            if v >= FEEDFORWARD_SHARE
+            f"{v:.3g} N·m at {joint} ({100 * r:.2g} %)"
+            for joint, v, r in zip(JOINTS, feedback, ratios, strict=True)
+            if not r < SERVO_SHARE
         ]
         notes.append(
             "replayed in MuJoCo, the gait's torques need the servos to follow its motion: they "
-            f"add {', '.join(worst)} torque (allowed < {100 * FEEDFORWARD_SHARE:g} % each)"
+            f"add {', '.join(worst)} RMS, of the robot's torque scale {scale:.3g} N·m (its "
+            f"largest joint's RMS torque; allowed < {100 * SERVO_SHARE:g} %: "
+            f"{SERVO_SHARE * scale:.2g} N·m)"
         )
-    shown = ("max_feedback_share",) + tuple(f"feedback_share_{joint}" for joint in JOINTS)
-    return Check("feedforward", passed, figures, notes, shown=shown)
+    shown = ("max_feedback_ratio", "torque_scale") + tuple(f"feedback_ratio_{j}" for j in JOINTS)
+    causes = [] if passed else ["servo share"]
+    return Check("feedforward", passed, figures, notes, shown=shown, causes=causes)
 
 
 def touchdown_jumps(biped: Biped, sim: Simulation, steps: int, window: float = JUMP_WINDOW):
@@ -320,24 +434,31 @@ def walk_figures(
         ):
             break
         walked += 1
+    # A step that lands without carrying the hip forward (shuffling), or none that lands
+    # while the robot stays up (standing), does not advance; a hip or trunk beyond its
+    # limits is a fall.
     shuffled = bool(np.any(np.array(sim.landed) & (advance < STEP_ADVANCE)))
+    fell = bool(hip.min() < lowest or np.abs(trunk).max() > TRUNK_LIMIT)
     counted = slice(0, max(walked, 1))
     durations = np.diff(sim.time[sim.step_starts].tolist() + [sim.time[-1] + dt])[counted]
-    fell = hip.min() < lowest or np.abs(trunk).max() > TRUNK_LIMIT or shuffled
     figures = {
         "steps": walked,
-        "fell": bool(not all(sim.landed) or fell),
+        "fell": fell,
+        "stalled": bool(shuffled or (not all(sim.landed) and not fell)),
+        "step_length": float(samples.step_length),
         "max_slip": float(slips.max()),
+        "max_slip_share": float(slips.max() / samples.step_length),
         "step_duration_range": [float(durations.min() / period), float(durations.max() / period)],
         "step_advance_range": [float(advance[counted].min()), float(advance[counted].max())],
         "max_landing_slide": float(sim.stance_foot_slip(settle, landing=True).max()),
         **_foot_figures(biped, samples, sim, tilt, counted),
         **_tracking_figures(biped, samples, sim, reaction, walked, reference),
-        "analytic_energy_per_step": float(energy),
         "warnings": int(sim.warnings),
         "distance": float(sim.hip_x()[-1] - sim.hip_x()[0]),
         "seconds_simulated": float(sim.time[-1] - sim.time[0]),
     }
+    figures["analytic_energy_per_step"] = float(energy)
+    figures["energy_ratio"] = _ratio(figures["energy_per_step"], float(energy))
     if biped.knee == "rolling":
         figures["max_knee_equality_violation"] = _knee_equality_violation(sim)
     return WalkFigures(**figures).to_dict()  # the names, their order and units declared there
@@ -349,6 +470,7 @@ def _foot_figures(biped, samples, sim: Simulation, tilt, counted: slice) -> dict
     scuffs = contact.scuffs(sim, samples.period)
     clearance = contact.clearance(biped, samples, sim)
     return {
+        "sole_length": float(biped.robot.foot_length),
         "max_foot_tilt": float(tilt.tilt.max()),
         "max_heel_lift": float(tilt.heel_lift.max()),
         "max_toe_lift": float(tilt.toe_lift.max()),
@@ -427,29 +549,77 @@ def scuff_notes(sim: Simulation, period: float, figures: dict, steps: int) -> li
     return []
 
 
-def walk_failures(figures: dict, steps: int) -> list[str]:
-    """Why the walk of ``walk_figures`` is not a walk of ``steps`` steps (empty: it is)."""
-    failures = []
-    if figures["steps"] < steps:
-        failures.append(f"{figures['steps']} of {steps} steps within the limits")
+def walk_findings(figures: dict, steps: int) -> list[tuple[str, str]]:
+    """Why the walk of ``walk_figures`` is not a walk of ``steps`` steps, as (cause, words)
+    pairs, the cause among ``CAUSES``, each tolerance on its physical scale (empty: it is)."""
+    found = []
     if figures["fell"]:
-        failures.append("fell")
+        found.append(
+            (
+                "fell",
+                f"fell (the hip below {HIP_DROP:.0%} of its lowest in the gait, or the trunk "
+                f"beyond {np.degrees(TRUNK_LIMIT):.0f}°)",
+            )
+        )
+    if figures["stalled"]:
+        found.append(
+            (
+                "did not advance",
+                "a step did not land, or landed having carried the hip less than "
+                f"{STEP_ADVANCE:g} of the step length",
+            )
+        )
     if not figures["max_slip"] < MAX_SLIP:
-        failures.append(
-            f"stance foot slipped {figures['max_slip'] * 1e3:.3g} mm "
-            f"(allowed < {MAX_SLIP * 1e3:g} mm)"
+        step = figures["step_length"]
+        found.append(
+            (
+                "slipped",
+                f"stance foot slipped {figures['max_slip'] * 1e3:.3g} mm, "
+                f"{100 * figures['max_slip_share']:.2g} % of the {step:.3g} m step "
+                f"(allowed < {MAX_SLIP * 1e3:g} mm, {100 * MAX_SLIP / step:.2g} %)",
+            )
         )
     if not figures["max_foot_tilt"] < MAX_FOOT_TILT:
-        failures.append(
-            f"stance foot tilted {figures['max_foot_tilt']:.3g} rad "
-            f"(allowed < {MAX_FOOT_TILT:g} rad)"
+        sole = figures["sole_length"]
+        lifted = max(figures["max_heel_lift"], figures["max_toe_lift"])
+        end = "heel" if figures["max_heel_lift"] >= figures["max_toe_lift"] else "toe"
+        found.append(
+            (
+                "tilted",
+                f"stance foot tilted {figures['max_foot_tilt']:.3g} rad, its {end} "
+                f"{lifted * 1e3:.3g} mm off the floor (allowed < {MAX_FOOT_TILT:g} rad: "
+                f"{MAX_FOOT_TILT * sole * 1e3:.2g} mm at the far end of the "
+                f"{sole * 100:.3g} cm sole)",
+            )
         )
     if figures["scuff_steps"] != 0:
         scuffed = figures["scuff_steps"]
-        failures.append(f"swing foot scuffed the floor in {scuffed} step{'s' * (scuffed != 1)}")
+        found.append(
+            (
+                "scuffed",
+                f"swing foot scuffed the floor in {scuffed} step{'s' * (scuffed != 1)} "
+                f"({figures['scuff_duration'] * 1e3:.3g} ms in all, "
+                f"{figures['scuff_depth'] * 1e3:.2g} mm deep; allowed none)",
+            )
+        )
     if figures["warnings"] != 0:
-        failures.append(f"{figures['warnings']} MuJoCo warnings")
-    return failures
+        found.append(("MuJoCo warning", f"{figures['warnings']} MuJoCo warnings"))
+    if figures["steps"] < steps:  # first: the count, then why the steps stopped counting
+        why = found[0][0] if found else "did not advance"
+        found.insert(0, (why, f"{figures['steps']} of {steps} steps within the limits"))
+    return found
+
+
+def walk_failures(figures: dict, steps: int) -> list[str]:
+    """Why the walk of ``walk_figures`` is not a walk of ``steps`` steps, in words (empty:
+    it is)."""
+    return [words for _, words in walk_findings(figures, steps)]
+
+
+def walk_causes(figures: dict, steps: int) -> list[str]:
+    """The causes (``CAUSES``, in that order) of ``walk_findings``: empty for a walk."""
+    found = {cause for cause, _ in walk_findings(figures, steps)}
+    return [cause for cause in CAUSES if cause in found]
 
 
 def walks(figures: dict, steps: int) -> bool:
@@ -480,16 +650,19 @@ def check_forward(walker: Walker, steps: int, energy: float):
         "steps",
         "fell",
         "max_slip",
+        "max_slip_share",
         "max_foot_tilt",
         "scuff_steps",
         "swing_clearance",
         "step_advance_range",
         "feedback_share",
         "zmp_rms_error",
+        "energy_ratio",
         "warnings",
         "real_time_factor",
     )
-    check = Check("forward", not failures, figures, notes, shown=shown)
+    causes = walk_causes(figures, steps)
+    check = Check("forward", not failures, figures, notes, shown=shown, causes=causes)
     return check, sim, reaction
 
 
@@ -502,12 +675,14 @@ def check_gains(walker: Walker, steps: int, energy: float, forward: Check) -> Ch
     """The walk at kp × ``GAIN_SCALES`` beside the default's."""
     results = {1.0: walks(forward.figures, steps)}
     clearances = {1.0: forward.figures["swing_clearance"]}
+    found = set(walk_causes(forward.figures, steps))
     notes = []
     for scale in GAIN_SCALES:
         sim = walker.walk(steps, WalkSettings(kp_scale=scale))
         figures = walk_figures(walker.biped, walker.samples, sim, energy)
         results[scale] = walks(figures, steps)
         clearances[scale] = figures["swing_clearance"]
+        found |= set(walk_causes(figures, steps))
         notes += [
             f"kp × {scale:g}: {note}" for note in scuff_notes(sim, walker.period, figures, steps)
         ]
@@ -528,4 +703,5 @@ def check_gains(walker: Walker, steps: int, energy: float, forward: Check) -> Ch
     passed = len(walked) == len(scales)
     if not passed:
         notes.insert(0, "walks at kp × " + (", ".join(f"{s:g}" for s in walked) or "none"))
-    return Check("gains", passed, figures, notes)
+    causes = [] if passed else [cause for cause in CAUSES if cause in found]
+    return Check("gains", passed, figures, notes, causes=causes)

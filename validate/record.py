@@ -324,7 +324,8 @@ def summary(biped: Biped, step: GaitSamples, sim: Simulation, checks, gait: Gait
     if checks:
         lines += ["", "## Checks", ""]
         for check in checks:
-            lines += [f"### {check.name}: {'PASS' if check.passed else 'FAIL'}", ""]
+            said = f" ({', '.join(check.causes)})" if check.causes else ""
+            lines += [f"### {check.name}: {'PASS' if check.passed else 'FAIL'}{said}", ""]
             lines += ["| figure | value |", "|---|---|"]
             lines += [f"| {name} | {_value(value)} |" for name, value in check.figures.items()]
             lines += [""] + [f"- {note}" for note in check.notes] + [""] * bool(check.notes)

@@ -9,7 +9,11 @@ of a joint is the share of its torque its servo had to add:
 
     share_i = rms(u_fb,i) / rms(u_ff,i + u_fb,i)        over the step, less its ends
 
-0.2 for a torque 20 % too small or too large, 1 for a joint without its torque. The exact
+0.2 for a torque 20 % too small or too large, 1 for a joint without its torque. The
+feedforward check (``validate.checks.check_feedforward``) reports it and judges each servo's
+RMS torque against the robot's torque scale instead (the largest RMS torque of its joints,
+``SERVO_SHARE``): a joint that carries little torque (a swing ankle's 0.05-0.2 N·m) has a
+large share of little servo torque, which changes nothing the robot does. The exact
 torques leave what the simulator's own physics adds: the servos are stiff against the links
 but not against the whole robot leaning on its stance foot (gravity's 600 N·m/rad about the
 ankle), and the soles are stiff springs, not a rigid floor. What they add falls with the

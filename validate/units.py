@@ -24,11 +24,15 @@ class WalkFigures:
 
     # the leading steps that land and advance the hip, the stance foot still and flat
     steps: int = unit_field(PURE)
-    fell: bool  # a step not landed, the hip too low or the trunk tilted, or shuffling
+    fell: bool  # the hip too low or the trunk tilted (``validate.checks.HIP_DROP``, ...)
+    stalled: bool  # a step not landed, the robot up, or landed without advancing the hip
+    step_length: float = unit_field("m")  # the gait's, the scale of the slip and the advance
     max_slip: float = unit_field("m")  # stance foot's travel in its stance, landing settled
+    max_slip_share: float = unit_field("S")  # that over the step length
     step_duration_range: list = unit_field(PERIOD)  # of the steps walked
     step_advance_range: list = unit_field("S")  # the hip's advance in each of them
     max_landing_slide: float = unit_field("m")  # the stance foot's in the landing windows
+    sole_length: float = unit_field("m")  # the robot's, the scale of the tilt
     max_foot_tilt: float = unit_field("rad")  # of the stance foot
     max_heel_lift: float = unit_field("m")  # of the stance sole's heel
     max_toe_lift: float = unit_field("m")  # and toe
@@ -47,6 +51,7 @@ class WalkFigures:
     landing_feedback_rms: float = unit_field("N·m")  # the servos' in the landing windows
     energy_per_step: float = unit_field("J")  # ∫ Σ |Γ θ̇| dt of MuJoCo's torques a step
     analytic_energy_per_step: float = unit_field("J")  # the gait's
+    energy_ratio: float = unit_field(PURE)  # MuJoCo's energy per step over the gait's
     warnings: int = unit_field(PURE)  # MuJoCo's
     distance: float = unit_field("m")  # the hip's travel
     seconds_simulated: float = unit_field("s")
@@ -127,6 +132,9 @@ FIGURE_UNITS = {
         "landing_speed": "m/s",
     },
     "feedforward": {
+        "max_feedback_ratio": PURE,  # a servo's RMS torque over the robot's torque scale
+        "torque_scale": "N·m",  # the largest RMS torque of the joints over the step
+        **{f"feedback_ratio_{joint}": PURE for joint in JOINTS},
         "max_feedback_share": PURE,
         **{f"feedback_share_{joint}": PURE for joint in JOINTS},
         **{f"feedback_rms_{joint}": "N·m" for joint in JOINTS},

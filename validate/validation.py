@@ -4,8 +4,9 @@
 ``validate.contact``) and the orbit check of ``validate.orbit``, and returns them, with the
 gait and what the recording and the video draw, as one ``Validation``
 (``validate.record.record`` and ``validate.video.write_video`` take it whole); ``as_json``
-gives the report: one object per check with its ``passed`` and ``notes`` (``Check.line``
-prints one line per check).
+gives the report: one object per check with its ``passed``, ``notes`` and ``causes`` (why it
+fails, in words of ``validate.checks.CAUSES``; ``Check.line`` prints one line per check,
+its causes first).
 """
 
 from __future__ import annotations
@@ -74,7 +75,8 @@ def validate(
 
 
 def as_json(checks) -> dict:
-    """One object per check (its figures, ``passed`` and ``notes``), and ``passed``."""
+    """One object per check (its figures, ``passed``, ``notes`` and ``causes``), and
+    ``passed``."""
 
     def clean(value):  # JSON has no NaN: a figure that could not be measured is null
         if isinstance(value, (np.bool_, bool)):
@@ -93,6 +95,7 @@ def as_json(checks) -> dict:
             **{k: clean(v) for k, v in check.figures.items()},
             "passed": bool(check.passed),
             "notes": list(check.notes),
+            "causes": list(check.causes),  # why it fails, among validate.checks.CAUSES
         }
     content["passed"] = all(check.passed for check in checks)
     return content
