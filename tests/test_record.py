@@ -147,13 +147,14 @@ def test_ground_reaction_arrow_stands_in_the_stance_foot(recorded):
 
 def test_summary_states_the_gait_and_every_verdict(recorded):
     """The summary names the knee, the speed, the criteria and each check with its verdict
-    and, when it fails, its causes."""
+    and, when it fails, its causes; the torques over one step are the page's, not its."""
     result, chunks, _ = recorded
     text = column(chunks, "/summary", "TextDocument:text")[0][0][0]
     assert "rolling" in text and "0.300" in text and "sthenic" in text
     for check in result.checks:
         said = f" ({', '.join(check.causes)})" if check.causes else ""
         assert f"### {check.name}: {'PASS' if check.passed else 'FAIL'}{said}\n" in text
+    assert "| gait_torque_rms |" in text and "_profile |" not in text
 
 
 def test_torque_range_follows_the_gait_not_the_landings():

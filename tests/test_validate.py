@@ -246,7 +246,7 @@ def test_model_errors_are_fail_lines(gait_path, tmp_path, capsys):
 
 def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
     """Each check is an object with ``passed``, ``notes`` and ``causes`` (none when it passes,
-    else words of ``CAUSES``); every number has its unit."""
+    else words of ``CAUSES``); every number has its unit, the per-joint torques too."""
     from biped.model.units import missing
     from validate.checks import CAUSES
 
@@ -257,6 +257,9 @@ def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
         causes = content[name]["causes"]  # why it fails, in the fixed words; none if it passes
         assert set(causes) <= set(CAUSES) and bool(causes) is not content[name]["passed"]
     assert missing(content, content["units"]) == []
+    forward = content["forward"]
+    for name in ("gait_torque_rms", "mujoco_torque_rms", "rotor_torque_rms", "servo_torque_rms"):
+        assert len(forward[name]) == 6 and content["units"][f"forward.{name}"] == "N·m"
     assert content["units"]["forward.max_slip_share"] == "S"
 
 

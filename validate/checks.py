@@ -29,7 +29,8 @@ forward           the file walked in MuJoCo with contact (``validate.simulate``)
                   floor: "tilted"), no scuff of the swing foot before its landing window
                   ("scuffed"), no MuJoCo warning ("MuJoCo warning"); ground reaction, centre
                   of pressure, velocity jump at touchdown, feedback, energy, clearance, the
-                  rolling-knee equality reported beside the gait's
+                  rolling-knee equality, and per joint the torques (the gait's, MuJoCo's, the
+                  servos') over the step reported beside the gait's
 gains             the same walk at kp × ``GAIN_SCALES``: the range of gains it walks over
                   (the causes of the walks that fail)
 
@@ -64,7 +65,7 @@ from validate.model import ModelError, model_problems
 from validate.replay import replay_model, replay_step
 from validate.samples import GaitSamples
 from validate.simulate import KP, Simulation, Walker, WalkSettings, reference_along
-from validate.units import FIGURE_UNITS, WalkFigures
+from validate.units import FIGURE_UNITS, PROFILES, WalkFigures
 
 # Agreement of two exact rigid-body models of one robot, in each figure's unit (N·m, N, m,
 # m/s, rad/s, N·s): a millionth of the torques (1-10 N·m), of the weight (687 N) and of the
@@ -106,6 +107,8 @@ JUMP_WINDOW = 0.02
 SCUFF_MARGIN = 1e-3
 # Scales of the servos' stiffness KP (the damping stays) of the gains check.
 GAIN_SCALES = (0.5, 2.0)
+# Points of the forward check's torque profiles over one step (``walk_figures``).
+PROFILE_POINTS = 50
 # Why a check fails, in words: every failing check names its causes among these (``Check``).
 CAUSES = (
     "fell",  # the hip dropped or the trunk tipped over
@@ -149,7 +152,9 @@ class Check:
         """PASS or FAIL, the name, the causes first, the figures shown with units, notes."""
         names = self.figures if self.shown is None else self.shown
         values = ", ".join(
-            f"{k} {_fmt(self.figures[k])}{_unit(self.name, k)}" for k in names if k in self.figures
+            f"{k} {_fmt(self.figures[k])}{_unit(self.name, k)}"
+            for k in names
+            if k in self.figures and k not in PROFILES
         )
         causes = f"[{', '.join(self.causes)}] " if self.causes else ""
         text = f"{'PASS' if self.passed else 'FAIL'}  {self.name:17} {causes}{values}".rstrip()
@@ -514,6 +519,59 @@ def _tracking_figures(biped, samples, sim: Simulation, reaction, walked: int, re
         "feedback_share": float(np.sqrt(fb_square / max(ff_square + fb_square, 1e-12))),
         "landing_feedback_rms": _rms(feedback[~steady]),
         "energy_per_step": float(np.trapezoid(power, sim.time[:end]) / max(walked, 1)),
+        **_joint_figures(biped, samples, sim, end, steady, torques_ref[:end]),
+    }
+
+
+def _paper_joints(sim: Simulation, radii, torques: np.ndarray) -> np.ndarray:
+    """(N, 6) torques of ``JOINT_ORDER`` in the paper's joint order (Γ1..Γ6: stance ankle to
+    swing ankle), by the stance side of each row."""
+    out = np.empty_like(torques)
+    stance = sim.stance_of()[: len(torques)]
+    for side in SIDES:
+        rows = stance == side
+        out[rows] = torques[rows][:, mapping(sim.model, side, radii).columns]
+    return out
+
+
+def _joint_figures(biped, samples, sim: Simulation, end: int, steady, reference) -> dict:
+    """``walk_figures`` per joint (the paper's order, ``JOINTS``) over the steps walked: the
+    RMS of the gait's torque at the phase followed, of MuJoCo's (its motors and servos), of
+    the rotors' part (the motors less the gait's Γ: MuJoCo's armature, which the paper's
+    robot lacks) and of the servos' part, the landings (``LANDING``) left out; and the
+    profiles of the four over one step (the mean over the steps walked, landings in, at
+    ``PROFILE_POINTS`` phases)."""
+    servo = _paper_joints(sim, biped.radii, sim.feedback()[:end])
+    motors = _paper_joints(sim, biped.radii, sim.feedforward()[:end])
+    total = motors + servo
+    rotor = motors - reference  # what the motors add to the gait's Γ: J_r θ̈ of the rotors
+    phase = np.clip(sim.phase[:end] / samples.period, 0.0, 1.0)
+    where = np.minimum((phase * PROFILE_POINTS).astype(int), PROFILE_POINTS - 1)
+    centres = (np.arange(PROFILE_POINTS) + 0.5) / PROFILE_POINTS
+
+    def profile(values):  # (PROFILE_POINTS, 6), NaN where no state of the walk fell
+        out = np.full((PROFILE_POINTS, values.shape[1]), np.nan)
+        for k in range(PROFILE_POINTS):
+            if np.any(where == k):
+                out[k] = values[where == k].mean(axis=0)
+        return out.tolist()
+
+    def rms(values):
+        if not steady.any():  # no steady state walked: not measured
+            return [float("nan")] * values.shape[1]
+        return np.sqrt(np.mean(values[steady] ** 2, axis=0)).tolist()
+
+    return {
+        "gait_torque_rms": rms(reference),
+        "mujoco_torque_rms": rms(total),
+        "rotor_torque_rms": rms(rotor),
+        "servo_torque_rms": rms(servo),
+        "landing_window": LANDING,
+        "profile_phase": centres.tolist(),
+        "gait_torque_profile": samples.at("torques", centres * samples.period).tolist(),
+        "mujoco_torque_profile": profile(total),
+        "rotor_torque_profile": profile(rotor),
+        "servo_torque_profile": profile(servo),
     }
 
 

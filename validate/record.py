@@ -63,6 +63,7 @@ from validate.mapping import mapping
 from validate.mjcf import HIP_OFFSET, SIDES
 from validate.samples import GaitSamples
 from validate.simulate import Simulation, reference_along
+from validate.units import PROFILES
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
 APPLICATION = "biped_validation"
@@ -327,7 +328,11 @@ def summary(biped: Biped, step: GaitSamples, sim: Simulation, checks, gait: Gait
             said = f" ({', '.join(check.causes)})" if check.causes else ""
             lines += [f"### {check.name}: {'PASS' if check.passed else 'FAIL'}{said}", ""]
             lines += ["| figure | value |", "|---|---|"]
-            lines += [f"| {name} | {_value(value)} |" for name, value in check.figures.items()]
+            lines += [
+                f"| {name} | {_value(value)} |"
+                for name, value in check.figures.items()
+                if name not in PROFILES  # the torques over one step: the page draws them
+            ]
             lines += [""] + [f"- {note}" for note in check.notes] + [""] * bool(check.notes)
     return "\n".join(lines)
 

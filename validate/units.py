@@ -52,6 +52,22 @@ class WalkFigures:
     energy_per_step: float = unit_field("J")  # ∫ Σ |Γ θ̇| dt of MuJoCo's torques a step
     analytic_energy_per_step: float = unit_field("J")  # the gait's
     energy_ratio: float = unit_field(PURE)  # MuJoCo's energy per step over the gait's
+    # Per joint, the paper's order (``biped.model.dynamics.JOINTS``: stance ankle, knee, hip,
+    # swing hip, knee, ankle), the steps walked, steady: RMS of the gait's torque at the phase
+    # followed, of MuJoCo's (motors and servos), of the rotors' part (the motors less the
+    # gait's Γ) and of the servos' part.
+    gait_torque_rms: list = unit_field("N·m")
+    mujoco_torque_rms: list = unit_field("N·m")
+    rotor_torque_rms: list = unit_field("N·m")
+    servo_torque_rms: list = unit_field("N·m")
+    landing_window: float = unit_field(PERIOD)  # after each touchdown, out of the RMS
+    # The same over one step (the mean over the steps walked, landings in), at the phases
+    # ``profile_phase``: (``validate.checks.PROFILE_POINTS``, 6) each.
+    profile_phase: list = unit_field(PERIOD)
+    gait_torque_profile: list = unit_field("N·m")
+    mujoco_torque_profile: list = unit_field("N·m")
+    rotor_torque_profile: list = unit_field("N·m")
+    servo_torque_profile: list = unit_field("N·m")
     warnings: int = unit_field(PURE)  # MuJoCo's
     distance: float = unit_field("m")  # the hip's travel
     seconds_simulated: float = unit_field("s")
@@ -62,6 +78,15 @@ class WalkFigures:
         values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         return {name: value for name, value in values.items() if value is not None}
 
+
+# The figures of a walk over one step (``WalkFigures``): arrays a page draws, not a table's.
+PROFILES = (
+    "profile_phase",
+    "gait_torque_profile",
+    "mujoco_torque_profile",
+    "rotor_torque_profile",
+    "servo_torque_profile",
+)
 
 # Units of the section's coordinates (``validate.orbit.COORDINATES``): six angles, six rates.
 SECTION_UNITS = ["rad"] * 6 + ["rad/s"] * 6
