@@ -8,6 +8,7 @@ import pytest
 
 from biped import Robot
 from biped.model.criteria import CONSTRAINTS
+from biped.model.dynamics import JOINTS
 from biped.model.gait import PARAMETERS
 from biped.records import gait_file
 from biped.records.gait_file import Gait
@@ -294,3 +295,102 @@ def test_a_designed_knees_page_states_its_radii_and_what_it_was_compared_with(tm
     gains = gait.design["gains_percent"]
     assert f"- optimal radii vs revolute: {gains['design_vs_revolute']:+.2f} %" in text
     assert f"- Table 1 radii vs revolute: {gains['table1_vs_revolute']:+.2f} %" in text
+
+
+@pytest.fixture(scope="module")
+def walked_page(tmp_path_factory):
+    """The validation report of the optimal rolling gait at 0.3 m/s (its replay and its
+    forward walk, as ``biped validate`` writes them) and its page's Markdown and figures."""
+    from biped.pages.page import Page, markdown, page_figures
+    from tests.conftest import gait_of, optimal_gait
+    from validate import checks
+    from validate.model import model_spec
+    from validate.samples import GaitSamples
+    from validate.simulate import Walker
+    from validate.units import report_units
+    from validate.validation import as_json
+
+    gait = gait_of(optimal_gait("rolling"))
+    spec = model_spec(gait.biped)
+    replay = checks.check_feedforward(spec, gait.biped, GaitSamples.from_gait(gait))
+    forward, _, _ = checks.check_forward(Walker(gait, spec), 10, gait.costs.energy)
+    report = as_json([replay, forward])
+    report["units"] = report_units(report)
+    path = tmp_path_factory.mktemp("walked") / f"{NAME}.json"
+    page = Page(NAME, path, gait, report)
+    return report, markdown(page, path.parent), page_figures(page)
+
+
+def test_page_shows_mujocos_walk_beside_the_models(walked_page):
+    """The page's table gives per joint the model's RMS torque, MuJoCo's, its rotors' and
+    servos' parts and the replay's servo against the torque scale, then the energy per step
+    of both and their ratio, the ground force's error over the weight; the figures in it are
+    the report's. MuJoCo's walk follows the model: the hips' torques over the step correlate
+    with the model's (above 0.95) and not with the other leg's."""
+    from biped.pages.figures import joint_label
+
+    report, text, _ = walked_page
+    forward, replay = report["forward"], report["feedforward"]
+    assert "### MuJoCo's walk beside the model's" in text
+    for j, joint in enumerate(JOINTS):
+        cells = [f"{forward[name][j]:.3g}" for name in ("gait_torque_rms", "mujoco_torque_rms")]
+        assert f"| {joint_label(j, joint)} | {' | '.join(cells)} |" in text, joint
+        assert f"| {replay[f'feedback_ratio_{joint}']:.2g} |\n" in text
+    ratio = forward["energy_per_step"] / forward["analytic_energy_per_step"]
+    assert forward["energy_ratio"] == pytest.approx(ratio)
+    assert (
+        f"| {forward['analytic_energy_per_step']:.3g} | {forward['energy_per_step']:.3g} | "
+        f"{ratio:.3g} | J |" in text
+    )
+    assert f"| {forward['ground_force_rms_error']:.3g} | | weight |" in text
+    phase = np.array(forward["profile_phase"])
+    after = phase >= forward["landing_window"]
+    model = np.array(forward["gait_torque_profile"])[after]
+    mujoco = np.array(forward["mujoco_torque_profile"])[after]
+    for hip, other in ((2, 3), (3, 2)):  # stance hip, swing hip
+        assert np.corrcoef(model[:, hip], mujoco[:, hip])[0, 1] > 0.95
+        assert np.corrcoef(model[:, hip], mujoco[:, other])[0, 1] < 0.5
+
+
+def test_page_draws_mujocos_torques_beside_the_models(walked_page, tmp_path):
+    """walk_torques.png: one panel per joint, titled Γ1..Γ6 with torque in N·m over t/T,
+    the model's curve and MuJoCo's, its rotors' and servos' parts (with ink when written)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+
+    from biped.pages.walk_figures import TORQUES_FIGURE
+
+    report, text, figures = walked_page
+    assert f"({NAME}/{TORQUES_FIGURE})" in text
+    figure = figures[TORQUES_FIGURE]
+    panels = [ax for ax in figure.axes if ax.get_title()]
+    assert [ax.get_title() for ax in panels] == [
+        f"Γ{j + 1} {joint.replace('_', ' ')}" for j, joint in enumerate(JOINTS)
+    ]
+    for ax in panels:
+        assert ax.get_ylabel() == "torque [N·m]" and ax.get_xlabel() == "normalised time t/T"
+        assert len(ax.get_lines()) >= 5  # zero, model, MuJoCo, rotors, servos
+    FigureCanvasAgg(figure).draw()
+    figure.savefig(tmp_path / TORQUES_FIGURE, dpi=60)
+    assert np.asarray(Image.open(tmp_path / TORQUES_FIGURE).convert("RGB")).std() > 20
+
+
+def test_a_walk_not_measured_is_unknown_on_the_page():
+    """A per-joint figure the walk could not measure (null in the report) is n/a on the page,
+    never 0; a report without the walk's per-joint figures has no such section."""
+    from biped.pages.walk_figures import walk_lines
+
+    forward = {
+        "steps": 0,
+        "gait_torque_rms": [None] * 6,
+        "mujoco_torque_rms": [None] * 6,
+        "rotor_torque_rms": [None] * 6,
+        "servo_torque_rms": [None] * 6,
+        "energy_per_step": None,
+        "analytic_energy_per_step": 1.5,
+        "energy_ratio": None,
+    }
+    text = "\n".join(walk_lines({"forward": forward}))
+    assert "| Γ1 stance ankle | n/a | n/a | n/a | n/a | n/a | n/a | n/a |" in text
+    assert "| 1.5 | n/a | n/a | J |" in text and "| 0 |" not in text
+    assert walk_lines({"forward": {"steps": 3}}) == []

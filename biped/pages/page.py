@@ -5,13 +5,17 @@
     <out>/<name>/angles.png          absolute angles [°], one panel per body
     <out>/<name>/ground.png          |Fx| / Fz against the model's friction, Fz, the ZMP
     <out>/<name>/constraints.png     Ψ1..Ψ7 over the step, the tightest sample of each marked
+    <out>/<name>/orbit.png           the validation's Floquet multipliers (with a report)
+    <out>/<name>/walk_torques.png    MuJoCo's joint torques over one step beside the model's
+                                     (with a report: ``biped.pages.walk_figures``)
 
 The page gives the gait's parameters by name with their units, its criteria, the tightest
 margin of each constraint (which sample of the step, and how far above the solver's margin δ),
 where a constraint dips below δ between the solver's samples (an inset on its panel), the
 jumps of the torques and ground reaction at the mid-step knot (marked on their panels), the
-ligament load each knee needs (the rolling knee's surfaces carry no tension), the verdict and
-figures of its validation in MuJoCo when a report is given, and links to the recording and the
+ligament load each knee needs (the rolling knee's surfaces carry no tension), the verdict,
+causes and figures of its validation in MuJoCo when a report is given with MuJoCo's walk beside
+the model's (torques per joint, ground force, energy per step), and links to the recording and the
 video. ``write_pages`` writes pages as a set, all or none (``biped.runtime.files.atomic_set``).
 The constraints are computed again from the gait's parameters on the grid the optimiser checks
 feasibility on (``CHECK_SAMPLES``).
@@ -49,6 +53,8 @@ from biped.pages.figures import (
     time_figure,
 )
 from biped.pages.orbit_figures import multipliers_figure
+from biped.pages.walk_figures import TORQUES_FIGURE, has_profiles, torques_figure
+from biped.pages.walk_figures import walk_lines as mujoco_walk_lines
 from biped.records.gait_file import Gait
 from biped.runtime.files import atomic_set
 
@@ -65,6 +71,18 @@ CONSTRAINT_MEANING = {
 FIGURE_NAMES = ("torques.png", "angles.png", "ground.png", "constraints.png")
 # The validation's orbit check drawn: its multipliers in the complex plane.
 ORBIT_FIGURE = "orbit.png"
+# What a check's table of figures leaves out: its verdict, notes and causes (said above and
+# below it), the torques over one step (drawn: ``TORQUES_FIGURE``).
+NOT_TABLED = (
+    "passed",
+    "notes",
+    "causes",
+    "profile_phase",
+    "gait_torque_profile",
+    "mujoco_torque_profile",
+    "rotor_torque_profile",
+    "servo_torque_profile",
+)
 # A constraint dips below δ_i where Ψ_i < δ_i (1 − DIP_TOLERANCE): IPOPT holds its
 # constraints to about 1e-9 (the gait file's optimizer.constraint_violation), a millionth of δ.
 DIP_TOLERANCE = 1e-6
@@ -770,13 +788,17 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
     if page.validation_source is not None:
         where = _relative(page.validation_source, folder)
         lines += [f"Report [`{page.validation_source}`]({where}): **{verdict}**.", ""]
+    figure = f"{page.name}/{TORQUES_FIGURE}" if has_profiles(report) else None
+    lines += mujoco_walk_lines(report, figure)
     for check, figures in report.items():
         if not isinstance(figures, dict) or "passed" not in figures:
             continue
-        lines += [f"### {check}: {'PASS' if figures['passed'] else 'FAIL'}", ""]
+        causes = figures.get("causes") or []
+        said = f" ({', '.join(causes)})" if causes else ""
+        lines += [f"### {check}: {'PASS' if figures['passed'] else 'FAIL'}{said}", ""]
         lines += ["| figure | value | unit |", "|---|---|---|"]
         for name, value in figures.items():
-            if name not in ("passed", "notes"):
+            if name not in NOT_TABLED:
                 unit = unit_text(units.get(f"{check}.{name}", ""))
                 lines += [f"| {name} | {_number(value)} | {unit} |"]
         lines += [""]
@@ -790,12 +812,15 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
 
 def page_figures(page: Page) -> dict[str, Figure]:
     """The page's figures: the gait's (``gait_figures``) and, with a validation report that
-    has an orbit check, its multipliers (``ORBIT_FIGURE``)."""
+    has an orbit check, its multipliers (``ORBIT_FIGURE``), and with one whose forward check
+    has the torques over one step, MuJoCo's beside the model's (``TORQUES_FIGURE``)."""
     figures = gait_figures(page.gait)
+    title = f"{page.gait.knee} knee, {page.gait.criterion}, {page.gait.speed:.3f} m/s"
     orbit = (page.validation or {}).get("orbit")
     if isinstance(orbit, dict):
-        title = f"{page.gait.knee} knee, {page.gait.criterion}, {page.gait.speed:.3f} m/s"
         figures[ORBIT_FIGURE] = multipliers_figure(orbit, title)
+    if has_profiles(page.validation):
+        figures[TORQUES_FIGURE] = torques_figure(page.validation["forward"], title)
     return figures
 
 
