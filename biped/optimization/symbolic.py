@@ -574,8 +574,7 @@ class StepGraph:
                 wrench[0, :], wrench[1, :], safety.friction, True
             )
         if "joint_stops" in safety.walkable:
-            theta = ca.DM(JOINT_MATRIX) @ self.rows("q")
-            theta = [theta[i, :] for i in range(6)]
+            theta = self._joint_angles()  # linear in the head: sparse rows, no curvature
             per_sample["joint_stops"] = walkable.joint_stop_margins(
                 theta, safety.joint_margin, True
             )
@@ -593,6 +592,17 @@ class StepGraph:
             constraints.append(ca.vec(stacked))  # sample-major
             self.constraint_names += [name] * stacked.numel()
         return constraints
+
+    def _joint_angles(self) -> list:
+        """The joints' angles θ (eq. 32) at the solver's samples, each a row (1, N), from the
+        head's spline coefficients (the stance foot's angle 0): the same numbers as from the
+        samples' q, linear in the head."""
+        _, (values, _, _) = spline_basis(self.samples_per_half, self.knots)
+        coefficients = ca.reshape(self.head_symbol[: self.period_index], self.period_index // 6, 6)
+        angles = ca.DM(values) @ coefficients  # (N, 6): qp2, q1, ..., q5
+        q7 = ca.horzcat(ca.SX.zeros(angles.shape[0], 1), angles)  # qp1 = 0
+        theta = (q7 @ ca.DM(JOINT_MATRIX[:, :7]).T).T  # (6, N)
+        return [theta[i, :] for i in range(6)]
 
     def _clearance_between_samples(self) -> list:
         """The swing heel's and toe's clearance (``clearance_envelope``) at every sample of
