@@ -218,8 +218,8 @@ PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
 # follows the model (``validate.margins_study``: the servos add at most a fifth of the joint
 # torque, MuJoCo spends within 5 % of the model's energy per step, every check passes).
 WALKABLE = Safety(
-    clearance=0.01,
-    zmp_margin=0.01,
+    clearance=0.005,
+    zmp_margin=0.005,
     landing_share=0.75,
     friction=0.6,
     joint_margin=0.05,
