@@ -1,5 +1,6 @@
 """``biped atlas``: where the rolling knee pays off, over speed x clearance (x a least knee bend),
-each difference with its error bar (``biped.studies.atlas``); then its CSV, figures and
+each difference with its error bar (``biped.studies.atlas``), under the walkable constraints
+or the paper's; then its CSV, figures and
 ``atlas.md`` (``biped.pages.atlas``), with the optima at the corners and at the best pay-off
 walked in MuJoCo (``validate.validation``)."""
 
@@ -37,7 +38,9 @@ knee_bends = _values("knee bends", "rad", MAX_KNEE_BEND)
 
 def cmd_atlas(args) -> int:
     """Certified optimal gaits of both knees over a grid of speed x swing-foot clearance (x a
-    least stance-knee bend), for each criterion asked; each difference between the knees,
+    least stance-knee bend), for each criterion asked, under the walkable constraints (the
+    cells' clearances and knee bends replace the preset's; --paper-constraints: the paper's
+    problem); each difference between the knees,
     (rolling − revolute) / revolute, with its uncertainty: the change on a grid of twice the
     samples, at ten times tighter tolerance and the spread of the starts; a difference
     no larger than it is not distinguishable. At the corner cells the gait is also optimized
@@ -47,6 +50,7 @@ def cmd_atlas(args) -> int:
     Run again to resume. Exits 0 when every final optimum is certified and every re-solve
     measured what it is for, 1 otherwise (a re-solve that did not converge leaves its term
     unknown: the run's last line and atlas.md say which and why)."""
+    from biped.model.criteria import PAPER_SAFETY, WALKABLE
     from biped.pages import atlas as pages
     from biped.runtime.runner import check_dask
     from biped.studies import atlas
@@ -62,10 +66,11 @@ def cmd_atlas(args) -> int:
             args.seed,
             args.starts,
             actuator_limits=args.actuator_limits,
+            safety=PAPER_SAFETY if args.paper_constraints else WALKABLE,
         )
     )
     types.claim_folder(args.out)
-    atlas.ATLAS.check(args.out, settings.to_dict())
+    atlas.check_folder(args.out, settings)
     if args.dask is not None:
         check_dask(args.dask)
     atlas.run_atlas(args.out, settings, **types.campaign(args, "atlas"))
@@ -163,6 +168,12 @@ def add_parser(commands) -> None:
     types.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
     parser.add_argument(
         "--no-walks", action="store_true", help="skip walking the chosen optima in MuJoCo"
+    )
+    parser.add_argument(
+        "--paper-constraints",
+        action="store_true",
+        help="the paper's problem (its constraints alone, the cells' clearances and knee bends "
+        "aside) instead of the walkable constraints",
     )
     parser.add_argument("--actuator-limits", action="store_true", help=types.ACTUATOR_LIMITS_HELP)
     types.add_robot(parser)

@@ -1,17 +1,20 @@
 """The atlas: the energy per metre is the energy per step over the step length; a
-difference no larger than its uncertainty is not distinguishable; a small atlas writes its
-CSV, figures and sentences from its numbers, resumes to the same files and refuses other
-settings."""
+difference no larger than its uncertainty is not distinguishable; a small atlas answers the
+walkable constraints unless asked the paper's, writes its CSV, figures and sentences from its
+numbers, resumes to the same files and refuses other settings."""
 
 import csv
+import dataclasses
 import io
+import json
 
 import numpy as np
 import pytest
 
 import biped
-from biped.model.criteria import PAPER_SAFETY
-from biped.optimization.optimize import optimize
+from biped.model.criteria import PAPER_SAFETY, WALKABLE, Safety, safety_dict
+from biped.model.kinematics import KNEES
+from biped.optimization.optimize import Report, checked, optimize
 from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 from biped.pages import atlas as pages
@@ -107,6 +110,65 @@ def test_a_small_atlas_writes_its_table_figures_and_sentences(small):
         assert f"by {-best.difference.value:.2f}" in text
     else:  # named among the cells not told apart, or whose uncertainty is not measured
         assert pages._where(best) in text
+
+
+def test_the_default_atlas_answers_the_walkable_constraints(small):
+    """An atlas's margins are the walkable constraints unless told otherwise: its record holds
+    them, its plan line says so, and each final optimum obeys them with its cell's clearance
+    (its variables checked again under a problem made here), as its gait file records."""
+    folder, settings, log = small
+    assert settings.safety == WALKABLE
+    record = json.loads((folder / atlas.MANIFEST).read_text())
+    assert record["safety"] == safety_dict(WALKABLE, kept=("knee_bend",))
+    assert atlas.load(folder).safety == WALKABLE
+    assert log.startswith(
+        "atlas under the walkable constraints: ZMP 0.01 m inside the sole, landing at 0.75 V "
+        "at most, friction 0.6, joints 0.05 rad from their stops, hip at 0.2 V at least: "
+    )
+    for cell in settings.cells():
+        safety = dataclasses.replace(WALKABLE, clearance=cell.clearance)
+        for knee in KNEES:
+            point = atlas.Point("final", knee, "sthenic", cell)
+            content = atlas.read(folder, point)
+            problem = GaitProblem(biped.Biped(ROBOT, knee), cell.speed, "sthenic", safety)
+            optimum = checked(
+                problem, np.array(content["variables"]), Report.from_dict(content["report"])
+            )
+            assert optimum.feasible and content["certified"]
+            assert set(optimum.evaluation.walkable) == set(WALKABLE.walkable)
+            assert min(m.min() for m in optimum.evaluation.walkable.values()) >= 0.0
+            assert Gait.read(folder / point.gait_filename()).safety == safety
+
+
+def test_the_paper_constraints_give_the_atlas_of_before(tmp_path, capsys):
+    """With the paper's margins an atlas's record is the one made before the margins existed
+    (no such field); a record without it reads as the paper's and resumes, and a run with
+    other margins is refused in one line naming both, by the command line with exit 2."""
+    from biped_cli import main
+
+    paper = atlas.Settings(
+        ROBOT, (0.3,), (0.0,), (0.0,), ("sthenic",), 1, 0, 1, safety=PAPER_SAFETY
+    )
+    content = paper.to_dict()
+    before = ["format", "robot", "speeds", "clearances", "knee_bends", "criteria", "knots"]
+    before += ["seed", "starts", "method", "version", "casadi", "optima_table"]
+    assert list(content) == before
+    assert atlas.Settings.from_dict(content).safety == PAPER_SAFETY
+    assert paper.constraints_words() == "the paper's constraints"
+    point = atlas.Point("final", "rolling", "sthenic", Cell(0.3, 0.02, 0.1))
+    assert paper.problem(point).safety == Safety(clearance=0.02, knee_bend=0.1)
+    (tmp_path / atlas.MANIFEST).write_text(json.dumps(content))
+    assert atlas.check_folder(tmp_path, paper)
+    walkable = dataclasses.replace(paper, safety=WALKABLE)
+    with pytest.raises(
+        biped.BipedError, match="this folder's atlas answers the paper's constraints"
+    ):
+        atlas.check_folder(tmp_path, walkable)
+    argv = ["atlas", "--speeds", "0.3", "--clearances", "0", "--criteria", "sthenic"]
+    assert main([*argv, "--starts", "1", "--out", str(tmp_path)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert "answers the paper's constraints, this run asks the walkable constraints: ZMP" in line
+    assert "run with --paper-constraints or choose another --out folder" in line
 
 
 def test_a_resumed_atlas_runs_nothing_and_other_settings_are_refused(small):

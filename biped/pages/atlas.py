@@ -5,7 +5,7 @@ The figure of a criterion: on the left the map of the difference between the kne
 x clearance (one panel per knee bend), blue where the rolling knee needs less, hatched where
 the difference is not larger than its uncertainty, a cross where a knee has no certified
 optimum; on the right the differences against speed, one curve per clearance, with their
-error bars.
+error bars. Its title and ``atlas.md`` say which problem the atlas answers.
 """
 
 from __future__ import annotations
@@ -184,6 +184,7 @@ def figure(settings: Settings, table: list[Row], criterion: str):
     fig.suptitle(
         f"{FIGURE_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: "
         "(rolling − revolute) / revolute knee\n"
+        f"under {settings.constraints_words()}\n"
         "blue: the rolling knee needs less; hatched: not distinguishable (±?: uncertainty not "
         "measured); x: no certified optimum of both knees",
         fontsize=10,
@@ -329,7 +330,8 @@ def sentences(settings: Settings, table: list[Row], walks=None) -> str:
     clearances = [100 * c for c in settings.clearances]
     bends = settings.knee_bends
     lines.append(
-        f"Optimal gaits of both knees (Table 1 robot unless the record says otherwise) over "
+        f"Optimal gaits of both knees (Table 1 robot unless the record says otherwise) under "
+        f"{settings.constraints_words()}, over "
         f"{_count(len(settings.speeds), 'speed')} ({_span(settings.speeds, 'm/s')}), "
         f"{_count(len(clearances), 'swing-foot clearance')} ({_span(clearances, 'cm')}) and "
         + ("a least stance-knee bend" if len(bends) == 1 else "least stance-knee bends")

@@ -36,7 +36,14 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
-from biped.model.criteria import ALL_CRITERIA, CRITERION_UNITS, WORK_CRITERIA, Safety
+from biped.model.criteria import (
+    ALL_CRITERIA,
+    CRITERION_UNITS,
+    PAPER_SAFETY,
+    WALKABLE,
+    WORK_CRITERIA,
+    Safety,
+)
 from biped.model.dynamics import Biped
 from biped.model.gait import check_knots
 from biped.model.kinematics import KNEES
@@ -54,7 +61,12 @@ from biped.optimization.optimize import (
     refine,
     single_start_note,
 )
-from biped.optimization.problem import GaitProblem, check_criterion, check_speed
+from biped.optimization.problem import (
+    GaitProblem,
+    check_criterion,
+    check_speed,
+    walkable_description,
+)
 from biped.records import gait_file
 from biped.runtime.claims import claimed
 from biped.runtime.files import atomic_write_text, distinct_values
@@ -108,7 +120,10 @@ class Point:
 
 @dataclass(frozen=True)
 class Settings(campaign.Settings):
-    """What shapes an atlas's numbers, recorded in its folder."""
+    """What shapes an atlas's numbers, recorded in its folder. ``safety``: the margins of every
+    cell, whose own clearance and knee bend replace the base's (``problem``): by default the
+    walkable constraints (``WALKABLE``); the paper's problem (``PAPER_SAFETY``) is recorded as
+    an atlas made before them was, without the field."""
 
     # 2: a robot without actuators has the catalog's default set (biped-gait/3)
     FORMAT = "biped-atlas/2"
@@ -121,16 +136,19 @@ class Settings(campaign.Settings):
     seed: int
     starts: int
     actuator_limits: bool = False  # Safety.actuator_limits; recorded only when asked
+    safety: Safety = WALKABLE  # the base margins of every cell; recorded unless the paper's
 
     def to_dict(self) -> dict:
         content = super().to_dict()
         if not self.actuator_limits:  # an atlas without them records what it did before
             del content["actuator_limits"]
+        if self.safety == PAPER_SAFETY:  # the paper's problem, as an atlas made before
+            del content["safety"]
         return content
 
     @classmethod
     def from_dict(cls, content: dict):
-        return super().from_dict({"actuator_limits": False, **content})
+        return super().from_dict({"actuator_limits": False, "safety": {}, **content})
 
     def cells(self) -> list[Cell]:
         return [
@@ -142,6 +160,10 @@ class Settings(campaign.Settings):
         unless the atlas is of the paper's spline, which the richer family holds)."""
         if self.knots != 1:
             return []
+        return self.grid_corners()
+
+    def grid_corners(self) -> list[Cell]:
+        """The corners of speed x clearance, every bend."""
         return [
             Cell(s, c, b)
             for b in self.knee_bends
@@ -149,16 +171,68 @@ class Settings(campaign.Settings):
             for s in sorted({self.speeds[0], self.speeds[-1]})
         ]
 
-    def problem(self, point: Point, knots: int | None = None, samples=None) -> GaitProblem:
-        cell = point.cell
-        safety = Safety(
+    def cell_safety(self, cell: Cell) -> Safety:
+        """The margins of ``cell``: the base's, with the cell's clearance and knee bend."""
+        return dataclasses.replace(
+            self.safety,
             clearance=cell.clearance,
             knee_bend=cell.knee_bend,
-            actuator_limits=self.actuator_limits,
+            actuator_limits=self.actuator_limits or self.safety.actuator_limits,
         )
+
+    def problem(self, point: Point, knots: int | None = None, samples=None) -> GaitProblem:
+        cell = point.cell
         model = Biped(self.robot, point.knee)
         knots = self.knots if knots is None else knots
-        return GaitProblem(model, cell.speed, point.criterion, safety, samples, knots)
+        return GaitProblem(
+            model, cell.speed, point.criterion, self.cell_safety(cell), samples, knots
+        )
+
+    def constraints_words(self) -> str:
+        """Which problem the atlas answers (``constraints_words``)."""
+        asked = self.actuator_limits or self.safety.actuator_limits
+        return constraints_words(dataclasses.replace(self.safety, actuator_limits=asked))
+
+
+def constraints_words(safety: Safety) -> str:
+    """Which problem an atlas of base margins ``safety`` answers, its cells' clearances and
+    knee bends aside: "the paper's constraints", "the walkable constraints: ..."
+    (``WALKABLE``'s) or "margins of ours: ..."."""
+    base = dataclasses.replace(safety, clearance=0.0, knee_bend=0.0)
+    parts = [f"ZMP {base.zmp_margin:g} m inside the sole"] if base.zmp_margin else []
+    parts += [part for part in walkable_description(base).split(", ") if part]
+    if base.clearance_window != PAPER_SAFETY.clearance_window:
+        parts.append(f"clearance windows {base.clearance_window:g} T")
+    parts += ["the motors within their limits"] if base.actuator_limits else []
+    if not parts:
+        return "the paper's constraints"
+    walkable = dataclasses.replace(WALKABLE, clearance=0.0, knee_bend=0.0)
+    name = "the walkable constraints" if base == walkable else "margins of ours"
+    return f"{name}: {', '.join(parts)}"
+
+
+def check_folder(folder, settings: Settings) -> bool:
+    """Whether ``folder``'s atlas record holds ``settings`` (False: it has none yet, a run may
+    claim it); writes nothing.
+
+    Raises:
+        BipedError: the record is unreadable or holds other settings: other margins named
+            first, in words (an atlas made before them is the paper's problem).
+    """
+    found = ATLAS.read(folder)
+    wanted = settings.to_dict()
+    if found is not None and found.get("safety", {}) != wanted.get("safety", {}):
+        try:
+            made = constraints_words(Safety(**found.get("safety", {})))
+        except (TypeError, BipedError):
+            made = f"safety = {found.get('safety')!r}"
+        flag = "without" if settings.safety == PAPER_SAFETY else "with"
+        raise BipedError(
+            f"{Path(folder) / MANIFEST}: this folder's atlas answers {made}, this run asks "
+            f"{settings.constraints_words()}: allowed only the same margins, run {flag} "
+            "--paper-constraints or choose another --out folder"
+        )
+    return ATLAS.check(folder, wanted)
 
 
 def check_settings(settings: Settings) -> Settings:
@@ -169,10 +243,12 @@ def check_settings(settings: Settings) -> Settings:
     distinct_values(settings.speeds, "speeds", "m/s", 3, "1 mm/s")
     distinct_values(settings.clearances, "clearances", "m", 3, "1 mm")
     distinct_values(settings.knee_bends, "knee bends", "rad", 3, "1 mrad")
+    if not isinstance(settings.safety, Safety):
+        raise BipedError(f"safety = {settings.safety!r}: allowed a biped.model.criteria.Safety")
     for clearance in settings.clearances:
-        Safety(clearance=clearance)
+        dataclasses.replace(settings.safety, clearance=clearance)
     for bend in settings.knee_bends:
-        Safety(knee_bend=bend)
+        dataclasses.replace(settings.safety, knee_bend=bend)
     for criterion in settings.criteria:
         check_criterion(criterion)
     check_knots(settings.knots)
@@ -372,16 +448,17 @@ def run_atlas(folder, settings: Settings, **where) -> Settings:
     ``where``: ``jobs``, ``dask``, ``stream``, ``progress``, as ``campaign.Campaign.run``."""
     check_settings(settings)
     with claimed(folder):  # one run at a time on the folder
+        check_folder(folder, settings)
         folder = ATLAS.claim(folder, settings, *STAGES)
         tasks = stages(folder, settings)
         total = len(settings.cells()) * len(settings.criteria) * len(KNEES) * 4
         total += len(settings.corners()) * len(settings.criteria) * len(KNEES)
         remaining = sum(map(len, tasks))
         plan = (
-            f"atlas: {total} optimizations of {len(settings.cells())} cells x "
-            f"{len(settings.criteria)} criteria x 2 knees in {folder} (own starts, final, finer "
-            f"grid, tighter tolerance, {RICHER_KNOTS} knots at the corners): "
-            f"{total - remaining} already done, {remaining} to run"
+            f"atlas under {settings.constraints_words()}: {total} optimizations of "
+            f"{len(settings.cells())} cells x {len(settings.criteria)} criteria x 2 knees in "
+            f"{folder} (own starts, final, finer grid, tighter tolerance, {RICHER_KNOTS} knots "
+            f"at the corners): {total - remaining} already done, {remaining} to run"
         )
         ATLAS.run(plan, tasks, lambda: summarize(folder, settings), **where)
     return settings
