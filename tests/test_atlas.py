@@ -333,3 +333,112 @@ def test_atlas_md_says_what_each_number_compares_for_one_speed(tmp_path):
     why = lines[2][pages.COLUMNS.index("why empty")]
     assert lines[2][pages.COLUMNS.index("difference with 3 knots [%]")] == ""
     assert why.startswith("3 knots not measured") and acceptable in why
+
+
+@pytest.fixture(scope="module")
+def walked(small, tmp_path_factory):
+    """The small atlas's optima walked in MuJoCo (a copy of its folder), and the run's log."""
+    import shutil
+
+    from validate import atlas_walks
+
+    folder = tmp_path_factory.mktemp("walked") / "atlas"
+    shutil.copytree(small[0], folder)
+    log = io.StringIO()
+    atlas_walks.run_walks(folder, small[1], jobs=1, stream=log)
+    return folder, log.getvalue()
+
+
+# The checks of `biped validate`, each run at the corners and the best pay-off.
+EVERY_CHECK = ["model", "inverse_dynamics", "knee_loads", "impact"]
+EVERY_CHECK += ["feedforward", "forward", "gains", "orbit"]
+
+
+def test_every_certified_optimum_gets_a_walk_record(small, walked):
+    """Each certified final optimum has the record of its walk: every check at the corners
+    (each cell of this atlas is one), its verdict, why a check failed, the key figures with
+    their units; a gait walks when every check passes, a stable orbit among them. A second
+    run walks nothing again."""
+    from validate import atlas_walks
+
+    _, settings, _ = small
+    folder, log = walked
+    assert log.startswith("atlas walks: 4 certified optima walked in MuJoCo (20-step forward")
+    assert "0 already walked, 4 to walk" in log
+    records = sorted(p.name for p in (folder / atlas.WALKS).glob("*.json"))
+    assert len(records) == 4
+    for cell in settings.cells():
+        for knee in KNEES:
+            point = atlas.Point("final", knee, "sthenic", cell)
+            content = json.loads((folder / point.at(atlas.WALKS).filename()).read_text())
+            walk = atlas.read_walk(folder, point)
+            assert walk.every_check and list(walk.checks) == EVERY_CHECK
+            assert walk.walks == all(c["passed"] for c in walk.checks.values())
+            assert content["walks"] == walk.walks and content["gait"] == point.gait_filename()
+            assert walk.checks["orbit"]["passed"] == (walk.figures["orbit_verdict"] == "stable")
+            assert all(bool(c["cause"]) != c["passed"] for c in walk.checks.values())
+            assert 0 <= walk.figures["steps"] <= 20 and walk.figures["spectral_radius"] > 0
+            for name in ("max_slip", "feedback_share", "replay_feedback_share"):
+                assert content["units"][f"figures.{name}"] and walk.figures[name] >= 0
+            modelled = walk.figures["model_energy_per_step"]
+            assert modelled == pytest.approx(Gait.read(folder / point.gait_filename()).costs.energy)
+    counted = sum(bool(atlas.read_walk(folder, p)) for p in atlas_walks.certified(folder, settings))
+    assert counted == 4
+    again = io.StringIO()
+    atlas_walks.run_walks(folder, settings, jobs=1, stream=again)
+    assert "4 already walked, 0 to walk" in again.getvalue()
+
+
+def test_away_from_the_corners_a_gait_is_walked_and_replayed(small, tmp_path):
+    """A walk of the light kind runs the forward walk and the replay alone: no orbit."""
+    from biped.studies.campaign import Task
+    from validate import atlas_walks
+
+    folder, settings, _ = small
+    point = atlas.Point("final", "rolling", "sthenic", settings.cells()[0])
+    (tmp_path / point.gait_filename()).write_bytes((folder / point.gait_filename()).read_bytes())
+    (tmp_path / atlas.WALKS).mkdir()
+    walk = atlas_walks.WalkPoint(point, every_check=False)
+    line = atlas_walks._walk(Task(atlas_walks._walk, settings, walk, str(tmp_path)))
+    found = atlas.read_walk(tmp_path, point)
+    assert list(found.checks) == ["feedforward", "forward"] and not found.every_check
+    assert "spectral_radius" not in found.figures and "(walk, replay)" in line
+
+
+def _stage_records(folder, speeds_values: dict) -> atlas.Settings:
+    """An atlas of one clearance whose final, finer-grid and tighter records are made up:
+    {speed: (revolute, rolling)} sthenic values, None for a knee not certified."""
+    speeds = tuple(speeds_values)
+    settings = atlas.Settings(ROBOT, speeds, (0.0,), (0.0,), ("sthenic",), 1, 0, 1)
+    for cell in settings.cells():
+        values = {}
+        for knee, value in zip(KNEES, speeds_values[cell.speed], strict=True):
+            status = "converged" if value is not None else "Infeasible_Problem_Detected"
+            for stage in ("final", "fine", "tight", "richer"):
+                values[(stage, knee)] = (value or 1.0, status)
+        _write_cell(folder, cell, values)
+    return settings
+
+
+def test_the_walks_are_the_certified_optima_every_check_at_corners_and_best_payoff(tmp_path):
+    """Every certified final optimum is walked, none other; every check at the corners and
+    at the best pay-off, the forward walk and the replay elsewhere. A walk that raised is
+    recorded, measures nothing and is walked again."""
+    from validate import atlas_walks
+
+    values = {0.2: (100.0, 99.0), 0.3: (100.0, 80.0), 0.4: (100.0, None), 0.5: (100.0, 98.0)}
+    settings = _stage_records(tmp_path, values)
+    assert atlas.best_payoff(tmp_path, settings, "sthenic") == Cell(0.3, 0.0, 0.0)
+    walks = atlas_walks.walks(tmp_path, settings)
+    chosen = {(w.point.cell.speed, w.point.knee): w.every_check for w in walks}
+    expected = {(s, k): s != 0.4 for s in values for k in KNEES if (s, k) != (0.4, "rolling")}
+    assert chosen == expected
+    walk = walks[0]
+    record = atlas_walks.content(walk, None, "BipedError: no gait file")
+    path = tmp_path / walk.filename()
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(json.dumps(record))
+    found = atlas.read_walk(tmp_path, walk.point)
+    assert found.walks is None and found.causes() == "not measured: BipedError: no gait file"
+    assert not atlas_walks._done(tmp_path, walk)
+    assert atlas_walks.unmeasured(tmp_path, settings)[0].endswith("(BipedError: no gait file)")

@@ -22,6 +22,11 @@ uncertainty is not distinguishable. A re-solve that did not converge measures no
 term is unknown, never 0, and the difference not distinguishable until it is measured, with
 why (``Difference.unmeasured``). A point whose solver did not converge, or whose optimum
 is infeasible, leaves its cell empty, with why.
+
+The margins of every cell are the settings' (``Settings.safety``: the walkable constraints by
+default, the paper's on request), each cell's clearance and knee bend replacing the base's.
+After the optimizations ``validate.atlas_walks`` walks every certified final optimum in
+MuJoCo (this package never imports it); its records are read here as plain JSON (``Walk``).
 """
 
 from __future__ import annotations
@@ -616,3 +621,93 @@ def load(folder) -> Settings:
     if found is None:
         raise BipedError(f"{Path(folder) / MANIFEST}: no atlas there: run 'biped atlas'")
     return Settings.from_dict(found)
+
+
+# MuJoCo's walks of the final optima (``validate.atlas_walks``, which writes them; read here
+# as plain JSON: this package never imports the simulator): a record per certified final
+# optimum, ``walks/<knee>-<criterion>-<cell>.json``, the ``Point`` of stage ``WALKS``.
+WALKS = "walks"
+WALK_FORMAT = "biped-atlas-walk/1"
+
+
+@dataclass(frozen=True)
+class Walk:
+    """What MuJoCo's walk of one final optimum says, as its record holds it.
+
+    Attributes:
+        every_check: every check of ``biped validate`` was run (the corners, the best
+            pay-off), else the forward walk with contact and the feedforward replay.
+        checks: each check run, by name: {"passed": bool, "cause": why it failed, in one
+            note ("" if it passed), "notes": [all its notes]}.
+        figures: the key figures (steps walked, fell, slip, feedback shares, energies per
+            step, the orbit's spectral radius and verdict where checked), None where not
+            measured.
+        error: why the walk could not be measured (then it neither walks nor fails).
+        steps: the steps of the forward walk asked.
+    """
+
+    every_check: bool
+    checks: dict
+    figures: dict
+    error: str | None = None
+    steps: int | None = None
+
+    @property
+    def walks(self) -> bool | None:
+        """Every check run passes (an orbit only 'undecided' does not); None: not measured."""
+        if self.error is not None or not self.checks:
+            return None
+        return all(check["passed"] for check in self.checks.values())
+
+    def causes(self) -> str:
+        """Why the gait does not walk: each failed check with its cause ("" when it walks),
+        or why the walk was not measured."""
+        if self.error is not None:
+            return f"not measured: {self.error}"
+        return "; ".join(
+            f"{name}: {check.get('cause') or 'failed'}"
+            for name, check in self.checks.items()
+            if not check["passed"]
+        )
+
+    @classmethod
+    def from_dict(cls, content: dict) -> Walk:
+        return cls(
+            bool(content["every_check"]),
+            dict(content["checks"]),
+            dict(content["figures"]),
+            content.get("error"),
+            content.get("steps_asked"),
+        )
+
+
+def read_walk(folder, point: Point) -> Walk | None:
+    """The walk of ``point``'s final optimum in ``folder`` (any stage's point names it), None
+    if it has no readable record."""
+    path = Path(folder) / point.at(WALKS).filename()
+    try:
+        content = json.loads(path.read_text())
+        if content.get("format") != WALK_FORMAT:
+            return None
+        return Walk.from_dict(content)
+    except (OSError, ValueError, UnicodeDecodeError, AttributeError, KeyError, TypeError):
+        return None
+
+
+def best_payoff(folder, settings: Settings, criterion: str, among=None) -> Cell | None:
+    """The cell where the rolling knee needs distinguishably the least for ``criterion`` (of
+    the cells ``among``, default all), else None."""
+    found = []
+    for cell in settings.cells() if among is None else among:
+        diff, _ = difference(folder, settings, criterion, cell)
+        if diff.distinguishable and diff.value < 0:
+            found.append((diff.value, cell))
+    return min(found, key=lambda pair: pair[0])[1] if found else None
+
+
+def fully_checked(folder, settings: Settings, criterion: str) -> list[Cell]:
+    """The cells whose optima of ``criterion`` MuJoCo checks with every check: the corners of
+    speed x clearance (every knee bend) and the best pay-off."""
+    cells = settings.grid_corners()
+    best = best_payoff(folder, settings, criterion)
+    return cells + ([best] if best is not None and best not in cells else [])
