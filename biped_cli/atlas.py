@@ -1,13 +1,11 @@
 """``biped atlas``: where the rolling knee pays off, over speed x clearance (x a least knee bend),
 each difference with its error bar (``biped.studies.atlas``), under the walkable constraints
-or the paper's; then its CSV, figures and
-``atlas.md`` (``biped.pages.atlas``), with the optima at the corners and at the best pay-off
-walked in MuJoCo (``validate.validation``)."""
+or the paper's; every certified optimum walked in MuJoCo (``validate.atlas_walks``); then
+its CSV, figures and ``atlas.md`` (``biped.pages.atlas``)."""
 
 from __future__ import annotations
 
 import argparse
-import sys
 
 import numpy as np
 
@@ -40,16 +38,20 @@ def cmd_atlas(args) -> int:
     """Certified optimal gaits of both knees over a grid of speed x swing-foot clearance (x a
     least stance-knee bend), for each criterion asked, under the walkable constraints (the
     cells' clearances and knee bends replace the preset's; --paper-constraints: the paper's
-    problem); each difference between the knees,
-    (rolling − revolute) / revolute, with its uncertainty: the change on a grid of twice the
-    samples, at ten times tighter tolerance and the spread of the starts; a difference
-    no larger than it is not distinguishable. At the corner cells the gait is also optimized
-    with 3 interior knots: how the difference moves with a richer gait. Writes the optima,
-    atlas.csv, atlas-<criterion>.png and atlas.md in --out; the optima at the corners and at
-    the best pay-off are walked in MuJoCo (unless --no-walks) and atlas.md says which pass.
-    Run again to resume. Exits 0 when every final optimum is certified and every re-solve
-    measured what it is for, 1 otherwise (a re-solve that did not converge leaves its term
-    unknown: the run's last line and atlas.md say which and why)."""
+    problem); each difference between the knees, (rolling − revolute) / revolute, with its
+    uncertainty: the change on a grid of twice the samples, at ten times tighter tolerance
+    and the spread of the starts; a difference no larger than it is not distinguishable. At
+    the corner cells the gait is also optimized with 3 interior knots: how the difference
+    moves with a richer gait. Then every certified optimum is walked in MuJoCo (unless
+    --no-walks): the forward walk with contact and the feedforward replay everywhere, every
+    check of biped validate at the corners and at each criterion's best pay-off; a gait
+    walks when every check run on it passes. Writes the optima, the walks' records,
+    atlas.csv, atlas-<criterion>.png and atlas.md (the pay-off among walking gaits beside
+    the pay-off over all certified cells) in --out. Run again to resume. Exits 0 when every
+    final optimum is certified, every re-solve measured what it is for and every walk was
+    measured (a gait that does not walk is a finding, not a failure), 1 otherwise (a
+    re-solve that did not converge leaves its term unknown: the run's last line and
+    atlas.md say which and why)."""
     from biped.model.criteria import PAPER_SAFETY, WALKABLE
     from biped.pages import atlas as pages
     from biped.runtime.runner import check_dask
@@ -74,8 +76,13 @@ def cmd_atlas(args) -> int:
     if args.dask is not None:
         check_dask(args.dask)
     atlas.run_atlas(args.out, settings, **types.campaign(args, "atlas"))
-    walks = None if args.no_walks else _walks(args.out, settings)
-    for path in pages.write(args.out, walks=walks):
+    unwalked = []
+    if not args.no_walks:
+        from validate import atlas_walks
+
+        atlas_walks.run_walks(args.out, settings, **types.campaign(args, "walks"))
+        unwalked = atlas_walks.unmeasured(args.out, settings)
+    for path in pages.write(args.out, walked=not args.no_walks):
         print(f"wrote {path}")
     certified = all(
         (content := atlas.read(args.out, atlas.Point("final", k, c, cell))) is not None
@@ -84,62 +91,7 @@ def cmd_atlas(args) -> int:
         for cell in settings.cells()
         for k in ("revolute", "rolling")
     )
-    return 0 if certified and not atlas.unmeasured(args.out, settings) else 1
-
-
-def _walks(folder, settings) -> list[str]:
-    """The optima at the corners and at the best pay-off of each criterion, walked in MuJoCo
-    (``validate.validation.validate``): a line each, what passes or fails and why."""
-    from pathlib import Path
-
-    from biped.records.gait_file import Gait
-    from biped.studies import atlas
-    from validate.validation import validate
-
-    lines = []
-    for criterion in settings.criteria:
-        chosen = {cell: "corner" for cell in _corners(settings)}
-        best = _best_payoff(folder, settings, criterion)
-        if best is not None:
-            chosen[best] = "corner, best pay-off" if best in chosen else "best pay-off"
-        for cell, why in chosen.items():
-            for knee in ("revolute", "rolling"):
-                path = Path(folder) / atlas.Point("final", knee, criterion, cell).gait_filename()
-                if not path.exists():
-                    continue
-                result = validate(Gait.read(path, consistent=True))
-                failed = [
-                    f"{c.name} ({'; '.join(c.notes) or 'failed'})"
-                    for c in result.checks
-                    if not c.passed
-                ]
-                verdict = "passes every check" if not failed else "fails " + ", ".join(failed)
-                lines.append(f"{path.name} ({why}): {verdict}")
-                print(f"walked {lines[-1]}", file=sys.stderr)
-    return lines
-
-
-def _corners(settings):
-    from biped.studies.atlas import Cell
-
-    bend = settings.knee_bends[0]
-    return [
-        Cell(s, c, bend)
-        for c in sorted({settings.clearances[0], settings.clearances[-1]})
-        for s in sorted({settings.speeds[0], settings.speeds[-1]})
-    ]
-
-
-def _best_payoff(folder, settings, criterion):
-    """The cell where the rolling knee needs distinguishably the least, else None."""
-    from biped.studies.atlas import difference
-
-    found = []
-    for cell in settings.cells():
-        diff, _ = difference(folder, settings, criterion, cell)
-        if diff.distinguishable and diff.value < 0:
-            found.append((diff.value, cell))
-    return min(found, key=lambda pair: pair[0])[1] if found else None
+    return 0 if certified and not atlas.unmeasured(args.out, settings) and not unwalked else 1
 
 
 def add_parser(commands) -> None:
@@ -167,7 +119,7 @@ def add_parser(commands) -> None:
     types.add_knots(parser)
     types.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
     parser.add_argument(
-        "--no-walks", action="store_true", help="skip walking the chosen optima in MuJoCo"
+        "--no-walks", action="store_true", help="skip walking the certified optima in MuJoCo"
     )
     parser.add_argument(
         "--paper-constraints",

@@ -260,16 +260,29 @@ def test_a_re_solve_that_did_not_converge_measures_nothing(tmp_path):
     assert "NOT MEASURED" in summary and "tighter tolerance" in summary and acceptable in summary
 
 
+def _walk(passed: bool, cause: str = "") -> atlas.Walk:
+    """A made-up walk of the forward walk alone."""
+    return atlas.Walk(False, {"forward": {"passed": passed, "cause": cause, "notes": []}}, {})
+
+
 def _drawn_figure(speeds, clearances, criterion):
-    """The atlas figure of a table of made-up differences, drawn, and its renderer."""
+    """The atlas figure of a table of made-up differences, walked (the first cell's rolling
+    knee's gait does not walk), drawn, and its renderer."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     settings = atlas.Settings(ROBOT, speeds, clearances, (0.0,), (criterion,), 1, 0, 1)
     table = [
-        pages.Row(criterion, cell, Difference(-1.0 - k, 0.1, 0.0, 0.1, None, ""), None, None)
+        pages.Row(
+            criterion,
+            cell,
+            Difference(-1.0 - k, 0.1, 0.0, 0.1, None, ""),
+            None,
+            None,
+            {"revolute": _walk(True), "rolling": _walk(k > 0, "" if k else "fell")},
+        )
         for k, cell in enumerate(settings.cells())
     ]
-    figure = pages.figure(settings, table, criterion)
+    figure = pages.figure(settings, table, criterion, walked=True)
     renderer = FigureCanvasAgg(figure).get_renderer()
     figure.draw(renderer)
     return figure, renderer
@@ -279,9 +292,9 @@ def _drawn_figure(speeds, clearances, criterion):
     "speeds, clearances", [((0.2,), (0.0, 0.03)), (atlas.DEFAULT_SPEEDS, atlas.DEFAULT_CLEARANCES)]
 )
 def test_the_atlas_figure_is_readable(speeds, clearances):
-    """Whatever the criterion and grid: no literal underscore outside mathtext, the speed
-    ticks of the curves apart, every cell's label 8 pt or larger on a box of its own (over
-    the hatching), the legend off the curves."""
+    """Whatever the criterion and grid: no literal underscore outside mathtext, the title
+    within the figure, the speed ticks of the curves apart, every cell's label 8 pt or larger
+    on a box of its own (over the hatching), the legends off the curves and the map."""
     import re
 
     from matplotlib.text import Text
@@ -290,6 +303,8 @@ def test_the_atlas_figure_is_readable(speeds, clearances):
         figure, renderer = _drawn_figure(speeds, clearances, criterion)
         for text in figure.findobj(Text):
             assert "_" not in re.sub(r"\$[^$]*\$", "", text.get_text()), text.get_text()
+        title = figure._suptitle.get_window_extent(renderer)
+        assert 0 <= title.x0 and title.x1 <= figure.bbox.width, figure._suptitle.get_text()
     (curves,) = [ax for ax in figure.axes if "bars" in ax.get_title()]
     (grid,) = [ax for ax in figure.axes if "cells" in ax.get_title()]
     low, high = curves.get_xlim()
@@ -302,6 +317,8 @@ def test_the_atlas_figure_is_readable(speeds, clearances):
     assert all(t.get_bbox_patch() is not None for t in grid.texts)  # over any hatching
     legend = curves.get_legend().get_window_extent(renderer)
     assert not legend.overlaps(curves.get_window_extent(renderer))
+    legend = grid.get_legend().get_window_extent(renderer)
+    assert not legend.overlaps(grid.get_window_extent(renderer)) and legend.y0 >= 0
 
 
 def test_atlas_md_says_what_each_number_compares_for_one_speed(tmp_path):
@@ -442,3 +459,104 @@ def test_the_walks_are_the_certified_optima_every_check_at_corners_and_best_payo
     assert found.walks is None and found.causes() == "not measured: BipedError: no gait file"
     assert not atlas_walks._done(tmp_path, walk)
     assert atlas_walks.unmeasured(tmp_path, settings)[0].endswith("(BipedError: no gait file)")
+
+
+def _write_walk(folder, cell, knee: str, checks: list, every_check: bool = False) -> None:
+    """The record of a made-up walk of ``knee``'s sthenic optimum in ``cell``, as
+    ``validate.atlas_walks`` writes it, of ``checks``: (name, passed, notes)."""
+    from validate import atlas_walks
+    from validate.checks import Check
+
+    point = atlas.Point("final", knee, "sthenic", cell)
+    walk = atlas_walks.WalkPoint(point, every_check)
+    made = [Check(name, passed, {}, notes) for name, passed, notes in checks]
+    path = folder / walk.filename()
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(json.dumps(atlas_walks.content(walk, made)))
+
+
+UNDECIDED = ["slowest multiplier 0.952", "not shown stable: within the landing's noise of 1"]
+WALKS = [("feedforward", True, []), ("forward", True, [])]
+
+
+def _made_up_walked_atlas(folder) -> atlas.Settings:
+    """Three cells whose rolling knee needs 20, 10 and 5 % less; at the best pay-off (0.2
+    m/s) the rolling knee's gait does not walk (its orbit only undecided), elsewhere both
+    knees' gaits walk."""
+    values = {0.2: (100.0, 80.0), 0.3: (100.0, 90.0), 0.4: (100.0, 95.0)}
+    settings = _stage_records(folder, values)
+    for cell in settings.cells():
+        for knee in KNEES:
+            every = cell.speed != 0.3
+            checks = WALKS + [("orbit", True, ["stable"])] if every else WALKS
+            if (cell.speed, knee) == (0.2, "rolling"):
+                checks = WALKS + [("orbit", False, UNDECIDED)]
+            _write_walk(folder, cell, knee, checks, every)
+    return settings
+
+
+def test_a_gait_that_does_not_walk_is_marked_in_the_csv_figure_and_page(tmp_path):
+    """A cell whose gait does not walk (an orbit only undecided) is 'no' with its cause in the
+    CSV, framed in red in the figure with a legend entry, and named with its cause in
+    atlas.md, which counts the optima that walk; not walked (--no-walks), nothing is."""
+    settings = _made_up_walked_atlas(tmp_path)
+    table = pages.rows(tmp_path, settings)
+    lines = list(csv.reader(pages.csv_text(table, ROBOT.weight).splitlines()))
+    walks = [(line[0], line[-2], line[-1]) for line in lines[1:]]
+    cause = "orbit: not shown stable: within the landing's noise of 1"
+    assert lines[0][-2:] == ["walks revolute", "walks rolling"]
+    assert walks == [
+        ("0.200", "yes", f"no: {cause}"),
+        ("0.300", "yes", "yes"),
+        ("0.400", "yes", "yes"),
+    ]
+    figure = pages.figure(settings, table, "sthenic", walked=True)
+    (grid,) = [ax for ax in figure.axes if "cells" in ax.get_title()]
+    (frame,) = [p for p in grid.patches if p.get_gid() == "not walking"]
+    assert frame.get_x() < 0 < frame.get_x() + frame.get_width()  # the first speed's cell
+    assert [t.get_text() for t in grid.get_legend().get_texts()] == [pages.NOT_WALKING_LABEL]
+    assert "a red frame where a knee's gait does not walk" in figure._suptitle.get_text()
+    text = pages.sentences(settings, table, walked=True)
+    assert "Of the 6 certified optima walked in MuJoCo, 5 walk" in text
+    assert f"0.2 m/s, clearance 0 cm: revolute walks; rolling does not walk: {cause}" in text
+    assert "4 of them, at the corners" in text
+    unwalked = pages.rows(tmp_path, settings, walked=False)
+    assert "not walked" in pages.csv_text(unwalked, ROBOT.weight).splitlines()[1]
+    figure = pages.figure(settings, unwalked, "sthenic")
+    assert not [p for p in figure.axes[0].patches if p.get_gid() == "not walking"]
+    assert "not walked in MuJoCo (--no-walks)" in figure._suptitle.get_text()
+
+
+def test_the_walking_payoff_is_among_walking_cells_only(tmp_path):
+    """atlas.md's pay-off among walking gaits is the best difference where both knees' gaits
+    walk (10 % at 0.3 m/s), beside the best over all certified cells (20 % at 0.2 m/s, whose
+    rolling knee's gait does not walk)."""
+    settings = _made_up_walked_atlas(tmp_path)
+    text = pages.sentences(settings, pages.rows(tmp_path, settings), walked=True)
+    assert "needs less in 3 of 3 cells, by 20.00 ± 0.00 % at most (0.2 m/s" in text
+    assert (
+        "- Among walking gaits (both knees' gaits walk in MuJoCo in 2 of the 3 certified "
+        "cells), the rolling knee needs less in 2, by 10.00 ± 0.00 % at most (0.3 m/s, "
+        "clearance 0 cm)." in text
+    )
+
+
+def test_an_atlas_stopped_by_signals_while_it_walks_resumes_to_the_same(small, walked, tmp_path):
+    """`biped atlas --jobs 2` whose optimizations are done, stopped while its workers walk the
+    optima in MuJoCo by Ctrl-C to its process group and then by SIGTERM, exits 130 then 143
+    within seconds with one line; run again, it ends with the walks of an uninterrupted
+    run, and its pages say which gaits walk."""
+    import shutil
+
+    folder, _, _ = small
+    out = tmp_path / "atlas"
+    shutil.copytree(folder, out)
+    argv = ["atlas", "--speeds", "0.3", "--clearances", "0,0.02", "--criteria", "sthenic"]
+    stops = stopped_twice_then_resumed([*argv, "--starts", "1", "--jobs", "2"], out)
+    assert [stop.status for stop in stops] == [130, 143]
+    for stop, name in zip(stops, ("Ctrl-C", "SIGTERM"), strict=True):
+        assert stop.stderr.splitlines()[-1] == f"biped atlas: interrupted ({name})"
+        assert "atlas walks: 4 certified optima walked" in stop.stderr
+        assert stop.seconds < PROMPTLY
+    assert numbers(out / atlas.WALKS) == numbers(walked[0] / atlas.WALKS)
+    assert "walks revolute" in (out / "atlas.csv").read_text()

@@ -4,8 +4,10 @@
 The figure of a criterion: on the left the map of the difference between the knees over speed
 x clearance (one panel per knee bend), blue where the rolling knee needs less, hatched where
 the difference is not larger than its uncertainty, a cross where a knee has no certified
-optimum; on the right the differences against speed, one curve per clearance, with their
-error bars. Its title and ``atlas.md`` say which problem the atlas answers.
+optimum, a red frame inside a cell where a knee's gait does not walk in MuJoCo;
+on the right the differences against speed, one curve per clearance, with their error bars.
+Its title, the CSV's walks and ``atlas.md`` say which problem the atlas answers and what the
+walks of its optima say (their records, ``biped.studies.atlas.read_walk``).
 """
 
 from __future__ import annotations
@@ -16,15 +18,19 @@ from pathlib import Path
 import numpy as np
 
 from biped.model.criteria import CRITERION_UNITS
+from biped.model.kinematics import KNEES
 from biped.runtime.files import atomic_path, atomic_write_text
 from biped.studies.atlas import (
     MEASURES,
     RICHER_KNOTS,
     Cell,
     Difference,
+    Point,
     Settings,
+    Walk,
     difference,
     load,
+    read_walk,
 )
 
 CRITERION_NAMES = {
@@ -56,25 +62,49 @@ CURVES_WIDTH = 7.4
 # matplotlib's; one speed in a span of this much either side of it [m/s].
 SPEED_TICKS = 12
 ONE_SPEED_SPAN = 0.05
+# The mark of a cell whose gait does not walk in MuJoCo (for either knee): a red frame inside
+# the cell, around its label, ``NOT_WALKING_INSET`` of a cell from its edges.
+NOT_WALKING = {"fill": False, "edgecolor": "#d6001c", "linewidth": 2.2}
+NOT_WALKING_INSET = 0.06
+NOT_WALKING_LABEL = "red frame: a knee's gait does not walk in MuJoCo"
 
 
 @dataclass(frozen=True)
 class Row:
-    """One line of ``atlas.csv``: a cell and criterion, both knees and their difference."""
+    """One line of ``atlas.csv``: a cell and criterion, both knees and their difference;
+    ``walks``: each knee's walk in MuJoCo (``Walk``, None where not walked), None when the
+    atlas was not walked."""
 
     criterion: str
     cell: Cell
     difference: Difference
     revolute: dict | None
     rolling: dict | None
+    walks: dict | None = None
+
+    def walking(self) -> bool:
+        """Both knees' gaits walk in MuJoCo."""
+        return self.walks is not None and all(
+            (w := self.walks.get(k)) is not None and w.walks for k in KNEES
+        )
+
+    def not_walking(self) -> bool:
+        """A knee's gait walked and does not walk (a walk not measured is neither)."""
+        return self.walks is not None and any(
+            w is not None and w.walks is False for w in self.walks.values()
+        )
 
 
-def rows(folder, settings: Settings) -> list[Row]:
+def rows(folder, settings: Settings, walked: bool = True) -> list[Row]:
+    """The atlas's lines; with each knee's walk (``read_walk``) when it was ``walked``."""
     found = []
     for criterion in settings.criteria:
         for cell in settings.cells():
             diff, finals = difference(folder, settings, criterion, cell)
-            found.append(Row(criterion, cell, diff, finals["revolute"], finals["rolling"]))
+            walks = None
+            if walked:
+                walks = {k: read_walk(folder, Point("final", k, criterion, cell)) for k in KNEES}
+            found.append(Row(criterion, cell, diff, finals["revolute"], finals["rolling"], walks))
     return found
 
 
@@ -99,6 +129,8 @@ COLUMNS = (
     "cost of transport revolute",
     "cost of transport rolling",
     "why empty",
+    "walks revolute",
+    "walks rolling",
 )
 # The criteria that are an energy per metre walked: their cost of transport is the value over
 # the robot's weight m g (dimensionless).
@@ -146,9 +178,21 @@ def csv_text(table: list[Row], weight: float) -> str:
                 for c in costs
             ),
             _quoted(why_empty(d)),
+            *(_quoted(walk_words(row, knee)) for knee in KNEES),
         ]
         lines.append(",".join(cells))
     return "\n".join(lines) + "\n"
+
+
+def walk_words(row: Row, knee: str) -> str:
+    """What the CSV says of a knee's walk: "yes", "no: " and why, "not walked" (no
+    certified optimum, or the atlas not walked), "not measured: " and why."""
+    walk = None if row.walks is None else row.walks.get(knee)
+    if walk is None:
+        return "not walked"
+    if walk.walks is None:
+        return walk.causes()
+    return "yes" if walk.walks else f"no: {walk.causes()}"
 
 
 def why_empty(d: Difference) -> str:
@@ -163,8 +207,9 @@ def _quoted(text: str) -> str:
     return "" if not text else '"' + text.replace('"', '""') + '"'
 
 
-def figure(settings: Settings, table: list[Row], criterion: str):
-    """The figure of one criterion (matplotlib ``Figure``), as the module says."""
+def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = False):
+    """The figure of one criterion (matplotlib ``Figure``), as the module says; ``walked``:
+    the atlas's optima were walked in MuJoCo (the rows' ``walks``)."""
     from matplotlib.figure import Figure
 
     bends = settings.knee_bends
@@ -180,16 +225,34 @@ def figure(settings: Settings, table: list[Row], criterion: str):
     for ax, bend in zip(axes[:-1], bends, strict=True):
         _map_panel(fig, ax, settings, [r for r in mine if r.cell.knee_bend == bend], top)
         ax.set_title(f"{_bend_words(bend)}\ncells: difference ± uncertainty [%]", fontsize=9)
+        if walked:
+            _walks_legend(ax, any(r.not_walking() for r in mine if r.cell.knee_bend == bend))
     _curves_panel(axes[-1], settings, [r for r in mine if r.cell.knee_bend == bends[0]])
+    walks = (
+        "walked in MuJoCo: a red frame where a knee's gait does not walk"
+        if walked
+        else "not walked in MuJoCo (--no-walks)"
+    )
     fig.suptitle(
         f"{FIGURE_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]: "
         "(rolling − revolute) / revolute knee\n"
         f"under {settings.constraints_words()}\n"
         "blue: the rolling knee needs less; hatched: not distinguishable (±?: uncertainty not "
-        "measured); x: no certified optimum of both knees",
+        f"measured); x: no certified optimum of both knees\n{walks}",
         fontsize=10,
     )
     return fig
+
+
+def _walks_legend(ax, marked: bool) -> None:
+    """The legend of the cells whose gait does not walk, under the map."""
+    from matplotlib.patches import Patch
+
+    label = NOT_WALKING_LABEL + ("" if marked else ": none")
+    handle = Patch(label=label, **NOT_WALKING)
+    ax.legend(
+        handles=[handle], fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1
+    )
 
 
 def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> None:
@@ -215,11 +278,22 @@ def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> Non
     for r in rows_:
         at = (speeds.index(r.cell.speed), clearances.index(r.cell.clearance))
         _cell_label(ax, at, r.difference, top, font)
+        if r.not_walking():
+            _not_walking_frame(ax, at)
     ax.set_xticks(range(len(speeds)), [f"{s:g}" for s in speeds])
     ax.set_yticks(range(len(clearances)), [f"{100 * c:g}" for c in clearances])
     ax.set_xlabel("speed [m/s]")
     ax.set_ylabel("swing-foot clearance [cm]")
     fig.colorbar(image, ax=ax, label="rolling vs revolute [%]")
+
+
+def _not_walking_frame(ax, at: tuple[int, int]) -> None:
+    """The red frame of the cell ``at`` (speed, clearance indices): a gait does not walk."""
+    from matplotlib.patches import Rectangle
+
+    corner = (at[0] - 0.5 + NOT_WALKING_INSET, at[1] - 0.5 + NOT_WALKING_INSET)
+    side = 1.0 - 2 * NOT_WALKING_INSET
+    ax.add_patch(Rectangle(corner, side, side, gid="not walking", zorder=2.5, **NOT_WALKING))
 
 
 def _map_area(settings: Settings) -> tuple[float, float]:
@@ -323,9 +397,9 @@ def _bend_words(bend: float) -> str:
     return f"stance knee bent {bend:g} rad at least"
 
 
-def sentences(settings: Settings, table: list[Row], walks=None) -> str:
+def sentences(settings: Settings, table: list[Row], walked: bool = False) -> str:
     """``atlas.md``: what the numbers say, criterion by criterion, computed from them;
-    ``walks``: a line per optimum walked in MuJoCo, None when none was asked to walk."""
+    ``walked``: the atlas's optima were walked in MuJoCo (the rows' ``walks``)."""
     lines = ["# Where the rolling knee pays off", ""]
     clearances = [100 * c for c in settings.clearances]
     bends = settings.knee_bends
@@ -343,17 +417,94 @@ def sentences(settings: Settings, table: list[Row], walks=None) -> str:
     for criterion in settings.criteria:
         lines += ["", f"## {CRITERION_NAMES[criterion]} [{CRITERION_UNITS[criterion]}]", ""]
         mine = [r for r in table if r.criterion == criterion]
-        lines += _criterion_sentences(mine) + _richer_sentences(mine)
+        lines += _criterion_sentences(mine)
+        lines += _walking_sentences(mine) if walked else []
+        lines += _richer_sentences(mine)
     lines += ["", "## Do the optima walk?", ""]
-    if walks is None:
+    if not walked:
         lines.append(
             "Not walked: the atlas was written without walking its optima in MuJoCo "
             "(`biped atlas --no-walks`); `biped validate GAIT.json` walks any of its gait files."
         )
-    elif not walks:
-        lines.append("No optimum walked: no corner or best pay-off has a gait file.")
-    lines += [f"- {line}" for line in walks or ()]
+    else:
+        lines += _walks_sentences(settings, table)
     return "\n".join(lines) + "\n"
+
+
+def _walking_sentences(mine: list[Row]) -> list[str]:
+    """The pay-off among walking gaits: the best difference among the cells where both
+    knees' gaits walk in MuJoCo, beside the one over all certified cells (the line before)."""
+    done = [r for r in mine if r.difference.value is not None]
+    if not done:  # the line before says so
+        return []
+    walking = [r for r in done if r.walking()]
+    cells = f"the {_count(len(done), 'certified cell')}"
+    among = f"{len(walking)} of {cells}"
+    if not walking:
+        return [f"- Among walking gaits: both knees' gaits walk in MuJoCo in none of {cells}."]
+    less = [r for r in walking if r.difference.distinguishable and r.difference.value < 0]
+    if not less:
+        return [
+            f"- Among walking gaits (both knees' gaits walk in MuJoCo in {among}), the rolling "
+            "knee needs distinguishably less in none."
+        ]
+    best = min(less, key=lambda r: r.difference.value)
+    return [
+        f"- Among walking gaits (both knees' gaits walk in MuJoCo in {among}), the rolling "
+        f"knee needs less in {len(less)}, by {-best.difference.value:.2f} ± "
+        f"{best.difference.uncertainty:.2f} % at most ({_where(best)})."
+    ]
+
+
+def _walks_sentences(settings: Settings, table: list[Row]) -> list[str]:
+    """How many certified optima walk in MuJoCo, of how many, which checks ran where, and
+    each cell whose gait does not walk (or whose walk was not measured), with why."""
+    walks = [w for r in table for w in (r.walks or {}).values() if w is not None]
+    walking = sum(bool(w.walks) for w in walks)
+    full = sum(w.every_check for w in walks)
+    optima = "optimum" if len(walks) == 1 else "optima"
+    steps = sorted({w.steps for w in walks if w.steps is not None})
+    lines = [
+        f"Of the {len(walks)} certified {optima} walked in MuJoCo, {walking} walk: every check "
+        "run on them passes (an orbit only 'undecided' is not a walk). Each was walked "
+        f"{' or '.join(map(str, steps)) or 'its'} steps with contact and replayed with its own "
+        f"torques (the forward and feedforward checks); {full} of them, at the corners of "
+        "speed x clearance and at each criterion's best pay-off, with every check of `biped "
+        "validate` (gains and orbit included). `atlas.csv` gives each knee's verdict, `walks/` "
+        "each walk's record.",
+        "",
+    ]
+    for criterion in settings.criteria:
+        mine = [r for r in table if r.criterion == criterion]
+        bad = [r for r in mine if r.not_walking() or _unmeasured_walk(r)]
+        count = sum(bool(w.walks) for r in mine for w in (r.walks or {}).values() if w)
+        of = sum(w is not None for r in mine for w in (r.walks or {}).values())
+        line = f"- {CRITERION_NAMES[criterion]}: {count} of {of} walk"
+        lines.append(
+            line + (f"; {_count(len(bad), 'cell')} where a gait does not:" if bad else ".")
+        )
+        lines += [f"  - {_where(r)}: {_walk_causes(r)}" for r in bad]
+    return lines
+
+
+def _unmeasured_walk(row: Row) -> bool:
+    return any(w is not None and w.walks is None for w in (row.walks or {}).values())
+
+
+def _walk_causes(row: Row) -> str:
+    """Each knee's walk of a cell that does not walk: its causes, or that it walks."""
+    words = []
+    for knee in KNEES:
+        walk: Walk | None = (row.walks or {}).get(knee)
+        if walk is None:
+            words.append(f"{knee} not walked")
+        elif walk.walks:
+            words.append(f"{knee} walks")
+        elif walk.walks is None:
+            words.append(f"{knee} {walk.causes()}")
+        else:
+            words.append(f"{knee} does not walk: {walk.causes()}")
+    return "; ".join(words)
 
 
 def _count(count: int, noun: str) -> str:
@@ -467,19 +618,19 @@ def _uncertainty_unmeasured(row: Row) -> str:
     return "; ".join(f"{what} not measured: {why}" for what, why in found)
 
 
-def write(folder, out=None, walks=None) -> list[Path]:
+def write(folder, out=None, walked: bool = True) -> list[Path]:
     """``atlas.csv``, ``atlas-<criterion>.png`` and ``atlas.md`` of the atlas in ``folder``, in
-    ``out`` (default the folder); ``walks``: lines saying which optima walk in MuJoCo, None
-    when none was asked to walk."""
+    ``out`` (default the folder); ``walked``: its optima were walked in MuJoCo (their records
+    read), else the pages say they were not (``--no-walks``)."""
     settings = load(folder)
     out = Path(folder if out is None else out)
     out.mkdir(parents=True, exist_ok=True)
-    table = rows(folder, settings)
+    table = rows(folder, settings, walked)
     written = [atomic_write_text(out / "atlas.csv", csv_text(table, settings.robot.weight))]
     for criterion in settings.criteria:
         path = out / f"atlas-{criterion}.png"
         with atomic_path(path) as tmp:
-            figure(settings, table, criterion).savefig(tmp, dpi=110, format="png")
+            figure(settings, table, criterion, walked).savefig(tmp, dpi=110, format="png")
         written.append(path)
-    written.append(atomic_write_text(out / "atlas.md", sentences(settings, table, walks)))
+    written.append(atomic_write_text(out / "atlas.md", sentences(settings, table, walked)))
     return written
