@@ -124,7 +124,7 @@ def content(walk: WalkPoint, checks: list | None, error: str | None = None) -> d
         }
         for name, check in by_name.items()
     }
-    walks = None if error is not None else all(c["passed"] for c in checked.values())
+    walks = None if error is not None or not checked else all(c["passed"] for c in checked.values())
     cell = point.cell
     return {
         "format": atlas.WALK_FORMAT,

@@ -288,12 +288,17 @@ def _map_panel(fig, ax, settings: Settings, rows_: list[Row], top: float) -> Non
 
 
 def _not_walking_frame(ax, at: tuple[int, int]) -> None:
-    """The red frame of the cell ``at`` (speed, clearance indices): a gait does not walk."""
+    """The red frame of the cell ``at`` (speed, clearance indices): a gait does not walk; a
+    white rim around it keeps it seen on the darkest red cells."""
+    from matplotlib import patheffects
     from matplotlib.patches import Rectangle
 
     corner = (at[0] - 0.5 + NOT_WALKING_INSET, at[1] - 0.5 + NOT_WALKING_INSET)
     side = 1.0 - 2 * NOT_WALKING_INSET
-    ax.add_patch(Rectangle(corner, side, side, gid="not walking", zorder=2.5, **NOT_WALKING))
+    rim = [patheffects.withStroke(linewidth=2 * NOT_WALKING["linewidth"], foreground="white")]
+    frame = Rectangle(corner, side, side, gid="not walking", zorder=2.5, **NOT_WALKING)
+    frame.set_path_effects(rim)
+    ax.add_patch(frame)
 
 
 def _map_area(settings: Settings) -> tuple[float, float]:
