@@ -122,8 +122,10 @@ def test_the_default_atlas_answers_the_walkable_constraints(small):
     assert record["safety"] == safety_dict(WALKABLE, kept=("knee_bend",))
     assert atlas.load(folder).safety == WALKABLE
     assert log.startswith(
-        "atlas under the walkable constraints: ZMP 0.01 m inside the sole, landing at 0.75 V "
-        "at most, friction 0.6, joints 0.05 rad from their stops, hip at 0.2 V at least: "
+        f"atlas under the walkable constraints: ZMP {WALKABLE.zmp_margin:g} m inside the sole, "
+        f"landing at {WALKABLE.landing_share:g} V at most, friction {WALKABLE.friction:g}, "
+        f"joints {WALKABLE.joint_margin:g} rad from their stops, hip at "
+        f"{WALKABLE.hip_progress:g} V at least: "
     )
     for cell in settings.cells():
         safety = dataclasses.replace(WALKABLE, clearance=cell.clearance)
