@@ -273,3 +273,40 @@ def test_orbit_and_robustness_name_a_file_of_another_kind(command, kind, tmp_pat
     error = capsys.readouterr().err
     assert error.count("\n") == 1 and f"{str(path)!r} is {kind} (which biped " in error
     assert "corrupt" not in error and not (tmp_path / "out").exists()
+
+
+# Reading a gait file in a process where CasADi and MuJoCo cannot be imported (``None`` in
+# ``sys.modules`` makes ``import`` raise): its figures recomputed from its parameters and
+# checked (``read_consistent``), then the same process trying to load the solver.
+_READ_WITHOUT_SOLVER_OR_SIMULATOR = """
+import sys
+sys.modules["casadi"] = None
+sys.modules["mujoco"] = None
+from biped.records import gait_file
+gait = gait_file.read_consistent(sys.argv[1])
+print(gait.costs.sthenic)
+try:
+    import biped.optimization.optimize
+except ImportError:
+    print("no solver")
+"""
+
+
+def test_reading_a_gait_file_needs_neither_casadi_nor_mujoco(content, tmp_path):
+    """A gait file reads and is checked against its parameters with CasADi and MuJoCo
+    blocked (the simulator's side and a reader need no solver); the solver itself does not
+    load there (the block holds)."""
+    import subprocess
+    import sys
+
+    path = gait_file.write_json(tmp_path / "gait.json", content)
+    done = subprocess.run(
+        [sys.executable, "-c", _READ_WITHOUT_SOLVER_OR_SIMULATOR, str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    value, blocked = done.stdout.split()[:2], done.stdout.splitlines()[1]
+    assert float(value[0]) == pytest.approx(content["costs"]["sthenic"], rel=1e-12)
+    assert blocked == "no solver"

@@ -70,6 +70,9 @@ BUILD_ERROR_COST = 1e12
 BUILD_ERROR_SLOPE = 1e13  # per metre out of reach
 
 
+# Constraints are divided by these in the solvers so that all are of order one
+# [N, m, m, rad, rad, m, m].
+CONSTRAINT_SCALES = np.array([1000.0, 0.1, 0.1, 1.0, 1.0, 0.1, 0.1])
 # Margins δ_i the optimiser keeps from each constraint [N, m, m, rad, rad, m, m]. With an
 # exponential penalty of finite weight, the minimum of the penalised criterion violates an
 # active constraint slightly; asking for Ψ_i >= δ_i there leaves Ψ_i >= 0 with room to spare.

@@ -20,6 +20,10 @@ import math
 from biped.optimization.penalty import OPTIMIZE_SAMPLES_PER_HALF
 from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PER_HALF
 
+# The knee radii a design names, and the changes of its comparison (``biped.optimization.design
+# .Comparison.gains``), by name.
+RADII = ("r1", "r2")
+GAINS = ("design_vs_revolute", "design_vs_table1", "table1_vs_revolute")
 # Convention of every difference between knees, in words (pages, figures, command lines).
 DIFFERENCE = "(rolling − revolute) / revolute; negative: the rolling knee needs less"
 # The same for any knee or design against the revolute knee.

@@ -43,7 +43,12 @@ from biped.errors import BipedError
 from biped.model.criteria import CRITERION_UNITS, PAPER_SAFETY, WORK_CRITERIA, Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import LENGTH_MIN, Robot
-from biped.optimization.comparison import DIFFERENCE_VS_REVOLUTE, relative_change
+from biped.optimization.comparison import (
+    DIFFERENCE_VS_REVOLUTE,
+    GAINS,
+    RADII,
+    relative_change,
+)
 from biped.optimization.optimize import (
     DEFAULT_STARTS,
     GUESS_PERIODS,
@@ -60,9 +65,6 @@ from biped.optimization.optimize import (
 from biped.optimization.problem import GaitProblem, check_criterion, check_speed
 from biped.optimization.solver import Solver
 
-RADII = ("r1", "r2")
-# The changes of a comparison (``Comparison.gains``), by name.
-GAINS = ("design_vs_revolute", "design_vs_table1", "table1_vs_revolute")
 # [m] Lower bound of a designed knee radius: the smallest length of a robot
 # (``biped.model.robot.LENGTH_MIN``); at 0 the rolling knee is the revolute knee (module docstring).
 MIN_RADIUS = LENGTH_MIN

@@ -21,13 +21,13 @@ from biped.errors import UnreachableError
 from biped.model.criteria import (
     BUILD_ERROR_COST,
     BUILD_ERROR_SLOPE,
+    CONSTRAINT_SCALES,
     checked_mask,
     evaluate_step,
     margin_profile,
 )
 from biped.model.gait import N_PARAMETERS, StepBuildError, build_step
 from biped.optimization.problem import GaitProblem
-from biped.optimization.symbolic import CONSTRAINT_SCALES
 
 # Samples per spline piece of the penalised criterion.
 OPTIMIZE_SAMPLES_PER_HALF = 40

@@ -30,6 +30,7 @@ from biped.model import walkable
 from biped.model.actuators import LIMITS, drive, limit_margins
 from biped.model.criteria import (
     ACTUATOR_MARGIN,
+    CONSTRAINT_SCALES,
     CONSTRAINTS,
     checked_mask,
     clearance_envelope,
@@ -60,9 +61,6 @@ from biped.optimization.problem import CHECK_SAMPLES, MIN_HIP_HEIGHT, index, var
 # [m] What the solver keeps above the clearance at the check grid's samples between its own:
 # the check's rounding (the solver meets its constraints to 1e-9 of their scale).
 BETWEEN_SAMPLES_MARGIN = 1e-6
-# Constraints are divided by these in the solvers so that all are of order one
-# [N, m, m, rad, rad, m, m].
-CONSTRAINT_SCALES = np.array([1000.0, 0.1, 0.1, 1.0, 1.0, 0.1, 0.1])
 
 
 class _Constants:

@@ -38,7 +38,7 @@ from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
 from biped.model.gait import breakpoints, build_step, parameter_names, piece_grid
 from biped.model.units import CONSTRAINT_UNITS, parameter_unit, unit_text
-from biped.optimization.design import GAINS, RADII
+from biped.optimization.comparison import GAINS, RADII
 from biped.optimization.problem import CHECK_SAMPLES, SOLVER_SAMPLES
 from biped.pages.figures import (
     ANGLE_PANELS,

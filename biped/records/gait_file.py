@@ -29,6 +29,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -62,8 +63,7 @@ from biped.model.units import (
     robot_unit,
     unit_field,
 )
-from biped.optimization.design import GAINS, RADII
-from biped.optimization.optimize import Optimum, Report
+from biped.optimization.comparison import GAINS, RADII
 from biped.optimization.problem import (
     CHECK_SAMPLES,
     VARIABLES,
@@ -71,8 +71,12 @@ from biped.optimization.problem import (
     check_speed,
     variable_names,
 )
+from biped.optimization.report import Report
 from biped.records.provenance import provenance as make_provenance
 from biped.runtime.files import atomic_write_text
+
+if TYPE_CHECKING:  # reading a gait file needs no solver (CasADi)
+    from biped.optimization.optimize import Optimum
 
 # 2: safety margins recorded; 3: a robot without actuators has the catalog's default set
 # (``biped.model.actuators.Actuators.default``).
