@@ -153,7 +153,7 @@ def figure(rows: list[dict], knob: str):
     # Unbounded drawn left of the others (a landing bound: the loosest is the largest).
     positions = {v: i for i, v in enumerate(values)}
     labels = ["none" if v is None else f"{v:g}" for v in values]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5.0), layout="constrained")
     panels = (
         ("feedback_share", "servos' share of the joint torque", 1.0),
         ("energy_error", "MuJoCo's energy per step / model's − 1 [%]", 100.0),
@@ -161,11 +161,14 @@ def figure(rows: list[dict], knob: str):
     for ax, (name, title, scale) in zip(axes, panels, strict=True):
         for (speed, clearance), style in zip(POINTS, ("s--", "o-", "^:", "d-."), strict=True):
             for knee, colour in zip(KNEES, ("tab:orange", "tab:blue"), strict=True):
-                line = [
-                    r
-                    for r in rows
-                    if (r["speed"], r["clearance"], r["knee"]) == (speed, clearance, knee)
-                ]
+                line = sorted(
+                    (
+                        r
+                        for r in rows
+                        if (r["speed"], r["clearance"], r["knee"]) == (speed, clearance, knee)
+                    ),
+                    key=lambda r: positions[r["value"]],
+                )
                 xs = [positions[r["value"]] for r in line if r[name] is not None]
                 ys = [scale * r[name] for r in line if r[name] is not None]
                 ax.plot(
@@ -198,7 +201,8 @@ def figure(rows: list[dict], knob: str):
         ax.set_xlabel(f"{what} [{unit}]")
         ax.set_title(title)
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=8, loc="upper right")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=8, loc="outside lower center", ncol=4)
     fig.suptitle(
         "MuJoCo's 20-step walk of each sthenic optimum (dashed: the targets; ×: a check failed "
         "or a figure off its target; green: the preset)"
@@ -222,7 +226,8 @@ def main(argv=None) -> int:
     # The preset held but for the knob (a landing share unbounded while it is varied).
     held = dataclasses.replace(WALKABLE, landing_share=None) if args.knob == "landing" else WALKABLE
     rows = list(run_tasks(measure, settings(args.knob, held), jobs=args.jobs, stream=None))
-    rows.sort(key=lambda r: (r["speed"], r["knee"], -1 if r["value"] is None else -r["value"]))
+    order = KNOBS[args.knob]["values"]
+    rows.sort(key=lambda r: (r["speed"], r["knee"], order.index(r["value"])))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     record = {
