@@ -1,5 +1,5 @@
-"""The README shows what exists: its images are there and not blank, and every command and
-option of its command table is one the program accepts."""
+"""The README and the pages of docs/ show what exists: their images are there and not blank,
+and every command and option of the README's command table is one the program accepts."""
 
 import argparse
 import re
@@ -11,16 +11,27 @@ from biped_cli import build_parser
 
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text(encoding="utf-8")
+DOCS = sorted((ROOT / "docs").glob("*.md"))
+
+
+def images(page: Path) -> set:
+    """The images a Markdown page shows, as paths from the repository's root."""
+    text = page.read_text(encoding="utf-8")
+    found = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", text)
+    return {(page.parent / image).resolve().relative_to(ROOT).as_posix() for image in found}
 
 
 def test_images_exist_and_are_not_blank():
-    """docs/walk.png (a frame of the walk) and docs/constraints.png (a figure) are shown and
-    have ink; a flat image would not."""
+    """docs/walk.png (a frame of the walk) is the README's picture, docs/constraints.png (a
+    figure) is shown on a page of docs/, every figure of docs/ is shown somewhere, and every
+    image shown has ink; a flat image would not."""
     from PIL import Image
 
-    images = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", README)
-    assert {"docs/walk.png", "docs/constraints.png"} <= set(images)
-    for image in images:
+    assert images(ROOT / "README.md") == {"docs/walk.png"}
+    shown = set().union(images(ROOT / "README.md"), *(images(page) for page in DOCS))
+    assert "docs/constraints.png" in set().union(*(images(page) for page in DOCS))
+    assert {f"docs/{p.name}" for p in (ROOT / "docs").glob("*.png")} <= shown
+    for image in shown:
         pixels = np.asarray(Image.open(ROOT / image).convert("RGB"), dtype=float)
         assert pixels.std() > 20, image
     assert np.zeros((4, 4, 3)).std() == 0.0
@@ -46,7 +57,7 @@ def test_command_table_names_real_commands_and_options():
 
 
 def test_robot_file_example_is_the_catalogs_actuator():
-    """The README's robot file reads, its [actuator] the catalog's AK10-9 V3.0 (to the
+    """docs/actuators.md's robot file reads, its [actuator] the catalog's AK10-9 V3.0 (to the
     digits written), its knees' resistance changed; a field of another actuator would not
     match."""
     import dataclasses
@@ -57,7 +68,8 @@ def test_robot_file_example_is_the_catalogs_actuator():
     from biped import Robot
     from biped.model.actuators import package_catalog
 
-    text = re.search(r"```toml\n(.*?)```", README, re.S).group(1)
+    page = (ROOT / "docs" / "actuators.md").read_text(encoding="utf-8")
+    text = re.search(r"```toml\n(.*?)```", page, re.S).group(1)
     values = tomllib.loads(text)
     robot = Robot.from_mapping(values)
     catalog = package_catalog()["AK10-9 V3.0 KV60"]
