@@ -1,11 +1,14 @@
 """The README and the pages of docs/ show what exists: their images are there and not blank,
-and every command and option of the README's command table is one the program accepts."""
+every command and option of their command tables is one the program accepts, docs/cli.md
+names every command, the README is a short front door linking every page of docs/, and
+every page links back to it."""
 
 import argparse
 import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from biped_cli import build_parser
 
@@ -37,23 +40,86 @@ def test_images_exist_and_are_not_blank():
     assert np.zeros((4, 4, 3)).std() == 0.0
 
 
-def test_command_table_names_real_commands_and_options():
-    """Each `biped COMMAND --option` of the command table parses as a command with that
-    option."""
+def commands() -> dict:
+    """The program's commands, by name, each its parser."""
     parser = build_parser()
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    table = [line for line in README.splitlines() if line.startswith("| `biped ")]
-    assert len(table) >= 8
-    for line in table:
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+
+
+def command_rows(text: str) -> list:
+    """The rows of a Markdown page's command tables: those starting with "| `biped "."""
+    return [line for line in text.splitlines() if line.startswith("| `biped ")]
+
+
+def check_command_table(rows: list):
+    """Each `biped COMMAND --option` of the rows, and each `--option` quoted in a row, parses as
+    a command with that option."""
+    choices = commands()
+    for line in rows:
         cell = line.split("`")[1]
         words = cell.split()
-        assert words[1] in sub.choices, cell
-        options = {o for a in sub.choices[words[1]]._actions for o in a.option_strings}
+        assert words[1] in choices, cell
+        options = {o for a in choices[words[1]]._actions for o in a.option_strings}
         for word in words[2:]:
             if word.startswith("--"):
                 assert word.strip("[]") in options, (cell, word)
         for option in re.findall(r"`(--[a-z-]+)", line):
             assert option in options, (cell, option)
+
+
+def test_command_table_names_real_commands_and_options():
+    """Each `biped COMMAND --option` of the README's command table parses as a command with
+    that option."""
+    rows = command_rows(README)
+    assert len(rows) >= 8
+    check_command_table(rows)
+    assert len(rows) <= 15
+    mangled = ["| `biped pipeline --no-such-option` | x |"]
+    with pytest.raises(AssertionError):
+        check_command_table(mangled)
+
+
+def test_cli_page_names_every_command_with_real_options():
+    """docs/cli.md's table has a row for every command of the program, and each of its
+    commands and options parses; a command left out would fail."""
+    rows = command_rows((ROOT / "docs" / "cli.md").read_text(encoding="utf-8"))
+    check_command_table(rows)
+    named = {line.split("`")[1].split()[1] for line in rows}
+    assert named == set(commands())
+
+
+def links(page: Path) -> set:
+    """The Markdown pages a page links to (not images, not web addresses), as paths from the
+    repository's root, anchors left out."""
+    text = page.read_text(encoding="utf-8")
+    found = re.findall(r"(?<!!)\[[^\]]*\]\(([^)#]+\.md)(?:#[^)]*)?\)", text)
+    targets = set()
+    for link in found:
+        target = (page.parent / link).resolve()
+        targets.add(target.relative_to(ROOT).as_posix() if target.is_relative_to(ROOT) else link)
+    return targets
+
+
+def test_readme_is_a_short_front_door_to_every_page():
+    """The README is at most 220 lines, links every page of docs/ and the CHANGELOG, and each
+    of its links to a page leads to a file that exists; a page left out or a link to a page
+    moved would fail."""
+    assert len(README.splitlines()) <= 220
+    linked = links(ROOT / "README.md")
+    assert {f"docs/{page.name}" for page in DOCS} | {"CHANGELOG.md"} <= linked
+    for target in linked:
+        assert (ROOT / target).is_file(), target
+
+
+def test_every_page_links_back_to_the_readme_and_to_pages_that_exist():
+    """Each page of docs/ says what it covers and links back to the README in its opening
+    lines, and every page it links to exists."""
+    assert DOCS
+    for page in DOCS:
+        opening = "\n".join(page.read_text(encoding="utf-8").splitlines()[:8])
+        assert "](../README.md)" in opening, page.name
+        for target in links(page):
+            assert (ROOT / target).is_file(), (page.name, target)
 
 
 def test_robot_file_example_is_the_catalogs_actuator():
@@ -62,8 +128,6 @@ def test_robot_file_example_is_the_catalogs_actuator():
     match."""
     import dataclasses
     import tomllib
-
-    import pytest
 
     from biped import Robot
     from biped.model.actuators import package_catalog
