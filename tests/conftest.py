@@ -1,6 +1,7 @@
 """Shared fixtures: both robots and seeded random motions with the stance foot fixed."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -116,3 +117,20 @@ def designed_gait():
     problem = DesignProblem(biped.Robot.paper(), 0.3)
     rolling, revolute = small_optimum("rolling"), small_optimum("revolute")
     return Gait.from_design(Comparison(problem, revolute, rolling, Design(problem, rolling)))
+
+
+# The full tier's tests (``tests/slow.txt``): marked ``slow``, so that ``pytest -m "not slow"``
+# runs the fast tier.
+_SLOW = {
+    line.strip()
+    for line in (Path(__file__).parent / "slow.txt").read_text(encoding="utf-8").splitlines()
+    if line.strip() and not line.startswith("#")
+}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark ``slow`` each test of a function, or of a test file, listed in
+    ``tests/slow.txt``."""
+    for item in items:
+        if {item.nodeid.split("[")[0], item.nodeid.split("::")[0]} & _SLOW:
+            item.add_marker(pytest.mark.slow)
