@@ -79,6 +79,16 @@ class Biped(Chain):
         coordinate_map: P (K + 2, 9) [-], y = (φ, x_H, z_H) = P q.
     """
 
+    def __new__(cls, robot: Robot | None = None, knee: str = "rolling"):
+        """A rolling knee whose surfaces are profiles (``Robot.profiled``) is a
+        ``biped.model.profile_biped.ProfileBiped``; circles and the revolute knee are this
+        class."""
+        if cls is Biped and knee == "rolling" and robot is not None and robot.profiled:
+            from biped.model.profile_biped import ProfileBiped
+
+            return super().__new__(ProfileBiped)
+        return super().__new__(cls)
+
     def __init__(self, robot: Robot, knee: str = "rolling"):
         super().__init__(robot, knee)
         k = len(self.direction_names)

@@ -365,7 +365,6 @@ class Chain:
             )
         dist2 = np.minimum(dist2, high**2)  # rounding above the straight leg
         r1, r2 = self.radii
-        shank, thigh = self.robot.shank_length - r1, self.robot.thigh_length - r2
         if r1 + r2 == 0.0:  # revolute: closed form
             l1, l2 = self.robot.shank_length, self.robot.thigh_length
             flexion = _acos(np.clip((dist2 - l1**2 - l2**2) / (2 * l1 * l2), -1.0, 1.0))
@@ -377,17 +376,24 @@ class Chain:
                     break
                 slope = self._reach_squared_derivative(flexion)
                 step = np.where(slope < 0.0, residual / np.where(slope < 0.0, slope, -1.0), 0.0)
-                flexion = np.clip(flexion - step, 0.0, np.pi)
+                flexion = np.clip(flexion - step, 0.0, self._flexion_table[-1])
             else:
                 raise UnreachableError("inverse geometric model did not converge")
-        link = r1 + r2
-        # Leg as a chain hanging from the ankle with shank angle 0: hip = -R(q1) v(θ).
-        gamma = r2 * flexion / link if link > 0.0 else 0.0
-        vx = link * np.sin(gamma) + thigh * np.sin(flexion)
-        vz = -shank - link * np.cos(gamma) - thigh * np.cos(flexion)
+        vx, vz = self._hanging_leg(flexion)
         shank_angle = _atan2(d[..., 1], d[..., 0]) - _atan2(-vz, -vx)
         shank_angle = (shank_angle + np.pi) % (2 * np.pi) - np.pi
         return np.stack([shank_angle, shank_angle + flexion], axis=-1)
+
+    def _hanging_leg(self, flexion):
+        """v(θ) = (vx, vz) [m]: the hip is −R(q1) v(θ) from the ankle, the leg a chain hanging
+        from it with shank angle 0 and knee flexion θ (``leg_angles``)."""
+        r1, r2 = self.radii
+        link = r1 + r2
+        shank, thigh = self.robot.shank_length - r1, self.robot.thigh_length - r2
+        gamma = r2 * flexion / link if link > 0.0 else 0.0
+        vx = link * np.sin(gamma) + thigh * np.sin(flexion)
+        vz = -shank - link * np.cos(gamma) - thigh * np.cos(flexion)
+        return vx, vz
 
 
 def swap_legs(chain: Chain, q, qd=None):

@@ -56,6 +56,8 @@ GRAVITY_RANGE = (0.1, 100.0)
 
 _MASSES = ("foot_mass", "shank_mass", "thigh_mass", "trunk_mass")
 _INERTIAS = ("foot_inertia", "shank_inertia", "thigh_inertia", "trunk_inertia")
+# The knee's surfaces: radii >= 0, the profile's rates of any sign (``biped.model.profile``).
+PROFILE_FIELDS = ("r1", "r2", "k1", "k2")
 _LENGTHS = ("foot_length", "ankle_height", "shank_length", "thigh_length", "trunk_length")
 
 
@@ -116,6 +118,11 @@ class Robot:
     """[m] Radius of the shank's rolling surface (rolling knee only)."""
     r2: float = 0.05
     """[m] Radius of the thigh's rolling surface (rolling knee only)."""
+    k1: float = 0.0
+    """[m/rad] Rate of the shank's radius of curvature with its tangent angle (rolling knee
+    only, ``biped.model.profile``): 0, the circle of radius r1; left out of the file when 0."""
+    k2: float = 0.0
+    """[m/rad] The thigh's, as ``k1``."""
     gravity: float = STANDARD_GRAVITY
     """[m/s²] Gravitational acceleration; plausible 0.1 to 100 m/s²."""
     actuators: Actuators | None = None
@@ -136,7 +143,7 @@ class Robot:
             if not math.isfinite(number):
                 raise ParameterError(field.name, value, "a finite number")
             object.__setattr__(self, field.name, number)
-        positive = [f.name for f in self.body_fields() if f.name not in ("r1", "r2")]
+        positive = [f.name for f in self.body_fields() if f.name not in PROFILE_FIELDS]
         for name in positive:
             if getattr(self, name) <= 0.0:
                 raise ParameterError(name, getattr(self, name), "> 0")
@@ -163,6 +170,25 @@ class Robot:
             )
         self._check_below("r1", "shank_length", "0 <= r1 < shank_length")
         self._check_below("r2", "thigh_length", "0 <= r2 < thigh_length")
+        self._check_profile()
+
+    def _check_profile(self):
+        """Profiles (k1, k2 not 0): convex surfaces over the knee's range
+        (``biped.model.profile.check_profile``)."""
+        from biped.model.profile import PROFILE_RANGE, KneeProfile, check_profile
+
+        try:
+            check_profile(KneeProfile.of(self))
+        except ValueError as broken:
+            which = {"shank": "k1", "thigh": "k2"}.get(str(broken).split()[0], "k1, k2")
+            value = {"k1": self.k1, "k2": self.k2}.get(which, (self.k1, self.k2))
+            why = "the surfaces stop rolling" if str(broken) == "rolling" else f"{broken} fails"
+            raise ParameterError(
+                which,
+                value,
+                f"convex surfaces over the knee's flexion {PROFILE_RANGE[0]:g} to "
+                f"{PROFILE_RANGE[1]:g} rad (radii of curvature r + k ψ > 0; here {why})",
+            ) from None
 
     @classmethod
     def body_fields(cls) -> tuple:
@@ -256,11 +282,19 @@ class Robot:
         """Field names to values, for JSON output; ``actuators`` (each kind's fields) only
         when given."""
         values = {f.name: getattr(self, f.name) for f in self.body_fields()}
+        for name in ("k1", "k2"):  # circles: the files of before
+            if values[name] == 0.0:
+                del values[name]
         if self.actuators is not None:
             values["actuators"] = self.actuators.to_dict()
         return values
 
     # ------------------------------------------------------------------ derived values
+    @property
+    def profiled(self) -> bool:
+        """The knee's surfaces are profiles (k1 or k2 not 0), not circles."""
+        return self.k1 != 0.0 or self.k2 != 0.0
+
     @property
     def total_mass(self) -> float:
         """[kg] Mass of the whole robot (two feet, two shanks, two thighs, trunk)."""

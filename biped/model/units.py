@@ -115,6 +115,8 @@ def robot_unit(field: str) -> str:
         return "kg·m²"
     if field == "gravity":
         return "m/s²"
+    if field in ("k1", "k2"):  # a knee profile's rates (``biped.model.profile``)
+        return "m/rad"
     return "m"  # lengths, centres of mass, the heel, the knee radii
 
 

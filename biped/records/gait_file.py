@@ -615,13 +615,18 @@ class Gait:
         safety: Safety = PAPER_SAFETY,
         actuators: bool = False,
         design: bool = False,
+        profile: bool = False,
     ) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion`` in the family of
         ``knots`` interior knots, under the margins ``safety`` (the paper's by default), with
         the robot's actuators if ``actuators`` (a robot file's, not the default set), with a
-        designed knee's block if ``design`` (``DESIGN_UNITS``), from the fields' declarations:
-        ``{"costs.sthenic": "N²·m·s", ...}``."""
+        designed knee's block if ``design`` (``DESIGN_UNITS``), with the knee profile's rates
+        k1, k2 if ``profile`` (a robot whose knee surfaces are not circles), from the fields'
+        declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
         units = declared_units(Gait, "", criterion)
+        if not profile:  # circles: k1 = k2 = 0 are not written (``Robot.to_dict``)
+            units.pop("robot.k1")
+            units.pop("robot.k2")
         written = safety_dict(safety)  # a setting left at its default is not written
         for name in [f.name for f in dataclasses.fields(Safety) if f.name not in written]:
             units.pop(f"safety.{name}", None)
@@ -652,6 +657,7 @@ class Gait:
             self.safety,
             self.robot.actuators is not None,
             self.design is not None,
+            self.robot.profiled,
         )
         for group in ("impact", "walkability"):  # a figure not written has no unit
             record = getattr(self, group)
