@@ -167,7 +167,9 @@ def _load(function: ca.Function, compiler: tuple) -> ca.Function:
 
 
 def _same_bits(function: ca.Function, machine: ca.Function) -> bool:
-    """Whether ``machine`` gives ``function``'s outputs, bit for bit, at fixed inputs."""
+    """Whether ``machine`` gives ``function``'s outputs, bit for bit, at fixed inputs: the
+    same numbers, NaN where the interpreter gives NaN (whose sign and payload C does not fix:
+    a profiled knee's square root of a negative number at inputs outside its family)."""
     rng = np.random.default_rng(0)
     inputs = [
         rng.uniform(-1.0, 1.0, (function.size1_in(k), function.size2_in(k) * CHECK_COLUMNS))
@@ -175,10 +177,15 @@ def _same_bits(function: ca.Function, machine: ca.Function) -> bool:
     ]
     mapped = [function.map(CHECK_COLUMNS), machine.map(CHECK_COLUMNS)]
     expected, found = (f.call(inputs) for f in mapped)
-    return all(
-        np.asarray(a).tobytes() == np.asarray(b).tobytes()
-        for a, b in zip(expected, found, strict=True)
-    )
+    return all(_same_numbers(a, b) for a, b in zip(expected, found, strict=True))
+
+
+def _same_numbers(a, b) -> bool:
+    """Every number the same bits, NaN at the same places."""
+    a, b = np.asarray(a), np.asarray(b)
+    nan = np.isnan(a)
+    same_nan = a.shape == b.shape and np.array_equal(nan, np.isnan(b))
+    return same_nan and a[~nan].tobytes() == b[~nan].tobytes()
 
 
 def _compiler() -> tuple[tuple[str, ...], str] | None:

@@ -22,7 +22,11 @@ every speed and every start (``solver_for``).
 With ``radius_bounds`` the knee radii (r1, r2) [m] are variables too (scaled by
 ``RADIUS_SCALE``), the rolling knee's graph built with them as symbols
 (``StepGraph(..., design=True)``): the gait and the knee optimised together
-(``biped.optimization.design``).
+(``biped.optimization.design``). With bounds of four numbers the variables are a profiled
+knee's (r1, r2 [m], k1, k2 [m/rad], ``biped.model.profile``), each scaled by
+``RADIUS_SCALE``, and the surfaces' bounds (``biped.model.profile.surface_margins``: convex
+and inside the disc of radius the upper bound of r_i over the knee's range) join the
+constraints, divided by ``SURFACE_SCALES``.
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.criteria import Safety
 from biped.model.dynamics import Biped
+from biped.model.profile import PARAMETERS, surface_margins
 from biped.model.robot import Robot
 from biped.optimization.derivatives import constraint_jacobian, lagrangian_hessian
 from biped.optimization.problem import GaitProblem, bounds, scales, variable_names
@@ -81,8 +86,12 @@ BARRIERS = {
 }
 # IPOPT's statuses that are a converged local optimum.
 CONVERGED = ("Solve_Succeeded",)
-# One unit of the knee radii in the solver's scaled space [m].
+# One unit of the knee radii in the solver's scaled space [m] (and of a profile's rates k1,
+# k2 [m/rad]).
 RADIUS_SCALE = 0.05
+# The surfaces' bounds of a profile design are divided by these: the convexity margins by
+# 0.1 m, the inside margins (limit² − |K − C|² [m²]) by the limit² (relative).
+CONVEX_SCALE = 0.1
 
 
 @dataclass(frozen=True)
@@ -98,7 +107,8 @@ class Solution:
             solver's scaled units.
         dual_infeasibility: IPOPT's unscaled dual infeasibility at the end.
         seconds: time of the solve.
-        radii: (r1, r2) [m] at the end, when the radii are variables (else None).
+        radii: (r1, r2) [m] at the end, when the radii are variables (else None); a
+            profile design's (r1, r2, k1, k2) [m, m, m/rad, m/rad].
     """
 
     variables: np.ndarray
@@ -145,7 +155,8 @@ class Solver:
     Args:
         radius_bounds: ((r1 low, r2 low), (r1 high, r2 high)) [m]: the knee radii are
             variables within these bounds (``solve(problem, start, radii)``); None: they
-            are ``model``'s.
+            are ``model``'s. Four numbers a side: a profile's (r1, r2, k1, k2) (module
+            docstring).
     """
 
     def __init__(
@@ -165,19 +176,30 @@ class Solver:
     def _build(self, model, criterion, safety, samples_per_half, radius_bounds, knots):
         one_blas_thread()
         design = radius_bounds is not None
+        self.knee_size = len(radius_bounds[0]) if design else 0  # 2 radii, or 4 of a profile
+        profile = self.knee_size == len(PARAMETERS)
         motors = criterion == "electrical"
-        self.graph = graph = StepGraph(model, samples_per_half, safety, design, knots, motors)
+        self.graph = graph = StepGraph(
+            model, samples_per_half, safety, design, knots, motors, profile=profile
+        )
         self.criterion = criterion
         self.design = design
         self.scales, self.size = scales(knots), len(variable_names(knots))
         y = ca.SX.sym("y", self.size)
         unknowns, scaled = [graph.z], [ca.DM(self.scales) * y]
         if design:
-            rho = ca.SX.sym("rho", 2)
+            rho = ca.SX.sym("rho", self.knee_size)
             y = ca.vertcat(y, rho)
             unknowns.append(graph.radii)
             scaled.append(RADIUS_SCALE * rho)
-        x, objective, g = self._objective_and_constraints(graph, criterion, y)
+        surfaces = []
+        if design and profile:
+            limits = tuple(float(v) for v in radius_bounds[1][:2])
+            margins = surface_margins([RADIUS_SCALE * rho[i] for i in range(4)], limits, ca)
+            divisors = [CONVEX_SCALE] * 2 + [limits[0] ** 2] * 2 + [CONVEX_SCALE] * 2
+            divisors += [limits[1] ** 2] * 2  # the order of ``MARGINS``
+            surfaces = [m / d for m, d in zip(margins, divisors, strict=True)]
+        x, objective, g = self._objective_and_constraints(graph, criterion, y, surfaces)
         head = ca.substitute(graph.head, ca.vertcat(*unknowns), ca.vertcat(*scaled))
         flat = ca.substitute([graph.flat(ca.vertcat(objective, g))], unknowns, scaled)[0]
         self.hessian = lagrangian_hessian(graph, x, graph.speed, head, objective, g)
@@ -208,12 +230,13 @@ class Solver:
         self.ubx = np.concatenate([upper, np.full(self.slacks, np.inf)])
         self.n_constraints = g.shape[0]
 
-    def _objective_and_constraints(self, graph: StepGraph, criterion: str, y):
+    def _objective_and_constraints(self, graph: StepGraph, criterion: str, y, surfaces=()):
         """The NLP's variables x, objective and constraints, on the graph's symbols (the
-        samples' quantities, the head; ``StepGraph.on_symbols``) and the slacks."""
+        samples' quantities, the head; ``StepGraph.on_symbols``), the slacks and a profile's
+        ``surfaces`` bounds (on y)."""
         period = graph.head_symbol[graph.period_index]
         hip_height = graph.head_symbol[graph.hip_height_index]
-        constraints = ca.vertcat(graph.on_symbols["constraints"], hip_height)
+        constraints = ca.vertcat(graph.on_symbols["constraints"], hip_height, *surfaces)
         if criterion == "sthenic":
             self.slacks = 0
             return y, graph.on_symbols["sthenic"], constraints
@@ -262,7 +285,11 @@ class Solver:
         options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
         options.update({f"ipopt.{key}": value for key, value in BARRIERS[barrier].items()})
         derivatives = {"hess_lag": self.hessian, "jac_g": self.jacobian, "grad_f": self.gradient}
-        return {**options, "print_time": False, **derivatives}
+        # A profile design's trial points may leave the family (no real rolling relation:
+        # NaN), which IPOPT's line search steps back from; said once by the report, not by
+        # every evaluation.
+        quiet = {"show_eval_warnings": False} if self.knee_size == len(PARAMETERS) else {}
+        return {**options, "print_time": False, **quiet, **derivatives}
 
     def _solve(self, problem, start, radii, hold_radii, barrier) -> Solution:
         began = time.perf_counter()
@@ -285,7 +312,7 @@ class Solver:
             x0 = np.concatenate([x0, start if np.all(np.isfinite(power)) else 0.0])
         lbx, ubx = self.lbx, self.ubx
         if self.design and hold_radii:
-            held = slice(self.size, self.size + 2)
+            held = slice(self.size, self.size + self.knee_size)
             lbx, ubx = lbx.copy(), ubx.copy()
             lbx[held] = ubx[held] = r0 / RADIUS_SCALE
         result = nlp(x0=x0, p=problem.speed, lbx=lbx, ubx=ubx, lbg=0.0, ubg=np.inf)
@@ -299,7 +326,7 @@ class Solver:
         )
         iterations = stats.get("iterations") or {}
         dual = iterations.get("inf_du") or [float("nan")]
-        end = self.size + 2 * self.design
+        end = self.size + self.knee_size
         return Solution(
             variables=x[: self.size] * self.scales,
             radii=tuple(map(float, x[self.size : end] * RADIUS_SCALE)) if self.design else None,

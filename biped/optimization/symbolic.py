@@ -56,6 +56,8 @@ from biped.model.kinematics import (
     ZH,
     point_table,
 )
+from biped.model.profile_biped import ProfileBiped
+from biped.optimization import profile_graph
 from biped.optimization.problem import CHECK_SAMPLES, MIN_HIP_HEIGHT, index, variable_names
 
 # [m] What the solver keeps above the clearance at the check grid's samples between its own:
@@ -72,6 +74,8 @@ class _Constants:
     ``biped.model.dynamics.Biped``; the rolling knee's two links C1C2 are always present (of
     length r1 + r2, so at r1 = r2 = 0 they carry nothing: the revolute knee).
     """
+
+    profile = False  # the circles (``profile_graph.ProfileConstants``: the profiles)
 
     def __init__(self, model: Biped, radii=None):
         self.model = model
@@ -147,7 +151,9 @@ def _sparse(array):
 
 def _stance_state(c: _Constants, angles, rates, accels):
     """q, q̇, q̈ (9,) and φ̇, φ̈, sin φ, cos φ of a stance-foot-fixed motion
-    (``Chain.stance_state``)."""
+    (``Chain.stance_state``); a profiled knee's q, q̇, q̈ and None."""
+    if c.profile:
+        return (*profile_graph.stance_state(c, angles, rates, accels), None, None, None, None)
     zero = ca.SX.zeros(1)
     q7, qd7, qdd7 = (ca.vertcat(zero, v) for v in (angles, rates, accels))
     phi, phid, phidd = c.phi @ q7, c.phi @ qd7, c.phi @ qdd7
@@ -186,6 +192,8 @@ def _torques_and_wrench(c: _Constants, qdd, phid, phidd, s, co):
 def _sole_heights(c: _Constants, angles):
     """Heights (n, 2) [m] of the swing heel and toe at the free angles ``angles`` (n, 6),
     the stance foot flat and fixed (``sample_function``'s Ψ6, Ψ7 without the margins)."""
+    if c.profile:
+        return profile_graph.sole_heights(c, angles)
     rows = []
     zero = ca.SX.zeros(angles.shape[0], 1)
     phi = ca.horzcat(zero, angles) @ c.phi.T  # (n, K) the directions' angles
@@ -199,6 +207,8 @@ def _sole_heights(c: _Constants, angles):
 
 def _mass_matrix(c: _Constants, q):
     """D(q) (9, 9) (``Biped.mass_matrix``)."""
+    if c.profile:
+        return profile_graph.mass_matrix(c, q)
     phi = c.phi @ q[:7]
     s, co = ca.sin(phi), ca.cos(phi)
     k = c.k
@@ -217,6 +227,8 @@ def _mass_matrix(c: _Constants, q):
 
 def _swing_contact_jacobian(c: _Constants, q):
     """A_c (3, 9) of the swing foot (``Chain.contact_jacobian(q, "swing")``)."""
+    if c.profile:
+        return profile_graph.swing_contact_jacobian(c, q)
     a, b = c.point("swing_ankle")
     phi = c.phi @ q[:7]
     s, co = ca.sin(phi), ca.cos(phi)
@@ -232,6 +244,8 @@ def _swing_contact_jacobian(c: _Constants, q):
 def _leg_angles(c: _Constants, bend, hip_from_ankle):
     """(shank, thigh) angles of a leg with knee flexion ``bend`` and the hip at
     ``hip_from_ankle`` (``Chain.leg_angles`` with the flexion known)."""
+    if c.profile:
+        return profile_graph.leg_angles(c, bend, hip_from_ankle)
     r1, r2 = c.radii
     link = r1 + r2
     shank = c.model.robot.shank_length - r1
@@ -248,6 +262,8 @@ def _leg_angles(c: _Constants, bend, hip_from_ankle):
 
 def _reach_squared(c: _Constants, bend):
     """|hip − ankle|² at knee flexion ``bend`` (``Chain.reach_squared``)."""
+    if c.profile:
+        return profile_graph.reach_squared(c, bend)
     r1, r2 = c.radii
     link = r1 + r2
     shank = c.model.robot.shank_length - r1
@@ -298,9 +314,15 @@ def sample_function(c: _Constants, robot, safety, radii=None, motors=False) -> c
     angles = motion[:6]
     rates, accels = motion[6:12] / period, motion[12:] / period**2
     q, qd, qdd, phid, phidd, s, co = _stance_state(c, angles, rates, accels)
-    torques, wrench = _torques_and_wrench(c, qdd, phid, phidd, s, co)
-    heel_a, heel_b = c.point("swing_heel")
-    toe_a, toe_b = c.point("swing_toe")
+    if c.profile:
+        torques, wrench = profile_graph.torques_and_wrench(c, q, qd, qdd)
+        heel, toe = (profile_graph.point_height(c, q, f"swing_{e}") for e in ("heel", "toe"))
+    else:
+        torques, wrench = _torques_and_wrench(c, qdd, phid, phidd, s, co)
+        heel_a, heel_b = c.point("swing_heel")
+        toe_a, toe_b = c.point("swing_toe")
+        heel = q[ZH] - ca.dot(co, heel_a) + ca.dot(s, heel_b)
+        toe = q[ZH] - ca.dot(co, toe_a) + ca.dot(s, toe_b)
     zmp = (torques[0] - robot.ankle_height * wrench[0]) / wrench[1]
     psi = ca.vertcat(
         wrench[1],
@@ -308,8 +330,8 @@ def sample_function(c: _Constants, robot, safety, radii=None, motors=False) -> c
         robot.foot_length - robot.foot_heel - zmp - safety.zmp_margin,
         q[Q2] - q[Q1] - safety.knee_bend,
         q[Q3] - q[Q4],
-        q[ZH] - ca.dot(co, heel_a) + ca.dot(s, heel_b),
-        q[ZH] - ca.dot(co, toe_a) + ca.dot(s, toe_b),
+        heel,
+        toe,
     )
     rates = ca.DM(JOINT_MATRIX) @ qd
     power = torques * rates
@@ -359,13 +381,17 @@ class StepGraph:
         design: bool = False,
         knots: int = 1,
         motors: bool = False,
+        profile: bool = False,
     ):
         self.model, self.samples_per_half = model, samples_per_half
         self.safety, self.design, self.knots = safety, design, knots
         # The motors' quantities, for the electrical criterion or the actuator limits.
         self.motors = motors or safety.actuator_limits
-        self.radii = ca.SX.sym("radii", 2) if design else None
-        c = _Constants(model, self.radii)
+        # A profiled knee (``biped.model.profile``): ``model``'s, or a design's of (r1, r2,
+        # k1, k2) with ``profile``.
+        self.profile = profile if design else isinstance(model, ProfileBiped)
+        self.radii = ca.SX.sym("radii", 4 if self.profile else 2) if design else None
+        c = (profile_graph.ProfileConstants if self.profile else _Constants)(model, self.radii)
         self.z = ca.SX.sym("z", len(variable_names(knots)))
         self.speed = ca.SX.sym("speed")
         self.period = self.z[-1]  # T [s]
@@ -451,7 +477,7 @@ class StepGraph:
         events = [("touchdown", self.touchdown, "landing" in walkable)]
         events.append(("impulse", self.impulse, "impact_friction" in walkable))
         self.period_index = coefficients.numel()
-        self.hip_height_index = self.period_index + 1 + len(radii) * 2
+        self.hip_height_index = self.period_index + 1 + sum(r.numel() for r in radii)
         parts, self.head_slices, at = [], {}, self.hip_height_index + 1
         for name, value, asked in events:
             if asked:
@@ -463,7 +489,7 @@ class StepGraph:
         self._constants = c
         self.sample = sample_function(c, self.model.robot, self.safety, self.radii, self.motors)
         self.basis = _sample_basis(
-            self.samples_per_half, self.knots, self.head.shape[0], self.design
+            self.samples_per_half, self.knots, self.head.shape[0], len(radii) and radii[0].numel()
         )
         n = self.basis.shape[0] // self.sample.size1_in(0)
         count = N_MOTOR_QUANTITIES if self.motors else N_QUANTITIES
@@ -623,7 +649,8 @@ class StepGraph:
         heights = _sole_heights(self._constants, angles)  # (n, 2): heel, toe
         if self.design:  # the radii as the head holds them
             at = self.period_index + 1
-            heights = ca.substitute(heights, self.radii, self.head_symbol[at : at + 2])
+            size = self.radii.numel()
+            heights = ca.substitute(heights, self.radii, self.head_symbol[at : at + size])
         floor = required[taken] + BETWEEN_SAMPLES_MARGIN
         scale = CONSTRAINT_SCALES[CONSTRAINTS.index("swing_heel")]
         margins = (heights - ca.repmat(ca.DM(floor), 1, 2)) / scale
@@ -648,13 +675,14 @@ class StepGraph:
         )
 
 
-def _sample_basis(samples_per_half: int, knots: int, head_size: int, design: bool) -> np.ndarray:
+def _sample_basis(samples_per_half: int, knots: int, head_size: int, knee: int) -> np.ndarray:
     """The constant matrix (N · inputs, head) that maps the head to the stacked inputs of
     the samples (``sample_function``): the spline bases (``biped.model.gait.spline_basis``)
-    on each angle's coefficients, then T and the radii passed on."""
+    on each angle's coefficients, then T and the ``knee`` parameters of a design (the radii,
+    2, or a profile's, 4; 0 without) passed on."""
     _, bases = spline_basis(samples_per_half, knots)
     n, rows = bases[0].shape  # rows: the coefficients of one angle, 4 per piece
-    width = SAMPLE_MOTION + 1 + 2 * design
+    width = SAMPLE_MOTION + 1 + knee
     matrix = np.zeros((n, width, head_size))
     for k, basis in enumerate(bases):  # values, rates, accels
         for angle in range(6):
