@@ -16,10 +16,12 @@ with (Fx, Fz) the ground's force on the stance foot (``Biped.inverse_dynamics``;
 foot's a_i is 0). The accelerations follow from the model's own kinematics:
 a_i = J_i(q) q̈ + J̇_i(q) q̇ (``Chain.point_jacobian``, ``Chain.point_bias_acceleration``).
 
-Decomposition. The rolling knee's thigh (circle of radius r2, centre C2) and shank (radius
-r1, centre C1) touch at one point of the line of their centres, which is the surfaces' common
-normal there: along the unit vector e from C2 towards C1 (e = u(γ), γ = (r1 q_shank +
-r2 q_thigh) / l, ``biped.model.kinematics``) and across it, e' = e turned +90°
+Decomposition (a profiled knee's, ``biped.model.profile``: along its common normal u(γ) at
+the contact and across it, as the circles' below). The rolling knee's thigh (circle of
+radius r2, centre C2) and shank (radius r1, centre C1) touch at one point of the line of
+their centres, which is the surfaces' common normal there: along the unit vector e from C2
+towards C1 (e = u(γ), γ = (r1 q_shank + r2 q_thigh) / l, ``biped.model.kinematics``) and
+across it, e' = e turned +90°
 (counter-clockwise, e' = u'(γ)),
 
     N = F · e,   T = F · e'
@@ -39,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.model.dynamics import Biped
+from biped.model.profile_biped import ProfileBiped
 
 # The knees, in the order of the last axis of every array here: the stance leg's, the swing
 # leg's (each one leg's knee during that leg's stance, resp. swing).
@@ -92,7 +95,10 @@ def momentum_rate(model: Biped, q, qd, qdd, bodies) -> np.ndarray:
 
 def knee_axes(model: Biped, q) -> np.ndarray:
     """The unit vectors e (..., 2, 2) of each knee (``KNEE_SIDES``): from C2 towards C1 for
-    the rolling knee, from the knee to the ankle for the revolute knee."""
+    the rolling knee, from the knee to the ankle for the revolute knee; the common normal
+    u(γ) at the contact of a profiled knee (``ProfileBiped.contact_normals``)."""
+    if isinstance(model, ProfileBiped):
+        return model.contact_normals(q)
     axes = []
     for side in KNEE_SIDES:
         if sum(model.radii) > 0.0:
