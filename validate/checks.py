@@ -50,6 +50,7 @@ import numpy as np
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import ZH
 from biped.model.knee_loads import KNEE_SIDES, knee_forces
+from biped.model.profile import KneeProfile
 from biped.model.units import PURE, unit_text
 from biped.records.gait_file import Gait
 from validate import contact
@@ -59,6 +60,7 @@ from validate.crosscheck import (
     mujoco_knee_forces,
     rigid_copy,
 )
+from validate.knee_fit import TARGET, knee_fit
 from validate.mapping import mapping, other
 from validate.mjcf import SIDES
 from validate.model import ModelError, model_problems
@@ -230,11 +232,26 @@ def _exact_verdict(name: str, figures: dict, what: str, scales: dict, notes=None
 
 
 def check_model(model: mujoco.MjModel, biped: Biped) -> Check:
-    """The model is the gait's robot (``validate.model.model_problems``); masses reported."""
+    """The model is the gait's robot (``validate.model.model_problems``); masses reported.
+    A profiled knee's also MuJoCo's knee against the analytical one over the knee's range
+    (``validate.knee_fit``: its largest distance and angle, each below ``TARGET``)."""
     problems = model_problems(model, biped)
     trunk = model.body("trunk").id
     mass = float(model.body_subtreemass[trunk])
     figures = {"mass_difference": mass - biped.robot.total_mass, "problems": len(problems)}
+    if biped.knee == "rolling" and biped.robot.profiled and not problems:
+        fit = knee_fit(model, KneeProfile.of(biped.robot))
+        figures["knee_position_error"], figures["knee_angle_error"] = fit.position, fit.angle
+        for what, value, target, unit in (
+            ("distance", fit.position, TARGET[0], "m"),
+            ("angle", fit.angle, TARGET[1], "rad"),
+        ):
+            if not value < target:  # NaN (not measured) fails too
+                problems.append(
+                    f"MuJoCo's knee differs from the analytical one by a {what} of "
+                    f"{value:.3g} {unit} over the knee's range (allowed < {target:g} {unit})"
+                )
+        figures["problems"] = len(problems)
     return Check("model", not problems, figures, notes=problems, causes=[MISMATCH] * bool(problems))
 
 
@@ -305,7 +322,7 @@ def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait
     exact = rigid_copy(model)
     q, qd_minus = samples.end()
     mj_qd_plus, mj_impulse = mujoco_impact(exact, biped, q, qd_minus)
-    start = mapping(exact, "right", biped.radii).qpos(samples.qd[0])
+    start = mapping(exact, "right", biped.radii).qvel(samples.q[0], samples.qd[0])
     velocity = np.abs(mj_qd_plus - start)
     slide = exact.jnt_type[exact.dof_jntid] == mujoco.mjtJoint.mjJNT_SLIDE  # m/s, else rad/s
     figures = {
@@ -403,7 +420,7 @@ def touchdown_jumps(biped: Biped, sim: Simulation, steps: int, window: float = J
             onset -= 1
         if onset + touch_ahead >= len(sim.time):
             break
-        to_paper = np.linalg.pinv(mapping(model, stance, biped.radii).qpos_from_q)
+        to_paper = mapping(model, stance, biped.radii).to_paper
         q, qd_minus = to_paper @ sim.qpos[onset - 1], to_paper @ sim.qvel[onset - 1]
         qd_plus, _ = biped.impact(q, qd_minus)
         seen = to_paper @ sim.qvel[onset - 1 + touch_ahead] - qd_minus

@@ -38,6 +38,7 @@ from biped.model.dynamics import Biped
 from validate.mapping import Mapping, mapping, other
 from validate.mjcf import SIDES, robot_xml
 from validate.model import JOINT_ORDER, ModelError
+from validate.profile_mjcf import model_profile
 
 
 def load_model(biped: Biped, exact: bool = False) -> mujoco.MjModel:
@@ -52,8 +53,8 @@ def rigid_copy(model: mujoco.MjModel) -> mujoco.MjModel:
     """A copy without armature and with massless knee links: the analytical robot exactly."""
     exact = copy.deepcopy(model)
     exact.dof_armature[:] = 0.0
-    for side in SIDES:
-        name = f"{side}_knee_link"
+    for side, part in ((s, p) for s in SIDES for p in ("link", "slider")):
+        name = f"{side}_knee_{part}"  # a profiled knee's slider too (validate.profile_mjcf)
         if mujoco.mj_name2id(exact, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
             body = exact.body(name).id
             exact.body_mass[body] = 0.0
@@ -74,8 +75,14 @@ def actuator_moments(model: mujoco.MjModel) -> np.ndarray:
     return moments
 
 
-def equality_jacobian(model: mujoco.MjModel) -> np.ndarray:
-    """J_eq (neq, nv) of the joint equalities joint1 = c0 + c1 joint2 (linear ones)."""
+def equality_jacobian(model: mujoco.MjModel, data: mujoco.MjData | None = None) -> np.ndarray:
+    """J_eq (neq, nv) of the joint equalities joint1 = c0 + c1 joint2 (linear ones); of a
+    profiled knee's (``validate.profile_mjcf``: quadratic, and a tendon), MuJoCo's own rows
+    at ``data``'s configuration (after ``mj_fwdPosition``)."""
+    if data is not None and model_profile(model) is not None:
+        n = data.nefc
+        rows = data.efc_J[: n * model.nv].reshape(n, model.nv)
+        return rows[data.efc_type[:n] == mujoco.mjtConstraint.mjCNSTR_EQUALITY].copy()
     rows = np.zeros((model.neq, model.nv))
     for k in range(model.neq):
         joint1, joint2 = model.eq_obj1id[k], model.eq_obj2id[k]
@@ -105,7 +112,7 @@ def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, sta
     motors = np.array([model.actuator(name).id for name in JOINT_ORDER])
     gears = model.actuator_gear[motors, 0]
     moments = actuator_moments(model)[motors]
-    j_eq = equality_jacobian(model)
+    j_eq = None if model_profile(model) is not None else equality_jacobian(model)
     unknowns = len(motors) + 3 + model.neq
     if unknowns != model.nv:
         raise ModelError(
@@ -115,7 +122,7 @@ def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, sta
         )
     site = model.site(f"{stance}_ankle").id
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
-    qpos, qvel, qacc = (mapped.qpos(x) for x in (q, qd, qdd))
+    qpos, qvel, qacc = mapped.qpos(q), mapped.qvel(q, qd), mapped.qacc(q, qd, qdd)
     n = len(qpos)
     torques, wrench = np.zeros((n, 6)), np.zeros((n, 3))
     coupling = np.zeros((n, model.neq))
@@ -127,7 +134,8 @@ def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, sta
         mujoco.mj_rne(model, data, 1, tau)
         mujoco.mj_jacSite(model, data, jacp, jacr, site)
         contact = np.stack([jacp[0], jacp[2], -jacr[1]])
-        system = np.concatenate([moments, contact, j_eq]).T
+        rows = equality_jacobian(model, data) if j_eq is None else j_eq
+        system = np.concatenate([moments, contact, rows]).T
         try:
             solution = np.linalg.solve(system, tau)
         except np.linalg.LinAlgError:
@@ -186,7 +194,8 @@ def mujoco_knee_forces(
     data = mujoco.MjData(model)
     knees = [_knee_bodies(model, side) for side in (stance, other(stance))]
     foot = model.body(f"{stance}_foot").id
-    qpos, qvel, qacc = (mapped.qpos(x) for x in (q, qd, qdd))
+    profiled = model_profile(model) is not None
+    qpos, qvel, qacc = mapped.qpos(q), mapped.qvel(q, qd), mapped.qacc(q, qd, qdd)
     force, axis = np.zeros((len(qpos), 2, 2)), np.zeros((len(qpos), 2, 2))
     for k in range(len(qpos)):
         data.qpos[:], data.qvel[:], data.qacc[:] = qpos[k], qvel[k], qacc[k]
@@ -198,6 +207,9 @@ def mujoco_knee_forces(
         mujoco.mj_rnePostConstraint(model, data)
         for j, (body, start, end) in enumerate(knees):
             force[k, j] = data.cfrc_int[body, [3, 5]]
+            if profiled:  # the common normal u(γ): the knee link's −z
+                axis[k, j] = -data.xmat[body][[2, 8]]
+                continue
             vector = (data.xanchor[end] - data.xanchor[start])[[0, 2]]
             axis[k, j] = vector / np.linalg.norm(vector)
     return KneeForces(force, axis)
@@ -231,9 +243,10 @@ def mujoco_impact(model: mujoco.MjModel, biped: Biped, q, qd_minus, stance: str 
     swing = "right" if stance == "left" else "left"
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
     mujoco.mj_jacSite(model, data, jacp, jacr, model.site(f"{swing}_ankle").id)
-    rows = np.concatenate([np.stack([jacp[0], jacp[2], -jacr[1]]), equality_jacobian(model)])
+    equalities = equality_jacobian(model, data)
+    rows = np.concatenate([np.stack([jacp[0], jacp[2], -jacr[1]]), equalities])
     k = len(rows)
     system = np.block([[mass, -rows.T], [rows, np.zeros((k, k))]])
-    rhs = np.concatenate([mass @ mapped.qpos(qd_minus), np.zeros(k)])
+    rhs = np.concatenate([mass @ mapped.qvel(q, qd_minus), np.zeros(k)])
     solution = np.linalg.solve(system, rhs)
     return solution[: model.nv], solution[model.nv : model.nv + 3]

@@ -12,8 +12,10 @@ import copy
 import mujoco
 import numpy as np
 
+from validate.mapping import PROFILE_JOINTS, knee_joints
 from validate.mjcf import SIDES
 from validate.model import JOINT_ORDER
+from validate.profile_mjcf import model_profile
 
 
 class Layout:
@@ -29,7 +31,8 @@ class Layout:
             None in a model without them.
         rotor_inertia: (6,) inertia [kg·m²] each joint's drive adds to it (MuJoCo's armature,
             seen through the joint: a rolling knee's two hinges turn by r1/l and r2/l of its
-            flexion, so their armatures add as a (r1/l)² + a (r2/l)²).
+            flexion, so their armatures add as a (r1/l)² + a (r2/l)²; a profiled knee's four
+            joints by their rates at the straight knee, ``validate.mapping.knee_joints``).
     """
 
     def __init__(self, model: mujoco.MjModel):
@@ -41,15 +44,23 @@ class Layout:
         self._rootx_dof = model.joint("rootx").dofadr[0]
         self.joints = np.zeros((6, model.nq))
         self.rotor_inertia = np.zeros(6)
+        profile = model_profile(model)
         for row, name in enumerate(JOINT_ORDER):
+            # (joint, its rate per unit of the joint angle, whether it sums to the angle)
             if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) >= 0:
-                parts = [(model.joint(name), 1.0)]
+                parts = [(model.joint(name), 1.0, True)]
+            elif profile is not None:  # the flexion over four joints: their rates at θ = 0
+                _, rates, _ = knee_joints(profile, 0.0)
+                parts = [
+                    (model.joint(f"{name}_{part}"), rate, part in ("upper", "lower"))
+                    for part, rate in zip(PROFILE_JOINTS, rates, strict=True)
+                ]
             else:  # rolling knee: the flexion splits over two hinges, lower = c upper
                 upper, lower = (model.joint(f"{name}_{part}") for part in ("upper", "lower"))
                 c = _coupling(model, upper.id, lower.id)
-                parts = [(upper, 1.0 / (1.0 + c)), (lower, c / (1.0 + c))]
-            for joint, share in parts:
-                self.joints[row, joint.qposadr[0]] = 1.0
+                parts = [(upper, 1.0 / (1.0 + c), True), (lower, c / (1.0 + c), True)]
+            for joint, share, summed in parts:
+                self.joints[row, joint.qposadr[0]] = 1.0 if summed else 0.0
                 self.rotor_inertia[row] += model.dof_armature[joint.dofadr[0]] * share**2
         self.motors = self._actuators("")
         self.gears = model.actuator_gear[self.motors, 0].copy()

@@ -42,9 +42,11 @@ import sys
 from pathlib import Path
 
 from biped.model.kinematics import check_knee
+from biped.model.profile import KneeProfile
 from biped.model.robot import FOOT_FRICTION as SLIDING_FRICTION
 from biped.model.robot import JOINT_STOPS, SOLE_EDGES, Robot
 from biped.runtime.files import atomic_write_text
+from validate import profile_mjcf
 
 SIDES = ("left", "right")
 # Near-massless knee link of the rolling knee (MuJoCo needs mass on a moving body) [kg, kg·m²].
@@ -143,9 +145,10 @@ def _f(value: float) -> str:
     return f"{value:.10g}"
 
 
-def _inertial(pos_z: float, mass: float, inertia: float) -> str:
+def _inertial(pos_z: float, mass: float, inertia: float, pos_x: float = 0.0) -> str:
     i = _f(inertia)
-    return f'<inertial pos="0 0 {_f(pos_z)}" mass="{_f(mass)}" diaginertia="{i} {i} {i}"/>'
+    at = f"{_f(pos_x)} 0 {_f(pos_z)}"
+    return f'<inertial pos="{at}" mass="{_f(mass)}" diaginertia="{i} {i} {i}"/>'
 
 
 def _range(limits: tuple[float, float], share: float = 1.0) -> str:
@@ -172,7 +175,12 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
     for side in SIDES:
         lines += _leg(robot, side, r1, r2)
     lines += ["    </body>", "  </worldbody>", ""]
-    lines += (_knee_coupling(r1, r2) if rolling else []) + _actuators(rolling, servos)
+    if rolling and robot.profiled:
+        solref, solimp = KNEE_SOLREF, KNEE_SOLIMP
+        lines += profile_mjcf.couplings(KneeProfile.of(robot), SIDES, solref, solimp)
+    elif rolling:
+        lines += _knee_coupling(r1, r2)
+    lines += _actuators(rolling, servos)
     lines += ["  <sensor>"]
     for side in SIDES:
         lines += [
@@ -182,7 +190,7 @@ def robot_xml(robot: Robot, knee: str, servos: tuple[float, float] | None = None
                 for site in ("ankle", "heel", "toe")
             ),
         ]
-    nq = 3 + 2 * (4 if rolling else 3)
+    nq = 3 + 2 * ((6 if robot.profiled else 4) if rolling else 3)
     home = ["0", _f(stand)] + ["0"] * (nq - 2)  # qpos0: standing straight on the floor
     lines += ["  </sensor>", "", "  <keyframe>", f'    <key name="home" qpos="{" ".join(home)}"/>']
     return "\n".join(lines + ["  </keyframe>", "</mujoco>", ""])
@@ -251,7 +259,18 @@ def _leg(r: Robot, side: str, r1: float, r2: float) -> list[str]:
         f'{pad}  <geom class="visual" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}" material="{side}"/>',
         f'{pad}  <geom name="{side}_thigh_contact" class="collision" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
     ]
-    if link > 0.0:
+    if link > 0.0 and r.profiled:  # four joints (``validate.profile_mjcf``)
+        parts = {
+            "armature": f'armature="{_f(KNEE_ARMATURE)}"',
+            "inertial": _inertial(0.0, KNEE_LINK_MASS, KNEE_LINK_INERTIA),
+        }
+        lines += profile_mjcf.knee_bodies(KneeProfile.of(r), side, thigh, pad, parts)
+        pad += "    "  # inside the knee link and the slider
+        # The shank's origin is C1' (its hinge), k1 ahead of C1 across the shank: its
+        # contents k1 behind (and its centre of mass never within MuJoCo's 1e-6 m of the
+        # origin, where MuJoCo puts it on the origin).
+        across = -r.k1 + 0.0
+    elif link > 0.0:
         disc = f'class="visual" type="cylinder" size="{{}} {_f(DISC_HALF_WIDTH)}"'
         hinge = f'armature="{_f(KNEE_ARMATURE)}"'
         lines += [
@@ -269,16 +288,19 @@ def _leg(r: Robot, side: str, r1: float, r2: float) -> list[str]:
             f'{pad}  <body name="{side}_shank" pos="0 0 {_f(-thigh)}">',
             f'{pad}    <joint name="{side}_knee" {_range(KNEE_RANGE)}/>',
         ]
+    x = _f(across) if link > 0.0 and r.profiled else "0"
     lines += [
-        f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia)}",
-        f'{pad}    <geom class="visual" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}" material="{side}"/>',
-        f'{pad}    <geom name="{side}_shank_contact" class="collision" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="0 0 0 0 0 {_f(-shank)}"/>',
-        f'{pad}    <body name="{side}_foot" pos="0 0 {_f(-shank)}">',
+        f"{pad}    {_inertial(-(r.shank_com - r1), r.shank_mass, r.shank_inertia, float(x))}",
+        f'{pad}    <geom class="visual" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="{x} 0 0 {x} 0 {_f(-shank)}" material="{side}"/>',
+        f'{pad}    <geom name="{side}_shank_contact" class="collision" type="capsule" size="{_f(SHANK_RADIUS)}" fromto="{x} 0 0 {x} 0 {_f(-shank)}"/>',
+        f'{pad}    <body name="{side}_foot" pos="{x} 0 {_f(-shank)}">',
         *_foot(r, side, f"{pad}      "),
         f"{pad}    </body>",
         f"{pad}  </body>",
     ]
-    return lines + (["        </body>"] if link > 0.0 else []) + ["      </body>"]
+    closing = ["          </body>"] if r.profiled and link > 0.0 else []  # the slider
+    closing += ["        </body>"] if link > 0.0 else []
+    return lines + closing + ["      </body>"]
 
 
 def _foot(r: Robot, side: str, pad: str) -> list[str]:

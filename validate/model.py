@@ -28,9 +28,11 @@ import numpy as np
 
 from biped.errors import BipedError
 from biped.model.dynamics import Biped
+from biped.model.profile import KneeProfile
 from biped.model.robot import SOLE_EDGES, Robot
 from biped.model.units import robot_unit
 from validate.mjcf import FOLDER, FOOT_FRICTION, SIDES, robot_xml, scene_xml
+from validate.profile_mjcf import model_profile
 
 # Names of the six actuated joints, in the order of every (N, 6) array of the validation.
 JOINT_ORDER = tuple(f"{side}_{joint}" for side in SIDES for joint in ("hip", "knee", "ankle"))
@@ -156,7 +158,9 @@ def model_problems(model: mujoco.MjModel, biped: Biped) -> list[str]:
     the model holds with another value, with both values (``parameter_differences``; the
     other differing fields named after it). Empty when none."""
     problems = []
-    if biped.knee == "rolling":
+    if biped.knee == "rolling" and (biped.robot.profiled or model_profile(model) is not None):
+        problems += _profile_problems(model, biped)
+    elif biped.knee == "rolling":
         ratio = biped.robot.r2 / biped.robot.r1
         for side in SIDES:
             seen = _knee_ratio(model, side)
@@ -173,6 +177,60 @@ def model_problems(model: mujoco.MjModel, biped: Biped) -> list[str]:
         also = f" (differing too: {', '.join(d.split(':')[0] for d in others)})" if others else ""
         problems.append(first + also)
     return problems
+
+
+def _profile_problems(model: mujoco.MjModel, biped: Biped) -> list[str]:
+    """A profiled knee's equalities (``validate.profile_mjcf``) on each side, against the
+    gait's robot: the arc's two, the slide's tendon and its pin; a profile against circles."""
+    problems = []
+    wanted = KneeProfile.of(biped.robot)
+    for side in SIDES:
+        held = model_profile(model, side)
+        if held is None:
+            problems.append(
+                f"{side} knee: no profiled knee's equalities (knee_arc on knee_upper and "
+                f"knee_lower), the gait's robot has k1 = {wanted.k1:.6g}, k2 = {wanted.k2:.6g}"
+            )
+            continue
+        if not biped.robot.profiled:
+            problems.append(
+                f"{side} knee: a profile (k1 = {held.k1:.6g}, k2 = {held.k2:.6g}) in the "
+                "model, circles in the gait's robot"
+            )
+        stretch = _stretch(model, side)
+        expected = {"slide": 1.0, "lower": wanted.k1, "upper": wanted.k2}
+        if stretch is None or any(
+            not math.isclose(stretch.get(p, 0.0), v, rel_tol=PARAMETER_TOLERANCE, abs_tol=1e-12)
+            for p, v in expected.items()
+        ):
+            problems.append(
+                f"{side} knee: no pinned tendon knee_slide + k1 knee_lower + k2 knee_upper "
+                f"(k1 = {wanted.k1:.6g}, k2 = {wanted.k2:.6g}) of the gait's robot"
+            )
+    return problems
+
+
+def _stretch(model: mujoco.MjModel, side: str) -> dict | None:
+    """The coefficients of the pinned tendon of ``side``'s knee slide, by joint part
+    (slide, lower, upper); None without it or its equality."""
+    tendon = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TENDON, f"{side}_knee_stretch")
+    if tendon < 0:
+        return None
+    pinned = any(
+        model.eq_type[k] == mujoco.mjtEq.mjEQ_TENDON
+        and model.eq_obj1id[k] == tendon
+        and model.eq_obj2id[k] < 0
+        and model.eq_active0[k]
+        for k in range(model.neq)
+    )
+    if not pinned:
+        return None
+    parts = {}
+    start, count = model.tendon_adr[tendon], model.tendon_num[tendon]
+    for w in range(start, start + count):
+        name = model.joint(model.wrap_objid[w]).name
+        parts[name.removeprefix(f"{side}_knee_")] = float(model.wrap_prm[w])
+    return parts
 
 
 def _knee_ratio(model: mujoco.MjModel, side: str) -> float | None:
@@ -242,7 +300,18 @@ def model_parameters(model: mujoco.MjModel, knee: str) -> dict[str, list[tuple[s
             add("foot_length", f"geoms {side}_heel_contact, {side}_toe_contact", toe - heel)
         r1 = r2 = 0.0
         below_thigh = shank
-        if knee == "rolling":
+        profile = model_profile(model, side) if knee == "rolling" else None
+        if profile is not None:  # validate.profile_mjcf
+            below_thigh = model.body(f"{side}_knee_link")
+            r1, r2 = profile.r1, profile.r2
+            where = f"equalities {side}_knee_thigh_arc, {side}_knee_shank_arc"
+            for name in ("r1", "r2", "k1", "k2"):
+                add(name, where, getattr(profile, name))
+            add("k2", f"position of {side}_knee_link", below_thigh.pos[0])
+            add("k1", f"position of {side}_foot", -foot.pos[0])
+            slider = model.body(f"{side}_knee_slider")
+            add("k1", f"position of {side}_knee_slider", slider.pos[0] + below_thigh.pos[0])
+        elif knee == "rolling":
             below_thigh = model.body(f"{side}_knee_link")
             ratio = _knee_ratio(model, side)  # r2 / r1
             if not ratio:  # None or not a ratio (model_problems says so)

@@ -211,7 +211,7 @@ def section_advance(walker: Walker) -> float:
 def paper_state(sim: Simulation, row: int, stance: str, radii) -> tuple[np.ndarray, np.ndarray]:
     """(q, q̇) (9,) of MuJoCo's state at ``row`` in the paper's coordinates of ``stance`` in
     stance, x_H from the stance ankle."""
-    to_paper = np.linalg.pinv(mapping(sim.model, stance, radii).qpos_from_q)
+    to_paper = mapping(sim.model, stance, radii).to_paper
     q, qd = to_paper @ sim.qpos[row], to_paper @ sim.qvel[row]
     q[XH] -= sim.ankle_x(stance)[row]
     return q, qd

@@ -114,19 +114,21 @@ def replay_step(
     middle = t + 0.5 * h  # the controls act over each step: the torques at its middle
     q, qd = samples.at("q", t), samples.at("qd", t)
     torques, qdd = samples.at("torques", middle), samples.at("qdd", middle)
+    at_middle = samples.at("q", middle), samples.at("qd", middle)
+    accelerations = layout.joint_angles(mapped.qacc(*at_middle, qdd))
     to_joint = mapped.columns  # paper joint i -> column of JOINT_ORDER
     # Motors: MuJoCo's joint torque -Γ plus the rotor's J_r θ̈_mj, per unit of gear.
     joint_torque = np.zeros((n, 6))
     joint_torque[:, to_joint] = -torques
-    joint_torque += layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
+    joint_torque += layout.rotor_inertia * accelerations
     controls = np.zeros((1, n, model.nu))
     controls[0][:, layout.motors] = joint_torque / layout.gears
     controls[0][:, layout.positions] = layout.joint_angles(mapped.qpos(q))
-    controls[0][:, layout.velocities] = layout.joint_angles(mapped.qpos(qd))
+    controls[0][:, layout.velocities] = layout.joint_angles(mapped.qvel(q, qd))
 
     data = mujoco.MjData(model)
     data.qpos[:] = mapped.qpos(q[0])
-    data.qvel[:] = mapped.qpos(qd[0])
+    data.qvel[:] = mapped.qvel(q[0], qd[0])
     mujoco.mj_forward(model, data)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(model, spec))
@@ -142,7 +144,7 @@ def replay_step(
     servo = kp * (controls[0][:, layout.positions] - angles)
     servo += kv * (controls[0][:, layout.velocities] - rates_after)
     motors = controls[0][:, layout.motors] * layout.gears
-    rotor = layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
+    rotor = layout.rotor_inertia * accelerations
     # Paper's sign and order: Γ = -(MuJoCo's joint torque).
     feedforward = -(motors - rotor)[:, to_joint]
     feedback = -servo[:, to_joint]

@@ -227,8 +227,8 @@ def phase_table(
         table[:, TORQUES][:, mapped.columns] = -torques
         table[:, TORQUES] /= layout.gears
         table[:, REFERENCES] = layout.joint_angles(mapped.qpos(q))
-        table[:, RATES] = layout.joint_angles(mapped.qpos(qd))
-        table[:, ROTORS] = layout.rotor_inertia * layout.joint_angles(mapped.qpos(qdd))
+        table[:, RATES] = layout.joint_angles(mapped.qvel(q, qd))
+        table[:, ROTORS] = layout.rotor_inertia * layout.joint_angles(mapped.qacc(q, qd, qdd))
         table[:, ROTORS] /= layout.gears
     return PhaseTable(advance, tau, speed=qd[:, XH], controls=controls)
 
@@ -662,7 +662,7 @@ def _walk_on(walker, steps, settings, model, data, start=None, stop_advance=None
     layout, samples, period = walker.layout.of(model), walker.samples, walker.period
     q0, qd0 = samples.start() if start is None else start
     left = mapping(model, "left", walker.biped.radii)
-    data.qpos[:], data.qvel[:] = left.qpos(q0), left.qpos(qd0)
+    data.qpos[:], data.qvel[:] = left.qpos(q0), left.qvel(q0, qd0)
     mujoco.mj_forward(model, data)
     dt = model.opt.timestep
     chunk = max(1, round(RESYNC / dt))  # physics steps per reading period

@@ -134,7 +134,12 @@ class OrbitFigures:
 
 
 FIGURE_UNITS = {
-    "model": {"mass_difference": "kg", "problems": PURE},
+    "model": {
+        "mass_difference": "kg",
+        "problems": PURE,
+        "knee_position_error": "m",  # a profiled knee's (``validate.knee_fit``)
+        "knee_angle_error": "rad",
+    },
     "inverse_dynamics": {
         "max_torque_error": "N·m",
         "max_force_error": "N",  # of Fx, Fz
