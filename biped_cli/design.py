@@ -62,6 +62,19 @@ def add_parsers(commands) -> None:
     design = types.add_command(commands, "design", help, cmd_design)
     types.add_speed(design)
     types.add_gait_out(design)
+    from biped.model.profile import FAMILIES
+
+    design.add_argument(
+        "--profile",
+        choices=FAMILIES,
+        default=None,
+        metavar="FAMILY",
+        help="design the knee's two surfaces as profiles of FAMILY ("
+        + ", ".join(FAMILIES)
+        + ": each radius of curvature r + k ψ of its tangent angle ψ), started from the "
+        "optimal circles and never worse than them; the gait file's robot holds r1, r2, "
+        "k1, k2 (default: circles)",
+    )
     _add_common(design)
 
     help = "optimal gait over a grid of knee radii, and the optimal radii, per speed"
@@ -142,10 +155,14 @@ def cmd_design(args) -> int:
     """
     from biped.optimization.design import bound_notes, compare
     from biped.records.gait_file import Gait
+    from biped_cli.profile import check_profile_options, run_profile
 
     robot = types.robot_of(args)
+    check_profile_options(args)
     problem = design_problem(args, robot, args.speed)
     types.check_output(args.out)
+    if args.profile is not None:
+        return run_profile(args, problem)
     print(f"designing the {problem.describe()} (seed {args.seed})...", file=sys.stderr)
     comparison = compare(problem, seed=args.seed, starts=args.starts)
     design = comparison.design

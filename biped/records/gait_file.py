@@ -71,6 +71,7 @@ from biped.optimization.problem import (
     check_speed,
     variable_names,
 )
+from biped.optimization.profile_design import PROFILE_DESIGN_UNITS
 from biped.optimization.report import Report
 from biped.records.provenance import provenance as make_provenance
 from biped.runtime.files import atomic_write_text
@@ -528,6 +529,15 @@ class Gait:
         return dataclasses.replace(gait, design=comparison.to_dict())
 
     @classmethod
+    def from_profile_design(cls, comparison) -> Gait:
+        """The gait of a knee profile's design
+        (``biped.optimization.profile_design.ProfileComparison``): the designed robot's gait
+        (the circles', when no profile did better), the comparison as its ``design``."""
+        design = comparison.profile
+        gait = cls.from_optimum(design.optimum, design.robot)
+        return dataclasses.replace(gait, design=comparison.to_dict())
+
+    @classmethod
     def read(cls, path: str | Path, allowed: str = GAIT_FILE, consistent: bool = False) -> Gait:
         """Read a gait file. Raises BipedError if it is not one, saying what it is if it is
         another of this project's files and what is ``allowed`` (default a gait file: what
@@ -616,13 +626,15 @@ class Gait:
         actuators: bool = False,
         design: bool = False,
         profile: bool = False,
+        profile_design: bool = False,
     ) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion`` in the family of
         ``knots`` interior knots, under the margins ``safety`` (the paper's by default), with
         the robot's actuators if ``actuators`` (a robot file's, not the default set), with a
         designed knee's block if ``design`` (``DESIGN_UNITS``), with the knee profile's rates
-        k1, k2 if ``profile`` (a robot whose knee surfaces are not circles), from the fields'
-        declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
+        k1, k2 if ``profile`` (a robot whose knee surfaces are not circles), with a profile
+        design's block if ``profile_design`` (``PROFILE_DESIGN_UNITS`` beside
+        ``DESIGN_UNITS``), from the fields' declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
         units = declared_units(Gait, "", criterion)
         if not profile:  # circles: k1 = k2 = 0 are not written (``Robot.to_dict``)
             units.pop("robot.k1")
@@ -633,8 +645,10 @@ class Gait:
         for name in walkable.SCALES:  # the margins of the walkable constraints asked only
             if name not in safety.walkable:
                 units.pop(f"walkability.{name}", None)
-        if design:
+        if design or profile_design:
             units.update(DESIGN_UNITS)
+        if profile_design:
+            units.update(PROFILE_DESIGN_UNITS)
         if actuators:
             for kind in KINDS:
                 for name, unit in ACTUATOR_UNITS.items():
@@ -658,6 +672,7 @@ class Gait:
             self.robot.actuators is not None,
             self.design is not None,
             self.robot.profiled,
+            isinstance(self.design, dict) and "profile" in self.design,
         )
         for group in ("impact", "walkability"):  # a figure not written has no unit
             record = getattr(self, group)
