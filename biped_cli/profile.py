@@ -4,20 +4,30 @@ family (``biped.model.profile``) with the gait, from the best circles
 
 from __future__ import annotations
 
+import dataclasses
 import sys
+from pathlib import Path
 
 from biped.errors import BipedError
+
+# The designed circles' gait file, beside the profile's: ``<stem>-circles.json``.
+CIRCLES_SUFFIX = "-circles.json"
 
 
 def run_profile(args, problem) -> int:
     """The profile design of ``problem`` (a circles' ``DesignProblem``): the circles'
     comparison, then the profile from its circles; prints the four knees and writes the gait
-    file of the designed profile. Exits 1 when the profile's search or a knee compared is
-    not certified (no file when the design itself is not)."""
+    file of the designed profile and, beside it, the designed circles' (``CIRCLES_SUFFIX``,
+    named in the profile's design block as ``circles_gait``). Exits 1 when the profile's
+    search or a knee compared is not certified (no file when the design itself is not)."""
     from biped.optimization.design import bound_notes
     from biped.optimization.profile_design import ProfileProblem, compare_profile
     from biped.records.gait_file import Gait
+    from biped_cli import args as types
 
+    out = Path(args.out)
+    circles_path = out.with_name(f"{out.stem}{CIRCLES_SUFFIX}")
+    types.check_output(str(circles_path))
     profiled = ProfileProblem(problem, args.profile)
     print(f"designing the {profiled.describe()} (seed {args.seed})...", file=sys.stderr)
     comparison = compare_profile(profiled, seed=args.seed, starts=args.starts)
@@ -37,8 +47,12 @@ def run_profile(args, problem) -> int:
         )
         print(f"biped design: {reason}; no file written", file=sys.stderr)
         return 1
-    path = Gait.from_profile_design(comparison).write(args.out)
+    gait = Gait.from_profile_design(comparison)
+    design = {**gait.design, "circles_gait": circles_path.name}
+    path = dataclasses.replace(gait, design=design).write(out)
     print(f"wrote {path}")
+    written = Gait.from_design(comparison.circles).write(circles_path)
+    print(f"wrote {written} (the designed circles' gait, which the page draws beside)")
     bad = comparison.circles.uncertified()
     if bad:
         print(

@@ -128,3 +128,25 @@ def test_a_profile_design_that_does_not_converge_exits_1(tmp_path, monkeypatch, 
     finally:
         for cache in caches:
             cache.cache_clear()
+
+
+def test_the_profiles_page_draws_it_beside_the_circles(designed, tmp_path):
+    """'biped report' on the profile's file: a section with its rates, the surfaces'
+    margins and gains, and the figure of the surfaces, the contact and the torques, the
+    circles' gait (written beside the profile's) drawn with it."""
+    from biped.pages.profile_figures import profile_figure
+    from biped.records import gait_file
+    from biped_cli import main
+
+    path = designed[3]
+    circles_path = path.with_name(path.stem + "-circles.json")
+    circles = gait_file.read(circles_path)
+    assert not circles.robot.profiled and circles.design["radii"]["r1"] > 0.18
+    assert main(["report", str(path), "--out", str(tmp_path / "pages")]) == 0
+    (page,) = (tmp_path / "pages").glob("*.md")
+    text = page.read_text()
+    assert "## Knee profile" in text and "profile vs designed circles" in text
+    assert (page.with_suffix("") / "profile.png").is_file()
+    figure = profile_figure(gait_file.read(path), circles)
+    lines = [line for ax in figure.axes[3:] for line in ax.get_lines()]
+    assert sum("circles" in line.get_label() for line in lines) == 6  # beside the circles'

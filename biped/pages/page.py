@@ -53,6 +53,7 @@ from biped.pages.figures import (
     time_figure,
 )
 from biped.pages.orbit_figures import multipliers_figure
+from biped.pages.profile_figures import PROFILE_FIGURE, profile_figure
 from biped.pages.walk_figures import TORQUES_FIGURE, has_profiles, torques_figure
 from biped.pages.walk_figures import walk_lines as mujoco_walk_lines
 from biped.records.gait_file import Gait
@@ -560,6 +561,7 @@ def markdown(page: Page, folder: Path) -> str:
             else []
         ),
         *design_lines(gait),
+        *profile_lines(gait, page.name),
         "",
         "## Criteria",
         "",
@@ -640,6 +642,52 @@ def design_lines(gait: Gait) -> list[str]:
         shown = f"{value:+.2f} %" if isinstance(value, (int, float)) else "n/a"
         lines += [f"- {first} vs {second}: {shown}"]
     return lines
+
+
+def profile_lines(gait: Gait, name: str) -> list[str]:
+    """The section of a designed knee profile (``biped design --profile``: the design's
+    ``profile``): its rates, the surfaces' margins, its gains and its figure."""
+    profile = (gait.design or {}).get("profile") if isinstance(gait.design, dict) else None
+    if not isinstance(profile, dict):
+        return []
+    rates = profile.get("rates") or {}
+    gains = gait.design.get("gains_percent") or {}
+    kept = "no profile ended below the circles: the circles are kept. " * bool(
+        profile.get("kept_circles")
+    )
+    lines = [
+        "",
+        "## Knee profile",
+        "",
+        f"The surfaces' radii of curvature r_i + k_i ψ ({profile.get('family')} family, "
+        f"`biped design --profile`), started from the designed circles; {kept}"
+        f"k1 = {_number(rates.get('k1'))} m/rad, k2 = {_number(rates.get('k2'))} m/rad "
+        f"(|k| <= {_number(profile.get('rate_bound'))} m/rad), over the knee's flexion "
+        f"{_number(profile.get('range'))} rad.",
+        "",
+        "| surfaces' bound | margin | unit |",
+        "|---|---|---|",
+    ]
+    for bound, margin in (profile.get("surface_margins") or {}).items():
+        lines += [f"| {bound} | {_number(margin)} | {'m' if 'convex' in bound else 'm²'} |"]
+    lines += [""]
+    for key, words in (
+        ("profile_vs_circles", "profile vs designed circles"),
+        ("profile_vs_revolute", "profile vs revolute"),
+    ):
+        value = gains.get(key)
+        lines += [f"- {words}: {value:+.3f} %" if isinstance(value, (int, float)) else ""]
+    lines += ["", f"![knee profile]({name}/{PROFILE_FIGURE})"]
+    return lines
+
+
+def _circles_of(page: Page) -> Gait | None:
+    """The designed circles' gait file a profile's design names (``circles_gait``), beside
+    the page's gait file; None without one."""
+    design = page.gait.design if isinstance(page.gait.design, dict) else {}
+    name = design.get("circles_gait")
+    path = Path(page.source).parent / name if isinstance(name, str) else None
+    return Gait.read(path) if path is not None and path.is_file() else None
 
 
 def _constraint_lines(gait: Gait) -> list[str]:
@@ -821,6 +869,8 @@ def page_figures(page: Page) -> dict[str, Figure]:
         figures[ORBIT_FIGURE] = multipliers_figure(orbit, title)
     if has_profiles(page.validation):
         figures[TORQUES_FIGURE] = torques_figure(page.validation["forward"], title)
+    if profile_lines(page.gait, page.name):
+        figures[PROFILE_FIGURE] = profile_figure(page.gait, _circles_of(page))
     return figures
 
 
