@@ -113,3 +113,25 @@ def test_the_model_check_reads_the_profile_back_and_tells_another(model, biped_m
     assert not circles.passed and "no profiled knee's equalities" in circles.notes[0]
     circle_gait = check_model(model, biped.Biped(ROBOT, "rolling"))
     assert not circle_gait.passed and "circles in the gait's robot" in circle_gait.notes[0]
+
+
+def test_rotor_torques_are_the_armatures_power(model, biped_model):
+    """The rotors' torques per joint (``rotor_torques``) times the joints' rates are the
+    power of every armature, Σ_j a_j q̈_j q̇_j, though a profiled knee's joints turn at rates
+    that vary with its flexion; the circles' keep ``Layout.rotor_inertia`` exactly."""
+    from validate.layout import Layout
+    from validate.mapping import rotor_torques
+
+    q, qd, qdd = random_state(biped_model, seed=4, n=8, spread=0.5)
+    layout = Layout(model)
+    mapped = mapping(model, "left", biped_model.radii)
+    torques = rotor_torques(mapped, layout, q, qd, qdd)
+    qvel, qacc = mapped.qvel(q, qd), mapped.qacc(q, qd, qdd)
+    power = (model.dof_armature * qacc * qvel).sum(-1)
+    joints = layout.joint_angles(qvel)
+    np.testing.assert_allclose((torques * joints).sum(-1), power, rtol=1e-12, atol=1e-12)
+    circles = scene_model(ROBOT, "rolling")
+    flat = mapping(circles, "left", (ROBOT.r1, ROBOT.r2))
+    circle_layout = Layout(circles)
+    expected = circle_layout.rotor_inertia * circle_layout.joint_angles(flat.qacc(q, qd, qdd))
+    assert np.array_equal(rotor_torques(flat, circle_layout, q, qd, qdd), expected)

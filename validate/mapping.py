@@ -175,3 +175,27 @@ def mapping(model: mujoco.MjModel, stance: str, radii=(0.0, 0.0)) -> Mapping:
         profile=profile,
         to_paper=to_paper,
     )
+
+
+def rotor_torques(mapped: Mapping, layout, q, qd, qdd) -> np.ndarray:
+    """(..., 6) The torques the drives' rotors (MuJoCo's armature) take along q, q̇, q̈, per
+    joint of ``JOINT_ORDER`` in MuJoCo's sign: Σ_j a_j s_j q̈_j over each joint's MuJoCo
+    joints j (armature a_j, rate s_j per unit of the joint's angle), virtual work exactly.
+    The circles' rates are constant: ``Layout.rotor_inertia`` times the joint angles'
+    accelerations; a profiled knee's vary with its flexion (``knee_joints``)."""
+    qacc = mapped.qacc(q, qd, qdd)
+    torques = layout.rotor_inertia * layout.joint_angles(qacc)
+    if not mapped.knees:
+        return torques
+    q = np.asarray(q, dtype=float)
+    armature = layout.model.dof_armature
+    sides = (mapped.stance, other(mapped.stance))
+    for side, (thigh, shank, addresses) in zip(sides, mapped.knees, strict=True):
+        _, rates, _ = knee_joints(mapped.profile, q[..., thigh] - q[..., shank])
+        row = JOINT_ORDER.index(f"{side}_knee")
+        # per unit of MuJoCo's knee angle, −θ: s_j = −dq_j/dθ
+        torques[..., row] = sum(
+            armature[address] * -rate * qacc[..., address]
+            for address, rate in zip(addresses, rates, strict=True)
+        )
+    return torques

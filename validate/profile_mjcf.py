@@ -20,8 +20,10 @@ and coupled by equalities that are the rolling relation itself, not a fit of it:
 (ψ_i = −knee_upper, −knee_lower; S_i(ψ) = r_i ψ + k_i ψ² / 2, MuJoCo's quartic holds them
 exactly; the equal arcs are rolling without slip.) The knee tendon upper + lower is the
 flexion, as the circles'; the motor drives it. The knee link, the slider and the arc's body
-carry ``KNEE_LINK_MASS`` (the arc's ``ARC_MASS``), every knee joint ``KNEE_ARMATURE``; the
-cross-check removes both (but the arc's mass).
+carry ``KNEE_LINK_MASS`` (the arc's ``ARC_MASS``), the hinges and the arc ``KNEE_ARMATURE``;
+the cross-check removes both (but the arc's mass). The slide has none: the lower leg it
+carries is its inertia, and a rotor's there would weigh on the knee by its rate Σ', which a
+large k2 makes metres a radian (8 m/rad: 0.16 kg·m² where the hinges' are 0.01).
 """
 
 from __future__ import annotations
@@ -99,7 +101,7 @@ def knee_bodies(profile: KneeProfile, side: str, thigh: float, pad: str, parts: 
         f"{pad}    {parts['inertial']}",
         f'{pad}    <body name="{side}_knee_slider" pos="{_f(profile.k1 - profile.k2)} 0 '
         f'{_f(-link)}">',
-        f'{pad}      <joint name="{side}_knee_slide" type="slide" axis="0 0 -1" {hinge}/>',
+        f'{pad}      <joint name="{side}_knee_slide" type="slide" axis="0 0 -1"/>',  # no armature
         f"{pad}      {parts['inertial']}",
         f'{pad}      <body name="{side}_shank">',
         f'{pad}        <joint name="{side}_knee_lower" '

@@ -39,7 +39,7 @@ from mujoco import rollout
 
 from biped.model.dynamics import JOINTS, Biped
 from validate.layout import Layout
-from validate.mapping import mapping
+from validate.mapping import mapping, rotor_torques
 from validate.model import JOINT_ORDER, with_servos
 from validate.samples import GaitSamples
 from validate.simulate import KP, KV
@@ -115,12 +115,12 @@ def replay_step(
     q, qd = samples.at("q", t), samples.at("qd", t)
     torques, qdd = samples.at("torques", middle), samples.at("qdd", middle)
     at_middle = samples.at("q", middle), samples.at("qd", middle)
-    accelerations = layout.joint_angles(mapped.qacc(*at_middle, qdd))
+    rotors = rotor_torques(mapped, layout, *at_middle, qdd)
     to_joint = mapped.columns  # paper joint i -> column of JOINT_ORDER
     # Motors: MuJoCo's joint torque -Γ plus the rotor's J_r θ̈_mj, per unit of gear.
     joint_torque = np.zeros((n, 6))
     joint_torque[:, to_joint] = -torques
-    joint_torque += layout.rotor_inertia * accelerations
+    joint_torque += rotors
     controls = np.zeros((1, n, model.nu))
     controls[0][:, layout.motors] = joint_torque / layout.gears
     controls[0][:, layout.positions] = layout.joint_angles(mapped.qpos(q))
@@ -144,7 +144,7 @@ def replay_step(
     servo = kp * (controls[0][:, layout.positions] - angles)
     servo += kv * (controls[0][:, layout.velocities] - rates_after)
     motors = controls[0][:, layout.motors] * layout.gears
-    rotor = layout.rotor_inertia * accelerations
+    rotor = rotors
     # Paper's sign and order: Γ = -(MuJoCo's joint torque).
     feedforward = -(motors - rotor)[:, to_joint]
     feedback = -servo[:, to_joint]

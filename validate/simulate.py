@@ -67,7 +67,7 @@ from biped.model.kinematics import XH, ZH
 from biped.records.gait_file import Gait
 from validate import DEFAULT_STEPS
 from validate.layout import Layout
-from validate.mapping import mapping, other
+from validate.mapping import mapping, other, rotor_torques
 from validate.mjcf import SIDES
 from validate.model import JOINT_ORDER, model_spec, with_servos
 from validate.samples import GaitSamples
@@ -228,7 +228,7 @@ def phase_table(
         table[:, TORQUES] /= layout.gears
         table[:, REFERENCES] = layout.joint_angles(mapped.qpos(q))
         table[:, RATES] = layout.joint_angles(mapped.qvel(q, qd))
-        table[:, ROTORS] = layout.rotor_inertia * layout.joint_angles(mapped.qacc(q, qd, qdd))
+        table[:, ROTORS] = rotor_torques(mapped, layout, q, qd, qdd)
         table[:, ROTORS] /= layout.gears
     return PhaseTable(advance, tau, speed=qd[:, XH], controls=controls)
 
