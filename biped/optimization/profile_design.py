@@ -48,9 +48,11 @@ from biped.optimization.optimize import CONFIRM, Optimum, Report, checked, multi
 from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 
-# [m/rad] Bound of |k_i|: a radius of curvature that changes by half a metre a radian, far
-# beyond what the surfaces' bounds allow within a segment (they bind first).
-RATE_BOUND = 0.5
+# [m/rad] Bound of |k_i|, the box IPOPT needs: 20 m a radian, beyond what the surfaces'
+# bounds allow (at 0.3 m/s with a 2 cm clearance the thigh's k2 = 8.1 m/rad is held by its
+# convexity at the extension stop and its distance at full flexion; at 0.5, 2 or 5 m/rad the
+# box bound it first, each lower the criterion).
+RATE_BOUND = 20.0
 # Profiles drawn about the circles' design as further starts: k_i uniform in
 # ±``RANDOM_RATE`` [m/rad], the radii the circles'.
 RANDOM_STARTS = 2
