@@ -11,7 +11,7 @@ import re
 import sys
 
 from biped.records.provenance import command_line, version
-from biped_cli import atlas, commands, design, orbit, report, robustness, size
+from biped_cli import atlas, commands, design, orbit, profile, report, robustness, size
 from biped_cli.args import complete_later, lazy_commands
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
 
@@ -63,6 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
         commands.add_table,
         atlas.add_parser,
         design.add_parsers,
+        profile.add_parser,
         report.add_parser,
         robustness.add_parser,
         orbit.add_parser,

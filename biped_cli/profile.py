@@ -77,3 +77,100 @@ def check_profile_options(args) -> None:
                 f"k2 = {robot.k2:g}): allowed a robot of circles (k1 = k2 = 0), the design's "
                 "first start"
             )
+
+
+def add_parser(commands) -> None:
+    from biped.studies.sweep import DEFAULT_SPEEDS
+    from biped_cli import args as types
+
+    help = "a designed knee profile over the speeds, against circles designed at each"
+    parser = types.add_command(commands, "profile-speeds", help, cmd_profile_speeds)
+    parser.add_argument("gait", metavar="GAIT.json", help="gait file of biped design --profile")
+    types.add_speeds(parser, DEFAULT_SPEEDS, "the sweep's, 0.15:0.45:13")
+    parser.add_argument("--out", required=True, metavar="FILE", help="JSON of the rows to write "
+                        "(its figure beside it, .png)")  # fmt: skip
+    types.add_options(
+        parser,
+        ("--starts", types.starts, 3, "N", "IPOPT starts of each optimization (default 3)"),
+        ("--seed", types.non_negative, 0, "N", "seed of the random starts (default 0)"),
+    )  # fmt: skip
+
+
+def cmd_profile_speeds(args) -> int:
+    """The knee profile of a gait file (``biped design --profile``: its robot's r1, r2, k1,
+    k2), machined once, at each speed of --speeds: its optimal gait beside the circles
+    designed at that speed and the revolute knee, for the file's criterion and margins
+    (``biped.studies.profile_speeds``). Prints the table, writes it as JSON and its figure
+    (.png beside). Exits 1 when a knee at a speed is not certified."""
+    from biped.model.criteria import CRITERION_UNITS
+    from biped.pages.profile_figures import speeds_figure
+    from biped.records.gait_file import Gait, write_json
+    from biped.studies.profile_speeds import row_at, table
+    from biped_cli import args as types
+
+    gait = Gait.read(args.gait, consistent=True)
+    if gait.knee != "rolling" or not gait.robot.profiled:
+        raise BipedError(
+            f"gait file {args.gait!r} has a {gait.knee} knee of circles: allowed the gait file "
+            "of a knee profile (biped design --profile)"
+        )
+    out = Path(args.out)
+    types.check_output(str(out))
+    figure_path = out.with_suffix(".png")
+    types.check_output(str(figure_path))
+    machined = _machined_circles(gait, args.gait)
+    rows = []
+    for speed in args.speeds:
+        print(f"at {speed:.3f} m/s ...", file=sys.stderr)
+        settings = (gait.criterion, gait.safety, args.seed, args.starts)
+        rows.append(row_at(gait.robot, machined, float(speed), *settings))
+    print(table(rows, CRITERION_UNITS[gait.criterion]))
+    content = {
+        "gait": str(args.gait),
+        "robot": gait.robot.to_dict(),
+        "criterion": gait.criterion,
+        "designed_at": gait.speed,
+        "machined_circles": dict(zip(("r1", "r2"), machined, strict=True)),
+        "rows": [row.to_dict() for row in rows],
+    }
+    content["units"] = units(content, CRITERION_UNITS[gait.criterion])
+    print(f"wrote {write_json(out, content)}")
+    speeds_figure(rows, gait.criterion, gait.speed).savefig(figure_path, dpi=120)
+    print(f"wrote {figure_path}")
+    bad = [row.speed for row in rows if not row.all_certified]
+    if bad:
+        print(
+            f"biped profile-speeds: not certified at {', '.join(f'{v:.3f}' for v in bad)} m/s "
+            "(their changes are unknown)",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
+
+
+def units(content: dict, criterion_unit: str) -> dict:
+    """The ``units`` map of a profile-speeds file (``biped.model.units``): every number's."""
+    from biped.model.units import PERCENT, robot_unit
+    from biped.studies.profile_speeds import CHANGES, KNEES
+
+    found = {f"robot.{name}": robot_unit(name) for name in content["robot"] if name != "actuators"}
+    found.update({"designed_at": "m/s", "rows[].speed": "m/s"})
+    found.update({f"machined_circles.{name}": "m" for name in ("r1", "r2")})
+    found.update({f"rows[].values.{knee}": criterion_unit for knee in KNEES})
+    found.update({f"rows[].circles_radii.{name}": "m" for name in ("r1", "r2")})
+    for name in CHANGES:
+        found[f"rows[].{name}"] = PERCENT
+    return found
+
+
+def _machined_circles(gait, path) -> tuple:
+    """(r1, r2) [m] of the circles designed at the profile's speed: its design block's row
+    of the designed circles."""
+    rows = (gait.design or {}).get("compared") if isinstance(gait.design, dict) else None
+    for row in rows or []:
+        if row.get("knee") == "rolling, optimal radii" and row.get("radii"):
+            return float(row["radii"]["r1"]), float(row["radii"]["r2"])
+    raise BipedError(
+        f"gait file {path!r} has no designed circles in its design block: allowed the gait "
+        "file of biped design --profile"
+    )

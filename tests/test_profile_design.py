@@ -150,3 +150,33 @@ def test_the_profiles_page_draws_it_beside_the_circles(designed, tmp_path):
     figure = profile_figure(gait_file.read(path), circles)
     lines = [line for ax in figure.axes[3:] for line in ax.get_lines()]
     assert sum("circles" in line.get_label() for line in lines) == 6  # beside the circles'
+
+
+def test_a_machined_profile_over_the_speeds_beside_circles_designed_at_each(designed):
+    """At its own speed the profile is its design (never worse than the circles designed
+    there, nor than those circles machined); a knee not certified leaves its changes
+    unknown (None), never zero."""
+    from biped.records import gait_file
+    from biped.studies.profile_speeds import SpeedRow, row_at, table
+
+    gait = gait_file.read(designed[3])
+    circles = next(r for r in gait.design["compared"] if r["knee"] == "rolling, optimal radii")
+    machined = (circles["radii"]["r1"], circles["radii"]["r2"])
+    row = row_at(gait.robot, machined, 0.3, "sthenic", gait.safety, starts=1)
+    assert row.all_certified and row.radii == pytest.approx(machined, abs=1e-6)
+    assert row.values["profile"] == pytest.approx(gait.costs.sthenic, rel=1e-6)
+    assert row.change("profile", "circles") < 0 and row.change("profile", "machined") < 0
+    assert row.values["machined"] == pytest.approx(row.values["circles"], rel=1e-6)
+    unknown = SpeedRow(0.5, row.values, {**row.certified, "profile": False}, row.radii)
+    assert unknown.change("profile", "circles") is None
+    assert unknown.to_dict()["profile_vs_revolute"] is None
+    assert "n/a" in table([unknown], "N²·m·s") and "NOT CERTIFIED: profile" in table([unknown], "")
+
+
+def test_profile_speeds_refuses_a_gait_of_circles(designed, capsys):
+    from biped_cli import main
+
+    circles = designed[3].with_name(designed[3].stem + "-circles.json")
+    assert main(["profile-speeds", str(circles), "--out", str(circles.with_name("s.json"))]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "of circles: allowed the gait file of a knee profile" in lines[0]

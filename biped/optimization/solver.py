@@ -285,10 +285,10 @@ class Solver:
         options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
         options.update({f"ipopt.{key}": value for key, value in BARRIERS[barrier].items()})
         derivatives = {"hess_lag": self.hessian, "jac_g": self.jacobian, "grad_f": self.gradient}
-        # A profile design's trial points may leave the family (no real rolling relation:
-        # NaN), which IPOPT's line search steps back from; said once by the report, not by
-        # every evaluation.
-        quiet = {"show_eval_warnings": False} if self.knee_size == len(PARAMETERS) else {}
+        # A profiled knee's trial points may leave its family (no real rolling relation, a
+        # flexion beyond its range: NaN), which IPOPT's line search steps back from; said
+        # once by the report, not by every evaluation.
+        quiet = {"show_eval_warnings": False} if self.graph.profile else {}
         return {**options, "print_time": False, **quiet, **derivatives}
 
     def _solve(self, problem, start, radii, hold_radii, barrier) -> Solution:

@@ -138,3 +138,46 @@ def profile_figure(gait, circles_gait=None) -> Figure:
         f"{gait.criterion}, {gait.speed:.3f} m/s"
     )
     return fig
+
+
+SPEEDS_FIGURE = "speeds.png"
+# The knees of ``biped.studies.profile_speeds`` as the legend names them.
+LEGENDS = {
+    "circles": "circles designed at each speed",
+    "machined": "circles designed with it, machined",
+}
+
+
+def speeds_figure(rows, criterion: str, designed_at: float) -> Figure:
+    """The changes over the speeds (``biped.studies.profile_speeds``): the profile machined
+    for ``designed_at`` against the circles designed at each speed, the circles designed with
+    it (machined too) and the revolute knee, the circles against the revolute knee [%]; a
+    speed not certified is left out (a gap)."""
+    fig = Figure(figsize=(8, 4.6), layout="constrained")
+    ax = fig.subplots()
+    speeds = np.array([row.speed for row in rows])
+    for (first, second), style in (
+        (("profile", "circles"), dict(color=COLORS["profile"], marker="o")),
+        (("profile", "machined"), dict(color="tab:purple", marker="D", ls="-.")),
+        (("profile", "revolute"), dict(color=COLORS["profile"], marker="s", ls="--")),
+        (("circles", "revolute"), dict(color=COLORS["circles"], marker="^", ls=":")),
+    ):
+        values = [row.change(first, second) for row in rows]
+        shown = np.array([np.nan if v is None else v for v in values])
+        label = f"{first} vs {LEGENDS.get(second, second)}"
+        ax.plot(speeds, shown, label=label, **style)
+    ax.axvline(designed_at, color="0.6", lw=0.8)
+    ax.text(
+        designed_at,
+        0.02,
+        f" profile designed at {designed_at:.3f} m/s",
+        transform=ax.get_xaxis_transform(),
+        fontsize=8,
+    )
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("walking speed [m/s]")
+    ax.set_ylabel(f"change of the {criterion} criterion [%]")
+    ax.set_title("one machined knee profile over the speeds (negative: it needs less)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
