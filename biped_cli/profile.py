@@ -91,7 +91,8 @@ def add_parser(commands) -> None:
                         "(its figure beside it, .png)")  # fmt: skip
     types.add_options(
         parser,
-        ("--starts", types.starts, 3, "N", "IPOPT starts of each optimization (default 3)"),
+        ("--starts", types.starts, 3, "N", "IPOPT starts of each optimization (default 3); "
+         + types.CERTIFIED_HELP),
         ("--seed", types.non_negative, 0, "N", "seed of the random starts (default 0)"),
     )  # fmt: skip
 

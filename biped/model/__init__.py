@@ -1,7 +1,9 @@
 """The analytical model of the bipeds (the paper's section 2 and appendices A, B): the robot's
 parameters and conventions (``robot``), geometry (``kinematics``), Lagrangian dynamics, ground
 wrench and ZMP (``dynamics``), the force through each knee and its parts along and across the
-rolling knee's line of centres (``knee_loads``), the flat-foot impact (``impact``), the spline
+rolling knee's line of centres (``knee_loads``), knee surfaces beyond circles (``profile``: a
+family of profiles and their rolling; ``profile_biped``: the biped of such a knee), the
+flat-foot impact (``impact``), the spline
 gait of one step (``gait``, section 3), its criteria and constraints (``criteria``, section 4),
 and the unit of every number, declared beside the fields of the records that hold them
 (``units``); ours: the joints' motors and gears and what they draw (``actuators``), the
