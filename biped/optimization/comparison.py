@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 
+from biped.model.profile import MARGINS, PARAMETER_UNITS
 from biped.optimization.penalty import OPTIMIZE_SAMPLES_PER_HALF
 from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PER_HALF
 
@@ -24,6 +25,21 @@ from biped.optimization.problem import CHECK_SAMPLES_PER_HALF, SOLVER_SAMPLES_PE
 # .Comparison.gains``), by name.
 RADII = ("r1", "r2")
 GAINS = ("design_vs_revolute", "design_vs_table1", "table1_vs_revolute")
+# The changes of a profile design's comparison (``biped.optimization.profile_design``), and
+# the units of its block in a gait file.
+PROFILE_GAINS = ("profile_vs_circles", "profile_vs_revolute", "circles_vs_revolute")
+PROFILE_DESIGN_UNITS = {
+    **{f"design.profile.rates.{name}": PARAMETER_UNITS[name] for name in ("k1", "k2")},
+    "design.profile.rate_bound": "m/rad",
+    "design.profile.range": "rad",
+    **{
+        f"design.profile.surface_margins.{name}": "m" if "convex" in name else "m²"
+        for name in MARGINS
+    },
+    "design.compared[].rates": "m/rad",
+    **{f"design.compared[].rates.{name}": "m/rad" for name in ("k1", "k2")},
+    **{f"design.gains_percent.{name}": "%" for name in PROFILE_GAINS},
+}
 # Convention of every difference between knees, in words (pages, figures, command lines).
 DIFFERENCE = "(rolling − revolute) / revolute; negative: the rolling knee needs less"
 # The same for any knee or design against the revolute knee.

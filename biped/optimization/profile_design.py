@@ -35,14 +35,17 @@ from biped.model.dynamics import Biped
 from biped.model.profile import (
     FAMILIES,
     MARGINS,
-    PARAMETER_UNITS,
     PARAMETERS,
     PROFILE_RANGE,
     KneeProfile,
     surface_margins,
 )
 from biped.model.robot import Robot
-from biped.optimization.comparison import relative_change
+from biped.optimization.comparison import (  # noqa: F401 (re-exported)
+    PROFILE_DESIGN_UNITS,
+    PROFILE_GAINS,
+    relative_change,
+)
 from biped.optimization.design import MIN_RADIUS, Comparison, Design, DesignProblem
 from biped.optimization.optimize import CONFIRM, Optimum, Report, checked, multistart
 from biped.optimization.problem import GaitProblem
@@ -222,7 +225,6 @@ def optimize_profile(problem: ProfileProblem, circles: Design, seed: int = 0) ->
 
 
 # The changes of a profile comparison, by name (``ProfileComparison.gains``).
-PROFILE_GAINS = ("profile_vs_circles", "profile_vs_revolute", "circles_vs_revolute")
 
 
 @dataclass
@@ -326,18 +328,6 @@ class ProfileComparison:
 
 
 # Units of a profile design's block beyond the circles' (``DESIGN_UNITS``).
-PROFILE_DESIGN_UNITS = {
-    **{f"design.profile.rates.{name}": PARAMETER_UNITS[name] for name in ("k1", "k2")},
-    "design.profile.rate_bound": "m/rad",
-    "design.profile.range": "rad",
-    **{
-        f"design.profile.surface_margins.{name}": "m" if "convex" in name else "m²"
-        for name in MARGINS
-    },
-    "design.compared[].rates": "m/rad",
-    **{f"design.compared[].rates.{name}": "m/rad" for name in ("k1", "k2")},
-    **{f"design.gains_percent.{name}": "%" for name in PROFILE_GAINS},
-}
 
 
 def compare_profile(

@@ -63,7 +63,7 @@ from biped.model.units import (
     robot_unit,
     unit_field,
 )
-from biped.optimization.comparison import GAINS, RADII
+from biped.optimization.comparison import GAINS, PROFILE_DESIGN_UNITS, RADII
 from biped.optimization.problem import (
     CHECK_SAMPLES,
     VARIABLES,
@@ -71,7 +71,6 @@ from biped.optimization.problem import (
     check_speed,
     variable_names,
 )
-from biped.optimization.profile_design import PROFILE_DESIGN_UNITS
 from biped.optimization.report import Report
 from biped.records.provenance import provenance as make_provenance
 from biped.runtime.files import atomic_write_text
