@@ -629,20 +629,22 @@ class StepGraph:
         return [theta[i, :] for i in range(6)]
 
     def _clearance_between_samples(self) -> list:
-        """The swing heel's and toe's clearance (``clearance_envelope``) at every sample of
-        the check grid between the solver's, within the swing (the envelope above 0), less
-        ``BETWEEN_SAMPLES_MARGIN``: on the solver's samples alone the sole may dip below it
-        between them (δ of Ψ6, Ψ7 is 1 mm there, ramping from 0 at the step's ends).
+        """The swing heel's and toe's clearance (``clearance_envelope``: 0 within the lift-off
+        and touchdown windows, the sole above the floor) at every sample of the check grid
+        between the solver's, less ``BETWEEN_SAMPLES_MARGIN``: on the solver's samples alone
+        the sole may dip below it between them (δ of Ψ6, Ψ7 is 1 mm there, ramping from 0 at
+        the step's ends: a fast gait's toe went 0.025-0.06 mm into the floor near landing).
         Functions of the head's spline coefficients (the sole's height at a time is a
         function of the angles alone)."""
         knots, safety = self.knots, self.safety
         t_check, (values, _, _) = spline_basis(CHECK_SAMPLES[knots], knots)
         t_solver = np.concatenate(piece_grid(self.samples_per_half, knots))
         required = clearance_envelope(t_check, safety.clearance, safety.clearance_window)
+        inside = (t_check > 0.0) & (t_check < 1.0)  # both feet on the ground at 0 and T
         taken = [
             j
             for j, t in enumerate(t_check)
-            if required[j] > 0.0 and np.min(np.abs(t_solver - t)) > 1e-12
+            if inside[j] and np.min(np.abs(t_solver - t)) > 1e-12
         ]
         coefficients = ca.reshape(self.head_symbol[: self.period_index], self.period_index // 6, 6)
         angles = ca.DM(values[taken, :]) @ coefficients  # (n, 6)
