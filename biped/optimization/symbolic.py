@@ -642,9 +642,7 @@ class StepGraph:
         required = clearance_envelope(t_check, safety.clearance, safety.clearance_window)
         inside = (t_check > 0.0) & (t_check < 1.0)  # both feet on the ground at 0 and T
         taken = [
-            j
-            for j, t in enumerate(t_check)
-            if inside[j] and np.min(np.abs(t_solver - t)) > 1e-12
+            j for j, t in enumerate(t_check) if inside[j] and np.min(np.abs(t_solver - t)) > 1e-12
         ]
         coefficients = ca.reshape(self.head_symbol[: self.period_index], self.period_index // 6, 6)
         angles = ca.DM(values[taken, :]) @ coefficients  # (n, 6)
