@@ -88,7 +88,7 @@ def add_parser(commands) -> None:
     parser.add_argument("gait", metavar="GAIT.json", help="gait file of biped design --profile")
     types.add_speeds(parser, DEFAULT_SPEEDS, "the sweep's, 0.15:0.45:13")
     parser.add_argument("--out", required=True, metavar="FILE", help="JSON of the rows to write "
-                        "(its figure beside it, .png)")  # fmt: skip
+                        f"(its figure beside it, .png; {types.FOLDERS_CREATED})")  # fmt: skip
     types.add_options(
         parser,
         ("--starts", types.starts, 3, "N", "IPOPT starts of each optimization (default 3); "

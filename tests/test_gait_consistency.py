@@ -203,6 +203,7 @@ GAIT_READERS = {
     "orbit": lambda gait, tmp: ["orbit", gait, "--out", f"{tmp}/out"],
     "report": lambda gait, tmp: ["report", gait, "--out", f"{tmp}/out"],
     "size": lambda gait, tmp: ["size", gait],
+    "profile-speeds": lambda gait, tmp: ["profile-speeds", gait, "--out", f"{tmp}/out/rows.json"],
     "figures": lambda sweep, tmp: ["figures", "--sweep", sweep, "--out", f"{tmp}/out"],
     "validate.video": lambda gait, tmp: [gait, "--out", f"{tmp}/walk.mp4", "--steps", "1"],
 }
