@@ -30,11 +30,13 @@ import biped  # noqa: E402
 from biped.optimization.optimize import optimize  # noqa: E402
 from biped.optimization.problem import GaitProblem  # noqa: E402
 from biped.records.gait_file import Gait  # noqa: E402
-from validate import mjcf, orbit, simulate  # noqa: E402
-from validate.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
-from validate.model import model_spec  # noqa: E402
-from validate.simulate import Walker  # noqa: E402
-from validate.validation import validate  # noqa: E402
+from validate.checks import orbit  # noqa: E402
+from validate.checks.crosscheck import load_model, mujoco_inverse_dynamics  # noqa: E402
+from validate.checks.validation import validate  # noqa: E402
+from validate.scene import mjcf  # noqa: E402
+from validate.scene.model import model_spec  # noqa: E402
+from validate.walk import simulate  # noqa: E402
+from validate.walk.simulate import Walker  # noqa: E402
 
 SAMPLES = 1000
 STEPS = 20

@@ -1,5 +1,5 @@
-"""The multipliers of one gait's walk in MuJoCo (``validate.orbit``), beside the same number of
-steps walked as one continuous walk in the same process.
+"""The multipliers of one gait's walk in MuJoCo (``validate.checks.orbit``), beside the same
+number of steps walked as one continuous walk in the same process.
 
     python benchmarks/bench_orbit.py
 
@@ -24,8 +24,8 @@ import biped  # noqa: E402
 from biped.optimization.optimize import optimize  # noqa: E402
 from biped.optimization.problem import GaitProblem  # noqa: E402
 from biped.records.gait_file import Gait  # noqa: E402
-from validate import orbit  # noqa: E402
-from validate.simulate import Walker, WalkSettings, quiet_mujoco  # noqa: E402
+from validate.checks import orbit  # noqa: E402
+from validate.walk.simulate import Walker, WalkSettings, quiet_mujoco  # noqa: E402
 
 REPEATS = 3
 

@@ -25,7 +25,7 @@ class BipedWarning(UserWarning):
 
 class ViewerWarning(BipedWarning):
     """No rerun viewer took a recording streamed to it (--spawn, --connect); the recording's
-    file is written all the same (``validate.record.record``)."""
+    file is written all the same (``validate.outputs.record.record``)."""
 
 
 class CompileWarning(BipedWarning):

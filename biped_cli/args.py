@@ -54,7 +54,7 @@ WALKABLE_HELP = (
     f"model (the sole lands at {_W.landing_share:g} times the walking speed at most, "
     f"friction {_W.friction:g}, clearance {_W.clearance:g} m, ZMP {_W.zmp_margin:g} m inside "
     f"the sole, hips and ankles {_W.joint_margin:g} rad from their stops, the hip at "
-    f"{_W.hip_progress:g} of the walking speed at least; validate/margins_study.py chose "
+    f"{_W.hip_progress:g} of the walking speed at least; validate/studies/margins_study.py chose "
     "them); an option given replaces the preset's value"
 )
 SLOW = f"allowed {MIN_SPEED} m/s or faster (a step lasts seconds, so slower steps are mm long)"

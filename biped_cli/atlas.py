@@ -1,6 +1,6 @@
 """``biped atlas``: where the rolling knee pays off, over speed x clearance (x a least knee bend),
 each difference with its error bar (``biped.studies.atlas``), under the walkable constraints
-or the paper's; every certified optimum walked in MuJoCo (``validate.atlas_walks``); then
+or the paper's; every certified optimum walked in MuJoCo (``validate.studies.atlas_walks``); then
 its CSV, figures and ``atlas.md`` (``biped.pages.atlas``)."""
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ def cmd_atlas(args) -> int:
     atlas.run_atlas(args.out, settings, **types.campaign(args, "atlas"))
     unwalked = []
     if not args.no_walks:
-        from validate import atlas_walks
+        from validate.studies import atlas_walks
 
         atlas_walks.run_walks(args.out, settings, **types.campaign(args, "walks"))
         unwalked = atlas_walks.unmeasured(args.out, settings)

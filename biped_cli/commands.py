@@ -33,7 +33,7 @@ DEFAULT_SPEED = 0.3  # [m/s] the walking speed of the pipeline
 
 
 def check_simulable(robot: Robot, knee: str, source: str) -> None:
-    """Fail before any work if MuJoCo cannot model the robot's knee (``validate.mjcf``: the
+    """Fail before any work if MuJoCo cannot model the robot's knee (``validate.scene.mjcf``: the
     rolling knee is a link between the centres of its two rolling circles, so r1, r2 > 0)."""
     if knee == "rolling" and (robot.r1 <= 0.0 or robot.r2 <= 0.0):
         raise BipedError(
@@ -368,7 +368,7 @@ def read_gaits(paths: list, model: str | None = None) -> list:
     for path, gait in zip(paths, gaits, strict=True):
         check_simulable(gait.robot, gait.knee, f"gait file {path!r}")
     if model is not None:
-        from validate.model import model_spec
+        from validate.scene.model import model_spec
 
         for path, gait in zip(paths, gaits, strict=True):
             with types.naming(f"--model, gait file {path!r}"):
@@ -387,7 +387,7 @@ def cmd_validate(args) -> int:
     and advances, no fall, no slip, the stance foot flat, no scuff of the swing foot); the
     same walk at half and twice the servo stiffness; the walk's orbit stable (the spectral
     radius of its return map from step to step, plus two of its spreads, below 1: biped
-    orbit, validate/orbit.py). Prints a table per gait (or JSON with
+    orbit, validate/checks/orbit.py). Prints a table per gait (or JSON with
     --json) and writes a rerun recording per gait (--spawn, --connect: also to a viewer), the
     report as JSON beside it (<recording>.report.json, which biped report reads) and,
     with --video, the video of the walk; exits 0 only when every check of every gait passes,
@@ -398,7 +398,7 @@ def cmd_validate(args) -> int:
 
     from biped.records.gait_file import write_json
     from biped_cli.progress import Progress
-    from validate.outputs import report_path
+    from validate.outputs.outputs import report_path
     from validate.workflows import validate_and_record
 
     gif = _check_video(args)
@@ -448,7 +448,7 @@ def _check_video(args) -> str | None:
     if args.gif and not args.video:
         raise BipedError("--gif writes beside the --video: allowed with --video FILE.mp4")
     if args.video:
-        from validate.video import check_suffix
+        from validate.outputs.video import check_suffix
 
         check_suffix(args.video, "--video", ".mp4", " (--gif writes a GIF beside it)")
         check_output(args.video, "--video")
@@ -463,7 +463,7 @@ def _recordings(args) -> list:
     that gait file's own before any work."""
     from pathlib import Path
 
-    from validate.outputs import check_owner, output_name
+    from validate.outputs.outputs import check_owner, output_name
 
     recordings = [
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
@@ -551,7 +551,7 @@ def cmd_pipeline(args) -> int:
 
     from biped.optimization.optimize import check_speed
     from biped_cli.design import design_problem
-    from validate.outputs import check_owner
+    from validate.outputs.outputs import check_owner
     from validate.workflows import Pipeline, run_pipeline
 
     robot = robot_of(args)

@@ -1,6 +1,6 @@
 """``biped orbit GAIT.json ... [--vary KNOB VALUES] [--out DIR]``: the orbit of each gait's walk
-in MuJoCo, its Floquet multipliers (``validate.orbit``), under the validation's controller or
-over a range of one of its gains (``validate.orbit_study``).
+in MuJoCo, its Floquet multipliers (``validate.checks.orbit``), under the validation's controller or
+over a range of one of its gains (``validate.studies.orbit_study``).
 
 Per gait ``<out>/<folder>-<gait>.json`` and ``.png`` (the multipliers in the complex plane, or
 with ``--vary`` ρ against the gain), written together; given gaits of both knees, also
@@ -29,11 +29,11 @@ MAX_SCALES = 100
 
 
 class Vary(argparse.Action):
-    """``--vary KNOB VALUES``: a knob of ``validate.orbit_study.KNOBS`` and its scales
+    """``--vary KNOB VALUES``: a knob of ``validate.studies.orbit_study.KNOBS`` and its scales
     (START:STOP:COUNT or a list, each 0 to ``MAX_SCALE``, distinct)."""
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from validate.orbit_study import KNOBS, MAX_SCALE
+        from validate.studies.orbit_study import KNOBS, MAX_SCALE
 
         knob, text = values
         if knob not in KNOBS:
@@ -80,8 +80,8 @@ def add_parser(commands) -> None:
 
 
 def _add_arguments(parser) -> None:
-    from validate.orbit import PHASES, RATE_STEP, STEP
-    from validate.orbit_study import KNOBS
+    from validate.checks.orbit import PHASES, RATE_STEP, STEP
+    from validate.studies.orbit_study import KNOBS
 
     types.add_gaits(parser)
     knobs = "; ".join(f"{name}: {scaled}" for name, (_, scaled) in KNOBS.items())
@@ -115,7 +115,7 @@ def _value(knob: str | None, value) -> str:
 
 
 def orbit_line(knob: str | None, orbit: dict) -> str:
-    """One printed line of an orbit (its figures and notes, ``validate.orbit_study``)."""
+    """One printed line of an orbit (its figures and notes, ``validate.studies.orbit_study``)."""
     where = _value(knob, orbit["value"])
     if "spectral_radius" not in orbit:
         return f"  {where}: {orbit['verdict'].upper()}: {'; '.join(orbit['notes'])}"
@@ -208,7 +208,7 @@ def cmd_orbit(args) -> int:
     averaged over positions of MuJoCo's physics-step grid (--phases); its eigenvalues, the
     Floquet multipliers, and the spectral radius ρ with its spread over the grid positions.
     The verdict: stable when ρ + 2 spreads < 1 at the gait's period, unstable when ρ - 2
-    spreads >= 1 or a walk falls (no orbit), undecided between (validate/orbit.py).
+    spreads >= 1 or a walk falls (no orbit), undecided between (validate/checks/orbit.py).
 
     Under the validation's controller, or with --vary over scales of one of its gains: the
     servos' stiffness (kp), their damping (kv) or the speed loop's gain (speed; 0 turns it
@@ -221,9 +221,9 @@ def cmd_orbit(args) -> int:
     from biped.pages.orbit_figures import knob_figure, multipliers_figure, speeds_figure
     from biped_cli.commands import read_gaits
     from biped_cli.progress import Progress
-    from validate.orbit import RATE_STEP, STEP, Steps
-    from validate.orbit_study import content, study
-    from validate.outputs import output_name
+    from validate.checks.orbit import RATE_STEP, STEP, Steps
+    from validate.outputs.outputs import output_name
+    from validate.studies.orbit_study import content, study
 
     types.check_folder(args.out, "--out")
     gaits = read_gaits(args.gait, args.model)

@@ -1,7 +1,7 @@
 """``biped report GAIT.json ... [--out DIR]``: one Markdown page per gait file, with figures.
 
 The page (``biped.pages.page``) is named from the gait file's path as its recording is
-(``validate.outputs``). Its validation is the report beside the gait file,
+(``validate.outputs.outputs``). Its validation is the report beside the gait file,
 ``<gait>.report.json`` (``biped pipeline`` writes it), else the one ``biped validate`` writes
 beside the gait's default recording, when that recording is the gait's as it is now; its
 links are the recording and videos that report names, or the
@@ -38,7 +38,7 @@ def validation_file(gait_path: str | Path) -> Path | None:
     """A gait file's validation report: the one beside it (``validation_path``, the
     pipeline's), else the one ``biped validate`` writes beside the gait's default recording
     when that recording was made from the gait file as it is now; None without either."""
-    from validate.outputs import belongs_to, output_name, report_path
+    from validate.outputs.outputs import belongs_to, output_name, report_path
 
     beside = validation_path(gait_path)
     if beside.exists():
@@ -67,7 +67,7 @@ def read_validation(path: Path | None) -> dict | None:
 def links(gait_path: Path, validation: dict | None) -> list:
     """The recording and videos of a gait that exist and were made from it as it is now."""
     from biped.pages.page import Link
-    from validate.outputs import belongs_to, open_command, output_name
+    from validate.outputs.outputs import belongs_to, open_command, output_name
 
     found = []
     recording = (validation or {}).get("recording")
@@ -103,7 +103,7 @@ def cmd_report(args) -> int:
     """
     from biped.pages.page import Page, write_pages
     from biped.records import gait_file
-    from validate.outputs import output_name
+    from validate.outputs.outputs import output_name
 
     check_folder(args.out, "--out")
     pages = []
@@ -112,7 +112,7 @@ def cmd_report(args) -> int:
         found = validation_file(path)
         validation = read_validation(found)
         if validation is not None and not isinstance(validation.get("units"), dict):
-            from validate.units import report_units  # a report from before the units map
+            from validate.checks.units import report_units  # a report from before the units map
 
             validation["units"] = report_units(validation)
         pages.append(

@@ -1,7 +1,7 @@
 """``biped robustness GAIT.json ... [--out DIR]``: the robustness map of gait files in MuJoCo
-(``validate.robustness``), written per gait as JSON and as a figure.
+(``validate.studies.robustness``), written per gait as JSON and as a figure.
 
-The files are named from the gait file's path as its recording is (``validate.outputs``):
+The files are named from the gait file's path as its recording is (``validate.outputs.outputs``):
 ``logs/robustness/<folder>-<gait>.json`` and ``.png``, written together, all or none.
 """
 
@@ -37,7 +37,7 @@ def add_parser(commands) -> None:
 
 
 def _add_arguments(parser) -> None:
-    from validate.robustness import RobustnessSettings
+    from validate.studies.robustness import RobustnessSettings
 
     default = RobustnessSettings()
     types.add_gaits(parser)
@@ -58,7 +58,7 @@ def _add_arguments(parser) -> None:
 
 
 def _settings(args):
-    from validate.robustness import RobustnessSettings
+    from validate.studies.robustness import RobustnessSettings
 
     if args.steps < 2:
         raise BipedError(
@@ -75,13 +75,13 @@ def _settings(args):
 def model_source(gait, model: str | None) -> str:
     """What the map's walks were played on: ``model`` as given, the committed model, or the
     one generated from the gait's robot."""
-    from validate.model import committed_model
+    from validate.scene.model import committed_model
 
     if model is not None:
         return model
     committed = committed_model(gait.biped)
     if committed is None:
-        return "generated from the gait's robot (validate.mjcf)"
+        return "generated from the gait's robot (validate.scene.mjcf)"
     return f"mjcf/{committed.name}"  # the committed model, wherever this copy keeps it
 
 
@@ -117,7 +117,7 @@ def lines(content: dict) -> list[str]:
 
 
 def _range(name: str, limit: dict) -> str:
-    from validate.robustness import reproducible_range
+    from validate.studies.robustness import reproducible_range
 
     low, high = reproducible_range(limit)
     if high == float("inf"):
@@ -130,8 +130,8 @@ def _range(name: str, limit: dict) -> str:
 def comparison_lines(maps: dict) -> list[str]:
     """Each limit of the first map (path -> JSON content) beside every other map's, said
     distinguishable only where the ranges they keep across machines do not overlap
-    (``validate.robustness.distinguishable``)."""
-    from validate.robustness import MACHINE_STEPS, distinguishable
+    (``validate.studies.robustness.distinguishable``)."""
+    from validate.studies.robustness import MACHINE_STEPS, distinguishable
 
     (first, reference), *others = maps.items()
     out = [
@@ -150,11 +150,11 @@ def comparison_lines(maps: dict) -> list[str]:
 
 
 def _write_map(out: Path, name: str, path: str, gait, source: str, result) -> dict:
-    """Write a gait's robustness map (``validate.robustness.RobustnessMap``) as
+    """Write a gait's robustness map (``validate.studies.robustness.RobustnessMap``) as
     <out>/<name>.json and .png, both or neither; returns the JSON content."""
     from biped.records.provenance import provenance
     from biped.runtime.files import atomic_set
-    from validate.robustness_figure import DPI, robustness_figure
+    from validate.studies.robustness_figure import DPI, robustness_figure
 
     content = {
         "gait": str(path),
@@ -190,8 +190,8 @@ def cmd_robustness(args) -> int:
     """
     from biped_cli.commands import read_gaits
     from biped_cli.progress import Progress
-    from validate import robustness
-    from validate.outputs import output_name
+    from validate.outputs.outputs import output_name
+    from validate.studies import robustness
 
     settings = _settings(args)
     types.check_folder(args.out, "--out")  # before the gait files' checks, which take time

@@ -359,7 +359,7 @@ def walked(small, tmp_path_factory):
     """The small atlas's optima walked in MuJoCo (a copy of its folder), and the run's log."""
     import shutil
 
-    from validate import atlas_walks
+    from validate.studies import atlas_walks
 
     folder = tmp_path_factory.mktemp("walked") / "atlas"
     shutil.copytree(small[0], folder)
@@ -378,7 +378,7 @@ def test_every_certified_optimum_gets_a_walk_record(small, walked):
     (each cell of this atlas is one), its verdict, why a check failed, the key figures with
     their units; a gait walks when every check passes, a stable orbit among them. A second
     run walks nothing again."""
-    from validate import atlas_walks
+    from validate.studies import atlas_walks
 
     _, settings, _ = small
     folder, log = walked
@@ -411,7 +411,7 @@ def test_every_certified_optimum_gets_a_walk_record(small, walked):
 def test_away_from_the_corners_a_gait_is_walked_and_replayed(small, tmp_path):
     """A walk of the light kind runs the forward walk and the replay alone: no orbit."""
     from biped.studies.campaign import Task
-    from validate import atlas_walks
+    from validate.studies import atlas_walks
 
     folder, settings, _ = small
     point = atlas.Point("final", "rolling", "sthenic", settings.cells()[0])
@@ -443,7 +443,7 @@ def test_the_walks_are_the_certified_optima_every_check_at_corners_and_best_payo
     """Every certified final optimum is walked, none other; every check at the corners and
     at the best pay-off, the forward walk and the replay elsewhere. A walk that raised is
     recorded, measures nothing and is walked again."""
-    from validate import atlas_walks
+    from validate.studies import atlas_walks
 
     values = {0.2: (100.0, 99.0), 0.3: (100.0, 80.0), 0.4: (100.0, None), 0.5: (100.0, 98.0)}
     settings = _stage_records(tmp_path, values)
@@ -465,9 +465,9 @@ def test_the_walks_are_the_certified_optima_every_check_at_corners_and_best_payo
 
 def _write_walk(folder, cell, knee: str, checks: list, every_check: bool = False) -> None:
     """The record of a made-up walk of ``knee``'s sthenic optimum in ``cell``, as
-    ``validate.atlas_walks`` writes it, of ``checks``: (name, passed, notes)."""
-    from validate import atlas_walks
-    from validate.checks import Check
+    ``validate.studies.atlas_walks`` writes it, of ``checks``: (name, passed, notes)."""
+    from validate.checks.checks import Check
+    from validate.studies import atlas_walks
 
     point = atlas.Point("final", knee, "sthenic", cell)
     walk = atlas_walks.WalkPoint(point, every_check)

@@ -63,9 +63,9 @@ def no_work(monkeypatch):
     import biped.studies.atlas
     import biped.studies.design_map
     import biped.studies.sweep
-    import validate.orbit_study
-    import validate.robustness
-    import validate.validation
+    import validate.checks.validation
+    import validate.studies.orbit_study
+    import validate.studies.robustness
 
     for module, name in [
         (biped.optimization.optimize, "optimize"),
@@ -74,9 +74,9 @@ def no_work(monkeypatch):
         (biped.studies.design_map, "run_design_map"),
         (biped.studies.atlas, "run_atlas"),
         (biped.pages.figures, "make_figures"),
-        (validate.validation, "validate"),
-        (validate.robustness, "robustness_map"),
-        (validate.orbit_study, "study"),
+        (validate.checks.validation, "validate"),
+        (validate.studies.robustness, "robustness_map"),
+        (validate.studies.orbit_study, "study"),
     ]:
         monkeypatch.setattr(module, name, _stand_in)
 

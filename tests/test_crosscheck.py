@@ -5,7 +5,7 @@ import pytest
 
 import biped
 from tests.conftest import random_state, small_optimum
-from validate.crosscheck import knee_link_effect, load_model, mujoco_inverse_dynamics
+from validate.checks.crosscheck import knee_link_effect, load_model, mujoco_inverse_dynamics
 
 ROBOT = biped.Robot.paper()
 
@@ -50,8 +50,8 @@ def test_knee_link_mass_is_negligible():
 def test_impact_map_agrees_with_mujoco(model):
     """MuJoCo's mass matrix and landing-foot Jacobian give the same q̇⁺ and impulse (eq. 23-24)."""
     from tests.test_impact import touchdown_state
-    from validate.crosscheck import mujoco_impact
-    from validate.mapping import mapping
+    from validate.checks.crosscheck import mujoco_impact
+    from validate.scene.mapping import mapping
 
     q, qd = touchdown_state(model, seed=44, n=8)
     qd_plus, impulse = model.impact(q, qd)
@@ -69,7 +69,7 @@ def test_knee_forces_agree_with_mujoco_on_random_motions(model, stance):
     the body below the knee, the ground's force from its own inverse dynamics) to 1e-9 N, and
     so are its parts along and across the axes taken from MuJoCo's joints."""
     from biped.model.knee_loads import knee_forces
-    from validate.crosscheck import mujoco_knee_forces
+    from validate.checks.crosscheck import mujoco_knee_forces
 
     q, qd, qdd = random_state(model, seed=45, n=30)
     expected = knee_forces(model, q, qd, qdd)

@@ -160,8 +160,8 @@ def test_designed_robot_passes_the_inverse_dynamics_crosscheck():
     """The MJCF generated for the designed radii gives MuJoCo's inverse dynamics of the
     designed gait the analytical torques and wrench to rounding; the Table 1 robot's MJCF
     does not (the check tells the radii)."""
-    from validate.crosscheck import load_model, mujoco_inverse_dynamics
-    from validate.validation import EXACT
+    from validate.checks.crosscheck import load_model, mujoco_inverse_dynamics
+    from validate.checks.validation import EXACT
 
     design = optimal_design()
     ev = design.optimum.evaluation
@@ -255,10 +255,10 @@ def test_designed_gait_passes_validation_on_its_own_robot_only(designed):
     """The designed gait walks 20 steps in MuJoCo on the MJCF of its radii and passes every
     check; played on the Table 1 robot, the inverse-dynamics check fails."""
     from biped.records import gait_file
-    from validate.checks import check_inverse_dynamics
-    from validate.model import compile_spec, model_spec
-    from validate.samples import GaitSamples
-    from validate.validation import validate
+    from validate.checks.checks import check_inverse_dynamics
+    from validate.checks.validation import validate
+    from validate.scene.model import compile_spec, model_spec
+    from validate.walk.samples import GaitSamples
 
     gait = gait_file.read(designed[3])
     result = validate(gait, steps=20)

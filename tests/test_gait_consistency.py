@@ -205,7 +205,7 @@ GAIT_READERS = {
     "size": lambda gait, tmp: ["size", gait],
     "profile-speeds": lambda gait, tmp: ["profile-speeds", gait, "--out", f"{tmp}/out/rows.json"],
     "figures": lambda sweep, tmp: ["figures", "--sweep", sweep, "--out", f"{tmp}/out"],
-    "validate.video": lambda gait, tmp: [gait, "--out", f"{tmp}/walk.mp4", "--steps", "1"],
+    "validate.outputs.video": lambda gait, tmp: [gait, "--out", f"{tmp}/walk.mp4", "--steps", "1"],
 }
 
 
@@ -230,7 +230,7 @@ def test_every_reader_refuses_edited_torques(command, content, tmp_path, capsys)
     """A gait file whose torques were doubled is refused by every command that reads gait
     files (a sweep's file of any name for figures): exit 2, one line naming the field and
     the file, nothing written."""
-    from validate import video
+    from validate.outputs import video
 
     def doubled(gait):
         gait["samples"]["torques"] = [[2 * x for x in row] for row in gait["samples"]["torques"]]
@@ -239,7 +239,7 @@ def test_every_reader_refuses_edited_torques(command, content, tmp_path, capsys)
     folder.mkdir()
     path = _write(content, folder, doubled, "mine.json")
     argv = GAIT_READERS[command](str(folder if command == "figures" else path), tmp_path)
-    code = video.main(argv) if command == "validate.video" else main(argv)
+    code = video.main(argv) if command == "validate.outputs.video" else main(argv)
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2
     assert len(err) == 1 and "samples.torques" in err[0] and str(path) in err[0], err

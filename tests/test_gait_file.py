@@ -16,7 +16,7 @@ from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped.records.provenance import PACKAGE
 from tests.conftest import edited_gait_file, refusal, small_optimum
-from validate.model import committed_model
+from validate.scene.model import committed_model
 
 
 @pytest.fixture(scope="module")
@@ -109,9 +109,9 @@ def _other_files() -> dict:
     what the refusal must call it."""
     from biped.model.criteria import PAPER_SAFETY
     from biped.studies import design_map, paper_method, sweep
-    from validate import robustness
-    from validate.checks import Check
-    from validate.validation import as_json
+    from validate.checks.checks import Check
+    from validate.checks.validation import as_json
+    from validate.studies import robustness
 
     robot = Robot.paper()
     limits = {
@@ -151,8 +151,8 @@ def _more_other_files() -> dict:
     from importlib import resources
 
     from biped.studies import atlas
-    from validate import orbit_study
-    from validate.outputs import claim
+    from validate.outputs.outputs import claim
+    from validate.studies import orbit_study
 
     def shipped(package, name):
         return json.loads(resources.files(package).joinpath(name).read_text())

@@ -8,18 +8,18 @@ import numpy as np
 import pytest
 
 import biped
-from validate.mjcf import FOLDER, KNEE_LINK_MASS, model_files, scene_model
-from validate.simulate import JOINT_ORDER, joint_matrix
+from validate.scene.mjcf import FOLDER, KNEE_LINK_MASS, model_files, scene_model
+from validate.walk.simulate import JOINT_ORDER, joint_matrix
 
 ROBOT = biped.Robot.paper()
 
 
 def test_committed_models_are_up_to_date():
-    """mjcf/*.xml equal what validate.mjcf generates from Robot.paper()."""
+    """mjcf/*.xml equal what validate.scene.mjcf generates from Robot.paper()."""
     for name, text in model_files().items():
         path = FOLDER / name
-        assert path.exists(), f"{name} missing: run python -m validate.mjcf"
-        assert path.read_text() == text, f"{name} is out of date: run python -m validate.mjcf"
+        assert path.exists(), f"{name} missing: run python -m validate.scene.mjcf"
+        assert path.read_text() == text, f"{name} is out of date: run python -m validate.scene.mjcf"
 
 
 @pytest.mark.parametrize("knee", biped.KNEES)
@@ -95,7 +95,7 @@ def test_a_robot_left_without_control_folds_at_its_stops_onto_the_floor(knee):
     """Dropped from standing with no control for 2 s, the robot folds like one: every hinge
     has a range, knees not inverted (their range stops 0.05 rad past straight), none passes
     its range by more than 0.02 rad, and no joint (hip, knees, ankles) goes into the floor."""
-    from validate.mjcf import KNEE_RANGE
+    from validate.scene.mjcf import KNEE_RANGE
 
     model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
     hinges = [j for j in range(model.njnt) if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]
@@ -222,7 +222,7 @@ needs_gl = pytest.mark.skipif(
 def test_tracking_camera_sees_both_legs(knee):
     """From the scene's tracking camera at qpos0, both legs' colours fill part of the frame and
     the robot's middle is in its middle third; a robot made invisible leaves none."""
-    from validate.video import leg_pixels
+    from validate.outputs.video import leg_pixels
 
     model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
     data = mujoco.MjData(model)
@@ -244,7 +244,7 @@ def test_tracking_camera_sees_both_legs(knee):
 def test_rolling_knee_discs_are_drawn(knee):
     """The rolling knee's discs have the radii r2 (thigh) and r1 (shank) and stand out of the
     links' side faces, where a side camera sees them."""
-    from validate.mjcf import SHANK_RADIUS, THIGH_RADIUS
+    from validate.scene.mjcf import SHANK_RADIUS, THIGH_RADIUS
 
     model = mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
     for side in ("left", "right"):
@@ -262,8 +262,8 @@ def fine_spec(gait, factor: int = 4) -> mujoco.MjSpec:
     the knee equality as stiff as that step allows, friction harder than the normal force
     (``IMPRATIO_HARD``): the physics the committed model's cheaper settings (2 ms, two points
     a sole, friction as soft as the normal force) stand for."""
-    from validate import mjcf
-    from validate.model import model_spec
+    from validate.scene import mjcf
+    from validate.scene.model import model_spec
 
     spec = mjcf.with_box_soles(model_spec(gait.biped), ROBOT)
     step = mjcf.TIMESTEP / factor
@@ -280,14 +280,14 @@ def fine_spec(gait, factor: int = 4) -> mujoco.MjSpec:
 
 def _physics(knee: str, spec_of) -> tuple:
     """MuJoCo's inverse-dynamics torques of the optimal gait's samples and the figures of
-    its 10-step walk (``validate.checks.walk_figures``) on the model ``spec_of(gait)``."""
+    its 10-step walk (``validate.checks.checks.walk_figures``) on the model ``spec_of(gait)``."""
     from tests.conftest import gait_of, optimal_gait
-    from validate.checks import walk_figures
-    from validate.contact import ground_reaction
-    from validate.crosscheck import mujoco_inverse_dynamics, rigid_copy
-    from validate.model import compile_spec
-    from validate.samples import GaitSamples
-    from validate.simulate import Walker
+    from validate.checks.checks import walk_figures
+    from validate.checks.crosscheck import mujoco_inverse_dynamics, rigid_copy
+    from validate.scene.model import compile_spec
+    from validate.walk.contact import ground_reaction
+    from validate.walk.samples import GaitSamples
+    from validate.walk.simulate import Walker
 
     optimum = optimal_gait(knee)
     gait = gait_of(optimum)
@@ -313,7 +313,7 @@ def settings_differences(knee: str, spec_of) -> list[str]:
     the finer model's by more than 1 % in distance, 2 % of a period in a step's duration,
     0.2 mm in the swing foot's clearance or 0.5 mm in the RMS of the centre of pressure
     against the gait's ZMP."""
-    from validate.checks import MAX_SLIP, walks
+    from validate.checks.checks import MAX_SLIP, walks
 
     torques, ours, gait_torques = _physics(knee, spec_of)
     fine_torques, fine, _ = _fine_physics(knee)
@@ -348,8 +348,8 @@ def test_cheaper_settings_leave_the_physics(knee):
     (``settings_differences``: the same inverse dynamics, the rigid bodies being one robot,
     and the same 10-step walk within stated bounds), and the finer model walks without
     slipping."""
-    from validate.checks import MAX_SLIP, walks
-    from validate.model import model_spec
+    from validate.checks.checks import MAX_SLIP, walks
+    from validate.scene.model import model_spec
 
     _, fine, _ = _fine_physics(knee)
     assert walks(fine, 10) and fine["max_slip"] < MAX_SLIP, fine
@@ -361,7 +361,7 @@ def test_settings_too_coarse_are_told_from_the_finer_model():
     20 ms time constant lets the rolling knee's stance foot slip (3 mm) and the walk go 5 %
     further. (As stiff as the 5 ms step allows, 10 ms, the slip lies at the 1 mm bound: 0.73
     mm on an optimum that differs from another by 1e-10 of its value, over 1 mm on that one.)"""
-    from validate.model import model_spec
+    from validate.scene.model import model_spec
 
     def coarse(gait):
         spec = model_spec(gait.biped)

@@ -1,4 +1,4 @@
-"""The walk's orbit in MuJoCo (``validate.orbit``): its return map is the walk's, its
+"""The walk's orbit in MuJoCo (``validate.checks.orbit``): its return map is the walk's, its
 multipliers predict how perturbations decay, two step sizes agree, and the check fails the
 controllers that do not walk the gait's orbit."""
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from tests.conftest import gait_of, optimal_gait
-from validate import orbit as o
-from validate.orbit_study import settings_at
-from validate.simulate import Walker, WalkSettings
+from validate.checks import orbit as o
+from validate.studies.orbit_study import settings_at
+from validate.walk.simulate import Walker, WalkSettings
 
 _WALKERS: dict = {}
 _ORBITS: dict = {}

@@ -15,7 +15,7 @@ from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import small_optimum
-from validate.outputs import belongs_to, check_owner, claim, output_name, owner
+from validate.outputs.outputs import belongs_to, check_owner, claim, output_name, owner
 
 NAME = "rolling-sthenic-0.300"
 
@@ -212,7 +212,7 @@ def test_the_printed_rerun_command_is_this_environments(tmp_path, monkeypatch):
     import shutil
     import sys
 
-    from validate.outputs import open_command, recording_lines, rerun_command
+    from validate.outputs.outputs import open_command, recording_lines, rerun_command
 
     command = shlex.split(rerun_command())
     assert os.access(command[0], os.X_OK), command
@@ -245,7 +245,7 @@ def test_pipeline_with_design_prints_every_file_it_writes_once(tmp_path, capsys,
     """Every file 'biped pipeline --design' writes in --out and --recordings (gait files,
     reports, recordings, their owner records, the videos) is named on exactly one printed
     line, and every printed path is a file it wrote (the videos stubbed: nothing renders)."""
-    import validate.video
+    import validate.outputs.video
     from biped.runtime.files import atomic_write_bytes
 
     def video(path, *args, gif=None, **kwargs):
@@ -253,7 +253,7 @@ def test_pipeline_with_design_prints_every_file_it_writes_once(tmp_path, capsys,
         path.parent.mkdir(parents=True, exist_ok=True)
         return [atomic_write_bytes(path, b"an mp4")]
 
-    monkeypatch.setattr(validate.video, "write_video", video)
+    monkeypatch.setattr(validate.outputs.video, "write_video", video)
     out, rrd = tmp_path / "pipeline", tmp_path / "recordings"
     argv = ["pipeline", "--knees", "revolute", "--steps", "1", "--starts", "1", "--design"]
     assert main([*argv, "--out", str(out), "--recordings", str(rrd)]) in (0, 1)
@@ -288,9 +288,9 @@ def test_a_video_path_of_another_container_is_refused_before_any_work(
 
 
 def test_the_video_module_refuses_suffixes_it_does_not_write(tmp_path, capsys):
-    """python -m validate.video refuses --out, --gif, --frame whose suffix is not .mp4, .gif,
+    """python -m validate.outputs.video refuses --out, --gif, --frame whose suffix is not .mp4, .gif,
     .png (exit 2, one line naming the option), before reading the gait file."""
-    from validate.video import main
+    from validate.outputs.video import main
 
     for option, path, allowed in (
         ("--out", "walk.avi", ".mp4"),
@@ -308,7 +308,7 @@ def test_video_writers_create_missing_folders(tmp_path):
     --help says (three small frames: nothing is rendered)."""
     import numpy
 
-    from validate.video import write_gif, write_mp4
+    from validate.outputs.video import write_gif, write_mp4
 
     frames = [numpy.full((32, 32, 3), 40 * k, dtype=numpy.uint8) for k in range(3)]
     mp4 = write_mp4(tmp_path / "new" / "dir" / "walk.mp4", frames)
@@ -399,7 +399,7 @@ def test_a_frame_outside_the_walk_is_refused_naming_its_span():
     import numpy
 
     from biped.errors import BipedError
-    from validate.video import frame_index
+    from validate.outputs.video import frame_index
 
     walk = SimpleNamespace(simulation=SimpleNamespace(time=numpy.linspace(0.0, 12.1, 606)))
     assert frame_index(walk, 3.1) == int(numpy.searchsorted(walk.simulation.time, 3.1))

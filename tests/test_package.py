@@ -17,6 +17,8 @@ FORBIDDEN = ("validate", "mujoco", "rerun", "biped_cli")
 
 # The layers of ``biped``, lowest first: each subpackage imports only those below it.
 LAYERS = ("runtime", "model", "optimization", "records", "studies", "pages")
+# The layers of ``validate``, lowest first, the same way; ``workflows`` (a module) is the top.
+VALIDATE_LAYERS = ("scene", "walk", "checks", "outputs", "studies", "workflows")
 
 
 def imported_modules(path: Path, depth: int = 1) -> set[str]:
@@ -26,19 +28,21 @@ def imported_modules(path: Path, depth: int = 1) -> set[str]:
         if isinstance(node, ast.Import):
             found = [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            found = [node.module]
+            # ``from validate import workflows`` imports the module validate.workflows.
+            found = [node.module] + [f"{node.module}.{alias.name}" for alias in node.names]
         else:
             continue
         names.update(".".join(name.split(".")[:depth]) for name in found)
     return names
 
 
-def upward_imports(root: Path) -> dict:
-    """{module: the biped layers above its own that it imports} of the tree at ``root``."""
+def upward_imports(root: Path, package: str = "biped", layers: tuple = LAYERS) -> dict:
+    """{module: the layers of ``package`` above its own that it imports} of the tree at
+    ``root``."""
     found = {}
-    for layer in LAYERS:
-        above = {f"biped.{other}" for other in LAYERS[LAYERS.index(layer) + 1 :]}
-        for path in sorted((root / "biped" / layer).glob("*.py")):
+    for layer in layers:
+        above = {f"{package}.{other}" for other in layers[layers.index(layer) + 1 :]}
+        for path in sorted((root / package / layer).glob("*.py")):
             offending = sorted(imported_modules(path, depth=2) & above)
             if offending:
                 found[str(path.relative_to(root))] = offending
@@ -55,10 +59,47 @@ def test_each_layer_imports_only_the_layers_below_it(tmp_path):
     assert upward_imports(tmp_path) == {"biped/optimization/design.py": ["biped.records"]}
 
 
+def test_each_validate_layer_imports_only_the_layers_below_it(tmp_path):
+    """No module of a validate subpackage imports a layer above its own
+    (``VALIDATE_LAYERS``), in either form of import; a check importing the walk's
+    recording layer, a scene module importing a walk module by ``from validate.walk import``
+    and a study importing the workflows are named."""
+    assert upward_imports(ROOT, "validate", VALIDATE_LAYERS) == {}
+    for layer, source in {
+        "checks": "from validate.outputs.record import record\n",
+        "scene": "def f():\n    from validate.walk import simulate\n",
+        "studies": "from validate import workflows\n",
+    }.items():
+        (tmp_path / "validate" / layer).mkdir(parents=True)
+        (tmp_path / "validate" / layer / "wrong.py").write_text(source)
+    assert upward_imports(tmp_path, "validate", VALIDATE_LAYERS) == {
+        "validate/checks/wrong.py": ["validate.outputs"],
+        "validate/scene/wrong.py": ["validate.walk"],
+        "validate/studies/wrong.py": ["validate.workflows"],
+    }
+
+
+def test_validate_modules_sit_in_its_layers():
+    """Every module of validate/ is in a layer's subpackage but the package's own
+    ``__init__`` and the workflows at the top: a module dropped beside them is outside
+    the layer test."""
+    loose = sorted(path.name for path in (ROOT / "validate").glob("*.py"))
+    assert loose == ["__init__.py", "workflows.py"]
+    folders = {path.parent.name for path in (ROOT / "validate").glob("*/*.py")}
+    assert folders == set(VALIDATE_LAYERS[:-1])
+
+
+def test_validate_never_imports_the_command_line():
+    """No module of validate/ imports biped_cli: the command line sits above both packages."""
+    modules = sorted((ROOT / "validate").rglob("*.py"))
+    assert len(modules) > 20
+    assert [str(p) for p in modules if "biped_cli" in imported_modules(p)] == []
+
+
 def test_imported_modules_sees_nested_imports(tmp_path):
     """The import scan finds imports inside functions too (a lazy import counts)."""
     source = tmp_path / "m.py"
-    source.write_text("import os.path\ndef f():\n    from validate.mjcf import x\n")
+    source.write_text("import os.path\ndef f():\n    from validate.scene.mjcf import x\n")
     assert imported_modules(source) == {"os", "validate"}
 
 
@@ -104,9 +145,9 @@ def test_provenance_does_not_import_mujoco():
 
 
 def test_mjcf_check_reports_stale_files_without_rewriting(tmp_path, capsys, monkeypatch):
-    """python -m validate.mjcf --check: the repository's models are current (exit 0); a
+    """python -m validate.scene.mjcf --check: the repository's models are current (exit 0); a
     changed or missing file is reported and left as it is."""
-    from validate import mjcf
+    from validate.scene import mjcf
 
     assert mjcf.main(["--check"]) == 0
     assert "up to date" in capsys.readouterr().out
@@ -124,8 +165,8 @@ def test_mjcf_check_reports_stale_files_without_rewriting(tmp_path, capsys, monk
 
 
 def test_mjcf_help_exits_0(capsys):
-    """python -m validate.mjcf --help documents --check."""
-    from validate import mjcf
+    """python -m validate.scene.mjcf --help documents --check."""
+    from validate.scene import mjcf
 
     with pytest.raises(SystemExit) as exit_info:
         mjcf.main(["--help"])
@@ -156,7 +197,7 @@ def test_an_installed_copy_carries_the_committed_models(tmp_path):
     assert {f"validate/models/{name}" for name in committed} <= names
     assert not any(name.startswith("mjcf/") for name in names)
     program = (
-        "import biped; from validate.model import committed_model; "
+        "import biped; from validate.scene.model import committed_model; "
         "print(committed_model(biped.Biped(biped.Robot.paper(), 'rolling')))"
     )
     found = subprocess.run(

@@ -14,7 +14,7 @@ from biped.records import gait_file
 from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import small_optimum
-from validate.outputs import claim
+from validate.outputs.outputs import claim
 
 NAME = "rolling-sthenic-0.300"
 
@@ -303,12 +303,12 @@ def walked_page(tmp_path_factory):
     forward walk, as ``biped validate`` writes them) and its page's Markdown and figures."""
     from biped.pages.page import Page, markdown, page_figures
     from tests.conftest import gait_of, optimal_gait
-    from validate import checks
-    from validate.model import model_spec
-    from validate.samples import GaitSamples
-    from validate.simulate import Walker
-    from validate.units import report_units
-    from validate.validation import as_json
+    from validate.checks import checks
+    from validate.checks.units import report_units
+    from validate.checks.validation import as_json
+    from validate.scene.model import model_spec
+    from validate.walk.samples import GaitSamples
+    from validate.walk.simulate import Walker
 
     gait = gait_of(optimal_gait("rolling"))
     spec = model_spec(gait.biped)

@@ -81,7 +81,7 @@ def test_the_profile_walks_on_its_own_mjcf_and_its_knee_is_the_models(designed):
     knee-load, impact, replay, walk and gains checks pass (the orbit's is reported,
     README: within the landing's noise)."""
     from biped.records import gait_file
-    from validate.validation import validate
+    from validate.checks.validation import validate
 
     result = validate(gait_file.read(designed[3]), steps=20)
     failed = [check.line() for check in result.checks if not check.passed]

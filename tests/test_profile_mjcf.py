@@ -1,4 +1,4 @@
-"""A profiled knee in MuJoCo (``validate.profile_mjcf``): its joints and equalities are the
+"""A profiled knee in MuJoCo (``validate.scene.profile_mjcf``): its joints and equalities are the
 exact rolling relation, so MuJoCo's knee, kinematics, inverse dynamics and impact are the
 analytical model's to rounding; another profile's model is told apart."""
 
@@ -11,12 +11,12 @@ import pytest
 import biped
 from biped.model.profile import KneeProfile
 from tests.conftest import random_state
-from validate.checks import check_model
-from validate.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
-from validate.knee_fit import TARGET, knee_fit
-from validate.mapping import mapping
-from validate.mjcf import robot_xml, scene_model
-from validate.model import model_parameters
+from validate.checks.checks import check_model
+from validate.checks.crosscheck import mujoco_impact, mujoco_inverse_dynamics, rigid_copy
+from validate.checks.knee_fit import TARGET, knee_fit
+from validate.scene.mapping import mapping
+from validate.scene.mjcf import robot_xml, scene_model
+from validate.scene.model import model_parameters
 
 ROBOT = biped.Robot.paper()
 # Round numbers, so that the MJCF's ten digits hold them exactly.
@@ -119,8 +119,8 @@ def test_rotor_torques_are_the_armatures_power(model, biped_model):
     """The rotors' torques per joint (``rotor_torques``) times the joints' rates are the
     power of every armature, Σ_j a_j q̈_j q̇_j, though a profiled knee's joints turn at rates
     that vary with its flexion; the circles' keep ``Layout.rotor_inertia`` exactly."""
-    from validate.layout import Layout
-    from validate.mapping import rotor_torques
+    from validate.scene.layout import Layout
+    from validate.scene.mapping import rotor_torques
 
     q, qd, qdd = random_state(biped_model, seed=4, n=8, spread=0.5)
     layout = Layout(model)

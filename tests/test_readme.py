@@ -122,6 +122,31 @@ def test_every_page_links_back_to_the_readme_and_to_pages_that_exist():
             assert (ROOT / target).is_file(), (page.name, target)
 
 
+# A source file named in prose (``validate/walk/simulate.py``) and a module run as a program
+# (``python -m validate.scene.mjcf``), a line break allowed after ``-m``.
+SOURCE_PATH = re.compile(r"\b((?:biped|biped_cli|validate|benchmarks|tests)/[\w/]+\.py)\b")
+PROGRAM = re.compile(r"python\s+-m\s+((?:biped|biped_cli|validate|benchmarks)(?:\.\w+)*)")
+
+
+def named_sources(text: str) -> set:
+    """The source files (paths from the root) that a page names, as files or as programs."""
+    modules = {name.replace(".", "/") for name in PROGRAM.findall(text)}
+    programs = {m + ".py" if not (ROOT / m).is_dir() else m + "/__main__.py" for m in modules}
+    return set(SOURCE_PATH.findall(text)) | programs
+
+
+def test_source_files_and_programs_the_pages_name_exist():
+    """Every source file and every ``python -m`` module the README and docs/ name is in the
+    tree (a module moved to a subpackage without its mentions fails); the old place of the
+    MJCF writer, ``validate/mjcf.py``, would be named."""
+    named = set().union(*(named_sources(p.read_text(encoding="utf-8")) for p in DOCS))
+    named |= named_sources(README)
+    assert {"validate/walk/simulate.py", "validate/scene/mjcf.py"} <= named
+    assert sorted(path for path in named if not (ROOT / path).is_file()) == []
+    stale = named_sources("run python -m validate.mjcf --check")
+    assert stale == {"validate/mjcf.py"} and not (ROOT / "validate/mjcf.py").exists()
+
+
 def test_robot_file_example_is_the_catalogs_actuator():
     """docs/actuators.md's robot file reads, its [actuator] the catalog's AK10-9 V3.0 (to the
     digits written), its knees' resistance changed; a field of another actuator would not

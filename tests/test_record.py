@@ -18,8 +18,8 @@ ROBOT = Robot.paper()
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory):
     """Two steps of the rolling knee's gait, validated and recorded; the chunks read back."""
-    from validate.record import record
-    from validate.validation import validate
+    from validate.checks.validation import validate
+    from validate.outputs.record import record
 
     folder = tmp_path_factory.mktemp("record")
     Gait.from_optimum(small_optimum("rolling"), ROBOT).write(folder / "rolling.json")
@@ -123,7 +123,7 @@ def test_ground_reaction_arrow_stands_in_the_stance_foot(recorded):
     """The arrow starts on the floor under the stance sole (heel to toe, 1 mm of slack) and
     its vertical length is the robot's weight at ARROW_SCALE, to 20 % in the median; the
     gait's ZMP point lies on the sole too."""
-    from validate.record import ARROW_SCALE
+    from validate.outputs.record import ARROW_SCALE
 
     result, chunks, _ = recorded
     sim = result.simulation
@@ -160,7 +160,7 @@ def test_summary_states_the_gait_and_every_verdict(recorded):
 def test_torque_range_follows_the_gait_not_the_landings():
     """A landing spike of 40 N·m does not set the plot's range around ±4 N·m torques, and a
     range from every sample would have let it."""
-    from validate.record import torque_range
+    from validate.outputs.record import torque_range
 
     t = np.linspace(0.0, 1.0, 1001)
     torque = 4.0 * np.sin(2 * np.pi * t)
@@ -236,7 +236,7 @@ def test_time_plots_open_on_the_last_steps_legends_clear_of_the_curves(recorded)
     """The torque, ground and ZMP plots open on the last SHOWN_STEPS steps of the walk; the
     torque plots have no legend over their curves (their key is a text beside them) and the
     others' legend has the top of the plot above the gait's curves and the sole's edges."""
-    from validate.record import SHOWN_STEPS
+    from validate.outputs.record import SHOWN_STEPS
 
     result, chunks, folder = recorded
     views = _views(folder / "rolling.rrd")
@@ -286,7 +286,7 @@ def test_a_viewer_that_does_not_take_the_stream_is_a_warning_the_file_written(
     import re
     import socket
 
-    import validate.record
+    import validate.outputs.record
     from biped.errors import ViewerWarning
 
     result, _, _ = recorded
@@ -294,10 +294,10 @@ def test_a_viewer_that_does_not_take_the_stream_is_a_warning_the_file_written(
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
     url = f"rerun+http://127.0.0.1:{port}/proxy"
-    monkeypatch.setattr(validate.record, "VIEWER_TIMEOUT", 0.5)
+    monkeypatch.setattr(validate.outputs.record, "VIEWER_TIMEOUT", 0.5)
     named = f"--connect {re.escape(repr(url))}.*no rerun viewer"
     with pytest.warns(ViewerWarning, match=named) as caught:
-        path = validate.record.record(tmp_path / "live.rrd", result, connect=url)
+        path = validate.outputs.record.record(tmp_path / "live.rrd", result, connect=url)
     assert str(tmp_path / "live.rrd") in str(caught[0].message)
     assert len(rerun.chunk.RrdReader(path).stream().to_chunks()) > 0
 
@@ -309,7 +309,7 @@ def test_connect_where_nothing_listens_warns_without_rerun_s_waits(recorded, mon
     import socket
     import time
 
-    import validate.record
+    import validate.outputs.record
     from biped.errors import ViewerWarning
 
     result, _, _ = recorded
@@ -323,11 +323,11 @@ def test_connect_where_nothing_listens_warns_without_rerun_s_waits(recorded, mon
 
     monkeypatch.setattr(rerun.RecordingStream, "connect_grpc", opened)
     with pytest.warns(ViewerWarning, match="nothing listens at that address"):
-        path = validate.record.record(tmp_path / "live.rrd", result, connect=url)
+        path = validate.outputs.record.record(tmp_path / "live.rrd", result, connect=url)
     assert len(rerun.chunk.RrdReader(path).stream().to_chunks()) > 0
     began = time.perf_counter()
-    assert validate.record._unreachable(url) is not None
-    assert time.perf_counter() - began < validate.record.PROBE_TIMEOUT + 0.5
+    assert validate.outputs.record._unreachable(url) is not None
+    assert time.perf_counter() - began < validate.outputs.record.PROBE_TIMEOUT + 0.5
 
 
 def test_the_viewer_is_found_beside_this_python_when_not_on_path(monkeypatch, tmp_path):
@@ -336,7 +336,7 @@ def test_the_viewer_is_found_beside_this_python_when_not_on_path(monkeypatch, tm
     import sys
     from pathlib import Path
 
-    from validate.record import viewer_executable
+    from validate.outputs.record import viewer_executable
 
     monkeypatch.setenv("PATH", str(tmp_path))
     beside = Path(sys.executable).parent / "rerun"
@@ -352,7 +352,7 @@ def test_spawn_starts_the_viewer_found_and_a_failed_start_is_a_warning(
 ):
     """--spawn hands rerun the viewer ``viewer_executable`` found (beside this Python when
     not on PATH); a viewer that cannot start is a ViewerWarning, the file written."""
-    import validate.record
+    import validate.outputs.record
     from biped.errors import ViewerWarning
 
     result, _, _ = recorded
@@ -362,8 +362,8 @@ def test_spawn_starts_the_viewer_found_and_a_failed_start_is_a_warning(
         asked.update(kwargs)
         raise RuntimeError("no display")
 
-    monkeypatch.setattr(validate.record.rr, "spawn", spawn)
+    monkeypatch.setattr(validate.outputs.record.rr, "spawn", spawn)
     with pytest.warns(ViewerWarning, match="the viewer it started: no rerun viewer.*no display"):
-        path = validate.record.record(tmp_path / "spawned.rrd", result, spawn=True)
-    assert asked["executable_path"] == validate.record.viewer_executable()
+        path = validate.outputs.record.record(tmp_path / "spawned.rrd", result, spawn=True)
+    assert asked["executable_path"] == validate.outputs.record.viewer_executable()
     assert path.is_file()

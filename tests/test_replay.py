@@ -10,10 +10,10 @@ import pytest
 from biped.model.dynamics import JOINTS
 from biped.records.gait_file import Gait
 from tests.conftest import gait_of, optimal_gait, with_torques
-from validate.checks import SERVO_SHARE, check_feedforward
-from validate.model import model_spec
-from validate.replay import replay_model, replay_step
-from validate.samples import GaitSamples
+from validate.checks.checks import SERVO_SHARE, check_feedforward
+from validate.scene.model import model_spec
+from validate.walk.replay import replay_model, replay_step
+from validate.walk.samples import GaitSamples
 
 KNEES = ("revolute", "rolling")
 

@@ -19,11 +19,11 @@ from biped.model.robot import FOOT_FRICTION
 from biped.records.gait_file import Gait
 from biped_cli import main
 from tests.conftest import gait_of, optimal_gait, with_torques
-from validate import robustness
-from validate.checks import walk_verdict
-from validate.mjcf import FOLDER
-from validate.model import compile_spec
-from validate.robustness import (
+from validate.checks.checks import walk_verdict
+from validate.scene.mjcf import FOLDER
+from validate.scene.model import compile_spec
+from validate.studies import robustness
+from validate.studies.robustness import (
     LIMITS,
     Limit,
     RobustnessSettings,
@@ -32,7 +32,7 @@ from validate.robustness import (
     robustness_map,
     trunk_mass_spec,
 )
-from validate.simulate import Push, Walker, WalkSettings
+from validate.walk.simulate import Push, Walker, WalkSettings
 
 SETTINGS = RobustnessSettings(steps=6, push_step=2, iterations=4)
 OPTIONS = ["--steps", "6", "--push-step", "2", "--iterations", "4"]

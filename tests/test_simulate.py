@@ -8,8 +8,7 @@ import pytest
 
 from biped.model.kinematics import ZH
 from tests.conftest import gait_of, optimal_gait, small_optimum, with_torques
-from validate import contact
-from validate.checks import (
+from validate.checks.checks import (
     MAX_FOOT_TILT,
     MAX_SLIP,
     scuff_notes,
@@ -17,8 +16,9 @@ from validate.checks import (
     walk_figures,
     walks,
 )
-from validate.model import model_spec
-from validate.simulate import FALLEN, RESYNC, Push, Walker, WalkSettings
+from validate.scene.model import model_spec
+from validate.walk import contact
+from validate.walk.simulate import FALLEN, RESYNC, Push, Walker, WalkSettings
 
 STEPS = 20
 
@@ -169,7 +169,7 @@ def test_shuffling_does_not_advance():
     """Landings that do not carry the hip forward by half a step length are not steps: a walk
     whose hip is held in place from its second step (a robot shuffling) walked one step, did
     not advance and did not fall (the hip stays up)."""
-    from validate.checks import walk_causes
+    from validate.checks.checks import walk_causes
 
     walker = Walker(gait_of(small_optimum("revolute")))
     sim = walker.walk(4)
@@ -239,7 +239,7 @@ def test_a_failed_forward_check_says_why_in_words():
     reason: the stance foot slides (mm, a share of the step) and rolls onto its edge (mm off
     the floor), the swing foot drags (ms, mm deep), no step lands, the hip stays up; the optimal gait's check passes with no such
     note and no cause."""
-    from validate.checks import check_forward
+    from validate.checks.checks import check_forward
 
     gait = gait_of(small_optimum("revolute"))
     limp = Walker(with_torques(gait, np.zeros_like(gait.samples.torques)))

@@ -88,7 +88,7 @@ def test_actuator_units_are_those_its_fields_document():
 
 
 def test_printed_check_lines_carry_the_units_of_their_figures():
-    from validate.checks import Check
+    from validate.checks.checks import Check
 
     line = Check(
         "forward", True, {"steps": 20, "max_slip": 2.5e-4, "step_advance_range": [1.0, 1.01]}
@@ -103,8 +103,8 @@ def test_printed_check_lines_carry_the_units_of_their_figures():
 def _all_units() -> dict:
     """Every unit the project's files declare, by where (a per-column list: each column)."""
     from biped.model.criteria import ALL_CRITERIA, WALKABLE
-    from validate import robustness
-    from validate.units import FIGURE_UNITS
+    from validate.checks.units import FIGURE_UNITS
+    from validate.studies import robustness
 
     declared = {}
     for criterion in ALL_CRITERIA:
@@ -138,7 +138,7 @@ def test_every_unit_is_one_unit_never_prose():
 
 def test_a_failed_range_prints_unknown_never_nan():
     """A range that could not be measured (kp × 1 does not walk) prints n/a, never nan-nan."""
-    from validate.checks import Check
+    from validate.checks.checks import Check
 
     line = Check("gains", False, {"kp_scale_range": [float("nan"), float("nan")]}).line()
     assert "kp_scale_range n/a" in line and "nan" not in line
@@ -152,7 +152,7 @@ def test_a_page_prints_units_per_column_as_units_never_a_list():
 
     from biped.model.units import unit_text
     from biped.pages.page import Page, _validation_lines
-    from validate.units import SECTION_UNITS, report_units
+    from validate.checks.units import SECTION_UNITS, report_units
 
     assert unit_text(SECTION_UNITS) == "rad (1-6), rad/s (7-12)"
     assert unit_text(["N", "N", "N·m"]) == "N (1-2), N·m (3)" and unit_text(["m"] * 3) == "m"

@@ -152,7 +152,7 @@ def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_pa
     the joints that carry the trunk, its note giving the share the servos add to each,
     beside inverse dynamics; on the model of its own robot (the default) the same replay
     passes."""
-    from validate.mjcf import FOLDER
+    from validate.scene.mjcf import FOLDER
 
     rrd = str(tmp_path / "heavy.rrd")
     model = str(FOLDER / "scene_revolute.xml")
@@ -184,7 +184,7 @@ def test_a_gait_of_a_heavier_trunk_fails_on_the_table_1_model(heavy_gait, tmp_pa
 def test_a_rolling_gait_on_the_revolute_model_is_refused(gait_path, tmp_path, capsys):
     """--model of the other knee: one line naming the model and both knees, exit 2, before
     any work (no recording)."""
-    from validate.mjcf import FOLDER
+    from validate.scene.mjcf import FOLDER
 
     rrd = tmp_path / "refused.rrd"
     model = str(FOLDER / "scene_revolute.xml")
@@ -199,7 +199,7 @@ def test_a_rolling_gait_on_the_revolute_model_is_refused(gait_path, tmp_path, ca
 def _rolling_model(folder, change) -> str:
     """The committed rolling-knee scene copied to ``folder`` with its robot file changed by
     ``change(text) -> text``; returns the scene's path."""
-    from validate.mjcf import FOLDER
+    from validate.scene.mjcf import FOLDER
 
     folder.mkdir(parents=True, exist_ok=True)
     robot = (FOLDER / "biped_rolling.xml").read_text()
@@ -248,7 +248,7 @@ def test_json_has_one_object_per_check_with_its_verdict_and_units(report):
     """Each check is an object with ``passed``, ``notes`` and ``causes`` (none when it passes,
     else words of ``CAUSES``); every number has its unit, the per-joint torques too."""
     from biped.model.units import missing
-    from validate.checks import CAUSES
+    from validate.checks.checks import CAUSES
 
     code, content, _ = report
     for name in ("model", "inverse_dynamics", "impact", "feedforward", "forward", "gains"):
@@ -271,7 +271,7 @@ def table_1_models():
     """The committed Table 1 scene of each knee, compiled."""
     import mujoco
 
-    from validate.mjcf import FOLDER
+    from validate.scene.mjcf import FOLDER
 
     return {
         knee: mujoco.MjModel.from_xml_path(str(FOLDER / f"scene_{knee}.xml"))
@@ -295,8 +295,8 @@ def test_the_model_check_names_a_field_that_differs(table_1_models, knee, field)
     import dataclasses
 
     from biped import Biped
-    from validate.checks import check_model
-    from validate.mjcf import scene_model
+    from validate.checks.checks import check_model
+    from validate.scene.mjcf import scene_model
 
     paper = Robot.paper()
     robot = dataclasses.replace(paper, **{field: 1.05 * getattr(paper, field)})
@@ -316,7 +316,7 @@ def test_a_revolute_model_does_not_hold_the_knee_radii(table_1_models):
     import dataclasses
 
     from biped import Biped
-    from validate.checks import check_model
+    from validate.checks.checks import check_model
 
     robot = dataclasses.replace(Robot.paper(), r1=0.08, r2=0.02)
     assert check_model(table_1_models["revolute"], Biped(robot, "revolute")).passed
@@ -333,10 +333,10 @@ def test_a_gait_under_other_gravity_passes_on_its_own_model(knee):
     from biped.optimization.optimize import optimize
     from biped.optimization.problem import GaitProblem
     from tests.conftest import gait_of
-    from validate import checks
-    from validate.mjcf import FOLDER
-    from validate.model import compile_spec, model_spec
-    from validate.samples import GaitSamples
+    from validate.checks import checks
+    from validate.scene.mjcf import FOLDER
+    from validate.scene.model import compile_spec, model_spec
+    from validate.walk.samples import GaitSamples
 
     robot = dataclasses.replace(Robot.paper(), gravity=9.5)
     biped = Biped(robot, knee)
@@ -366,9 +366,9 @@ def test_the_knee_loads_check_fails_a_wrong_radius_or_lower_leg_mass(table_1_mod
     from biped import Biped
     from biped.model.knee_loads import knee_forces
     from tests.conftest import gait_of
-    from validate.checks import check_knee_loads
-    from validate.model import compile_spec, model_spec
-    from validate.samples import GaitSamples
+    from validate.checks.checks import check_knee_loads
+    from validate.scene.model import compile_spec, model_spec
+    from validate.walk.samples import GaitSamples
 
     gait = gait_of(small_optimum(knee))
     samples = GaitSamples.from_gait(gait)

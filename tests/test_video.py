@@ -16,7 +16,7 @@ pytestmark = needs_gl
 @pytest.fixture(scope="module")
 def walk(tmp_path_factory):
     """Two steps of the rolling knee's gait at 0.3 m/s, validated (checks and simulation)."""
-    from validate.validation import validate
+    from validate.checks.validation import validate
 
     path = tmp_path_factory.mktemp("gait") / "rolling.json"
     Gait.from_optimum(small_optimum("rolling"), Robot.paper()).write(path)
@@ -35,7 +35,14 @@ def band_colours(band: np.ndarray) -> dict:
 def test_first_frame_shows_the_robot_and_the_verdict(walk):
     """The first frame holds both legs in their colours under a caption band whose verdict
     is green for a gait that passed and red for one that failed."""
-    from validate.video import CAPTION_HEIGHT, SIZE, Captioned, WalkRenderer, leg_pixels, verdict_of
+    from validate.outputs.video import (
+        CAPTION_HEIGHT,
+        SIZE,
+        Captioned,
+        WalkRenderer,
+        leg_pixels,
+        verdict_of,
+    )
 
     renderer = WalkRenderer(walk.biped, walk.samples, walk.simulation)
     try:
@@ -60,7 +67,7 @@ def test_first_frame_shows_the_robot_and_the_verdict(walk):
 def test_ghost_stands_on_the_stance_foot_and_follows_the_walk(walk):
     """The gait's ghost has its stance ankle on MuJoCo's at the start of each step, and its
     hip within 3 cm of MuJoCo's all along the walk (the walk follows the gait)."""
-    from validate.video import WalkRenderer
+    from validate.outputs.video import WalkRenderer
 
     sim = walk.simulation
     renderer = WalkRenderer(walk.biped, walk.samples, sim)
@@ -92,7 +99,14 @@ def test_video_is_h264_with_a_frame_per_thirtieth_of_a_second(walk, tmp_path):
     import imageio_ffmpeg
     from PIL import Image
 
-    from validate.video import CAPTION_HEIGHT, FPS, SIZE, frame_states, leg_pixels, write_video
+    from validate.outputs.video import (
+        CAPTION_HEIGHT,
+        FPS,
+        SIZE,
+        frame_states,
+        leg_pixels,
+        write_video,
+    )
 
     mp4, gif = tmp_path / "walk.mp4", tmp_path / "walk.gif"
     written = write_video(mp4, walk, gif=gif)
@@ -138,11 +152,11 @@ def test_validate_command_writes_the_video_and_a_gif(tmp_path, capsys):
 
 
 def test_frame_command_writes_a_png_of_the_walk(tmp_path):
-    """python -m validate.video GAIT --frame FILE.png writes one captioned frame showing both
+    """python -m validate.outputs.video GAIT --frame FILE.png writes one captioned frame showing both
     legs; asked for nothing to write, it refuses."""
     from PIL import Image
 
-    from validate.video import CAPTION_HEIGHT, leg_pixels, main
+    from validate.outputs.video import CAPTION_HEIGHT, leg_pixels, main
 
     gait = tmp_path / "rolling.json"
     Gait.from_optimum(small_optimum("rolling"), Robot.paper()).write(gait)

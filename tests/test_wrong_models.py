@@ -4,7 +4,7 @@ respect (the trunk's mass, an inertia, a centre of mass, the foot's geometry, th
 radii, gravity) fail, each naming its cause; on the Table 1 model they pass every check.
 
 The feedforward replay judges a servo's torque against the robot's torque scale (the largest
-RMS torque of its joints, ``validate.checks.SERVO_SHARE``), no longer against the joint's own
+RMS torque of its joints, ``validate.checks.checks.SERVO_SHARE``), no longer against the joint's own
 torque (the per-joint share, still reported, below 0.05 before): every wrong model that share
 caught is still caught but one, the swing foot's centre of mass 3.3 mm lower, whose 0.005 N·m
 at the swing ankle lies below what a correct gait's swing ankle needs after its torque jumps at
@@ -18,11 +18,11 @@ import pytest
 from biped import Biped, Robot
 from biped.model.dynamics import JOINTS
 from tests.conftest import gait_of, optimal_gait
-from validate import checks
-from validate.checks import CAUSES, SERVO_SHARE
-from validate.model import compile_spec, model_spec
-from validate.samples import GaitSamples
-from validate.simulate import Walker
+from validate.checks import checks
+from validate.checks.checks import CAUSES, SERVO_SHARE
+from validate.scene.model import compile_spec, model_spec
+from validate.walk.samples import GaitSamples
+from validate.walk.simulate import Walker
 
 PAPER = Robot.paper()
 # The per-joint share the feedforward check judged each joint's servo by before
@@ -178,7 +178,7 @@ def test_the_table_1_model_passes_every_check(knee, walkable):
     from biped.model.criteria import WALKABLE
     from biped.optimization.optimize import optimize
     from biped.optimization.problem import GaitProblem
-    from validate.validation import as_json, validate
+    from validate.checks.validation import as_json, validate
 
     if walkable:
         gait = gait_of(optimize(GaitProblem(Biped(PAPER, knee), 0.3, safety=WALKABLE)))

@@ -1,7 +1,8 @@
 """Workflows: a gait from the optimizer to its file, to MuJoCo, to its recording and video.
 
-``validate_and_record``: every check of one gait (``validate.validation``), its recording
-(``validate.record``) claimed by its gait file (``validate.outputs``), its video and report.
+``validate_and_record``: every check of one gait (``validate.checks.validation``), its
+recording (``validate.outputs.record``) claimed by its gait file (``validate.outputs.outputs``),
+its video and report.
 ``run_pipeline``: ``biped pipeline`` whole, each knee's optimal gait at one speed written,
 validated and recorded, the knee's radii optimised too with a design problem, the knees
 compared; it prints (``say``) as it goes. The command line checks the input before; nothing
@@ -33,19 +34,19 @@ def validate_and_record(
     source: str | Path | None = None,
     model=None,
 ):
-    """Every check of a gait on ``model`` (an MJCF path; None: ``validate.model.model_spec``'s
+    """Every check of a gait on ``model`` (an MJCF path; None: ``validate.scene.model.model_spec``'s
     default), its recording at ``rrd`` (also streamed to a viewer with ``spawn`` or
     ``connect``) and, if asked, the video of its walk at ``video`` (MP4) and ``gif``.
-    ``source``: the gait file, named as the recording's owner (``validate.outputs``).
+    ``source``: the gait file, named as the recording's owner (``validate.outputs.outputs``).
 
     Returns the validation and its report (the checks as JSON with their ``units``, the
     recording's and video's paths).
     """
     from biped.records.provenance import provenance
-    from validate import validation
-    from validate.outputs import claim
-    from validate.record import record
-    from validate.units import report_units
+    from validate.checks import validation
+    from validate.checks.units import report_units
+    from validate.outputs.outputs import claim
+    from validate.outputs.record import record
 
     result = validation.validate(gait, steps=steps, model=model)
     written = record(rrd, result, spawn=spawn, connect=connect)
@@ -59,7 +60,7 @@ def validate_and_record(
         "provenance": provenance(),
     }
     if video is not None or gif is not None:
-        from validate import video as videos
+        from validate.outputs import video as videos
 
         report["video"] = [str(path) for path in videos.write_video(video, result, gif=gif)]
     return result, report
@@ -68,7 +69,7 @@ def validate_and_record(
 def files_lines(report: dict, gait_path: Path | None = None, report_path=None) -> list[str]:
     """What a workflow prints of the files it wrote for a gait: the gait file and its
     report (if given), the recording (and its owner record), the videos."""
-    from validate.outputs import recording_lines
+    from validate.outputs.outputs import recording_lines
 
     return [
         *([f"gait {gait_path}, report {report_path}"] if gait_path is not None else []),
@@ -193,7 +194,7 @@ def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
     designed gait written and validated in MuJoCo as the knees' are. Returns whether every
     step passed."""
     from biped.optimization.design import bound_notes, compare
-    from validate.outputs import check_owner
+    from validate.outputs.outputs import check_owner
 
     problem, name = pipeline.design, pipeline.name("design")
     rrd, gait_path = pipeline.recordings / f"{name}.rrd", pipeline.out / f"{name}.json"

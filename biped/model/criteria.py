@@ -218,8 +218,8 @@ class Safety:
 
 PAPER_SAFETY = Safety()  # the paper's constraints, no margin of ours
 # The walkable preset (``--walkable``): the margins at which MuJoCo's walk of the optimal gaits
-# follows the model (``validate.margins_study``, docs/margins-*.png: the servos add at most a
-# fifth of the joint torque, MuJoCo spends within 5 % of the model's energy per step, every
+# follows the model (``validate.studies.margins_study``, docs/margins-*.png: the servos add at
+# most a fifth of the joint torque, MuJoCo spends within 5 % of the model's energy per step, every
 # check passes). The landing share is the study's choice: the loosest at which every point of
 # 0.2-0.6 m/s meets the targets (at 1 V the rolling knee's servos add 0.2003 at 0.3 m/s; no
 # share makes the 1 m/s optima walk). Clearance and ZMP margin move neither figure

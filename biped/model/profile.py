@@ -33,7 +33,7 @@ are the centres of the circles of curvature at the straight knee's contact; at k
 the circles' (r1 + r2) u(γ). The points C2' = C2 + k2 u'(q_thigh) and C1' = C1 + k1 u'(q_shank)
 are fixed in the thigh and the shank and V' = C1' − C2' = Σ u(γ) + (k1 − k2) u'(γ): a link of
 length Σ(θ) at angle γ with a constant offset across it, which the MJCF builds
-(``validate.mjcf``).
+(``validate.scene.mjcf``).
 
 Bounds (``surface_margins``). Over the knee's range of flexion ``PROFILE_RANGE`` (its stops,
 ``biped.model.robot.JOINT_STOPS``: a machined knee rolls over all of it) each surface is convex,

@@ -28,12 +28,12 @@ from biped.model.actuators import Actuators
 # Standard gravity [m/s²].
 STANDARD_GRAVITY = 9.81
 # Coefficient of sliding friction μ between the soles and the floor, the one the MuJoCo models
-# use (``validate.mjcf``): a gait whose stance foot needs |Fx| / Fz above it would slip.
+# use (``validate.scene.mjcf``): a gait whose stance foot needs |Fx| / Fz above it would slip.
 FOOT_FRICTION = 1.0
 # Stops of the joints [rad], a human's anatomical range, each joint's angle taken as its child's
 # absolute angle minus its parent's (hip q_thigh − q_trunk, knee q_shank − q_thigh, ankle
 # q_foot − q_shank; the paper's θ of eq. (32) is minus that): the MJCF's joint ranges
-# (``validate.mjcf``) and the constraint that keeps a gait inside them
+# (``validate.scene.mjcf``) and the constraint that keeps a gait inside them
 # (``biped.model.walkable``). Extension 29° and flexion 115° at the hip, flexion 138° and 3°
 # past straight at the knee, plantar flexion 46° and dorsiflexion 34° at the ankle.
 JOINT_STOPS = {"hip": (-0.5, 2.0), "knee": (-2.4, 0.05), "ankle": (-0.8, 0.6)}

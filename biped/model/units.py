@@ -20,7 +20,7 @@ Only numbers (and null, a figure that could not be measured) have units; texts, 
 
 A record declares the unit of each of its fields beside it (``unit_field``), and its map
 follows from the declarations (``declared_units``): the gait file's ``Gait`` and its inner
-records, the optimizer's ``Report``, a walk's figures (``validate.units``).
+records, the optimizer's ``Report``, a walk's figures (``validate.checks.units``).
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Figures of a walk's orbit in MuJoCo, drawn from the JSON of the orbit check
-(``validate.orbit``: a validation report's ``orbit`` object, or a study's ``orbits``).
+(``validate.checks.orbit``: a validation report's ``orbit`` object, or a study's ``orbits``).
 
     multipliers_figure   the Floquet multipliers in the complex plane with the unit circle,
                          the spectral radius and its uncertainty as circles
@@ -81,7 +81,7 @@ def multipliers_figure(orbit: dict, title: str) -> Figure:
 
 
 def knob_figure(content: dict, title: str) -> Figure:
-    """ρ against the knob's values of a study's content (``validate.orbit_study.content``):
+    """ρ against the knob's values of a study's content (``validate.studies.orbit_study.content``):
     each orbit's ρ with its bar; the values without an orbit in a strip above, off ρ's scale
     (nothing measured there); a band between two values where the verdict changes, dotted
     where ρ crosses 1 in it; the legend below, off the data, naming only what is drawn."""

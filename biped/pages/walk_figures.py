@@ -1,5 +1,5 @@
 """MuJoCo's walk beside the model's, drawn from a validation report's JSON (``validate``: its
-``forward`` and ``feedforward`` objects, the figures ``validate.checks.walk_figures`` and
+``forward`` and ``feedforward`` objects, the figures ``validate.checks.checks.walk_figures`` and
 ``check_feedforward`` measure).
 
     walk_lines        the page's section: per joint the RMS torque of the model (the gait's
@@ -75,7 +75,7 @@ def walk_lines(report: dict, figure: str | None = None) -> list[str]:
         "### MuJoCo's walk beside the model's",
         "",
         f"The forward check's walk ({_value(steps)} steps walked, each landing's settling "
-        "left out of the RMS: `validate.checks.LANDING`): per joint the RMS torque of the "
+        "left out of the RMS: `validate.checks.checks.LANDING`): per joint the RMS torque of the "
         "model (the gait's Γ at the phase MuJoCo's controller followed), of MuJoCo (its "
         "motors and its servos), of the rotors' part (the motors less Γ: MuJoCo's armature, "
         "which the paper's robot lacks) and of the servos' part; and the servo "

@@ -118,7 +118,7 @@ OTHER_KEYS = (
         "one optimization of an atlas (which biped atlas writes)",
     ),
 )
-# A recording's owner record (``validate.outputs``) holds these keys and no other.
+# A recording's owner record (``validate.outputs.outputs``) holds these keys and no other.
 OWNER_RECORD = (
     {"gait", "sha256"},
     "a recording's owner record (which biped validate and biped pipeline write beside it)",
@@ -846,7 +846,7 @@ def other_kind(content) -> str | None:
 
 
 def _validation_report(content) -> bool:
-    """Whether ``content`` is a validation report (``validate.validation.as_json``)."""
+    """Whether ``content`` is a validation report (``validate.checks.validation.as_json``)."""
     return (
         isinstance(content, dict)
         and "passed" in content

@@ -25,7 +25,7 @@ is infeasible, leaves its cell empty, with why.
 
 The margins of every cell are the settings' (``Settings.safety``: the walkable constraints by
 default, the paper's on request), each cell's clearance and knee bend replacing the base's.
-After the optimizations ``validate.atlas_walks`` walks every certified final optimum in
+After the optimizations ``validate.studies.atlas_walks`` walks every certified final optimum in
 MuJoCo (this package never imports it); its records are read here as plain JSON (``Walk``).
 """
 
@@ -623,7 +623,7 @@ def load(folder) -> Settings:
     return Settings.from_dict(found)
 
 
-# MuJoCo's walks of the final optima (``validate.atlas_walks``, which writes them; read here
+# MuJoCo's walks of the final optima (``validate.studies.atlas_walks``, which writes them; read here
 # as plain JSON: this package never imports the simulator): a record per certified final
 # optimum, ``walks/<knee>-<criterion>-<cell>.json``, the ``Point`` of stage ``WALKS``.
 WALKS = "walks"

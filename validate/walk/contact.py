@@ -6,7 +6,7 @@
     clearance         how high the swing foot passes over the floor, in MuJoCo and in the gait
     advances          how far the hip goes forward in each step
 
-A foot is a rigid sole between its heel and toe sites (``validate.mjcf``): its tilt is the
+A foot is a rigid sole between its heel and toe sites (``validate.scene.mjcf``): its tilt is the
 angle of the heel-to-toe segment from the floor, and a heel or toe lifts when its site rises
 above the floor. A flat, loaded sole sits a fraction of a millimetre in the soft floor; a
 foot that rolls on its toe or heel edge (the centre of pressure at the edge, which a ZMP
@@ -21,9 +21,9 @@ import mujoco
 import numpy as np
 
 from biped.model.dynamics import Biped
-from validate.mapping import other
-from validate.samples import GaitSamples
-from validate.simulate import LANDING_WINDOW, LIFT_WINDOW, TOUCH_THRESHOLD, Simulation
+from validate.scene.mapping import other
+from validate.walk.samples import GaitSamples
+from validate.walk.simulate import LANDING_WINDOW, LIFT_WINDOW, TOUCH_THRESHOLD, Simulation
 
 # Post-process every this many simulation states for the ground reaction.
 SAMPLE_EVERY = 5

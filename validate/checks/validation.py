@@ -1,12 +1,12 @@
 """The validation of a gait file: every check against MuJoCo on one model, and its report.
 
-``validate`` runs the checks of ``validate.checks`` (the walk's contact read by
-``validate.contact``) and the orbit check of ``validate.orbit``, and returns them, with the
-gait and what the recording and the video draw, as one ``Validation``
-(``validate.record.record`` and ``validate.video.write_video`` take it whole); ``as_json``
-gives the report: one object per check with its ``passed``, ``notes`` and ``causes`` (why it
-fails, in words of ``validate.checks.CAUSES``; ``Check.line`` prints one line per check,
-its causes first).
+``validate`` runs the checks of ``validate.checks.checks`` (the walk's contact read by
+``validate.walk.contact``) and the orbit check of ``validate.checks.orbit``, and returns them,
+with the gait and what the recording and the video draw, as one ``Validation``
+(``validate.outputs.record.record`` and ``validate.outputs.video.write_video`` take it whole);
+``as_json`` gives the report: one object per check with its ``passed``, ``notes`` and
+``causes`` (why it fails, in words of ``validate.checks.checks.CAUSES``; ``Check.line`` prints
+one line per check, its causes first).
 """
 
 from __future__ import annotations
@@ -20,12 +20,12 @@ import numpy as np
 from biped.model.dynamics import Biped
 from biped.records.gait_file import Gait
 from validate import DEFAULT_STEPS
-from validate import checks as c
-from validate.checks import EXACT, Check
-from validate.model import compile_spec, model_spec
-from validate.orbit import Orbit, check_orbit
-from validate.samples import GaitSamples
-from validate.simulate import Simulation, Walker
+from validate.checks import checks as c
+from validate.checks.checks import EXACT, Check
+from validate.checks.orbit import Orbit, check_orbit
+from validate.scene.model import compile_spec, model_spec
+from validate.walk.samples import GaitSamples
+from validate.walk.simulate import Simulation, Walker
 
 __all__ = ["EXACT", "Check", "Validation", "as_json", "validate"]
 
@@ -39,8 +39,8 @@ class Validation:
     biped: Biped
     samples: GaitSamples
     simulation: Simulation
-    contact: dict  # the walk's ground reaction (``validate.contact.ground_reaction``)
-    orbit: Orbit | None = None  # the walk's orbit and its multipliers (``validate.orbit``)
+    contact: dict  # the walk's ground reaction (``validate.walk.contact.ground_reaction``)
+    orbit: Orbit | None = None  # the walk's orbit and its multipliers (``validate.checks.orbit``)
 
     @property
     def passed(self) -> bool:
@@ -51,7 +51,7 @@ def validate(
     gait: Gait, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
 ):
     """All checks of a gait on ``model``
-    (``validate.model.model_spec``: by default the committed model of the gait's knee for
+    (``validate.scene.model.model_spec``: by default the committed model of the gait's knee for
     Table 1, the model generated from the gait's robot otherwise).
 
     Raises BipedError if the model cannot be read or is of the other knee.
@@ -95,7 +95,7 @@ def as_json(checks) -> dict:
             **{k: clean(v) for k, v in check.figures.items()},
             "passed": bool(check.passed),
             "notes": list(check.notes),
-            "causes": list(check.causes),  # why it fails, among validate.checks.CAUSES
+            "causes": list(check.causes),  # why it fails, among validate.checks.checks.CAUSES
         }
     content["passed"] = all(check.passed for check in checks)
     return content

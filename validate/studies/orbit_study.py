@@ -1,9 +1,9 @@
 """The orbit of gaits under a range of one controller gain: where the walk stops being stable.
 
-A knob (``KNOBS``) scales one gain of the walk's controller (``validate.simulate``): ``kp``
+A knob (``KNOBS``) scales one gain of the walk's controller (``validate.walk.simulate``): ``kp``
 the servos' stiffness ``KP``, ``kv`` their damping ``KV``, ``speed`` the speed loop's gain
 ``SPEED_GAIN`` (0: the speed loop off). At each value the orbit is found and its multipliers
-computed (``validate.orbit.orbit``); a walk that falls has no orbit and counts as unstable.
+computed (``validate.checks.orbit.orbit``); a walk that falls has no orbit and counts as unstable.
 The boundaries are where the verdict changes between two neighbouring values, and where ρ
 crosses 1 between them (linear between the two radii; none where a walk falls).
 
@@ -23,10 +23,10 @@ from biped.errors import BipedError
 from biped.model.units import PURE
 from biped.records.gait_file import Gait
 from biped.runtime.runner import ProgressBar, run_tasks
-from validate.model import model_spec
-from validate.orbit import NOMINAL, Orbit, Steps, figures, notes, orbit
-from validate.simulate import Walker, WalkSettings, quiet_mujoco
-from validate.units import FIGURE_UNITS
+from validate.checks.orbit import NOMINAL, Orbit, Steps, figures, notes, orbit
+from validate.checks.units import FIGURE_UNITS
+from validate.scene.model import model_spec
+from validate.walk.simulate import Walker, WalkSettings, quiet_mujoco
 
 # Knob -> (the WalkSettings field it sets, what it scales, in words).
 KNOBS = {

@@ -31,12 +31,12 @@ from biped.model.dynamics import Biped
 from biped.model.profile import KneeProfile
 from biped.model.robot import SOLE_EDGES, Robot
 from biped.model.units import robot_unit
-from validate.mjcf import FOLDER, FOOT_FRICTION, SIDES, robot_xml, scene_xml
-from validate.profile_mjcf import model_profile
+from validate.scene.mjcf import FOLDER, FOOT_FRICTION, SIDES, robot_xml, scene_xml
+from validate.scene.profile_mjcf import model_profile
 
 # Names of the six actuated joints, in the order of every (N, 6) array of the validation.
 JOINT_ORDER = tuple(f"{side}_{joint}" for side in SIDES for joint in ("hip", "knee", "ankle"))
-# What the validation reads by name (as ``validate.mjcf`` writes it).
+# What the validation reads by name (as ``validate.scene.mjcf`` writes it).
 BASE_JOINTS = ("rootx", "rootz", "rooty")
 SITES = ("ankle", *SOLE_EDGES)  # per side
 SENSORS = ("touch", "ankle_pos", "heel_pos", "toe_pos")  # per side
@@ -63,7 +63,7 @@ def knee_of(model: mujoco.MjModel, source: str = "the model") -> str:
     raise BipedError(
         f"{source} has neither the joints left_knee, right_knee (revolute knee) nor "
         "left_knee_upper, left_knee_lower, right_knee_upper, right_knee_lower (rolling knee): "
-        "allowed an MJCF of this biped (mjcf/scene_<knee>.xml, validate.mjcf)"
+        "allowed an MJCF of this biped (mjcf/scene_<knee>.xml, validate.scene.mjcf)"
     )
 
 
@@ -123,7 +123,7 @@ def _one_line(error: Exception) -> str:
 
 
 def _add_floor(spec: mujoco.MjSpec) -> None:
-    """The floor of ``validate.mjcf.scene_xml`` under a robot file given without it."""
+    """The floor of ``validate.scene.mjcf.scene_xml`` under a robot file given without it."""
     spec.worldbody.add_geom(
         name="floor",
         type=mujoco.mjtGeom.mjGEOM_PLANE,
@@ -148,7 +148,7 @@ def _check_names(model: mujoco.MjModel, source: str) -> None:
             what = kind.name.removeprefix("mjOBJ_").lower()
             raise BipedError(
                 f"{source} has no {what} named {name!r}: allowed a model with the names of "
-                "validate.mjcf (mjcf/biped_<knee>.xml)"
+                "validate.scene.mjcf (mjcf/biped_<knee>.xml)"
             )
 
 
@@ -180,7 +180,7 @@ def model_problems(model: mujoco.MjModel, biped: Biped) -> list[str]:
 
 
 def _profile_problems(model: mujoco.MjModel, biped: Biped) -> list[str]:
-    """A profiled knee's equalities (``validate.profile_mjcf``) on each side, against the
+    """A profiled knee's equalities (``validate.scene.profile_mjcf``) on each side, against the
     gait's robot: the arc's two, the slide's tendon and its pin; a profile against circles."""
     problems = []
     wanted = KneeProfile.of(biped.robot)
@@ -252,7 +252,7 @@ def _knee_ratio(model: mujoco.MjModel, side: str) -> float | None:
 
 def model_parameters(model: mujoco.MjModel, knee: str) -> dict[str, list[tuple[str, float]]]:
     """The fields of ``biped.Robot`` that ``model`` holds, each as the (where, value) pairs of
-    every place that holds it, read back through ``validate.mjcf``'s layout (bodies from the
+    every place that holds it, read back through ``validate.scene.mjcf``'s layout (bodies from the
     hip down each leg, sites of the ankle, heel, toe and head, the soles' contact spheres, the
     knee link and equality of a rolling knee, gravity). Fields the model does not hold (the
     radii of a revolute knee, the trunk's length without a ``head`` site; a rolling knee's
@@ -301,7 +301,7 @@ def model_parameters(model: mujoco.MjModel, knee: str) -> dict[str, list[tuple[s
         r1 = r2 = 0.0
         below_thigh = shank
         profile = model_profile(model, side) if knee == "rolling" else None
-        if profile is not None:  # validate.profile_mjcf
+        if profile is not None:  # validate.scene.profile_mjcf
             below_thigh = model.body(f"{side}_knee_link")
             r1, r2 = profile.r1, profile.r2
             where = f"equalities {side}_knee_thigh_arc, {side}_knee_shank_arc"

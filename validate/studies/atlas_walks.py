@@ -4,9 +4,9 @@ optimizations (``biped.studies.atlas``), run on the campaign's machinery
 whole, Ctrl-C and SIGTERM as every campaign's).
 
 Each certified final optimum (every criterion, cell and knee) is walked from its gait file:
-the forward walk with contact of ``STEPS`` steps (``validate.checks.check_forward``) and the
+the forward walk with contact of ``STEPS`` steps (``validate.checks.checks.check_forward``) and the
 feedforward replay (``check_feedforward``) everywhere; every check of
-``validate.validation.validate`` (the gains and the orbit included) at the corners of speed x
+``validate.checks.validation.validate`` (the gains and the orbit included) at the corners of speed x
 clearance and at each criterion's best pay-off (``biped.studies.atlas.fully_checked``). A
 gait walks when every check run on it passes: an orbit only 'undecided' fails the orbit
 check, and is not a walk.
@@ -88,11 +88,11 @@ def _clean(value):
 
 def _checks(gait: Gait, every_check: bool) -> list:
     """The checks of ``gait`` in MuJoCo: every check of ``validate``, or the light ones."""
-    from validate import checks as c
-    from validate.model import model_spec
-    from validate.samples import GaitSamples
-    from validate.simulate import Walker
-    from validate.validation import validate
+    from validate.checks import checks as c
+    from validate.checks.validation import validate
+    from validate.scene.model import model_spec
+    from validate.walk.samples import GaitSamples
+    from validate.walk.simulate import Walker
 
     if every_check:
         return validate(gait, STEPS).checks
@@ -160,7 +160,7 @@ def _cause(check) -> str:
 
 def _walk(task: Task) -> str:
     """Walk one final optimum, write its record whole; its line."""
-    from validate.simulate import quiet_mujoco
+    from validate.walk.simulate import quiet_mujoco
 
     walk, began = task.point, time.perf_counter()
     path = Path(task.folder) / walk.point.gait_filename()

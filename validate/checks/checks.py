@@ -4,7 +4,7 @@ scale beside its constant, and a failing check's note gives the figure on that s
 
 model             the MJCF is the gait's robot: the rolling knee's equalities and their
                   ratio r2 / r1, and every field of ``biped.Robot`` the MJCF holds
-                  (``validate.model.parameter_differences``: the first that differs named
+                  (``validate.scene.model.parameter_differences``: the first that differs named
                   with both values); its mass beside the gait's ("model mismatch")
 inverse_dynamics  the file's Γ, F_e, ZMP against MuJoCo's dynamics of the model along the
                   file's motion (``EXACT``; "model mismatch")
@@ -17,11 +17,11 @@ impact            the file's start velocities and impulse against MuJoCo's impac
                   (mass matrix and foot Jacobian) applied to the file's end state (``EXACT``;
                   "model mismatch")
 feedforward       each step replayed against the clock with the file's torques
-                  (``validate.replay``): the torque each joint's servo had to add, RMS over
+                  (``validate.walk.replay``): the torque each joint's servo had to add, RMS over
                   the step, below ``SERVO_SHARE`` of the robot's torque scale (the largest
                   RMS torque of its joints) for every joint ("servo share"); each joint's
                   share of its own torque reported beside it
-forward           the file walked in MuJoCo with contact (``validate.simulate``): every step
+forward           the file walked in MuJoCo with contact (``validate.walk.simulate``): every step
                   lands and advances the hip by ``STEP_ADVANCE`` of the step length at
                   least ("did not advance"), no fall ("fell"), no slip of the stance foot
                   (``MAX_SLIP``, also as a share of the step: "slipped"), the stance foot
@@ -34,9 +34,9 @@ forward           the file walked in MuJoCo with contact (``validate.simulate``)
 gains             the same walk at kp × ``GAIN_SCALES``: the range of gains it walks over
                   (the causes of the walks that fail)
 
-A model the harness cannot use as the gait's robot (``validate.model.ModelError``: a rolling
+A model the harness cannot use as the gait's robot (``validate.scene.model.ModelError``: a rolling
 knee without its equalities) fails the checks that need it, with the reason as a note
-("model mismatch"). The orbit check (``validate.orbit``) fails as "unstable orbit".
+("model mismatch"). The orbit check (``validate.checks.orbit``) fails as "unstable orbit".
 """
 
 from __future__ import annotations
@@ -53,28 +53,28 @@ from biped.model.knee_loads import KNEE_SIDES, knee_forces
 from biped.model.profile import KneeProfile
 from biped.model.units import PURE, unit_text
 from biped.records.gait_file import Gait
-from validate import contact
-from validate.crosscheck import (
+from validate.checks.crosscheck import (
     mujoco_impact,
     mujoco_inverse_dynamics,
     mujoco_knee_forces,
     rigid_copy,
 )
-from validate.knee_fit import TARGET, knee_fit
-from validate.mapping import mapping, other
-from validate.mjcf import SIDES
-from validate.model import ModelError, model_problems
-from validate.replay import replay_model, replay_step
-from validate.samples import GaitSamples
-from validate.simulate import KP, Simulation, Walker, WalkSettings, reference_along
-from validate.units import FIGURE_UNITS, PROFILES, WalkFigures
+from validate.checks.knee_fit import TARGET, knee_fit
+from validate.checks.units import FIGURE_UNITS, PROFILES, WalkFigures
+from validate.scene.mapping import mapping, other
+from validate.scene.mjcf import SIDES
+from validate.scene.model import ModelError, model_problems
+from validate.walk import contact
+from validate.walk.replay import replay_model, replay_step
+from validate.walk.samples import GaitSamples
+from validate.walk.simulate import KP, Simulation, Walker, WalkSettings, reference_along
 
 # Agreement of two exact rigid-body models of one robot, in each figure's unit (N·m, N, m,
 # m/s, rad/s, N·s): a millionth of the torques (1-10 N·m), of the weight (687 N) and of the
 # sole (0.26 m) of the gaits it compares; two models of one robot agree to rounding (1e-13
 # measured), a robot 5 % off in any field of Table 1 differs by 1e-3 or more.
 EXACT = 1e-6
-# Largest torque a joint's servo may add in the replay (``validate.replay``), RMS over the
+# Largest torque a joint's servo may add in the replay (``validate.walk.replay``), RMS over the
 # step, as a share of the robot's torque scale: the largest RMS torque of its joints over
 # that step (a stance hip's or ankle's: 1.7 N·m for the optimal gaits at 0.3 m/s, 7.3 N·m at
 # 0.6 m/s). Judged against that scale, not against each joint's own torque: a swing ankle
@@ -232,9 +232,9 @@ def _exact_verdict(name: str, figures: dict, what: str, scales: dict, notes=None
 
 
 def check_model(model: mujoco.MjModel, biped: Biped) -> Check:
-    """The model is the gait's robot (``validate.model.model_problems``); masses reported.
+    """The model is the gait's robot (``validate.scene.model.model_problems``); masses reported.
     A profiled knee's also MuJoCo's knee against the analytical one over the knee's range
-    (``validate.knee_fit``: its largest distance and angle, each below ``TARGET``)."""
+    (``validate.checks.knee_fit``: its largest distance and angle, each below ``TARGET``)."""
     problems = model_problems(model, biped)
     trunk = model.body("trunk").id
     mass = float(model.body_subtreemass[trunk])
@@ -356,7 +356,7 @@ def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait
 
 
 def check_feedforward(spec: mujoco.MjSpec, biped: Biped, samples: GaitSamples) -> Check:
-    """Both stance sides replayed (``validate.replay``): each joint's servo torque, RMS over
+    """Both stance sides replayed (``validate.walk.replay``): each joint's servo torque, RMS over
     the step, against the robot's torque scale (the largest RMS torque of its joints over
     the step), below ``SERVO_SHARE`` at every joint; each joint's share of its own torque
     reported beside it."""
@@ -434,7 +434,7 @@ def walk_figures(
     biped: Biped, samples: GaitSamples, sim: Simulation, energy: float, reaction=None
 ) -> dict:
     """Figures of a forward simulation (see the module docstring); those of the ground
-    reaction (``validate.contact.ground_reaction``) only when it is given."""
+    reaction (``validate.walk.contact.ground_reaction``) only when it is given."""
     period, dt = samples.period, sim.model.opt.timestep
     settle = int(contact.SETTLE * period / dt)
     slips, tilt = sim.stance_foot_slip(settle), contact.foot_tilt(sim, period)

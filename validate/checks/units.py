@@ -1,4 +1,4 @@
-"""Units of the validation report's figures (``validate.validation``), for its ``units`` map.
+"""Units of the validation report's figures (``validate.checks.validation``), for its ``units`` map.
 
 Paths and notation as in ``biped.model.units``: ``"forward.max_slip": "m"``. "weight" is a
 fraction of the robot's weight, "S" of the gait's step length. One figure has one unit: the
@@ -14,17 +14,17 @@ from dataclasses import dataclass
 from biped.model.dynamics import JOINTS
 from biped.model.units import PERIOD, PURE, declared_units, unit_field
 
-GAIN_KEYS = ("0_5", "1", "2")  # validate.checks.GAIN_SCALES and the default, as keys
+GAIN_KEYS = ("0_5", "1", "2")  # validate.checks.checks.GAIN_SCALES and the default, as keys
 
 
 @dataclass(frozen=True)
 class WalkFigures:
-    """The figures of a forward walk (``validate.checks.walk_figures``), each with its unit, in
-    the report's order; ``max_knee_equality_violation`` for the rolling knee only."""
+    """The figures of a forward walk (``validate.checks.checks.walk_figures``), each with its
+    unit, in the report's order; ``max_knee_equality_violation`` for the rolling knee only."""
 
     # the leading steps that land and advance the hip, the stance foot still and flat
     steps: int = unit_field(PURE)
-    fell: bool  # the hip too low or the trunk tilted (``validate.checks.HIP_DROP``, ...)
+    fell: bool  # the hip too low or the trunk tilted (``validate.checks.checks.HIP_DROP``, ...)
     stalled: bool  # a step not landed, the robot up, or landed without advancing the hip
     step_length: float = unit_field("m")  # the gait's, the scale of the slip and the advance
     max_slip: float = unit_field("m")  # stance foot's travel in its stance, landing settled
@@ -62,7 +62,7 @@ class WalkFigures:
     servo_torque_rms: list = unit_field("N·m")
     landing_window: float = unit_field(PERIOD)  # after each touchdown, out of the RMS
     # The same over one step (the mean over the steps walked, landings in), at the phases
-    # ``profile_phase``: (``validate.checks.PROFILE_POINTS``, 6) each.
+    # ``profile_phase``: (``validate.checks.checks.PROFILE_POINTS``, 6) each.
     profile_phase: list = unit_field(PERIOD)
     gait_torque_profile: list = unit_field("N·m")
     mujoco_torque_profile: list = unit_field("N·m")
@@ -88,13 +88,13 @@ PROFILES = (
     "servo_torque_profile",
 )
 
-# Units of the section's coordinates (``validate.orbit.COORDINATES``): six angles, six rates.
+# Units of the section's coordinates (``validate.checks.orbit.COORDINATES``): six angles, six rates.
 SECTION_UNITS = ["rad"] * 6 + ["rad/s"] * 6
 
 
 @dataclass(frozen=True)
 class OrbitFigures:
-    """The figures of the orbit check (``validate.orbit``), each with its unit, in the
+    """The figures of the orbit check (``validate.checks.orbit``), each with its unit, in the
     report's order; without an orbit (a walk fell) only the settings and ``verdict``."""
 
     verdict: str
@@ -137,7 +137,7 @@ FIGURE_UNITS = {
     "model": {
         "mass_difference": "kg",
         "problems": PURE,
-        "knee_position_error": "m",  # a profiled knee's (``validate.knee_fit``)
+        "knee_position_error": "m",  # a profiled knee's (``validate.checks.knee_fit``)
         "knee_angle_error": "rad",
     },
     "inverse_dynamics": {
@@ -184,8 +184,8 @@ FIGURE_UNITS = {
 
 
 def report_units(report: dict) -> dict:
-    """The ``units`` map of a report (``validate.validation.as_json``): the unit of each figure
-    of its checks that ``FIGURE_UNITS`` names."""
+    """The ``units`` map of a report (``validate.checks.validation.as_json``): the unit of each
+    figure of its checks that ``FIGURE_UNITS`` names."""
     units = {}
     for check, figures in report.items():
         if not isinstance(figures, dict):

@@ -11,7 +11,7 @@ MuJoCo's qpos is a constant linear map of q (all angles relative, parent to chil
 and for the rolling knee the flexion q_shank - q_thigh splits into knee_upper = r1/l and
 knee_lower = r2/l of it. Velocities and accelerations map the same way.
 
-A profiled knee (``validate.profile_mjcf``) is not linear: its four joints are functions of
+A profiled knee (``validate.scene.profile_mjcf``) is not linear: its four joints are functions of
 the flexion θ = q_thigh − q_shank (knee_upper = −ψ2, knee_lower = −ψ1, knee_slide = Σ − r1 − r2,
 knee_arc = S2(ψ2), ``biped.model.profile``), read with the profile from the model's own
 equalities; ``Mapping.qvel`` and ``qacc`` carry their first and second derivatives in θ.
@@ -27,9 +27,9 @@ import numpy as np
 
 from biped.model.kinematics import NQ, Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH
 from biped.model.profile import KneeProfile, rolling
-from validate.mjcf import SIDES
-from validate.model import JOINT_ORDER
-from validate.profile_mjcf import model_profile
+from validate.scene.mjcf import SIDES
+from validate.scene.model import JOINT_ORDER
+from validate.scene.profile_mjcf import model_profile
 
 # Paper torque order Γ1..Γ6 as (role, joint).
 TORQUES = (
@@ -58,7 +58,7 @@ class Mapping:
     qpos_from_q: np.ndarray  # (nq, 9)
     actuator_order: np.ndarray  # index of the actuator carrying Γ1..Γ6
     stance: str
-    columns: np.ndarray = None  # index in ``validate.model.JOINT_ORDER`` of Γ1..Γ6's joint
+    columns: np.ndarray = None  # index in ``validate.scene.model.JOINT_ORDER`` of Γ1..Γ6's joint
     # (thigh, shank, qpos addresses of ``PROFILE_JOINTS``) of each profiled knee
     knees: tuple = ()
     profile: KneeProfile | None = None

@@ -35,10 +35,10 @@ import mujoco
 import numpy as np
 
 from biped.model.dynamics import Biped
-from validate.mapping import Mapping, mapping, other
-from validate.mjcf import SIDES, robot_xml
-from validate.model import JOINT_ORDER, ModelError
-from validate.profile_mjcf import model_profile
+from validate.scene.mapping import Mapping, mapping, other
+from validate.scene.mjcf import SIDES, robot_xml
+from validate.scene.model import JOINT_ORDER, ModelError
+from validate.scene.profile_mjcf import model_profile
 
 
 def load_model(biped: Biped, exact: bool = False) -> mujoco.MjModel:
@@ -54,7 +54,7 @@ def rigid_copy(model: mujoco.MjModel) -> mujoco.MjModel:
     exact = copy.deepcopy(model)
     exact.dof_armature[:] = 0.0
     for side, part in ((s, p) for s in SIDES for p in ("link", "slider")):
-        name = f"{side}_knee_{part}"  # a profiled knee's slider too (validate.profile_mjcf)
+        name = f"{side}_knee_{part}"  # a profiled knee's slider too (validate.scene.profile_mjcf)
         if mujoco.mj_name2id(exact, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
             body = exact.body(name).id
             exact.body_mass[body] = 0.0
@@ -77,7 +77,7 @@ def actuator_moments(model: mujoco.MjModel) -> np.ndarray:
 
 def equality_jacobian(model: mujoco.MjModel, data: mujoco.MjData | None = None) -> np.ndarray:
     """J_eq (neq, nv) of the joint equalities joint1 = c0 + c1 joint2 (linear ones); of a
-    profiled knee's (``validate.profile_mjcf``: quadratic, and a tendon), MuJoCo's own rows
+    profiled knee's (``validate.scene.profile_mjcf``: quadratic, and a tendon), MuJoCo's own rows
     at ``data``'s configuration (after ``mj_fwdPosition``)."""
     if data is not None and model_profile(model) is not None:
         n = data.nefc

@@ -4,14 +4,15 @@ that chose the walkable preset (``biped.model.criteria.WALKABLE``).
 For each operating point (knee, speed, clearance) and each setting of one knob (the sole's
 largest landing speed as a share of the walking speed, the swing clearance, or the ZMP's
 margin inside the sole), the certified sthenic optimum under that
-setting is validated in MuJoCo (``validate.validation.validate``, every check), and two
+setting is validated in MuJoCo (``validate.checks.validation.validate``, every check), and two
 figures of its 20-step walk are kept: the servos' share of the joint torque
 (``forward.feedback_share``: what the controller had to add to the gait's own torques) and
 the energy per step MuJoCo spends against the model's (``forward.energy_per_step`` over
 ``analytic_energy_per_step``, less 1). The preset takes the loosest setting at which every
 point's walk passes every check with both figures within their targets (``TARGETS``).
 
-    python -m validate.margins_study [--knob landing|clearance|zmp] [--out logs/margins] [--jobs N]
+    python -m validate.studies.margins_study [--knob landing|clearance|zmp]
+        [--out logs/margins] [--jobs N]
 
 writes ``<knob>.json`` (one row per optimum, atomically) and ``<knob>.png`` (both figures
 against the knob, a line per point, the targets dashed), and prints the rows.
@@ -75,7 +76,7 @@ def measure(setting: Setting) -> dict:
     from biped.optimization.optimize import optimize
     from biped.optimization.problem import GaitProblem
     from biped.records.gait_file import Gait
-    from validate.validation import as_json, validate
+    from validate.checks.validation import as_json, validate
 
     robot = biped.Robot.paper()
     problem = GaitProblem(biped.Biped(robot, setting.knee), setting.speed, safety=setting.safety())
@@ -215,7 +216,7 @@ def main(argv=None) -> int:
     from biped.runtime.runner import run_tasks
 
     parser = argparse.ArgumentParser(
-        prog="python -m validate.margins_study", description=__doc__.split("\n\n")[0]
+        prog="python -m validate.studies.margins_study", description=__doc__.split("\n\n")[0]
     )
     parser.add_argument("--knob", choices=tuple(KNOBS), default="landing")
     parser.add_argument("--out", default="logs/margins")

@@ -1,6 +1,6 @@
 """MJCF models of both bipeds, generated from ``biped.Robot`` (the single source of truth).
 
-    python -m validate.mjcf            # rewrite mjcf/*.xml from Robot.paper()
+    python -m validate.scene.mjcf            # rewrite mjcf/*.xml from Robot.paper()
 
 Layout (mujoco_menagerie style): the trunk is the root body, at the hip, with the planar base
 ``rootx``, ``rootz`` (slides, equal to the paper's x_H, z_H) and ``rooty`` (hinge, equal to
@@ -10,13 +10,13 @@ the robot standing straight with its soles on the floor, the ``home`` key, and q
 equals x_H, z_H, q5 (MuJoCo moves a body by qpos - ref). Every hinge turns about "0 -1 0", so a positive angle is
 counter-clockwise in the x-z plane like the paper's angles: a child's absolute angle is its
 parent's plus the joint angle. The legs are ``left`` and ``right``; which one is the stance leg
-changes every step (``validate.mapping``). Every hinge but ``rooty`` stops at a human's range
+changes every step (``validate.scene.mapping``). Every hinge but ``rooty`` stops at a human's range
 (``HIP_RANGE``, ``KNEE_RANGE``, ``ANKLE_RANGE``: the knee never inverted beyond 0.05 rad, the
 paper's Ψ4, Ψ5 >= 0) and the trunk, thighs and shanks collide with the floor as the soles do,
 so that the robot left without control (``python -m mujoco.viewer``) folds and lies down like
 one; the gaits never come near the stops or touch the floor with a link.
 
-The MJCF holds every field of ``biped.Robot`` (``validate.model.model_parameters`` reads them
+The MJCF holds every field of ``biped.Robot`` (``validate.scene.model.model_parameters`` reads them
 back): segment lengths as the bodies' places, masses, inertias and centres of mass as their
 ``inertial``, the sole as the heel and toe sites and contact points, the knee radii as the
 rolling knee's link (r1 + r2) and equality (r2 / r1), the trunk's length as its ``head`` site,
@@ -46,7 +46,7 @@ from biped.model.profile import KneeProfile
 from biped.model.robot import FOOT_FRICTION as SLIDING_FRICTION
 from biped.model.robot import JOINT_STOPS, SOLE_EDGES, Robot
 from biped.runtime.files import atomic_write_text
-from validate import profile_mjcf
+from validate.scene import profile_mjcf
 
 SIDES = ("left", "right")
 # Near-massless knee link of the rolling knee (MuJoCo needs mass on a moving body) [kg, kg·m²].
@@ -134,8 +134,9 @@ OFFSCREEN = (1280, 720)
 def _models_folder() -> Path:
     """Where the committed models are: ``mjcf/`` of a source checkout (editable installs
     too), else the copy an installed package carries (``validate/models``, pyproject.toml)."""
-    source = Path(__file__).resolve().parent.parent / "mjcf"
-    return source if source.is_dir() else Path(__file__).resolve().parent / "models"
+    package = Path(__file__).resolve().parents[1]  # validate/, above this scene/
+    source = package.parent / "mjcf"
+    return source if source.is_dir() else package / "models"
 
 
 FOLDER = _models_folder()
@@ -259,7 +260,7 @@ def _leg(r: Robot, side: str, r1: float, r2: float) -> list[str]:
         f'{pad}  <geom class="visual" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}" material="{side}"/>',
         f'{pad}  <geom name="{side}_thigh_contact" class="collision" type="capsule" size="{_f(THIGH_RADIUS)}" fromto="0 0 0 0 0 {_f(-thigh)}"/>',
     ]
-    if link > 0.0 and r.profiled:  # four joints (``validate.profile_mjcf``)
+    if link > 0.0 and r.profiled:  # four joints (``validate.scene.profile_mjcf``)
         parts = {
             "armature": f'armature="{_f(KNEE_ARMATURE)}"',
             "inertial": _inertial(0.0, KNEE_LINK_MASS, KNEE_LINK_INERTIA),
@@ -468,11 +469,11 @@ def stale_models(folder: Path = FOLDER, robot: Robot | None = None) -> list[Path
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m validate.mjcf [--check]``; returns the exit status."""
+    """``python -m validate.scene.mjcf [--check]``; returns the exit status."""
     import argparse
 
     parser = argparse.ArgumentParser(
-        prog="python -m validate.mjcf",
+        prog="python -m validate.scene.mjcf",
         description=f"Write the MJCF models of both knees ({FOLDER}/*.xml) from "
         "biped.Robot.paper(), or check that they are up to date.",
         epilog="Exit status: 0 written or up to date, 1 out of date (--check), 2 error.",
@@ -487,14 +488,14 @@ def main(argv: list[str] | None = None) -> int:
         if args.check:
             stale = stale_models(FOLDER)
             for path in stale:
-                print(f"out of date: {path} (run: python -m validate.mjcf)")
+                print(f"out of date: {path} (run: python -m validate.scene.mjcf)")
             if not stale:
                 print(f"up to date: {len(model_files())} files in {FOLDER}")
             return 1 if stale else 0
         for written in write_models(FOLDER):
             print(f"wrote {written}", file=sys.stderr)
     except OSError as error:
-        print(f"python -m validate.mjcf: error: {error}", file=sys.stderr)
+        print(f"python -m validate.scene.mjcf: error: {error}", file=sys.stderr)
         return 2
     return 0
 

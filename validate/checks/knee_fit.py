@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 
 from biped.model.profile import PROFILE_RANGE, KneeProfile, knee_vectors, rolling
-from validate.mjcf import SIDES
+from validate.scene.mjcf import SIDES
 
 # Flexions compared over the knee's range.
 POINTS = 201
@@ -32,7 +32,7 @@ ITERATIONS, RESIDUAL = 30, 1e-14
 class KneeFit:
     """The largest difference over the range, both knees."""
 
-    position: float  # [m] of the shank's origin C1' (``validate.profile_mjcf``)
+    position: float  # [m] of the shank's origin C1' (``validate.scene.profile_mjcf``)
     angle: float  # [rad] of the shank
     residual: float  # [m or rad] the largest equality residual left by Newton's method
 
@@ -94,5 +94,5 @@ def knee_fit(model: mujoco.MjModel, profile: KneeProfile) -> KneeFit:
 
 def model_thigh(model: mujoco.MjModel, side: str) -> float:
     """[m] l2 − r2: how far below the hip the thigh's centre C2 lies (the knee arc's body
-    sits there, ``validate.profile_mjcf``)."""
+    sits there, ``validate.scene.profile_mjcf``)."""
     return float(-model.body(f"{side}_knee_arc").pos[2])

@@ -24,7 +24,7 @@ Entity paths, on the timeline ``time`` (seconds of simulation):
     summary                               the gait's parameters, criteria and every check
     orbit/{unit_circle,radius,band,axes}  the complex plane of the orbit check's multipliers:
     orbit/multipliers                     the unit circle, ρ and ρ ± 2 spreads, the
-                                          multipliers μ (y up: Im μ; ``validate.orbit``)
+                                          multipliers μ (y up: Im μ; ``validate.checks.orbit``)
     torque_key                            the torque plots' series in words (their legend)
 
 ``blueprint()`` lays them out: the 3D view following the robot, one plot per joint with its
@@ -57,13 +57,13 @@ from biped.model.dynamics import JOINTS, Biped
 from biped.model.robot import SOLE_EDGES
 from biped.records.gait_file import Gait
 from biped.runtime.files import atomic_path
-from validate.checks import LANDING
-from validate.contact import SAMPLE_EVERY
-from validate.mapping import mapping
-from validate.mjcf import HIP_OFFSET, SIDES
-from validate.samples import GaitSamples
-from validate.simulate import Simulation, reference_along
-from validate.units import PROFILES
+from validate.checks.checks import LANDING
+from validate.checks.units import PROFILES
+from validate.scene.mapping import mapping
+from validate.scene.mjcf import HIP_OFFSET, SIDES
+from validate.walk.contact import SAMPLE_EVERY
+from validate.walk.samples import GaitSamples
+from validate.walk.simulate import Simulation, reference_along
 
 FRAME_EVERY = 20  # draw the robots every 20 simulation steps (50 Hz)
 APPLICATION = "biped_validation"
@@ -350,7 +350,7 @@ def _value(value) -> str:
 
 
 def record(path: str | Path, validation, spawn: bool = False, connect: str | None = None) -> Path:
-    """Write the recording of a validation (``validate.validation.Validation``: its walk, the
+    """Write the recording of a validation (``validate.checks.validation.Validation``: its walk, the
     gait's samples drawn as the ghost, the walk's contact, and for the summary the gait and
     its checks) to ``path`` (.rrd), atomically.
 

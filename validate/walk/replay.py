@@ -10,7 +10,7 @@ of a joint is the share of its torque its servo had to add:
     share_i = rms(u_fb,i) / rms(u_ff,i + u_fb,i)        over the step, less its ends
 
 0.2 for a torque 20 % too small or too large, 1 for a joint without its torque. The
-feedforward check (``validate.checks.check_feedforward``) reports it and judges each servo's
+feedforward check (``validate.checks.checks.check_feedforward``) reports it and judges each servo's
 RMS torque against the robot's torque scale instead (the largest RMS torque of its joints,
 ``SERVO_SHARE``): a joint that carries little torque (a swing ankle's 0.05-0.2 N·m) has a
 large share of little servo torque, which changes nothing the robot does. The exact
@@ -38,11 +38,11 @@ import numpy as np
 from mujoco import rollout
 
 from biped.model.dynamics import JOINTS, Biped
-from validate.layout import Layout
-from validate.mapping import mapping, rotor_torques
-from validate.model import JOINT_ORDER, with_servos
-from validate.samples import GaitSamples
-from validate.simulate import KP, KV
+from validate.scene.layout import Layout
+from validate.scene.mapping import mapping, rotor_torques
+from validate.scene.model import JOINT_ORDER, with_servos
+from validate.walk.samples import GaitSamples
+from validate.walk.simulate import KP, KV
 
 # Physics step of the replay [s] and the contact's time constant and damping ratio there
 # (the shortest MuJoCo allows: two steps).

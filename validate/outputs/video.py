@@ -1,10 +1,10 @@
 """Videos of MuJoCo's walk: the tracking camera, the floor, the analytical gait as a ghost and a
 caption band with the step, the time and the verdict of the validation.
 
-    python -m validate.video GAIT.json --out walk.mp4 [--gif walk.gif] [--steps 20]
-    python -m validate.video GAIT.json --frame docs/walk.png [--at 2.0]
+    python -m validate.outputs.video GAIT.json --out walk.mp4 [--gif walk.gif] [--steps 20]
+    python -m validate.outputs.video GAIT.json --frame docs/walk.png [--at 2.0]
 
-The frames are the states that ``validate.simulate.simulate`` recorded (no simulation of
+The frames are the states that ``validate.walk.simulate.simulate`` recorded (no simulation of
 its own): one every 1 / ``FPS`` s, drawn by MuJoCo's offscreen renderer (set
 ``MUJOCO_GL=egl`` on a machine without a display) from the model's ``track`` camera. The
 ghost is the gait at the phase the controller followed, its stance foot on MuJoCo's stance
@@ -29,9 +29,9 @@ import numpy as np
 from biped.model.dynamics import Biped
 from biped.runtime.files import atomic_path
 from validate import DEFAULT_STEPS
-from validate.mapping import mapping
-from validate.mjcf import SIDES
-from validate.simulate import Simulation
+from validate.scene.mapping import mapping
+from validate.scene.mjcf import SIDES
+from validate.walk.simulate import Simulation
 
 # Frames per second of the video (simulated time runs at real time).
 FPS = 30
@@ -203,7 +203,7 @@ class Captioned:
 
 
 def verdict_of(checks) -> tuple[str, bool]:
-    """Caption of a list of ``validate.validation.Check``: PASS or the failed checks, and the
+    """Caption of a list of ``validate.checks.validation.Check``: PASS or the failed checks, and the
     steps walked."""
     passed = all(check.passed for check in checks)
     failed = [check.name for check in checks if not check.passed]
@@ -272,7 +272,7 @@ def write_gif(path: str | Path, frames) -> Path:
 
 @contextlib.contextmanager
 def _captioned(validation, ghost: bool):
-    """The walk of a validation (``validate.validation.Validation``) captioned with its
+    """The walk of a validation (``validate.checks.validation.Validation``) captioned with its
     verdict, its renderer closed after the block."""
     verdict, passed = verdict_of(validation.checks) if validation.checks else ("", None)
     renderer = WalkRenderer(
@@ -287,7 +287,7 @@ def _captioned(validation, ghost: bool):
 def write_video(
     path: str | Path | None, validation, gif: str | Path | None = None, ghost: bool = True
 ) -> list[Path]:
-    """Render the walk of a validation (``validate.validation.Validation``) to an MP4 at
+    """Render the walk of a validation (``validate.checks.validation.Validation``) to an MP4 at
     ``path`` and/or a GIF at ``gif`` (their missing folders created); returns the files
     written. Its checks give the verdict in the caption."""
     states = frame_states(validation.simulation)
@@ -334,9 +334,11 @@ def main(argv=None) -> int:
     """Validate a gait file and write the video, GIF or one frame of its walk in MuJoCo."""
     from biped.errors import BipedError
     from biped.records import gait_file
-    from validate.validation import validate
+    from validate.checks.validation import validate
 
-    parser = argparse.ArgumentParser(prog="python -m validate.video", description=main.__doc__)
+    parser = argparse.ArgumentParser(
+        prog="python -m validate.outputs.video", description=main.__doc__
+    )
     parser.add_argument("gait", metavar="GAIT.json", help="a gait file (optimize, pipeline)")
     parser.add_argument("--out", metavar="FILE.mp4", help="the video (H.264)")
     parser.add_argument("--gif", metavar="FILE.gif", help="an animated GIF of the walk")

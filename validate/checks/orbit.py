@@ -1,6 +1,6 @@
 """Is the walk a stable orbit? The return map of MuJoCo's closed-loop walk and its multipliers.
 
-A walking gait is a periodic orbit; the walk in MuJoCo (``validate.simulate``: the file's
+A walking gait is a periodic orbit; the walk in MuJoCo (``validate.walk.simulate``: the file's
 torques, the servos, the speed loop on the stance ankle) is stable when a small error in the
 state at one step is smaller at the next. The map from the state at one step to the state at
 the next (a Poincaré return map) says how much smaller: near its fixed point x*,
@@ -85,10 +85,10 @@ import numpy as np
 
 from biped.errors import BipedError
 from biped.model.kinematics import QP1, XH, ZH
-from validate.checks import LANDING, Check
-from validate.mapping import mapping
-from validate.simulate import Simulation, Walker, WalkSettings
-from validate.units import OrbitFigures
+from validate.checks.checks import LANDING, Check
+from validate.checks.units import OrbitFigures
+from validate.scene.mapping import mapping
+from validate.walk.simulate import Simulation, Walker, WalkSettings
 
 # The 12 coordinates of a state on the section, in order: the free angles [rad], then their
 # rates [rad/s] (``biped.model.kinematics``: qp2 swing foot, q1 stance shank, q2 stance thigh,
@@ -481,7 +481,7 @@ def _chord_steps(returns: ReturnMap, x, jacobian, steps: Steps):
 
 
 def figures(result: Orbit) -> dict:
-    """The orbit check's figures (``validate.units.OrbitFigures``) of ``result``."""
+    """The orbit check's figures (``validate.checks.units.OrbitFigures``) of ``result``."""
     settings, steps = result.settings, result.steps
     known = {
         "verdict": result.verdict,

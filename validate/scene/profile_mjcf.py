@@ -1,4 +1,4 @@
-"""The MJCF of a profiled rolling knee (``biped.model.profile``), for ``validate.mjcf``.
+"""The MJCF of a profiled rolling knee (``biped.model.profile``), for ``validate.scene.mjcf``.
 
 The pose of the shank relative to the thigh (``biped.model.profile``): the point
 C2' = C2 + k2 u'(q_thigh) of the thigh and the point C1' = C1 + k1 u'(q_shank) of the shank
@@ -83,7 +83,7 @@ def _drawn(points: np.ndarray, origin_z: float, material: str, pad: str) -> list
 
 def knee_bodies(profile: KneeProfile, side: str, thigh: float, pad: str, parts: dict) -> list:
     """The knee's bodies inside the thigh's (``pad`` its indentation), opened down to the
-    shank's (its knee_lower joint written; ``validate.mjcf`` writes the rest and closes the
+    shank's (its knee_lower joint written; ``validate.scene.mjcf`` writes the rest and closes the
     three bodies). ``parts``: the link's mass and inertia line, the armature attribute."""
     drawn = surfaces(profile)
     hinge, ends = parts["armature"], ranges(profile)
@@ -140,7 +140,7 @@ def couplings(profile: KneeProfile, sides, solref: str, solimp: str) -> list[str
 
 
 def model_profile(model: mujoco.MjModel, side: str = "left") -> KneeProfile | None:
-    """The knee profile ``side``'s equalities hold (``validate.profile_mjcf``: knee_arc =
+    """The knee profile ``side``'s equalities hold (``validate.scene.profile_mjcf``: knee_arc =
     −r2 upper + k2/2 upper², = −r1 lower + k1/2 lower²), None without a knee_arc joint or
     without those equalities."""
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{side}_knee_arc") < 0:

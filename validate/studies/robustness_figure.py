@@ -1,4 +1,4 @@
-"""The figure of a robustness map (``validate.robustness``): one row per condition.
+"""The figure of a robustness map (``validate.studies.robustness``): one row per condition.
 
 Drawn from the map's JSON content (``RobustnessMap.to_dict``), so a map written earlier can
 be drawn again. Each row: the range the gait walks over (a bar from one limit to the other),

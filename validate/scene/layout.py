@@ -2,7 +2,7 @@
 
 Every array the validation reads out of MuJoCo (a state vector, qpos, the sensors) is read
 through a ``Layout``: ``layout.hip_x(qpos)`` rather than ``qpos[:, 0]``. The names are those
-``validate.mjcf`` writes (``validate.model`` refuses a model without them).
+``validate.scene.mjcf`` writes (``validate.scene.model`` refuses a model without them).
 """
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import copy
 import mujoco
 import numpy as np
 
-from validate.mapping import PROFILE_JOINTS, knee_joints
-from validate.mjcf import SIDES
-from validate.model import JOINT_ORDER
-from validate.profile_mjcf import model_profile
+from validate.scene.mapping import PROFILE_JOINTS, knee_joints
+from validate.scene.mjcf import SIDES
+from validate.scene.model import JOINT_ORDER
+from validate.scene.profile_mjcf import model_profile
 
 
 class Layout:
@@ -27,12 +27,12 @@ class Layout:
             the sum of its two hinges) θ_mj = S qpos in ``JOINT_ORDER``, MuJoCo's sign; also
             maps qvel (nq = nv in these planar models).
         motors: (6,) ids of the motors, in ``JOINT_ORDER``.
-        positions, velocities: (6,) ids of the servos (``validate.model.with_servos``), or
+        positions, velocities: (6,) ids of the servos (``validate.scene.model.with_servos``), or
             None in a model without them.
         rotor_inertia: (6,) inertia [kg·m²] each joint's drive adds to it (MuJoCo's armature,
             seen through the joint: a rolling knee's two hinges turn by r1/l and r2/l of its
             flexion, so their armatures add as a (r1/l)² + a (r2/l)²; a profiled knee's four
-            joints by their rates at the straight knee, ``validate.mapping.knee_joints``).
+            joints by their rates at the straight knee, ``validate.scene.mapping.knee_joints``).
     """
 
     def __init__(self, model: mujoco.MjModel):
@@ -160,7 +160,7 @@ class Layout:
 
 def _coupling(model: mujoco.MjModel, upper: int, lower: int) -> float:
     """c of the joint equality lower = c upper between two hinges (1 if there is none: the
-    model is then reported by ``validate.model.model_problems``)."""
+    model is then reported by ``validate.scene.model.model_problems``)."""
     for k in range(model.neq):
         if model.eq_type[k] != mujoco.mjtEq.mjEQ_JOINT:
             continue

@@ -1,6 +1,6 @@
 """Forward simulation of a gait file in MuJoCo with contact, legs alternating every step.
 
-What is played is the file: the motors apply the torques of its samples (``validate.samples``)
+What is played is the file: the motors apply the torques of its samples (``validate.walk.samples``)
 and the joints follow the motion of its samples. Control, per joint, at every physics step:
 
     u = Γ(τ) + J_r θ̈(τ) ṡ²  +  kp (θ_ref(τ) - θ) + kv (θ̇_ref(τ) ṡ - θ̇)
@@ -17,7 +17,7 @@ foot is an inverted pendulum.
 
 The phase is read from the state every ``RESYNC`` and carried forward at the hip's speed in
 between, so MuJoCo runs each stretch on its own (``mujoco.rollout``, no Python in the loop)
-with the feedback closed at every physics step by its servos (``validate.model.with_servos``).
+with the feedback closed at every physics step by its servos (``validate.scene.model.with_servos``).
 
 The stance ankle has no servo: its torque places the centre of pressure under the foot, and a
 servo there (kp = 1000 N·m/rad against a pendulum of m g l ≈ 600 N·m/rad) would move the
@@ -37,7 +37,7 @@ A step ends when the swing foot, after leaving the ground, touches it in the lan
 (the last ``1 - LANDING_WINDOW`` of the step, by phase); the legs then swap roles. A foot
 late for the floor keeps coming down: past the end of the step the references go on at the
 step's end rates. A touch between the lift-off (the first ``LIFT_WINDOW`` of the step) and
-the landing window is a scuff: the step goes on (``validate.contact`` reports it). If the
+the landing window is a scuff: the step goes on (``validate.walk.contact`` reports it). If the
 foot has not landed after ``STEP_TIMEOUT`` periods, or the hip has dropped below ``FALLEN``
 of its height, the walk ends.
 
@@ -45,7 +45,7 @@ of its height, the walk ends.
 (gains, friction, a push): the robustness of a gait is many walks of one walker. A walk starts
 from the file's start state, or from another state of the left leg in stance (``start``), and
 may end its last step when the hip has advanced by a given distance over the stance ankle
-(``stop_advance``): the return map of ``validate.orbit`` is walks from one section of the
+(``stop_advance``): the return map of ``validate.checks.orbit`` is walks from one section of the
 orbit to the next.
 """
 
@@ -66,11 +66,11 @@ from biped.model.dynamics import Biped
 from biped.model.kinematics import XH, ZH
 from biped.records.gait_file import Gait
 from validate import DEFAULT_STEPS
-from validate.layout import Layout
-from validate.mapping import mapping, other, rotor_torques
-from validate.mjcf import SIDES
-from validate.model import JOINT_ORDER, model_spec, with_servos
-from validate.samples import GaitSamples
+from validate.scene.layout import Layout
+from validate.scene.mapping import mapping, other, rotor_torques
+from validate.scene.mjcf import SIDES
+from validate.scene.model import JOINT_ORDER, model_spec, with_servos
+from validate.walk.samples import GaitSamples
 
 __all__ = ["JOINT_ORDER", "Push", "Simulation", "WalkSettings", "Walker", "simulate"]
 
@@ -223,7 +223,7 @@ def phase_table(
     for side in SIDES:
         mapped = mapping(layout.model, side, radii)
         table = controls[side] = np.zeros((points, CONTROLS))
-        # Motor controls: MuJoCo's joint torque -Γ, per unit of gear (validate.mjcf: gear -1).
+        # Motor controls: MuJoCo's joint torque -Γ, per unit of gear (validate.scene.mjcf: gear -1).
         table[:, TORQUES][:, mapped.columns] = -torques
         table[:, TORQUES] /= layout.gears
         table[:, REFERENCES] = layout.joint_angles(mapped.qpos(q))
@@ -359,7 +359,7 @@ class Walker:
 
     Args:
         gait: the gait (``Gait``).
-        model: the scene to walk on (``validate.model.model_spec``: a file, or by default the
+        model: the scene to walk on (``validate.scene.model.model_spec``: a file, or by default the
             committed model of the gait's knee for Table 1, the generated one otherwise);
             a spec, or a path.
     """
@@ -523,7 +523,7 @@ class PhaseController:
         self.rotor_torques = np.empty_like(self.rotors)
         columns = np.concatenate([layout.motors, layout.positions, layout.velocities])
         self.commands = self.rows[COMMANDS].T  # (chunk, 18): in ``columns`` order
-        ordered = np.array_equal(columns, np.arange(len(columns)))  # as validate.model does
+        ordered = np.array_equal(columns, np.arange(len(columns)))  # as validate.scene.model does
         self.columns = slice(0, len(columns)) if ordered else columns
         self.hip_x_at, self.hip_speed_at = map(layout.state_index, ("hip_x", "hip_speed"))
 
