@@ -51,8 +51,8 @@ BIPED = [sys.executable, "-m", "biped"]
 class Before(solver_module.Solver):
     """The solver before: CasADi's Hessian of the whole graph, IPOPT scaling the gradients."""
 
-    def _options(self, barrier):
-        options = super()._options(barrier)
+    def ipopt_options(self, barrier):
+        options = super().ipopt_options(barrier)
         for key in ("hess_lag", "jac_g", "grad_f"):
             options.pop(key, None)
         options["ipopt.nlp_scaling_method"] = "gradient-based"
@@ -149,7 +149,7 @@ def interpreted():
     after it, built anew compiled."""
     before = os.environ.get(compiled_module.SWITCH)
     os.environ[compiled_module.SWITCH] = "0"
-    solver_module._solver.cache_clear()
+    solver_module.forget_solvers()
     try:
         yield
     finally:
@@ -157,7 +157,7 @@ def interpreted():
             del os.environ[compiled_module.SWITCH]
         else:
             os.environ[compiled_module.SWITCH] = before
-        solver_module._solver.cache_clear()
+        solver_module.forget_solvers()
 
 
 @contextlib.contextmanager

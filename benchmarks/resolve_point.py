@@ -180,14 +180,14 @@ def sweep(out: Path, first_stage: bool, ipopt: dict) -> None:
 
     os.environ[IPOPT_ENV] = json.dumps(ipopt)
     _more_ipopt_options()
-    stages = sweeps._stages
+    stages = sweeps.sweep_stages
 
     def own_starts_only(*args):  # each stage without its final tasks, in the same order
-        own = sweeps._solve_independent
+        own = sweeps.solve_independent
         return [[t for t in tasks if t.solve is own] for tasks in stages(*args)]
 
     if first_stage:
-        sweeps._stages = own_starts_only
+        sweeps.sweep_stages = own_starts_only
     began = time.perf_counter()
     code = biped_main(["sweep", "--paper-seeds", "0", "--out", str(out)])  # 1 without finals
     what = "first stage alone" if first_stage else "whole"

@@ -6,7 +6,9 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import re
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -98,44 +100,69 @@ def add_command(commands, name: str, help: str, run):
     return parser
 
 
-class Commands(dict):
-    """The subcommands' parsers by name (argparse's map of them, ``add_subparsers``), whose
-    arguments may be added when the parser is first looked up (``complete_later``): a
-    command then runs without the imports another's options need (MuJoCo's)."""
+class Commands(Mapping):
+    """The subcommands' parsers by name (argparse's ``choices`` of ``add_subparsers``), each
+    completed when looked up: its arguments may be added when it is first used
+    (``complete_later``), so that a command runs without the imports another's options need
+    (MuJoCo's)."""
 
-    def __init__(self):
-        super().__init__()
-        self.pending = {}  # name -> what completes its parser, in order
-
-    def complete_later(self, name: str, complete) -> None:
-        self.pending.setdefault(name, []).append(complete)
+    def __init__(self, parsers: dict):
+        self.parsers = parsers
 
     def __getitem__(self, name):
-        parser = super().__getitem__(name)
-        for complete in self.pending.pop(name, ()):
-            complete(parser)
-        return parser
+        return self.parsers[name].complete()
 
-    def get(self, name, default=None):
-        return self[name] if name in self else default
+    def __iter__(self):
+        return iter(self.parsers)
 
-    def values(self):
-        return [self[name] for name in self]
-
-    def items(self):
-        return [(name, self[name]) for name in self]
-
-
-def lazy_commands(subcommands) -> Commands:
-    """Make the parsers of argparse's ``subcommands`` (not added yet) a ``Commands``."""
-    subcommands._name_parser_map = subcommands.choices = Commands()
-    return subcommands.choices
+    def __len__(self):
+        return len(self.parsers)
 
 
 def complete_later(commands, name: str, complete) -> None:
-    """Add the arguments of ``name``'s parser by ``complete(parser)`` when it is first looked
-    up (``commands``: argparse's subcommands, made ``lazy_commands``)."""
-    commands.choices.complete_later(name, complete)
+    """Add the arguments of ``name``'s parser by ``complete(parser)`` when it is first used
+    (``commands``: argparse's subcommands, whose parsers are ``biped_cli.main``'s)."""
+    commands.choices[name].complete_later(complete)
+
+
+# An argument argparse must hand to its option as a value, not read as an option: a number
+# with a minus sign, alone or first of a list or range (-1, -.5, -1e-3, -0.1,0.2, -0.1:0.3:3,
+# -inf). argparse reads only -1 and -0.1 so, and `--speeds -0.1,0.2` failed with "expected one
+# argument" before the speeds' check could name the value. No option of the program starts
+# like a number.
+NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
+# Marks a negative number that is one of several values of an option (``--vary kp -1``), which
+# argparse would read as an option and which no "=" can join to it; the option's action reads
+# the value back with ``value_text``. No argument from a shell holds it.
+VALUE_MARK = "\0"
+
+
+def numbers_as_values(args: list[str], takes: dict) -> list[str]:
+    """``args`` with each negative number (``NEGATIVE_NUMBER``) given to the option before it as
+    its value: ``--speeds -0.1,0.2`` as ``--speeds=-0.1,0.2``, a value of an option of several
+    (``--vary kp -1``) marked (``VALUE_MARK``). ``takes``: {option string: its nargs} of the
+    options that take values; what follows ``--`` is left as it is."""
+    out = []
+    owed = 0  # values still owed to an option of a fixed number of several
+    for index, arg in enumerate(args):
+        if arg == "--":
+            return out + args[index:]
+        number = NEGATIVE_NUMBER.match(arg) is not None
+        if owed and (number or not arg.startswith("-")):
+            out.append(VALUE_MARK + arg if number else arg)
+            owed -= 1
+        elif number and out and out[-1] in takes:
+            out[-1] = f"{out[-1]}={arg}"
+        else:
+            out.append(arg)
+            nargs = takes.get(arg)
+            owed = nargs if isinstance(nargs, int) and nargs > 1 else 0
+    return out
+
+
+def value_text(text: str) -> str:
+    """A value as it was given (``numbers_as_values`` marks some)."""
+    return text.removeprefix(VALUE_MARK)
 
 
 # Gait files whose outputs share a name (named from their folder and file names).

@@ -7,34 +7,65 @@ of ``biped_cli.guard``.
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 
 from biped.records.provenance import command_line, version
 from biped_cli import atlas, commands, design, orbit, profile, report, robustness, size
-from biped_cli.args import complete_later, lazy_commands
+from biped_cli.args import Commands, complete_later, numbers_as_values
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
 
 DEBUG_HELP = "on an error, print its traceback before the one-line message"
 
 
-# An argument argparse must hand to its option as a value, not read as an option: a number
-# with a minus sign, alone or first of a list or range (-1, -.5, -1e-3, -0.1,0.2, -0.1:0.3:3,
-# -inf). argparse's own pattern takes only -1 and -0.1, so `--speeds -0.1,0.2` failed with
-# "expected one argument" before the speeds' check could name the value. No option of the
-# program starts like a number.
-NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
-
-
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors: 'biped optimize: error: ...' and exit status 2,
-    negative numbers read as values (``NEGATIVE_NUMBER``), and no abbreviated option:
-    ``--start 2`` is refused, not read as ``--starts 2``."""
+    negative numbers read as values (``biped_cli.args.numbers_as_values``), no abbreviated
+    option (``--start 2`` is refused, not read as ``--starts 2``), and arguments that may be
+    added when the parser is first used (``complete_later``)."""
 
     def __init__(self, *args, **kwargs):
+        self.takes = {}  # option string -> its nargs, for the options that take values
+        self.pending = []  # what adds the rest of the arguments, in order (complete_later)
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
-        self._negative_number_matcher = NEGATIVE_NUMBER
+
+    def note(self, action: argparse.Action) -> argparse.Action:
+        """Keep which option strings of ``action`` take values (``takes``); returns it."""
+        if action.option_strings and action.nargs != 0:
+            self.takes.update(dict.fromkeys(action.option_strings, action.nargs))
+        return action
+
+    def add_argument(self, *args, **kwargs):
+        return self.note(super().add_argument(*args, **kwargs))
+
+    def add_mutually_exclusive_group(self, **kwargs):
+        group = super().add_mutually_exclusive_group(**kwargs)
+        add = group.add_argument
+        group.add_argument = lambda *args, **kwargs: self.note(add(*args, **kwargs))
+        return group
+
+    def complete_later(self, complete) -> None:
+        """Add arguments by ``complete(self)`` when the parser is first used."""
+        self.pending.append(complete)
+
+    def complete(self) -> _Parser:
+        """The parser with every argument (``complete_later``)."""
+        while self.pending:
+            self.pending.pop(0)(self)
+        return self
+
+    def parse_known_args(self, args=None, namespace=None):
+        self.complete()
+        args = sys.argv[1:] if args is None else list(args)
+        return super().parse_known_args(numbers_as_values(args, self.takes), namespace)
+
+    def format_usage(self):
+        self.complete()
+        return super().format_usage()
+
+    def format_help(self):
+        self.complete()
+        return super().format_help()
 
     def error(self, message):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
@@ -52,7 +83,6 @@ def build_parser() -> argparse.ArgumentParser:
     subcommands = parser.add_subparsers(
         dest="command", required=True, metavar="COMMAND", parser_class=_Parser
     )
-    lazy_commands(subcommands)
     for add in (
         commands.add_demo,
         commands.add_optimize,
@@ -72,7 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
         add(subcommands)
     for name in subcommands.choices:  # after the command too: biped demo --debug
         complete_later(subcommands, name, _add_debug)
-    parser.command_parsers = subcommands.choices  # each command's own parser, by name
+    parser.command_parsers = Commands(subcommands.choices)  # each command's, by name
     return parser
 
 

@@ -35,7 +35,7 @@ class Vary(argparse.Action):
     def __call__(self, parser, namespace, values, option_string=None):
         from validate.studies.orbit_study import KNOBS, MAX_SCALE
 
-        knob, text = values
+        knob, text = (types.value_text(value) for value in values)
         if knob not in KNOBS:
             raise argparse.ArgumentError(self, f"knob {knob!r}: allowed one of {', '.join(KNOBS)}")
         try:

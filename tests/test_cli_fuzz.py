@@ -118,15 +118,14 @@ def paths(tmp_path):
 
 def _commands():
     """Each command's name and its options and positional arguments."""
-    parser = build_parser()
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    parsers = build_parser().command_parsers  # each with every argument
     return {
         name: [
             a
             for a in command._actions
             if not isinstance(a, argparse._HelpAction) and a.dest != "debug"
         ]
-        for name, command in sub.choices.items()
+        for name, command in parsers.items()
     }
 
 

@@ -7,7 +7,13 @@ import argparse
 import pytest
 
 from biped_cli import main
-from biped_cli.args import CERTIFIED_HELP, CRITERION_HELP
+from biped_cli.args import (
+    CERTIFIED_HELP,
+    CRITERION_HELP,
+    VALUE_MARK,
+    numbers_as_values,
+    value_text,
+)
 from biped_cli.main import build_parser
 
 # Number-like values with a minus sign, in the forms the number options take.
@@ -80,6 +86,19 @@ def test_negative_speeds_are_named_in_both_spellings(capsys):
         assert main(argv) == 2
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and "'-0.1,0.2'" in err and "> 0" in err, err
+
+
+def test_negative_numbers_are_given_to_their_option():
+    """A negative number after an option taking a value becomes its value ('='); one of
+    several values (``--vary KNOB SCALES``) is marked and read back as given; a number after
+    a flag, a word and what follows ``--`` are left as they are."""
+    takes = {"--speeds": None, "--vary": 2, "--connect": "?"}
+    given = ["--speeds", "-0.1,0.2", "--vary", "kp", "-1", "--connect", "-inf", "--json", "-1"]
+    out = numbers_as_values(given + ["--", "--speeds", "-2"], takes)
+    assert out[:5] == ["--speeds=-0.1,0.2", "--vary", "kp", VALUE_MARK + "-1", "--connect=-inf"]
+    assert out[5:] == ["--json", "-1", "--", "--speeds", "-2"]
+    assert [value_text(v) for v in out[1:4]] == ["--vary", "kp", "-1"]
+    assert numbers_as_values(["--vary", "-1", "2"], takes) == ["--vary", VALUE_MARK + "-1", "2"]
 
 
 @pytest.mark.parametrize("command, action", _documented())

@@ -211,15 +211,11 @@ GAIT_READERS = {
 
 def test_every_command_taking_gait_files_is_checked_here():
     """Each subcommand with a GAIT.json argument is among the readers tested below."""
-    import argparse
-
     from biped_cli.main import build_parser
 
-    parser = build_parser()
-    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     takes_gaits = {
         name
-        for name, sub in commands.choices.items()
+        for name, sub in build_parser().command_parsers.items()
         if any(a.metavar == "GAIT.json" for a in sub._actions if not a.option_strings)
     }
     assert takes_gaits and takes_gaits <= set(GAIT_READERS), takes_gaits

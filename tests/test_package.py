@@ -115,6 +115,57 @@ def test_biped_never_imports_the_simulator():
     assert {k: v for k, v in offenders.items() if v} == {}
 
 
+# Names with a leading underscore that a library documents as public.
+PUBLIC_BY_DOCS = {"os._exit"}
+
+
+def private_uses(path: Path) -> list[str]:
+    """The private names (one leading underscore) a Python file imports, or reaches as an
+    attribute of anything but ``self``, ``cls`` or ``super()``: another module's or
+    argparse's internals (``subcommands._name_parser_map``), another object's."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+        if isinstance(node, ast.ImportFrom):
+            names = [f"{node.module}.{a.name}" for a in node.names if _private(a.name)]
+        elif isinstance(node, ast.Attribute) and _private(node.attr):
+            base = node.value
+            own = isinstance(base, ast.Name) and base.id in ("self", "cls")
+            parent = isinstance(base, ast.Call) and ast.unparse(base.func) == "super"
+            names = [] if own or parent else [ast.unparse(node)]
+        else:
+            continue
+        found += [f"{path.name}:{node.lineno} {name}" for name in names]
+    return [use for use in found if use.split(" ")[1] not in PUBLIC_BY_DOCS]
+
+
+def _private(name: str) -> bool:
+    return name.startswith("_") and not name.endswith("__")
+
+
+def test_no_module_outside_tests_uses_a_private_name(tmp_path):
+    """No module of biped, biped_cli, validate or benchmarks imports a private name or reaches
+    one on another object: argparse's internals and another module's are replaced by public
+    names; each wrong form is named."""
+    modules = [
+        p
+        for root in ("biped", "biped_cli", "validate", "benchmarks")
+        for p in sorted((ROOT / root).rglob("*.py"))
+    ]
+    assert len(modules) > 50
+    assert [use for path in modules for use in private_uses(path)] == []
+    wrong = tmp_path / "wrong.py"
+    wrong.write_text(
+        "import argparse\nfrom biped.studies.sweep import _plan\n"
+        "class P(argparse.ArgumentParser):\n    def f(self, commands):\n"
+        "        self._mine = super()._get_formatter()\n"
+        "        commands._name_parser_map = {}\n"
+    )
+    assert private_uses(wrong) == [
+        "wrong.py:2 biped.studies.sweep._plan",
+        "wrong.py:6 commands._name_parser_map",
+    ]
+
+
 def test_entry_points():
     """The biped script is biped_cli:main and every package is installed."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())

@@ -3,7 +3,6 @@ every command and option of their command tables is one the program accepts, doc
 names every command, the README is a short front door linking every page of docs/, and
 every page links back to it."""
 
-import argparse
 import re
 from pathlib import Path
 
@@ -41,9 +40,8 @@ def test_images_exist_and_are_not_blank():
 
 
 def commands() -> dict:
-    """The program's commands, by name, each its parser."""
-    parser = build_parser()
-    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+    """The program's commands, by name, each its parser (with every argument)."""
+    return build_parser().command_parsers
 
 
 def command_rows(text: str) -> list:

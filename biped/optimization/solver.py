@@ -212,7 +212,7 @@ class Solver:
         )
         nlp = {"x": x, "p": graph.speed, "f": flat[0], "g": flat[1:]}
         name = "design" if design else "gait"
-        self.nlp = ca.nlpsol(name, "ipopt", nlp, self._options("adaptive"))
+        self.nlp = ca.nlpsol(name, "ipopt", nlp, self.ipopt_options("adaptive"))
         self._nlps = {"adaptive": self.nlp}  # and the other barriers', built when first used
         # The powers the slacks bound: the motors' P_i for the electrical criterion (s >= P,
         # s >= 0), the joints' Γ_i θ̇_i for the energy criteria (s >= |Γ θ̇|).
@@ -275,11 +275,14 @@ class Solver:
     def _nlp(self, barrier: str):
         if barrier not in self._nlps:  # the same problem (IPOPT's oracle), other settings
             self._nlps[barrier] = ca.nlpsol(
-                f"{self.nlp.name()}_{barrier}", "ipopt", self.nlp.oracle(), self._options(barrier)
+                f"{self.nlp.name()}_{barrier}",
+                "ipopt",
+                self.nlp.oracle(),
+                self.ipopt_options(barrier),
             )
         return self._nlps[barrier]
 
-    def _options(self, barrier: str) -> dict:
+    def ipopt_options(self, barrier: str) -> dict:
         """nlpsol's options: ``IPOPT_OPTIONS`` with those of ``barrier``, the derivatives built
         sample by sample (``biped.optimization.derivatives``)."""
         options = {f"ipopt.{key}": value for key, value in IPOPT_OPTIONS.items()}
@@ -342,6 +345,12 @@ class Solver:
 @functools.lru_cache(maxsize=8)
 def _solver(robot: Robot, knee: str, criterion: str, safety: Safety, samples: int, knots) -> Solver:
     return Solver(Biped(robot, knee), criterion, safety, samples, knots=knots)
+
+
+def forget_solvers() -> None:
+    """Build each solver anew at its next use (``solver_for``): after a setting its build reads
+    from the environment changed (``biped.optimization.compiled.SWITCH``)."""
+    _solver.cache_clear()
 
 
 def solver_for(problem: GaitProblem) -> Solver:

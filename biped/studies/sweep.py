@@ -120,7 +120,7 @@ def _optimum_of(gait: gait_file.Gait, settings: Settings, point: Point) -> Optim
     return checked(_problem(settings, point), variables, gait.optimizer.report())
 
 
-def _solve_independent(task: Task) -> str:
+def solve_independent(task: Task) -> str:
     """A point's own starts, in ``INDEPENDENT`` (``task.folder``); the energy criterion's also
     from the sthenic optimum of its problem (``task.given``), solved."""
     settings, point = task.settings, task.point
@@ -216,7 +216,7 @@ def run_sweep(folder: Path, settings: Settings, knees=KNEES, criteria=CRITERIA, 
         points = [Point(k, c, s) for c in criteria for k in knees for s in settings.speeds]
         final = [p for p in points if _read_gait(folder / p.filename(), p, settings) is None]
         saved = {p for p in points if _read_gait(folder / INDEPENDENT / p.filename(), p, settings)}
-        stages = _stages(folder, settings, points, final, knees, saved)
+        stages = sweep_stages(folder, settings, points, final, knees, saved)
         plan = _plan(folder, points, final, stages, saved)
         SWEEP.run(plan, stages, lambda: summarize(folder, points, settings), **where)
     return points
@@ -241,7 +241,7 @@ def _plan(folder: Path, points, final, stages, saved: set) -> str:
     return text
 
 
-def _stages(folder: Path, settings: Settings, points, final, knees, saved: set) -> list:
+def sweep_stages(folder: Path, settings: Settings, points, final, knees, saved: set) -> list:
     """The tasks still to run, in stages whose tasks are independent of each other and
     depend only on the files of the stages before: the sthenic independent optima; the
     energy ones (each started from the sthenic optimum of its problem, when the sweep has
@@ -261,7 +261,7 @@ def _stages(folder: Path, settings: Settings, points, final, knees, saved: set) 
 
     def independent_task(p):
         given = (twins[p],) if p in twins else ()
-        return Task(_solve_independent, settings, p, str(folder / INDEPENDENT), given)
+        return Task(solve_independent, settings, p, str(folder / INDEPENDENT), given)
 
     def final_task(p):
         given = tuple(neighbours(p, speeds, knees))

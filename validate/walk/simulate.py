@@ -372,7 +372,7 @@ class Walker:
         self.model = with_servos(spec, self.biped.knee, KP, KV)
         self.layout = Layout(self.model)
         self.table = phase_table(self.samples, self.layout, self.biped.radii)
-        self._spare_data = []  # MjData of finished walks (list.pop and append are atomic)
+        self.spare_data = []  # MjData of finished walks (list.pop and append are atomic)
 
     @property
     def period(self) -> float:
@@ -427,7 +427,7 @@ def _walk(walker: Walker, steps: int, settings: WalkSettings, start, stop_advanc
         collides = (model.geom_contype != 0) | (model.geom_conaffinity != 0)
         model.geom_friction[collides, 0] = settings.friction
     # The data of a finished walk serves (the copy has the same sizes), reset as new.
-    spare = walker._spare_data
+    spare = walker.spare_data
     try:
         data = spare.pop()
     except IndexError:  # none spare (or another thread took it)
