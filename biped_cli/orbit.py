@@ -114,45 +114,47 @@ def _value(knob: str | None, value) -> str:
     return "the validation's controller" if knob is None else f"{knob} x {value:g}"
 
 
-def orbit_line(knob: str | None, orbit: dict) -> str:
-    """One printed line of an orbit (its figures and notes, ``validate.studies.orbit_study``)."""
-    where = _value(knob, orbit["value"])
-    if "spectral_radius" not in orbit:
-        return f"  {where}: {orbit['verdict'].upper()}: {'; '.join(orbit['notes'])}"
+def orbit_line(knob: str | None, orbit) -> str:
+    """One printed line of an orbit (``validate.studies.orbit_study.StudiedOrbit``)."""
+    where, figures = _value(knob, orbit.value), orbit.figures
+    if not orbit.found:
+        return f"  {where}: {figures.verdict.upper()}: {'; '.join(orbit.notes)}"
     return (
-        f"  {where}: {orbit['verdict'].upper()}  ρ {orbit['spectral_radius']:.3f} ± "
-        f"{orbit['spectral_radius_spread']:.3f}, steps {orbit['period_ratio']:.3f} T; "
-        f"{'; '.join(orbit['notes'][:1])}"
+        f"  {where}: {figures.verdict.upper()}  ρ {figures.spectral_radius:.3f} ± "
+        f"{figures.spectral_radius_spread:.3f}, steps {figures.period_ratio:.3f} T; "
+        f"{'; '.join(orbit.notes[:1])}"
     )
 
 
-def boundary_lines(content: dict) -> list[str]:
-    """Where the orbit stops being stable over the knob's values."""
-    knob, out = content["knob"], []  # a knob given (--vary)
-    for boundary in content["boundaries"]:
-        (a, b), (left, right) = boundary["between"], boundary["verdicts"]
-        at = boundary["radius_crosses_1_at"]
+def boundary_lines(study) -> list[str]:
+    """Where the orbit stops being stable over the knob's values (``study``: a
+    ``validate.studies.orbit_study.OrbitStudy`` with a knob)."""
+    knob, out = study.knob, []
+    for boundary in study.boundaries:
+        (a, b), (left, right) = boundary.between, boundary.verdicts
+        at = boundary.radius_crosses_1_at
         crossing = "" if at is None else f"; ρ crosses 1 at {knob} x {at:.3g}"
         for value in (a, b):
-            orbit = content["orbits"][content["values"].index(value)]
-            if "spectral_radius" not in orbit:  # no orbit: why, as its first note says
-                crossing = f"; at {knob} x {value:g} {orbit['notes'][0].split(':')[0]}"
+            orbit = study.orbits[study.values.index(value)]
+            if not orbit.found:  # no orbit: why, as its first note says
+                crossing = f"; at {knob} x {value:g} {orbit.notes[0].split(':')[0]}"
                 break
         out.append(f"  boundary: {left} at {knob} x {a:g}, {right} at {knob} x {b:g}{crossing}")
-    if not content["boundaries"]:
-        verdicts = sorted({o["verdict"] for o in content["orbits"]})
+    if not study.boundaries:
+        verdicts = sorted({o.figures.verdict for o in study.orbits})
         out.append(f"  no boundary over the values: {', '.join(verdicts)} throughout")
     return out
 
 
-def knee_lines(contents: list[dict]) -> list[str]:
+def knee_lines(studies: list) -> list[str]:
     """The knees side by side at each criterion and speed both were given at, and per
-    criterion the mean difference over the speeds with its spread."""
+    criterion the mean difference over the speeds with its spread (``studies``: each an
+    ``OrbitStudy`` under the validation's controller)."""
     from biped.pages.orbit_figures import SPREADS, rho_difference
 
     rows = {}
-    for content in contents:
-        rows[content["criterion"], content["speed"], content["knee"]] = content["orbits"][0]
+    for study in studies:
+        rows[study.criterion, study.speed, study.knee] = study.orbits[0]
     out = ["knees compared: ρ ± spread; (rolling − revolute) / revolute ± 2 spreads"]
     differences: dict = {}
     for criterion, speed in sorted({(c, v) for c, v, _ in rows}):
@@ -162,8 +164,8 @@ def knee_lines(contents: list[dict]) -> list[str]:
         revolute, rolling = pair
         shown = [f"{knee} {_rho(o)}" for knee, o in (("revolute", revolute), ("rolling", rolling))]
         line = f"  {criterion} {speed:.3f} m/s: {', '.join(shown)}"
-        if "spectral_radius" in revolute and "spectral_radius" in rolling:
-            difference, spread = rho_difference(rolling, revolute)
+        if revolute.found and rolling.found:
+            difference, spread = rho_difference(rolling.to_dict(), revolute.to_dict())
             distinct = abs(difference) > SPREADS * spread
             differences.setdefault(criterion, []).append((difference, spread, distinct))
             line += (
@@ -181,10 +183,11 @@ def knee_lines(contents: list[dict]) -> list[str]:
     return out
 
 
-def _rho(orbit: dict) -> str:
-    if "spectral_radius" not in orbit:
-        return f"no orbit ({orbit['verdict']})"
-    return f"{orbit['spectral_radius']:.3f} ± {orbit['spectral_radius_spread']:.3f}"
+def _rho(orbit) -> str:
+    figures = orbit.figures
+    if not orbit.found:
+        return f"no orbit ({figures.verdict})"
+    return f"{figures.spectral_radius:.3f} ± {figures.spectral_radius_spread:.3f}"
 
 
 def _write(out: Path, name: str, content: dict, figure) -> None:
@@ -223,7 +226,7 @@ def cmd_orbit(args) -> int:
     from biped_cli.progress import Progress
     from validate.checks.orbit import RATE_STEP, STEP, Steps
     from validate.outputs.outputs import output_name
-    from validate.studies.orbit_study import content, study
+    from validate.studies.orbit_study import OrbitStudy, study
 
     types.check_folder(args.out, "--out")
     gaits = read_gaits(args.gait, args.model)
@@ -233,36 +236,37 @@ def cmd_orbit(args) -> int:
     knob, values = args.vary if args.vary is not None else (None, [None])
 
     steps = Steps(angle=args.step, rate=args.step * RATE_STEP / STEP, phases=args.phases)
-    out, contents, unstable = Path(args.out), [], []
+    out, studies, unstable = Path(args.out), [], []
     began = time.perf_counter()
     with Progress(len(gaits) * len(values), "orbit") as bar:
         results = study(gaits, knob, values, args.model, steps, args.jobs, progress=bar)
     wall = time.perf_counter() - began
     for path, gait, name, orbits in zip(args.gait, gaits, names, results, strict=True):
-        body = content(path, gait, knob, values, orbits)
-        contents.append(body)
+        found = OrbitStudy.of(path, gait, knob, values, orbits)
+        studies.append(found)
+        body = found.to_dict()
         label = f"{path}: {gait.knee} knee, {gait.criterion}, {gait.speed} m/s"
         print(label)
         for orbit in orbits:
             print(orbit_line(knob, orbit))
         if knob is None:
-            figure = multipliers_figure(orbits[0], label)
-            if orbits[0]["verdict"] != "stable":
+            figure = multipliers_figure(body["orbits"][0], label)
+            if orbits[0].figures.verdict != "stable":
                 unstable.append(path)
         else:
             figure = knob_figure(body, label)
-            for line in boundary_lines(body):
+            for line in boundary_lines(found):
                 print(line)
         _write(out, name, body, figure)
         print(f"  wrote {out / (name + '.json')}, {out / (name + '.png')}", flush=True)
-    walks = sum(o["walks"] for body in contents for o in body["orbits"])
+    walks = sum(o.figures.walks for found in studies for o in found.orbits)
     print(f"{walks} walks in {wall:.1f} s on {args.jobs} process{'es' * (args.jobs > 1)}")
-    if knob is None and len({body["knee"] for body in contents}) == 2:
-        for line in knee_lines(contents):
+    if knob is None and len({found.knee for found in studies}) == 2:
+        for line in knee_lines(studies):
             print(line)
         rows = [
-            {**body["orbits"][0], **{k: body[k] for k in ("knee", "criterion", "speed")}}
-            for body in contents
+            {**s.orbits[0].to_dict(), "knee": s.knee, "criterion": s.criterion, "speed": s.speed}
+            for s in studies
         ]
         figure = speeds_figure(rows, "the optimal gaits' walks in MuJoCo")
         _save_figure(out / KNEES_FIGURE, figure)

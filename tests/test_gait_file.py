@@ -151,6 +151,7 @@ def _more_other_files() -> dict:
     from importlib import resources
 
     from biped.studies import atlas
+    from validate.checks.units import OrbitFigures
     from validate.outputs.outputs import claim
     from validate.studies import orbit_study
 
@@ -170,7 +171,9 @@ def _more_other_files() -> dict:
         "one optimization of an atlas": atlas._record(optimum, 1.0),
         "a table of optima": shipped("biped.optimization", "optima.json"),
         "a catalog of actuators": shipped("biped.model", "catalog.json"),
-        "an orbit study": orbit_study.content("g.json", gait, None, [None], [{"verdict": "x"}]),
+        "an orbit study": orbit_study.OrbitStudy.of(
+            "g.json", gait, None, [None], [orbit_study.StudiedOrbit(None, OrbitFigures("x"))]
+        ).to_dict(),
         "a recording's owner record": owner,
     }
 

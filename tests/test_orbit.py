@@ -2,6 +2,8 @@
 multipliers predict how perturbations decay, two step sizes agree, and the check fails the
 controllers that do not walk the gait's orbit."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -207,24 +209,18 @@ def test_a_boundary_at_a_value_without_orbit_says_why():
     """Where the orbit search ends without an orbit, the boundary line says why, as the
     orbit's note does (a walk that missed the section did not fall)."""
     from biped_cli.orbit import boundary_lines
+    from validate.checks.units import OrbitFigures
+    from validate.studies.orbit_study import Boundary, OrbitStudy, StudiedOrbit, boundaries
 
     missed = "the walk did not reach the section in step 2: no orbit (an orbit that cannot "
-    content = {
-        "knob": "speed",
-        "values": [0.0, 0.25],
-        "orbits": [
-            {"verdict": "unstable", "notes": [missed + "be found is unstable)"]},
-            {"verdict": "stable", "spectral_radius": 0.69, "notes": ["slowest"]},
-        ],
-        "boundaries": [
-            {
-                "between": [0.0, 0.25],
-                "verdicts": ["unstable", "stable"],
-                "radius_crosses_1_at": None,
-            }
-        ],
-    }
-    assert boundary_lines(content) == [
+    orbits = [
+        StudiedOrbit(0.0, OrbitFigures("unstable"), (missed + "be found is unstable)",)),
+        StudiedOrbit(0.25, OrbitFigures("stable", spectral_radius=0.69), ("slowest",)),
+    ]
+    study = OrbitStudy("g.json", "rolling", "sthenic", 0.3, "speed", (0.0, 0.25), tuple(orbits))
+    study = dataclasses.replace(study, boundaries=tuple(boundaries(study.values, orbits)))
+    assert study.boundaries == (Boundary((0.0, 0.25), ("unstable", "stable"), None),)
+    assert boundary_lines(study) == [
         "  boundary: unstable at speed x 0, stable at speed x 0.25; at speed x 0 the walk did "
         "not reach the section in step 2"
     ]
@@ -309,3 +305,42 @@ def test_the_knob_figure_draws_what_it_measured_and_names_what_it_draws(crossing
     found = [orbit for orbit in content["orbits"] if "spectral_radius" in orbit]
     top = max(orbit["spectral_radius"] + 2 * orbit["spectral_radius_spread"] for orbit in found)
     assert ax.get_ylim()[1] >= top  # every bar whole, none clipped to the top
+
+
+def test_an_orbit_study_reads_back_what_it_writes():
+    """An orbit study's JSON (``OrbitStudy.to_dict``) reads back as the same record, its keys
+    in the written order; an orbit without a radius is not found, and a study whose verdict
+    changes between two found orbits has ρ's crossing of 1 between them."""
+    import json
+
+    from validate.checks.units import OrbitFigures
+    from validate.studies.orbit_study import OrbitStudy, StudiedOrbit, boundaries
+
+    found = OrbitFigures("stable", spectral_radius=0.5, spectral_radius_spread=0.01, walks=27)
+    fell = OrbitFigures("unstable", walks=3)
+    over = OrbitFigures("unstable", spectral_radius=1.5, spectral_radius_spread=0.01)
+    orbits = [StudiedOrbit(1.0, found, ("a",)), StudiedOrbit(0.5, over, ("b",))]
+    study = OrbitStudy("g.json", "rolling", "sthenic", 0.3, "kp", (1.0, 0.5), tuple(orbits))
+    study = dataclasses.replace(study, boundaries=tuple(boundaries(study.values, orbits)))
+    assert study.boundaries[0].radius_crosses_1_at == pytest.approx(0.75)
+    content = json.loads(json.dumps(study.to_dict()))
+    assert OrbitStudy.from_dict(content) == study
+    assert list(content) == [
+        "gait",
+        "knee",
+        "criterion",
+        "speed",
+        "knob",
+        "scales",
+        "values",
+        "orbits",
+        "boundaries",
+        "units",
+    ]
+    assert list(content["orbits"][0])[:3] == ["value", "verdict", "spectral_radius"]
+    assert content["orbits"][0]["notes"] == ["a"] and "multipliers_real" not in content["orbits"][0]
+    assert not StudiedOrbit(0.25, fell).found and orbits[0].found
+    nominal = OrbitStudy("g.json", "rolling", "sthenic", 0.3, None, (None,), (orbits[0],))
+    assert (
+        nominal.to_dict()["knob"] == "none" and OrbitStudy.from_dict(nominal.to_dict()) == nominal
+    )

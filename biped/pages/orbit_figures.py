@@ -81,10 +81,11 @@ def multipliers_figure(orbit: dict, title: str) -> Figure:
 
 
 def knob_figure(content: dict, title: str) -> Figure:
-    """ρ against the knob's values of a study's content (``validate.studies.orbit_study.content``):
-    each orbit's ρ with its bar; the values without an orbit in a strip above, off ρ's scale
-    (nothing measured there); a band between two values where the verdict changes, dotted
-    where ρ crosses 1 in it; the legend below, off the data, naming only what is drawn."""
+    """ρ against the knob's values of a study's content
+    (``validate.studies.orbit_study.OrbitStudy.to_dict``): each orbit's ρ with its bar; the
+    values without an orbit in a strip above, off ρ's scale (nothing measured there); a band
+    between two values where the verdict changes, dotted where ρ crosses 1 in it; the legend
+    below, off the data, naming only what is drawn."""
     figure = Figure(figsize=(7.0, 5.2), layout="constrained")
     strip, ax = figure.subplots(2, 1, sharex=True, height_ratios=(1.0, 6.0))
     values, orbits = np.array(content["values"], float), content["orbits"]

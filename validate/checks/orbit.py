@@ -481,6 +481,11 @@ def _chord_steps(returns: ReturnMap, x, jacobian, steps: Steps):
 
 
 def figures(result: Orbit) -> dict:
+    """The orbit check's figures of ``result`` by name, those not measured left out."""
+    return orbit_figures(result).to_dict()
+
+
+def orbit_figures(result: Orbit) -> OrbitFigures:
     """The orbit check's figures (``validate.checks.units.OrbitFigures``) of ``result``."""
     settings, steps = result.settings, result.steps
     known = {
@@ -497,7 +502,7 @@ def figures(result: Orbit) -> dict:
     }
     m = result.multipliers
     if m is None:
-        return OrbitFigures(**known).to_dict()
+        return OrbitFigures(**known)
     mode = m.vectors[:, 0]
     distance = np.abs(result.fixed_point - result.file_state)
     return OrbitFigures(
@@ -522,7 +527,7 @@ def figures(result: Orbit) -> dict:
         residual_rate=float(np.abs(result.residual[6:]).max()),
         noise_rate=float(result.noise[6:].max()),
         period_ratio=result.period_ratio,
-    ).to_dict()
+    )
 
 
 def notes(result: Orbit) -> list[str]:
