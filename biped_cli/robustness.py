@@ -92,31 +92,31 @@ def _value(name: str, value: float | None) -> str:
     return f"{factor * value:{sign if value else ''}.3g} {unit}".rstrip()
 
 
-def lines(content: dict) -> list[str]:
-    """The printed lines of a map's JSON content (its limits, their brackets and why the
-    first failing walk failed)."""
-    walk = content["walk"]
+def lines(result) -> list[str]:
+    """The printed lines of a map (``validate.studies.robustness.RobustnessMap``: its limits,
+    their brackets and why the first failing walk failed)."""
+    settings = result.settings
     out = [
-        f"  walks of {walk['steps']} steps; pushes at mid-step {walk['push_step']} "
-        f"({walk['push_time']:.3f} s); {walk['iterations']} bisections per limit"
+        f"  walks of {settings.steps} steps; pushes at mid-step {settings.push_step} "
+        f"({result.push_time:.3f} s); {settings.iterations} bisections per limit"
     ]
-    for name, limit in content["limits"].items():
+    for name, limit in result.limits.items():
         label = SHOWN[name][0]
-        near, far = limit["bracket"]
+        near, far = limit.bracket
         bracket = f"bracket {_value(name, near)} to {_value(name, far)}"
-        if limit["bracketed"]:
-            low, high = limit["reproducible"]
+        if limit.bracketed:
+            low, high = limit.reproducible
             machines = f"on any machine {_value(name, low)} to {_value(name, high)}"
-            detail = f"fails at {_value(name, limit['fails_at'])}; {machines}; {bracket}"
-            why = ": " + ", ".join(limit["failures"])
+            detail = f"fails at {_value(name, limit.fails_at)}; {machines}; {bracket}"
+            why = ": " + ", ".join(limit.failures)
         else:
             detail = f"{bracket}: its end walks too, the limit lies beyond"
             why = ""
-        out.append(f"  {label:19} {_value(name, limit['limit']):>11}  ({detail}){why}")
+        out.append(f"  {label:19} {_value(name, limit.limit):>11}  ({detail}){why}")
     return out
 
 
-def _range(name: str, limit: dict) -> str:
+def _range(name: str, limit) -> str:
     from validate.studies.robustness import reproducible_range
 
     low, high = reproducible_range(limit)
@@ -128,7 +128,7 @@ def _range(name: str, limit: dict) -> str:
 
 
 def comparison_lines(maps: dict) -> list[str]:
-    """Each limit of the first map (path -> JSON content) beside every other map's, said
+    """Each limit of the first map (path -> ``RobustnessMap``) beside every other map's, said
     distinguishable only where the ranges they keep across machines do not overlap
     (``validate.studies.robustness.distinguishable``)."""
     from validate.studies.robustness import MACHINE_STEPS, distinguishable
@@ -138,9 +138,9 @@ def comparison_lines(maps: dict) -> list[str]:
         f"compared (each limit as it lies on any machine: {MACHINE_STEPS} bisection step "
         "either way of its bracket)"
     ]
-    for name, limit in reference["limits"].items():
-        for path, content in others:
-            other = content["limits"][name]
+    for name, limit in reference.limits.items():
+        for path, result in others:
+            other = result.limits[name]
             verdict = "distinct" if distinguishable(limit, other) else "not distinguishable"
             out.append(
                 f"  {SHOWN[name][0]:19} {first} {_range(name, limit)}, "
@@ -149,29 +149,20 @@ def comparison_lines(maps: dict) -> list[str]:
     return out
 
 
-def _write_map(out: Path, name: str, path: str, gait, source: str, result) -> dict:
-    """Write a gait's robustness map (``validate.studies.robustness.RobustnessMap``) as
-    <out>/<name>.json and .png, both or neither; returns the JSON content."""
+def _write_map(out: Path, name: str, mapped) -> None:
+    """Write a gait's robustness map (``validate.studies.robustness.GaitMap``) as
+    <out>/<name>.json and .png, both or neither."""
     from biped.records.provenance import provenance
     from biped.runtime.files import atomic_set
     from validate.studies.robustness_figure import DPI, robustness_figure
 
-    content = {
-        "gait": str(path),
-        "knee": gait.knee,
-        "criterion": gait.criterion,
-        "speed": gait.speed,
-        "model": source,
-        **result.to_dict(),
-    }
-    content["units"] = {"speed": "m/s", **content["units"]}
-    content["provenance"] = provenance()
-    figure = robustness_figure(content, f"{path}: {gait.knee} knee, {gait.speed} m/s")
+    content = {**mapped.to_dict(), "provenance": provenance()}
+    title = f"{mapped.gait}: {mapped.knee} knee, {mapped.speed} m/s"
+    figure = robustness_figure(mapped.map, title)
     with atomic_set(out, f"robustness-{name}") as staging:  # both or neither
         text = json.dumps(content, indent=1, allow_nan=False)
         (staging / f"{name}.json").write_text(text, encoding="utf-8")
         figure.savefig(staging / f"{name}.png", dpi=DPI)
-    return content
 
 
 def cmd_robustness(args) -> int:
@@ -214,8 +205,12 @@ def cmd_robustness(args) -> int:
                 print(f"  FAIL  the nominal walk: {', '.join(result.nominal_failures)}; no map")
                 failed.append(path)
                 continue
-            mapped[path] = content = _write_map(out, name, path, gait, source, result)
-            for line in lines(content):
+            found = robustness.GaitMap(
+                str(path), gait.knee, gait.criterion, gait.speed, source, result
+            )
+            _write_map(out, name, found)
+            mapped[path] = result
+            for line in lines(result):
                 print(line)
             print(
                 f"  wrote {out / (name + '.json')}, {out / (name + '.png')} ({result.walks} walks, "

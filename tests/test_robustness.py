@@ -151,12 +151,10 @@ def test_a_limit_lies_on_any_machine_within_a_step_of_its_bracket(mapped):
             assert (low, high) == pytest.approx((near - limit.tolerance, far + limit.tolerance))
 
 
-def _shifted(limit: Limit, steps: float) -> dict:
-    """``limit`` moved ``steps`` bisection steps away from its nominal value, as JSON."""
+def _shifted(limit: Limit, steps: float) -> Limit:
+    """``limit`` moved ``steps`` bisection steps away from its nominal value."""
     move = steps * (limit.fails_at - limit.limit)
-    return dataclasses.replace(
-        limit, limit=limit.limit + move, fails_at=limit.fails_at + move
-    ).to_dict()
+    return dataclasses.replace(limit, limit=limit.limit + move, fails_at=limit.fails_at + move)
 
 
 def test_limits_a_step_apart_are_not_distinguishable_and_far_ones_are(mapped):
@@ -164,14 +162,15 @@ def test_limits_a_step_apart_are_not_distinguishable_and_far_ones_are(mapped):
     machines; by four steps they can; a limit beyond its bracket's end is distinct from one
     well inside it and not from another beyond it."""
     push = mapped.limits["push_forward"]
-    same = push.to_dict()
+    same = Limit.from_dict("push_forward", json.loads(json.dumps(push.to_dict())))
+    assert same == push  # as a map written earlier reads back
     assert not distinguishable(same, _shifted(push, 1.0))
     assert not distinguishable(same, _shifted(push, 2.0))
     assert distinguishable(same, _shifted(push, 4.0))
     assert distinguishable(_shifted(push, 4.0), same)  # symmetric
-    beyond = Limit("push_forward", "N·s", (0.0, 2.0), 2.0, None, (), False, 1).to_dict()
+    beyond = Limit("push_forward", "N·s", (0.0, 2.0), 2.0, None, (), False, 1)
     assert distinguishable(same, beyond) == (push.reproducible[1] < 2.0)
-    assert not distinguishable(beyond, dict(beyond))
+    assert not distinguishable(beyond, dataclasses.replace(beyond))
 
 
 def test_the_map_keeps_its_limits_without_avx512_kernels(tmp_path):
@@ -326,3 +325,27 @@ def test_settings_refuse_a_push_after_the_last_step():
     """The walk goes on after the push: a push at the last step is refused."""
     with pytest.raises(BipedError, match="push step"):
         RobustnessSettings(steps=4, push_step=4)
+
+
+def test_a_map_reads_back_what_it_writes():
+    """A gait's map as written (``GaitMap.to_dict``, through JSON) reads back as the same
+    records, its settings but the processes, which the content does not keep; the gait's
+    fields come first and the speed has its unit."""
+    from validate.studies.robustness import GaitMap, RobustnessMap
+
+    limits = {
+        name: Limit(name, robustness.LIMIT_UNITS[name], (0.0, 2.0), 0.5, 0.75, ("fell",), False, 5)
+        for name in LIMITS
+    }
+    high = Limit("kp_scale_high", limits["friction"].unit, (1.0, 16.0), 16.0, None, (), True, 1)
+    limits["kp_scale_high"] = high
+    result = RobustnessMap(SETTINGS, 0.59, 1.5, 1.0, 10.0, (), limits)
+    mapped = GaitMap("g.json", "rolling", "sthenic", 0.3, "mjcf/scene_rolling.xml", result)
+    content = json.loads(json.dumps(mapped.to_dict()))
+    assert list(content)[:6] == ["gait", "knee", "criterion", "speed", "model", "passed"]
+    assert content["units"]["speed"] == "m/s" and content["ranges"]["kp_scale"] == [0.5, 16.0]
+    read = GaitMap.from_dict(content)
+    assert read.map.settings == dataclasses.replace(SETTINGS, jobs=1)
+    assert read == mapped and read.to_dict() == content
+    failed = dataclasses.replace(result, nominal_failures=("fell",), limits={})
+    assert RobustnessMap.from_dict(failed.to_dict()) == failed

@@ -49,7 +49,7 @@ import mujoco
 
 from biped.errors import BipedError
 from biped.model.dynamics import Biped
-from biped.model.units import PURE
+from biped.model.units import PURE, unit_field
 from biped.records.gait_file import Gait
 from biped.runtime.runner import ProgressBar, run_tasks
 from validate.checks.checks import walk_verdict
@@ -180,6 +180,20 @@ class Limit:
             "failures": list(self.failures),
         }
 
+    @classmethod
+    def from_dict(cls, name: str, content: dict) -> Limit:
+        """The limit ``name`` (one of ``LIMITS``) of a map's JSON content (``to_dict``)."""
+        return cls(
+            name,
+            LIMIT_UNITS[name],
+            tuple(content["bracket"]),
+            content["limit"],
+            content["fails_at"],
+            tuple(content["failures"]),
+            content["bisection"] == "geometric",
+            content["walks"],
+        )
+
 
 @dataclass(frozen=True)
 class RobustnessMap:
@@ -255,6 +269,52 @@ class RobustnessMap:
         content["units"] = units(content)
         return content
 
+    @classmethod
+    def from_dict(cls, content: dict) -> RobustnessMap:
+        """The map of its JSON content (``to_dict``); its settings' ``jobs`` are 1 (the
+        content is the same for any number of processes and does not keep it)."""
+        walk, nominal = content["walk"], content["nominal"]
+        return cls(
+            RobustnessSettings(walk["steps"], walk["push_step"], walk["iterations"]),
+            walk["period"],
+            walk["push_time"],
+            nominal["friction"],
+            nominal["trunk_mass"],
+            tuple(nominal["failures"]),
+            {name: Limit.from_dict(name, limit) for name, limit in content["limits"].items()},
+        )
+
+
+@dataclass(frozen=True)
+class GaitMap:
+    """A gait file's robustness map as ``biped robustness`` writes it: the file (as given),
+    its knee, criterion and speed, the model its walks were played on (in words), the map.
+    ``to_dict`` is its JSON (but the provenance), ``from_dict`` reads it back."""
+
+    gait: str
+    knee: str
+    criterion: str
+    speed: float = unit_field("m/s")
+    model: str = ""
+    map: RobustnessMap | None = None
+
+    def to_dict(self) -> dict:
+        content = {
+            "gait": self.gait,
+            "knee": self.knee,
+            "criterion": self.criterion,
+            "speed": self.speed,
+            "model": self.model,
+            **self.map.to_dict(),
+        }
+        content["units"] = {"speed": "m/s", **content["units"]}
+        return content
+
+    @classmethod
+    def from_dict(cls, content: dict) -> GaitMap:
+        fields = (content[key] for key in ("gait", "knee", "criterion", "speed", "model"))
+        return cls(*fields, RobustnessMap.from_dict(content))
+
 
 def units(content: dict) -> dict:
     """The ``units`` map of a map's JSON content: the unit of each of its numbers, by path."""
@@ -281,19 +341,18 @@ def units(content: dict) -> dict:
     return found
 
 
-def reproducible_range(limit: dict) -> tuple[float, float]:
-    """Where a limit of a map's JSON content (``Limit.to_dict``) lies on any machine: its
-    ``reproducible`` range, or, if the far end of its bracket walked, beyond that end."""
-    if limit["reproducible"] is not None:
-        low, high = limit["reproducible"]
-        return (low, high)
-    nominal, far = limit["bracket"]
+def reproducible_range(limit: Limit) -> tuple[float, float]:
+    """Where ``limit`` lies on any machine: its ``reproducible`` range, or, if the far end of
+    its bracket walked, beyond that end."""
+    if limit.reproducible is not None:
+        return limit.reproducible
+    nominal, far = limit.bracket
     return (far, math.inf) if far > nominal else (-math.inf, far)
 
 
-def distinguishable(a: dict, b: dict) -> bool:
-    """Whether two maps' values of one limit (``Limit.to_dict``) differ by more than what
-    they keep across machines: their ``reproducible_range``s do not overlap."""
+def distinguishable(a: Limit, b: Limit) -> bool:
+    """Whether two maps' values of one limit differ by more than what they keep across
+    machines: their ``reproducible_range``s do not overlap."""
     (a_low, a_high), (b_low, b_high) = reproducible_range(a), reproducible_range(b)
     return a_high < b_low or b_high < a_low
 
@@ -473,6 +532,7 @@ _MAPS = itertools.count()
 
 __all__ = [
     "LIMITS",
+    "GaitMap",
     "Limit",
     "RobustnessMap",
     "RobustnessSettings",

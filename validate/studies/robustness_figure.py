@@ -1,14 +1,19 @@
 """The figure of a robustness map (``validate.studies.robustness``): one row per condition.
 
-Drawn from the map's JSON content (``RobustnessMap.to_dict``), so a map written earlier can
-be drawn again. Each row: the range the gait walks over (a bar from one limit to the other),
-the bisection's uncertainty beyond each limit up to the first value that failed (hatched),
-the bracket searched (grey line) and the nominal walk's value (black line).
+Drawn from the map (``RobustnessMap``; one written earlier read back by
+``RobustnessMap.from_dict``). Each row: the range the gait walks over (a bar from one limit to
+the other), the bisection's uncertainty beyond each limit up to the first value that failed
+(hatched), the bracket searched (grey line) and the nominal walk's value (black line).
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from matplotlib.figure import Figure
+
+if TYPE_CHECKING:  # the figure draws without MuJoCo
+    from validate.studies.robustness import Limit, RobustnessMap
 
 WALKS = "#2a9d8f"
 UNSURE_BAR = dict(color="#e9c46a", hatch="///", edgecolor="0.3")
@@ -25,24 +30,24 @@ ROWS = (
 )
 
 
-def _end(limit: dict, factor: float) -> tuple:
+def _end(limit: Limit, factor: float) -> tuple:
     """A limit's end of its row: (the value found to walk, the first value found to fail or
     None, the bracket's far end), each times ``factor``."""
-    fails = limit["fails_at"]
+    fails = limit.fails_at
     return (
-        factor * limit["limit"],
+        factor * limit.limit,
         None if fails is None else factor * fails,
-        factor * limit["bracket"][1],
+        factor * limit.bracket[1],
     )
 
 
-def robustness_figure(content: dict, title: str) -> Figure:
-    """The figure of a map's JSON content whose nominal walk walked."""
-    limits = content["limits"]
+def robustness_figure(result: RobustnessMap, title: str) -> Figure:
+    """The figure of a map whose nominal walk walked."""
+    limits = result.limits
     figure = Figure(figsize=(8.0, 6.0), layout="constrained")
     axes = figure.subplots(len(ROWS), 1)
     for ax, (label, low, high, factor, scale) in zip(axes, ROWS, strict=True):
-        nominal = factor * limits[low]["bracket"][0]
+        nominal = factor * limits[low].bracket[0]
         searched = [_end(limits[name], factor) for name in (low, high) if name is not None]
         (low_walks, _, low_far), (high_walks, _, high_far) = (
             (nominal, None, nominal) if name is None else _end(limits[name], factor)
@@ -62,10 +67,10 @@ def robustness_figure(content: dict, title: str) -> Figure:
         ax.set_ylim(-0.8, 0.8)
         ax.set_yticks([])
         ax.set_title(label, fontsize=9, loc="left")
-    walk = content["walk"]
+    settings = result.settings
     figure.suptitle(
-        f"{title}\nwalks of {walk['steps']} steps, pushes at mid-step {walk['push_step']} "
-        f"({walk['push_time']:.3f} s), {walk['iterations']} bisections per limit\n"
+        f"{title}\nwalks of {settings.steps} steps, pushes at mid-step {settings.push_step} "
+        f"({result.push_time:.3f} s), {settings.iterations} bisections per limit\n"
         "green: walks; hatched: up to the first failing value; grey: bracket searched",
         fontsize=9,
     )
