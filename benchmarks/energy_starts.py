@@ -19,12 +19,10 @@ import biped
 from biped.optimization import table
 from biped.optimization.optimize import (
     AGREEMENT,
-    CONFIRM,
     MONOTONE,
-    NEAR,
     STHENIC_START,
+    Candidate,
     Start,
-    barrier_of,
     first_guesses,
     optimize,
     starts_at_value,
@@ -35,7 +33,9 @@ from biped.optimization.solver import CONVERGED, solver_for
 from biped.runtime.runner import free_cores, run_forked
 from biped.studies.sweep import DEFAULT_SPEEDS
 
-ENDINGS = ("", MONOTONE, CONFIRM, NEAR)  # the adaptive barrier, then monotone from 1e-2 ...
+# The barriers each start near an optimum is solved under: the adaptive, then monotone from
+# 1e-2, 1e-3 and 1e-4.
+NEAR_BARRIERS = ("adaptive", "monotone", "confirm", "near")
 NEAR_STARTS = (table.TABLE_START, table.OTHER_KNEE_START, STHENIC_START)
 FIRST_GUESSES = "first guesses"
 STHENIC_STARTS = [STHENIC_START, STHENIC_START + MONOTONE]
@@ -50,7 +50,7 @@ def problem_of(knee: str, speed: float) -> GaitProblem:
 
 def starts_now(problem: GaitProblem) -> list[str]:
     """The kinds of the energy criterion's starts of ``optimize`` today at ``problem``."""
-    kinds = [kind for kind, _ in table_starts(problem, 1)] + STHENIC_STARTS
+    kinds = [start.kind for start in table_starts(problem, 1)] + STHENIC_STARTS
     return kinds if table.covers(problem) else [FIRST_GUESSES, *kinds]
 
 
@@ -59,14 +59,17 @@ def solve_point(point) -> list[Start]:
     problem = problem_of(*point)
     solver = solver_for(problem)
     sthenic = optimize(GaitProblem(problem.model, problem.speed, "sthenic"), jobs=1)
-    near = dict(table_starts(problem, 1))
+    near = {start.source: start.variables for start in table_starts(problem, 1)}
     near[STHENIC_START] = sthenic.variables
-    runs = [(f"{FIRST_GUESSES}: {kind}", z) for kind, z in first_guesses(problem, 3, 0, False)]
-    runs += [(start + end, near[start]) for start in NEAR_STARTS for end in ENDINGS]
+    runs = [
+        Candidate(f"{FIRST_GUESSES}: {guess.source}", guess.variables, guess.barrier)
+        for guess in first_guesses(problem, 3, 0, False)
+    ]
+    runs += [Candidate(s, near[s], barrier) for s in NEAR_STARTS for barrier in NEAR_BARRIERS]
     found = []
-    for kind, z in runs:
-        end = solver.solve(problem, z, barrier=barrier_of(kind))
-        found.append(Start(kind, end.value, end.status, end.iterations))
+    for run in runs:
+        end = solver.solve(problem, run.variables, barrier=run.barrier)
+        found.append(Start(run.kind, end.value, end.status, end.iterations))
     return found
 
 

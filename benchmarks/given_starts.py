@@ -38,7 +38,7 @@ def main() -> None:
             for speed in speeds:
                 point = Point(knee, criterion, speed)
                 problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), speed, criterion)
-                own = [z for _, z in table_starts(problem, 1)]
+                own = [start.variables for start in table_starts(problem, 1)]
                 for other in neighbours(point, speeds, biped.KNEES):
                     first = json.loads((folder / INDEPENDENT / other.filename()).read_text())
                     z = campaign.variables(first["optimizer"]["variables"])

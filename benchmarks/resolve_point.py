@@ -118,16 +118,16 @@ from biped.optimization import solver as S
 S.IPOPT_OPTIONS.update(json.loads(sys.argv[1]))
 import biped
 from biped.optimization.problem import GaitProblem
-from biped.optimization.optimize import table_starts, barrier_of
+from biped.optimization.optimize import table_starts
 for knee in ("revolute", "rolling"):
     p = GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3, "energy")
     s = S.solver_for(p)
     starts = table_starts(p, 1)
-    s.prepare({barrier_of(k) for k, _ in starts})
+    s.prepare({start.barrier for start in starts})
     seconds, iterations, values = 0.0, 0, []
-    for kind, z in starts:
+    for start in starts:
         began = time.perf_counter()
-        end = s.solve(p, z, barrier=barrier_of(kind))
+        end = s.solve(p, start.variables, barrier=start.barrier)
         seconds += time.perf_counter() - began
         iterations += end.iterations
         values.append(f"{end.value:.9f}")

@@ -48,8 +48,8 @@ def test_a_move_not_measured_is_unknown_never_zero(optima, monkeypatch):
     no other start converged, leaves the uncertainty and the verdict unknown."""
     real = knees.refine
 
-    def refine(problem, start, kind="given"):  # a re-solve that stops short
-        optimum = real(problem, start, kind)
+    def refine(problem, start, barrier="adaptive"):  # a re-solve that stops short
+        optimum = real(problem, start, barrier)
         report = dataclasses.replace(optimum.report, status="Maximum_Iterations_Exceeded")
         return dataclasses.replace(optimum, report=report)
 

@@ -23,9 +23,9 @@ from biped.optimization.optimize import (
     MONOTONE_START,
     NEAR,
     STHENIC_START,
+    Candidate,
     Report,
     Start,
-    barrier_of,
     confirm,
     optimize,
     starts_at_value,
@@ -269,11 +269,11 @@ def test_a_point_solved_under_three_barriers_is_one_start_at_the_best():
     given = [start("given"), start("given"), start("given" + CONFIRM)]
     assert starts_at_value(given, value) == 2
     assert starts_at_value(given + [start("given" + CONFIRM)] * 2, value) == 3
-    assert [barrier_of(k) for k in ("given", "given" + CONFIRM, TABLE_START + MONOTONE)] == [
-        "adaptive",
-        "confirm",
-        "monotone",
-    ]
+    kinds = [Candidate("given", None).kind, Candidate("given", None, "confirm").kind]
+    assert kinds == ["given", "given" + CONFIRM]
+    assert Candidate(TABLE_START, None).under("monotone").kind == TABLE_START + MONOTONE
+    with pytest.raises(biped.BipedError, match="barrier = .gentle."):
+        Candidate("given", None, "gentle")
 
 
 def test_a_best_reached_by_one_start_is_confirmed_by_the_near_starts():
@@ -333,7 +333,7 @@ def test_confirm_solves_no_start_the_optimum_holds_already(monkeypatch):
         """Raised instead of solving."""
 
     def record(candidates, *args, **kwargs):
-        asked.extend(kind for kind, _ in candidates)
+        asked.extend(start.kind for start in candidates)
         raise Asked
 
     monkeypatch.setattr(optimize_module, "multistart", record)
@@ -351,7 +351,7 @@ def test_a_given_start_that_is_a_table_start_is_left_out():
     from biped.optimization.problem import scales
 
     problem = GaitProblem(biped.Biped(ROBOT, "revolute"), 0.3, "sthenic")
-    other = dict(table_starts(problem, 1))[OTHER_KNEE_START]
+    (other,) = [s.variables for s in table_starts(problem, 1) if s.source == OTHER_KNEE_START]
     near = other + 0.1 * SAME_START * scales()
     far = other + 10 * SAME_START * scales()
     kept = apart_from_table(problem, [near, far, problem.first_guess()])
@@ -735,7 +735,7 @@ def test_starts_at_one_coarse_optimum_are_polished_once_and_others_apart():
         polished.append((float(start[0]), barrier))
         return solution(float(start[0]) - 1, iterations=5)
 
-    candidates = [(f"start {z:g}", np.array([z])) for z in searches]
+    candidates = [Candidate(f"start {z:g}", np.array([z])) for z in searches]
     ends = coarse_to_fine(candidates, lambda z, _: searches[float(z[0])], polish, jobs=1)
     assert polished == [(10.0, "adaptive"), (12.0, "adaptive"), (4.0, "adaptive")]
     assert [end.value for end in ends] == [9.0, 9.0, 11.0, 3.0]

@@ -137,20 +137,20 @@ def test_the_energy_criterion_replaces_its_first_guesses_by_the_table_where_it_c
     assert len(first_guesses(covered, DEFAULT_STARTS + 2, 0)) == 2
     assert len(first_guesses(beyond, DEFAULT_STARTS, 0)) == DEFAULT_STARTS
     assert len(first_guesses(covered, DEFAULT_STARTS, 0, by_table=False)) == DEFAULT_STARTS
-    assert [kind for kind, _ in table_starts(covered, 1)] == [
+    assert [start.kind for start in table_starts(covered, 1)] == [
         table.TABLE_START,
         table.TABLE_START + NEAR,
         table.OTHER_KNEE_START,
         table.OTHER_KNEE_START + MONOTONE,
         table.OTHER_KNEE_START + NEAR,
     ]
-    assert [kind for kind, _ in table_starts(beyond, 1)] == [  # as before the table covered
+    assert [start.kind for start in table_starts(beyond, 1)] == [  # as before the table covered
         table.TABLE_START,
         table.TABLE_START + MONOTONE,
         table.OTHER_KNEE_START,
     ]
     sthenic = _problem("revolute", 0.3, "sthenic")
-    assert [kind for kind, _ in table_starts(sthenic, 1)] == [
+    assert [start.kind for start in table_starts(sthenic, 1)] == [
         table.TABLE_START,
         table.OTHER_KNEE_START,
     ]

@@ -52,8 +52,8 @@ from biped.optimization.comparison import (
 from biped.optimization.optimize import (
     DEFAULT_STARTS,
     GUESS_PERIODS,
+    Candidate,
     Optimum,
-    barrier_of,
     best_of,
     checked,
     multistart,
@@ -266,18 +266,20 @@ DESIGN_STARTS = (GUESS_PERIODS[0], GUESS_PERIODS[1], None, GUESS_PERIODS[2])
 
 
 def design_starts(problem: DesignProblem, starts: int, seed: int) -> list[tuple]:
-    """(kind, (z, radii)) of ``starts`` starts in the order of ``DESIGN_STARTS``."""
+    """The ``starts`` starts (each a ``Candidate`` of (z, radii)) in the order of
+    ``DESIGN_STARTS``."""
     schedule = start_schedule(starts, seed, DESIGN_STARTS)
     rng = np.random.default_rng(seed)
     reference = problem.reference_radii
     result = []
-    for kind, period in schedule:
+    for source, period in schedule:
         if period is not None:
             z = problem.gait_problem(reference).first_guess(period)
-            result.append((kind, (z, reference)))
+            result.append(Candidate(source, (z, reference)))
             continue
         radii = tuple(float(r) for r in rng.uniform(problem.lower, problem.upper))
-        result.append((kind, (perturbed(problem.gait_problem(radii).first_guess(), rng), radii)))
+        z = perturbed(problem.gait_problem(radii).first_guess(), rng)
+        result.append(Candidate(source, (z, radii)))
     return result
 
 
@@ -297,7 +299,7 @@ def optimize_design(
     candidates = design_starts(problem, starts, seed)
     for z, radii in given:
         start = (np.asarray(z, dtype=float), check_radii(problem.robot, radii))
-        candidates.append(("given", start))
+        candidates.append(Candidate("given", start))
     if problem.criterion in WORK_CRITERIA and starts > 0:  # as for gaits: least torque first
         sthenic = optimize_design(dataclasses.replace(problem, criterion="sthenic"), seed, starts)
         candidates += sthenic_starts(sthenic.report, (sthenic.optimum.variables, sthenic.radii))
@@ -305,7 +307,7 @@ def optimize_design(
     def solve(start, barrier):
         return solver.solve(problem, *start, barrier=barrier)
 
-    solver.prepare({barrier_of(kind) for kind, _ in candidates})
+    solver.prepare({start.barrier for start in candidates})
     best, report = multistart(candidates, solve, seed, began)
     # IPOPT may end a hair outside a bound (its bound_relax_factor): back inside
     radii = tuple(

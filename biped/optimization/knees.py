@@ -30,7 +30,7 @@ import math
 from dataclasses import dataclass
 
 from biped.optimization.comparison import DIFFERENCE, relative_change
-from biped.optimization.optimize import TIGHT, Optimum, next_optimum, refine
+from biped.optimization.optimize import Optimum, next_optimum, refine
 
 # The knees compared, the reference first.
 KNEES = ("revolute", "rolling")
@@ -157,7 +157,7 @@ def _finer(optimum: Optimum):
 
 def _tighter(optimum: Optimum):
     """The optimum re-solved to the tighter tolerance, or why it is not one."""
-    found = refine(optimum.problem, optimum.variables, "given" + TIGHT)
+    found = refine(optimum.problem, optimum.variables, "tight")
     return found if found.feasible and found.report.status in TIGHT_ENDS else _failure(found)
 
 

@@ -50,7 +50,7 @@ from biped.optimization.problem import (  # noqa: F401 (re-exported)
     scales,
 )
 from biped.optimization.report import Report, Start  # noqa: F401 (re-exported)
-from biped.optimization.solver import CONVERGED, solver_for
+from biped.optimization.solver import BARRIERS, CONVERGED, solver_for
 from biped.optimization.table import OTHER_KNEE_START, TABLE_START
 from biped.runtime.runner import free_cores, run_forked
 
@@ -63,6 +63,32 @@ GUESS_PERIODS = (FIRST_GUESS_PERIOD, 0.8, 0.45)
 PERTURBATION = 1.0
 # Two starts reach the same optimum when their values agree to this, relative.
 AGREEMENT = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class Candidate:
+    """A start of a multistart: where it comes from (``source``: "first guess", "given",
+    ``TABLE_START``, ``STHENIC_START``, ...), what it starts from (``variables``: the solver's
+    variables, or what a design's solver takes, such as (z, radii)) and the barrier it is
+    solved under (one of ``biped.optimization.solver.BARRIERS``). A report's history names
+    it by its ``kind``: the source, then the barrier's ending (``BARRIER_ENDINGS``)."""
+
+    source: str
+    variables: object
+    barrier: str = "adaptive"
+
+    def __post_init__(self):
+        if self.barrier not in BARRIERS:
+            raise BipedError(f"barrier = {self.barrier!r}: allowed one of {', '.join(BARRIERS)}")
+
+    @property
+    def kind(self) -> str:
+        """The start's name in a report's history: "sthenic optimum, monotone barrier"."""
+        return self.source + ENDINGS.get(self.barrier, "")
+
+    def under(self, barrier: str) -> Candidate:
+        """The same start solved under ``barrier``."""
+        return dataclasses.replace(self, barrier=barrier)
 
 
 @dataclass
@@ -119,7 +145,7 @@ def check_method(method: str) -> str:
 
 
 def start_schedule(starts: int, seed: int, periods) -> list[tuple[str, float | None]]:
-    """(kind, period) of ``starts`` starts: the first guesses of the step periods [s]
+    """(source, period) of ``starts`` starts: the first guesses of the step periods [s]
     ``periods`` in order (None: a random start), random starts after them."""
     if isinstance(starts, bool) or not isinstance(starts, int) or starts < 0:
         raise BipedError(f"starts = {starts!r}: allowed an integer >= 0")
@@ -134,7 +160,7 @@ def start_schedule(starts: int, seed: int, periods) -> list[tuple[str, float | N
 
 def first_guesses(
     problem: GaitProblem, starts: int, seed: int, by_table: bool = True
-) -> list[tuple[str, np.ndarray]]:
+) -> list[Candidate]:
     """``starts`` first guesses in the bounds: the default first guess, then first guesses of
     other step periods (``GUESS_PERIODS``: the step length a gait settles on is its largest
     choice, and the basins of the optima follow it), then perturbations of the default. For
@@ -148,11 +174,11 @@ def first_guesses(
     schedule = start_schedule(starts, seed, GUESS_PERIODS)
     guess, rng = problem.first_guess(), np.random.default_rng(seed)
     return [
-        (
-            kind,
+        Candidate(
+            source,
             perturbed(guess, rng, problem.knots) if period is None else problem.first_guess(period),
         )
-        for kind, period in schedule
+        for source, period in schedule
     ]
 
 
@@ -183,13 +209,15 @@ def energy_first_guesses(
 def _energy_guesses(problem: GaitProblem, starts: int, seed: int) -> list:
     lengths = ENERGY_GUESS_LENGTHS[:starts]
     guesses = [
-        (f"first guess S = {length:g} m{MONOTONE}", problem.first_guess(length / problem.speed))
+        Candidate(
+            f"first guess S = {length:g} m", problem.first_guess(length / problem.speed), "monotone"
+        )
         for length in lengths
     ]
     rng = np.random.default_rng(seed)
-    base = guesses[0][1] if guesses else problem.first_guess()
+    base = guesses[0].variables if guesses else problem.first_guess()
     guesses += [
-        (f"perturbed{MONOTONE}", perturbed(base, rng, problem.knots))
+        Candidate("perturbed", perturbed(base, rng, problem.knots), "monotone")
         for _ in range(starts - len(lengths))
     ]
     return guesses
@@ -210,7 +238,7 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
     and what solves one.
 
     Args:
-        candidates: (kind, start) pairs; a kind names its barrier (``barrier_of``).
+        candidates: the starts (``Candidate``: each its barrier).
         solve: ``solve(start, barrier)`` -> ``biped.optimization.solver.Solution``.
         seed: recorded in the report.
         began: ``time.perf_counter()`` when the search began, for the report's seconds.
@@ -229,14 +257,13 @@ def multistart(candidates, solve, seed: int, began: float, jobs: int | None = No
     jobs = free_cores() if jobs is None else jobs
     if search is None:
 
-        def solve_start(candidate):
-            kind, start = candidate
-            return solve(start, barrier_of(kind))
+        def solve_start(candidate: Candidate):
+            return solve(candidate.variables, candidate.barrier)
 
         ends = run_forked(solve_start, list(candidates), jobs, _far_first(candidates))
     else:
         ends = coarse_to_fine(list(candidates), search, solve, jobs)
-    solutions = list(zip([kind for kind, _ in candidates], ends, strict=True))
+    solutions = list(zip([c.kind for c in candidates], ends, strict=True))
     converged = [s for _, s in solutions if s.converged]
     pool = converged or [s for _, s in solutions]
     best = min(pool, key=lambda s: s.value if np.isfinite(s.value) else np.inf)
@@ -262,17 +289,17 @@ def _far_first(candidates) -> list[int]:
     solved first: far from the criterion's optima, they are the longest at most points (at
     0.3 m/s 89-169 IPOPT iterations, where the table's starts take 29-114), and a long
     solve started last keeps one process busy alone."""
-    return [i for i, (kind, _) in enumerate(candidates) if start_of(kind) == STHENIC_START]
+    return [i for i, c in enumerate(candidates) if c.source == STHENIC_START]
 
 
 def coarse_to_fine(candidates, search, solve, jobs: int) -> list:
-    """The end of each start (kind, z) of ``candidates``: searched on the coarse grid
+    """The end of each start (``Candidate``) of ``candidates``: searched on the coarse grid
     (``search``), then polished from there on the problem's own (``solve``, IPOPT's adaptive
     barrier). Starts whose searches end at one value (within ``AGREEMENT``) are one coarse
     optimum, polished once: they share its end. A search that did not converge is solved on
     the problem's grid from its start instead. Each end counts the iterations and seconds of
     both grids."""
-    searched = run_forked(lambda c: search(c[1], barrier_of(c[0])), candidates, jobs)
+    searched = run_forked(lambda c: search(c.variables, c.barrier), candidates, jobs)
     groups = []  # [index of the search polished, indices of the starts sharing it]
     for index, end in enumerate(searched):
         shared = next(
@@ -294,7 +321,8 @@ def coarse_to_fine(candidates, search, solve, jobs: int) -> list:
         first = searched[group[0]]
         if first.converged:
             return solve(first.variables, "adaptive")
-        return solve(candidates[group[0]][1], barrier_of(candidates[group[0]][0]))
+        start = candidates[group[0]]
+        return solve(start.variables, start.barrier)
 
     polished = run_forked(polish, groups, jobs)
     ends = [None] * len(candidates)
@@ -352,7 +380,7 @@ def prepare(problem: GaitProblem) -> float:
 
 
 def barriers_of(problem: GaitProblem) -> tuple[str, ...]:
-    """The barriers (``barrier_of``) the starts of an optimization of ``problem`` are solved
+    """The barriers (``Candidate.barrier``) the starts of an optimization of ``problem`` are solved
     with: the adaptive one, and for the criteria of work the monotone one too (their table
     start, ``table_starts``, and the energy per step's first guesses), for the energy per
     step also the one from mu = 1e-4 (its table start, ``NEAR``)."""
@@ -419,7 +447,7 @@ def optimize(
     candidates = first_guesses(problem, starts, seed) + table_starts(problem, starts)
     if starts > 0:  # the table's starts are among these: a given one of them is that start
         given = apart_from_table(problem, given)
-    candidates += [("given", np.asarray(z, dtype=float)) for z in given]
+    candidates += [Candidate("given", np.asarray(z, dtype=float)) for z in given]
     if problem.knots != 1 and starts > 0:
         candidates += _paper_start(problem, seed, starts, solvers, jobs)
     if problem.criterion in WORK_CRITERIA and starts > 0:
@@ -427,7 +455,7 @@ def optimize(
     candidates += _nelder_mead_starts(
         problem, seed, nelder_mead_starts, max_restarts, evaluations_per_run
     )
-    barriers = {barrier_of(kind) for kind, _ in candidates}
+    barriers = {c.barrier for c in candidates}
     solver.prepare(barriers)
     best, report = multistart(
         candidates,
@@ -453,7 +481,7 @@ def _nelder_mead_starts(problem, seed, count, max_restarts, evaluations_per_run)
             evaluations_per_run,
         )
         try:
-            starts.append(("nelder-mead", problem.from_parameters(parameters)))
+            starts.append(Candidate("nelder-mead", problem.from_parameters(parameters)))
         except BipedError:
             continue  # a Nelder-Mead point out of reach starts nothing
     return starts
@@ -485,19 +513,19 @@ def table_starts(problem: GaitProblem, starts: int) -> list:
     if starts == 0:
         return []
     found = [
-        (TABLE_START, _embedded(problem, table.start(problem))),
-        (OTHER_KNEE_START, _embedded(problem, table.other_knee_start(problem))),
+        Candidate(TABLE_START, _embedded(problem, table.start(problem))),
+        Candidate(OTHER_KNEE_START, _embedded(problem, table.other_knee_start(problem))),
     ]
-    found = [(kind, start) for kind, start in found if start is not None]
+    found = [start for start in found if start.variables is not None]
     if problem.criterion not in WORK_CRITERIA:
         return found
-    twins = {TABLE_START: (MONOTONE,)}
+    twins = {TABLE_START: ("monotone",)}
     if problem.criterion == "energy" and table.covers(problem):
-        twins = {TABLE_START: (NEAR,), OTHER_KNEE_START: (MONOTONE, NEAR)}
+        twins = {TABLE_START: ("near",), OTHER_KNEE_START: ("monotone", "near")}
     return [
-        pair
-        for kind, start in found
-        for pair in [(kind, start)] + [(kind + end, start) for end in twins.get(kind, ())]
+        twin
+        for start in found
+        for twin in [start] + [start.under(barrier) for barrier in twins.get(start.source, ())]
     ]
 
 
@@ -512,7 +540,7 @@ def apart_from_table(problem: GaitProblem, given) -> list[np.ndarray]:
     the table was made from such a campaign (in the default sweep at 49 of its 52 points,
     ``benchmarks/given_starts.py``): it is one of the point's own starts already, and
     solved again it would reach the same end and count as a second start."""
-    own = [z for _, z in table_starts(problem, 1)]
+    own = [start.variables for start in table_starts(problem, 1)]
     scale = scales(problem.knots)
 
     def known(z):
@@ -536,7 +564,9 @@ def _paper_start(problem: GaitProblem, seed, starts, solvers=None, jobs=None) ->
     problem's richer family: from it the richer family's optimum is never worse."""
     paper = dataclasses.replace(problem, knots=1, samples_per_half=None)
     optimum = optimize(paper, seed, starts, solvers=solvers, jobs=jobs)
-    return [(PAPER_START, problem.embedded(optimum.variables))] if optimum.report.converged else []
+    if not optimum.report.converged:
+        return []
+    return [Candidate(PAPER_START, problem.embedded(optimum.variables))]
 
 
 # The energy criterion's starts from the sthenic optimum, under IPOPT's adaptive and its
@@ -571,11 +601,13 @@ def _sthenic_start(
     return sthenic_starts(sthenic.report, sthenic.variables)
 
 
-def sthenic_starts(report: Report, start) -> list:
+def sthenic_starts(report: Report, start) -> list[Candidate]:
     """The energy criterion's starts ``start`` from a sthenic optimum found as ``report``
     says, under both barriers (``STHENIC_START``, ``MONOTONE_START``): none unless it
     converged."""
-    return [(STHENIC_START, start), (MONOTONE_START, start)] if report.converged else []
+    if not report.converged:
+        return []
+    return [Candidate(STHENIC_START, start), Candidate(STHENIC_START, start, "monotone")]
 
 
 # A start solved to a tighter tolerance (``biped.optimization.solver.BARRIERS["tight"]``).
@@ -586,34 +618,31 @@ CONFIRM = ", monotone barrier from 1e-3"
 # A start near an optimum solved under the monotone barrier from mu = 1e-4
 # (``BARRIERS["near"]``, ``table_starts``).
 NEAR = ", monotone barrier from 1e-4"
-# The barrier a start's kind names by its ending; no ending: the adaptive one.
+# The ending of a start's kind in a report's history for the barrier it was solved under
+# (``Candidate.kind``); none: the adaptive one.
 BARRIER_ENDINGS = {TIGHT: "tight", MONOTONE: "monotone", CONFIRM: "confirm", NEAR: "near"}
+ENDINGS = {barrier: ending for ending, barrier in BARRIER_ENDINGS.items()}
 
 
 def _ending(kind: str) -> str:
-    """The ending of ``BARRIER_ENDINGS`` a start's kind has, or ""."""
+    """The ending of ``BARRIER_ENDINGS`` a recorded start's kind has, or ""."""
     return next((end for end in BARRIER_ENDINGS if kind.endswith(end)), "")
 
 
-def barrier_of(kind: str) -> str:
-    """The barrier strategy (``biped.optimization.solver.BARRIERS``) a start of this kind is solved
-    with."""
-    return BARRIER_ENDINGS.get(_ending(kind), "adaptive")
-
-
 def start_of(kind: str) -> str:
-    """The start a kind names, without the barrier it was solved with (``BARRIER_ENDINGS``)."""
+    """The start a recorded kind (a report's history, as read from a file) names, without the
+    barrier it was solved with (``BARRIER_ENDINGS``)."""
     return kind[: len(kind) - len(_ending(kind))]
 
 
-def refine(problem: GaitProblem, start, kind: str = "given", seed: int = 0) -> Optimum:
-    """``problem`` solved from the one start ``start`` (variables), under the barrier its
-    ``kind`` names (``barrier_of``; ``"given" + TIGHT``: to a tighter tolerance): an optimum
-    re-solved on a finer grid or more tightly, for its error bar."""
+def refine(problem: GaitProblem, start, barrier: str = "adaptive", seed: int = 0) -> Optimum:
+    """``problem`` solved from the one start ``start`` (variables, "given"), under ``barrier``
+    (``"tight"``: to a tighter tolerance): an optimum re-solved on a finer grid or more
+    tightly, for its error bar."""
     began = time.perf_counter()
     solver = solver_for(problem)
     best, report = multistart(
-        [(kind, np.asarray(start, dtype=float))],
+        [Candidate("given", np.asarray(start, dtype=float), barrier)],
         lambda z, barrier: solver.solve(problem, z, barrier=barrier),
         seed,
         began,
@@ -675,18 +704,18 @@ def confirm(problem: GaitProblem, optimum: Optimum, given=(), jobs: int | None =
     settled = report.method != "ipopt" or not report.converged or report.confirmed
     if settled or problem.criterion not in WORK_CRITERIA:
         return optimum
-    near = [(kind, z) for kind, z in table_starts(problem, 1) if start_of(kind) == kind]
-    candidates = [(kind + CONFIRM, z) for kind, z in near]
-    candidates += [(kind + MONOTONE, z) for kind, z in near if kind == OTHER_KNEE_START]
+    near = [start for start in table_starts(problem, 1) if start.barrier == "adaptive"]
+    candidates = [start.under("confirm") for start in near]
+    candidates += [start.under("monotone") for start in near if start.source == OTHER_KNEE_START]
     solved = {start.kind for start in report.history}  # the same start again adds nothing
-    candidates = [(kind, z) for kind, z in candidates if kind not in solved]
+    candidates = [start for start in candidates if start.kind not in solved]
     given = apart_from_table(problem, given)
-    candidates += [("given" + CONFIRM, np.asarray(z, dtype=float)) for z in given]
+    candidates += [Candidate("given", np.asarray(z, dtype=float), "confirm") for z in given]
     if not candidates:
         return optimum
     began = time.perf_counter()
     solver = solver_for(problem)
-    solver.prepare({barrier_of(kind) for kind, _ in candidates})
+    solver.prepare({start.barrier for start in candidates})
     best, again = multistart(
         candidates,
         lambda z, barrier: solver.solve(problem, z, barrier=barrier),

@@ -47,7 +47,7 @@ from biped.optimization.comparison import (  # noqa: F401 (re-exported)
     relative_change,
 )
 from biped.optimization.design import MIN_RADIUS, Comparison, Design, DesignProblem
-from biped.optimization.optimize import CONFIRM, Optimum, Report, checked, multistart
+from biped.optimization.optimize import Candidate, Optimum, Report, checked, multistart
 from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 
@@ -190,14 +190,14 @@ class ProfileDesign:
 
 
 def profile_starts(problem: ProfileProblem, circles: Design, seed: int) -> list[tuple]:
-    """(kind, (z, parameters)) of the starts (module docstring)."""
+    """The starts (each a ``Candidate`` of (z, parameters); module docstring)."""
     z = np.asarray(circles.optimum.variables, dtype=float)
     base = (*circles.radii, 0.0, 0.0)
-    starts = [("circles", (z, base)), ("circles" + CONFIRM, (z, base))]
+    starts = [Candidate("circles", (z, base)), Candidate("circles", (z, base), "confirm")]
     rng = np.random.default_rng(seed)
     for _ in range(RANDOM_STARTS):
         rates = rng.uniform(-RANDOM_RATE, RANDOM_RATE, 2)
-        starts.append(("perturbed", (z, (*circles.radii, *map(float, rates)))))
+        starts.append(Candidate("perturbed", (z, (*circles.radii, *map(float, rates)))))
     return starts
 
 

@@ -55,7 +55,6 @@ from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization.comparison import relative_change
 from biped.optimization.optimize import (
-    TIGHT,
     Optimum,
     Report,
     apart_from_table,
@@ -379,7 +378,7 @@ def _solve_refined(task: Task) -> str:
         samples = FINER * settings.problem(point).samples_per_half
         optimum = refine(settings.problem(point, samples=samples), start)
     elif point.stage == "tight":
-        optimum = refine(settings.problem(point), start, "given" + TIGHT)
+        optimum = refine(settings.problem(point), start, "tight")
     else:
         richer = settings.problem(point, knots=RICHER_KNOTS)
         others = [read(task.folder, p) for p in task.given]
