@@ -31,7 +31,7 @@ from biped.model.criteria import (
     Safety,
 )
 from biped.model.dynamics import Biped
-from biped.model.gait import KNOTS
+from biped.model.gait import MAX_KNOTS
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization.comparison import CERTIFIED
@@ -87,8 +87,9 @@ CRITERION_HELP = (
     "(no regeneration), from the robot's actuators [J/m]"
 )
 KNOTS_HELP = (
-    "interior knots of each angle's cubic spline: 1, the paper's (21 parameters); 3 or 5, "
-    "richer gaits that hold the paper's (45, 69 parameters)"
+    "interior knots of each angle's cubic spline: 1, the paper's (21 parameters); K more, "
+    "richer gaits of 21 + 12 (K − 1) parameters (an odd K holds the paper's; 1, 3, 7, 15 "
+    "each hold the one before)"
 )
 CERTIFIED_HELP = f"certified: {CERTIFIED}"
 
@@ -221,11 +222,10 @@ def add_knots(parser) -> None:
     """``--knots K``: the gait family (``biped.model.gait.KNOTS``)."""
     parser.add_argument(
         "--knots",
-        type=int,
-        choices=KNOTS,
+        type=bounded(1, MAX_KNOTS),
         default=1,
         metavar="K",
-        help=f"{KNOTS_HELP}; K one of {', '.join(map(str, KNOTS))} (default %(default)s)",
+        help=f"{KNOTS_HELP}; K from 1 to {MAX_KNOTS} (default %(default)s)",
     )
 
 

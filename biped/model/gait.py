@@ -28,9 +28,11 @@ Richer families (``knots`` = K interior knots, at t_n = k / (K + 1)): a C¹ cubi
 angle on K + 1 pieces, each piece the cubic Hermite polynomial of the values and rates at its
 ends; the parameters replace the 12 accelerations by the six angles and their rates at each
 interior knot (``parameter_names``): 21 + 12 (K − 1) parameters, with the same conditions at
-both ends (flat feet, leg swap, impact map). A family contains the paper's when its knots
-include t_n = 0.5 (K = 3, 5: ``KNOTS``): the paper's spline, smooth on each half, is the
-Hermite spline of its own values and rates at those knots (``embedded``), so a richer
+both ends (flat feet, leg swap, impact map), for K from 1 to ``MAX_KNOTS``. A family holds
+another when its knots include the other's (every odd K holds the paper's, t_n = 0.5; the
+ladder K = 1, 3, 7, 15, ... (``ladder``) halves the pieces at each rung, each rung holding
+the one below): a spline smooth on each of its pieces is the Hermite spline of its own
+values and rates at the richer family's knots (``embedded``), the same motion, so a richer
 family's optimum is never worse.
 
 Step length and speed ("d" of the paper): the walking speed V is given; the hip advances by
@@ -60,18 +62,28 @@ PARAMETERS = (
 )
 N_PARAMETERS = len(PARAMETERS)  # 21
 FREE_ANGLES = ("qp2", "q1", "q2", "q3", "q4", "q5")
-# Interior knots of the gait families: the paper's spline (1) and two richer ones holding it.
-KNOTS = (1, 3, 5)
+# Most interior knots of a gait family: 31 is the ladder's fifth rung (``ladder``), 381
+# parameters.
+MAX_KNOTS = 31
+# Interior knots of the gait families: the paper's spline (1) and richer ones.
+KNOTS = tuple(range(1, MAX_KNOTS + 1))
 
 
 def check_knots(knots) -> int:
     """``knots`` if it names a family (``KNOTS``), else a clear error."""
-    if isinstance(knots, bool) or knots not in KNOTS:
+    integer = isinstance(knots, (int, np.integer)) and not isinstance(knots, bool)
+    if not integer or knots not in KNOTS:
         raise BipedError(
-            f"knots = {knots!r}: allowed {', '.join(map(str, KNOTS))} interior knots (1: the "
+            f"knots = {knots!r}: allowed an integer from 1 to {MAX_KNOTS} interior knots (1: the "
             "paper's spline)"
         )
     return int(knots)
+
+
+def ladder(rungs: int) -> tuple:
+    """The nested families K = 2^(k+1) − 1 (1, 3, 7, 15, ...) of ``rungs`` rungs: each halves
+    the pieces of the one below, so holds it (``check_embedding``)."""
+    return tuple(2 ** (k + 1) - 1 for k in range(rungs))
 
 
 @functools.cache
@@ -331,8 +343,16 @@ def sample(model: Biped, step: Step, samples_per_half: int, points=()):
 def embedded(step: Step, knots: int) -> np.ndarray:
     """The knots' angles and rates (``knots``, 2, 6) of ``step``'s spline: the parameters
     beyond the ends' of the family of ``knots`` interior knots that holds it (its knots
-    include ``step``'s: ``check_embedding``)."""
+    include ``step``'s: ``check_embedding``), the same motion."""
     check_embedding(step.knots, knots)
+    return at_knots(step, knots)
+
+
+def at_knots(step: Step, knots: int) -> np.ndarray:
+    """``step``'s angles and rates (``knots``, 2, 6) at the interior knots of the family of
+    ``knots``: its embedding where that family holds it (``embedded``), otherwise the
+    Hermite spline through them, an approximation of it (a first guess)."""
+    check_knots(knots)
     times = breakpoints(knots)[1:-1]
     ends = breakpoints(step.knots)
     rows = []

@@ -8,7 +8,8 @@ CasADi (``profile_graph``) and its surfaces designed with the gait (``profile_de
 the words and sign with
 which optima are compared (``comparison``: a difference between knees, "certified", the two
 grids of a criterion), and the two knees' optima compared, each difference with what moves it
-and a verdict (``knees``).
+and a verdict (``knees``), and one problem's optima over a ladder of nested gait families
+(``ladder``).
 
 May import: ``biped.model``, ``biped.runtime``, ``biped.errors``, numpy, scipy, casadi.
 """

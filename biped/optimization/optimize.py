@@ -403,6 +403,7 @@ def optimize(
     solvers=None,
     sthenic: Optimum | None = None,
     jobs: int | None = None,
+    below: Optimum | None = None,
 ) -> Optimum:
     """The best gait of ``problem``.
 
@@ -431,6 +432,9 @@ def optimize(
             energy criterion as the one this call would compute (None: computed here).
         jobs: processes solving the starts at once (default: the cores free,
             ``biped.runtime.runner.free_cores``); the optimum is the same.
+        below: for a richer family, the optimum of the same problem in a family it holds
+            (the rung below on a ladder, ``biped.optimization.ladder``), its start in place of
+            the paper's spline's optimum (None: that optimum, computed here).
     """
     check_method(method)
     if not isinstance(problem, GaitProblem):
@@ -449,7 +453,7 @@ def optimize(
         given = apart_from_table(problem, given)
     candidates += [Candidate("given", np.asarray(z, dtype=float)) for z in given]
     if problem.knots != 1 and starts > 0:
-        candidates += _paper_start(problem, seed, starts, solvers, jobs)
+        candidates += _paper_start(problem, seed, starts, solvers, jobs, below)
     if problem.criterion in WORK_CRITERIA and starts > 0:
         candidates += _sthenic_start(problem, seed, starts, solvers, sthenic, jobs)
     candidates += _nelder_mead_starts(
@@ -552,21 +556,48 @@ def apart_from_table(problem: GaitProblem, given) -> list[np.ndarray]:
 
 def _embedded(problem: GaitProblem, variables):
     """The paper spline's ``variables`` in the problem's family (None stays None)."""
-    return None if variables is None else problem.embedded(variables)
+    return None if variables is None else problem.embedded(variables, exact=False)
 
 
-# A richer family's start from the optimum of the paper's spline (its family holds it).
+# A richer family's start from the optimum of the paper's spline (its family holds it), or
+# of the family below it on a ladder (``BELOW_START``).
 PAPER_START = "optimum of the paper's spline"
+BELOW_START = "optimum of the family below"
 
 
-def _paper_start(problem: GaitProblem, seed, starts, solvers=None, jobs=None) -> list:
-    """The optimum of the same problem with the paper's spline, the same gait in the
-    problem's richer family: from it the richer family's optimum is never worse."""
-    paper = dataclasses.replace(problem, knots=1, samples_per_half=None)
-    optimum = optimize(paper, seed, starts, solvers=solvers, jobs=jobs)
-    if not optimum.report.converged:
+def _paper_start(
+    problem: GaitProblem, seed, starts, solvers=None, jobs=None, below: Optimum | None = None
+) -> list:
+    """The optimum of the same problem with the paper's spline (``below``, the optimum of a
+    family the problem's holds, when given), the same gait in the problem's richer family:
+    from it the richer family's optimum is never worse. A family that does not hold the
+    paper's (an even number of knots) starts from the spline through its angles and rates at
+    the knots."""
+    if below is None:
+        paper = dataclasses.replace(problem, knots=1, samples_per_half=None)
+        below = optimize(paper, seed, starts, solvers=solvers, jobs=jobs)
+        kind = PAPER_START
+    else:
+        _check_below(problem, below)
+        kind = PAPER_START if below.problem.knots == 1 else BELOW_START
+    if not below.report.converged:
         return []
-    return [Candidate(PAPER_START, problem.embedded(optimum.variables))]
+    exact = below.problem.knots != 1 or problem.knots % 2 == 1
+    start = problem.embedded(below.variables, below.problem.knots, exact=exact)
+    return [Candidate(kind, start)]
+
+
+def _check_below(problem: GaitProblem, below) -> None:
+    """Refuse a ``below`` that is not an optimum of the same problem in a family the
+    problem's holds."""
+    if not isinstance(below, Optimum):
+        raise BipedError(f"below = {below!r}: allowed a biped.optimization.optimize.Optimum")
+    same = dataclasses.replace(below.problem, knots=problem.knots, samples_per_half=None)
+    if _family(same)[:-2] != _family(problem)[:-2]:
+        raise BipedError(
+            f"below: an optimum of {below.problem.describe()}: allowed one of "
+            f"{problem.describe()} in a family it holds"
+        )
 
 
 # The energy criterion's starts from the sthenic optimum, under IPOPT's adaptive and its

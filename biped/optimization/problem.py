@@ -37,8 +37,10 @@ from biped.errors import BipedError
 from biped.model.criteria import ALL_CRITERIA, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
 from biped.model.gait import (
+    KNOTS,
     N_PARAMETERS,
     PARAMETERS,
+    at_knots,
     build_step,
     check_knots,
     embedded,
@@ -73,9 +75,35 @@ FIRST_GUESS_PERIOD = 0.6
 # 202 samples per step), where Ψ_i may dip below δ_i between them.
 SOLVER_SAMPLES_PER_HALF = 25
 CHECK_SAMPLES_PER_HALF = 100
-# The same per piece of each family (``biped.model.gait.KNOTS``), about as many per step.
-SOLVER_SAMPLES = {1: SOLVER_SAMPLES_PER_HALF, 3: 13, 5: 9}
-CHECK_SAMPLES = {1: CHECK_SAMPLES_PER_HALF, 3: 50, 5: 34}
+# The same per piece of each family (``biped.model.gait.KNOTS``): about as many per step
+# (``solver_samples``, ``check_samples``), and no fewer per piece than these, so that the
+# solver's samples follow a piece's cubic and the check grid resolves it; the check grid's
+# pieces of an even number of intervals, where Simpson's rule is the plain composite one. A
+# gait embedded in a richer family (``biped.optimization.ladder``) has the same costs to
+# round-off where the two check grids coincide (K = 1 and 3: 1/200 of the step apart), to the
+# quadrature's error elsewhere (2e-7 relative of the sthenic criterion from K = 3 to 7 at
+# 0.3 m/s): a ladder compares a rung's optimum with the rung below's on the rung's own grid.
+SOLVER_SAMPLES_PER_STEP = 2 * SOLVER_SAMPLES_PER_HALF
+CHECK_SAMPLES_PER_STEP = 2 * CHECK_SAMPLES_PER_HALF
+MIN_SOLVER_SAMPLES = 6
+MIN_CHECK_SAMPLES = 26
+
+
+def solver_samples(knots: int) -> int:
+    """Samples per piece where the solvers impose the constraints in the family of ``knots``
+    interior knots (25 for the paper's spline, 13 for 3 knots, 7 for 7, 6 for 15)."""
+    return max(math.ceil(SOLVER_SAMPLES_PER_STEP / (knots + 1)), MIN_SOLVER_SAMPLES)
+
+
+def check_samples(knots: int) -> int:
+    """Samples per piece of the check grid of the family of ``knots`` interior knots, an even
+    number (100 for the paper's spline, 50 for 3 knots, 34 for 5, 26 for 7 and more)."""
+    per_piece = max(math.ceil(CHECK_SAMPLES_PER_STEP / (knots + 1)), MIN_CHECK_SAMPLES)
+    return per_piece + per_piece % 2
+
+
+SOLVER_SAMPLES = {knots: solver_samples(knots) for knots in KNOTS}
+CHECK_SAMPLES = {knots: check_samples(knots) for knots in KNOTS}
 # Scales and bounds of a richer family's knot angles [rad] and rates [rad/s].
 KNOT_SCALES = {"": 0.03, "rate_": 0.3}
 KNOT_ANGLE_BOUND = np.pi
@@ -88,13 +116,35 @@ def variable_names(knots: int = 1) -> tuple:
     return ("stance_knee_bend", "swing_knee_bend") + parameter_names(knots)[2:]
 
 
+# Families of more knots than this have their scales shrunk (``scales``).
+SCALED_FROM_KNOTS = 5
+# Exponents of the shrinking of the angles' (and the period's) and the rates' scales.
+ANGLE_EXPONENT, RATE_EXPONENT = 3.0, 1.5
+
+
 @functools.cache
 def scales(knots: int = 1) -> np.ndarray:
-    """``SCALES`` of the family: the paper's, the accelerations' replaced by the knots'."""
+    """``SCALES`` of the family: the paper's, the accelerations' replaced by the knots'.
+
+    Beyond ``SCALED_FROM_KNOTS`` knots the pieces shorten, and the criterion's curvature in
+    a variable grows as the pieces' accelerations do (the Hessian's diagonal at the optimum
+    at 0.3 m/s, in these units: 0.1 to 1.5e5 for 3 knots, 6 to 8e6 for 15): IPOPT's dual
+    infeasibility stalls at 1e-8 to 1e-7 where its tolerance asks 1e-9 (every start of 15
+    knots at its acceptable level, a step of 1e-11). With f = (``SCALED_FROM_KNOTS`` + 1) /
+    (K + 1), the angles' and the period's scales are multiplied by f^``ANGLE_EXPONENT``, the
+    rates' by f^``RATE_EXPONENT``: the exponents at which every start of 15 knots converged
+    (those of the curvature alone, 1.5 and 0.5, left it at 1e-8)."""
     if knots == 1:
         return SCALES
     at_knots = [KNOT_SCALES[kind] for _ in range(knots) for kind in KNOT_SCALES for _ in range(6)]
-    return np.concatenate([SCALES[:8], at_knots, SCALES[-1:]])
+    found = np.concatenate([SCALES[:8], at_knots, SCALES[-1:]])
+    if knots <= SCALED_FROM_KNOTS:
+        return found
+    f = (SCALED_FROM_KNOTS + 1) / (knots + 1)
+    rates = np.array(["rate" in name for name in variable_names(knots)])
+    found = found * np.where(rates, f**RATE_EXPONENT, f**ANGLE_EXPONENT)
+    found.setflags(write=False)
+    return found
 
 
 def bounds(knots: int = 1) -> tuple[np.ndarray, np.ndarray]:
@@ -292,18 +342,23 @@ class GaitProblem:
         p[3:7] = -self.speed / leg  # q1..q4 turn backwards as the hip passes over the feet
         p[PARAMETERS.index("period")] = period
         paper = dataclasses.replace(self, knots=1, samples_per_half=None)
-        return self.embedded(paper.from_parameters(p))
+        return self.embedded(paper.from_parameters(p), exact=False)
 
-    def embedded(self, variables) -> np.ndarray:
-        """The variables of this problem's family for the paper's spline of ``variables``
-        (21): the same gait (``biped.model.gait.embedded``); ``variables`` themselves for the
-        paper's spline."""
+    def embedded(self, variables, knots: int = 1, exact: bool = True) -> np.ndarray:
+        """The variables of this problem's family for the gait of ``variables`` of the family
+        of ``knots`` interior knots (the paper's spline's 21 by default): the same gait where
+        this family holds that one (``biped.model.gait.embedded``), ``variables`` themselves
+        in the same family. ``exact`` False: the Hermite spline through that gait's angles and
+        rates at this family's knots where it does not hold it (``at_knots``; a first guess)."""
         z = np.asarray(variables, dtype=float)
-        if self.knots == 1:
+        if knots == self.knots:
             return z
-        paper = dataclasses.replace(self, knots=1, samples_per_half=None)
-        step = build_step(self.model, self.speed, paper.to_parameters(z))
-        return np.concatenate([z[:8], embedded(step, self.knots).ravel(), z[-1:]])
+        if self.knots == 1:  # its variables are accelerations, not knots' angles and rates
+            raise BipedError(f"a gait of {knots} knots: allowed in a family of knots only")
+        below = dataclasses.replace(self, knots=knots, samples_per_half=None)
+        step = build_step(self.model, self.speed, below.to_parameters(z), knots)
+        inner = (embedded if exact else at_knots)(step, self.knots)
+        return np.concatenate([z[:8], inner.ravel(), z[-1:]])
 
     def first_parameters(self) -> np.ndarray:
         """The parameters of ``first_guess``."""
