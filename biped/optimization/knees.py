@@ -91,12 +91,35 @@ class KneeDifference:
         return f"{what}: {shown}: {self.verdict()}"
 
 
-def compare_knees(optima: dict) -> list[KneeDifference]:
-    """Each cost of ``COSTS`` of the knees' certified ``optima`` ({knee: Optimum}, one
-    problem but the knee) compared, the criterion they minimise first."""
-    criterion = optima["rolling"].problem.criterion
+def resolved(optima: dict) -> tuple[dict, dict]:
+    """Each knee's optimum of ``optima`` re-solved on the finer grid and to the tighter
+    tolerance ({knee: Optimum, or why it is not one}, each): what moves a difference."""
     fine = {knee: _finer(optimum) for knee, optimum in optima.items()}
     tight = {knee: _tighter(optimum) for knee, optimum in optima.items()}
+    return fine, tight
+
+
+def optimum_uncertainty(optimum: Optimum, fine, tight) -> float | str:
+    """[%] What moves one optimum's value, relative: its re-solves on the finer grid and to
+    the tighter tolerance (``resolved``), and the spread of its starts (``next_optimum``),
+    summed; or why it is unknown (a re-solve failed, no other start converged)."""
+    failed = [f"{name}: {why}" for name, why in (("finer grid", fine), ("tighter", tight))
+              if isinstance(why, str)]  # fmt: skip
+    spread = next_optimum(optimum.report)
+    if spread is None:
+        failed.append("starts: no other start converged")
+    if failed:
+        return f"not measured ({'; '.join(failed)})"
+    moves = [relative_change(other.value, optimum.value) for other in (fine, tight)]
+    return sum(abs(move) for move in moves) + 100 * spread
+
+
+def compare_knees(optima: dict, resolves: tuple | None = None) -> list[KneeDifference]:
+    """Each cost of ``COSTS`` of the knees' certified ``optima`` ({knee: Optimum}, one
+    problem but the knee) compared, the criterion they minimise first; ``resolves``: their
+    re-solves (``resolved``) when made already."""
+    criterion = optima["rolling"].problem.criterion
+    fine, tight = resolved(optima) if resolves is None else resolves
     found = []
     for cost in sorted(COSTS, key=lambda c: c != criterion):
         value = _change(optima, cost)

@@ -2,7 +2,8 @@
 (``figures``), a Markdown page per gait file (``page``), and the figures of a walk's orbit
 and of MuJoCo's walk beside the model's drawn from a validation report's JSON
 (``orbit_figures``, ``walk_figures``), the figures of a designed knee profile and of it over
-the speeds (``profile_figures``).
+the speeds (``profile_figures``), and the optima over nested gait families
+(``converge_figures``).
 
 May import: every other layer of ``biped``, numpy, matplotlib.
 """

@@ -2,7 +2,8 @@
 (``sweep``), the map of knee radii (``design_map``), the paper's own method over seeds
 (``paper_method``), each its science on the one mechanism that claims a folder, resumes, runs
 stages on a pool or Dask, shows progress and summarizes (``campaign``); and a machined knee
-profile over the speeds (``profile_speeds``: a table of optimizations, no folder of its own).
+profile over the speeds (``profile_speeds``: a table of optimizations, no folder of its own),
+and both knees over nested gait families until their comparison converges (``converge``).
 
 May import: ``biped.model``, ``biped.optimization``, ``biped.records``, ``biped.runtime``,
 ``biped.errors``, numpy, and matplotlib (the design map's figures).
