@@ -106,22 +106,23 @@ def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
     its gait file, what the comparisons use); its criterion on the solver's samples
     (``optimizer.value``, what ranked the starts; left out for a result without it)."""
     from biped.model.criteria import CRITERION_UNITS
-    from biped.optimization.comparison import (
-        CHECK_SAMPLES_PER_STEP,
-        NELDER_MEAD_SAMPLES_PER_STEP,
-        SOLVER_SAMPLES_PER_STEP,
-    )
+    from biped.optimization.comparison import NELDER_MEAD_SAMPLES_PER_STEP
+    from biped.optimization.problem import CHECK_SAMPLES
 
+    problem = optimum.problem
+    pieces = problem.knots + 1  # each piece closed: its ends counted on both sides
+    check_per_step = pieces * (CHECK_SAMPLES[problem.knots] + 1)
+    solver_per_step = pieces * (problem.samples_per_half + 1)
     ev = optimum.evaluation
     lines = [
         f"{knee} knee, {criterion}-optimal gait at {speed} m/s: period "
         f"{optimum.step.period:.4f} s, step {optimum.step.step_length:.4f} m",
-        f"  costs, on the check grid ({CHECK_SAMPLES_PER_STEP} samples per step; the "
+        f"  costs, on the check grid ({check_per_step} samples per step; the "
         f"comparisons use them): sthenic {ev.sthenic:.6g} N²·m·s, energy {ev.energy:.6g} J, "
         f"electrical {ev.electrical / optimum.step.step_length:.6g} J/m (no regeneration)",
     ]
     samples = (
-        f"{SOLVER_SAMPLES_PER_STEP} per step; it ranks the starts"
+        f"{solver_per_step} per step; it ranks the starts"
         if optimum.report.method == "ipopt"
         else f"{NELDER_MEAD_SAMPLES_PER_STEP} per step, penalties included"
     )

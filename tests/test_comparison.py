@@ -14,6 +14,7 @@ from biped.optimization.comparison import (
     SOLVER_VALUE,
     relative_change,
 )
+from biped.optimization.problem import SOLVER_SAMPLES
 from biped.records.gait_file import Gait
 from biped.studies.sweep import Point, _line
 
@@ -45,7 +46,7 @@ def test_the_two_values_of_a_criterion_are_named_for_what_they_are():
     assert "ranks the starts" in SOLVER_VALUE and "comparisons use" in CHECKED_VALUE
 
 
-def _optimum(converged=True, feasible=True, value=27.77, solver_value=27.78):
+def _optimum(converged=True, feasible=True, value=27.77, solver_value=27.78, knots=1):
     report = SimpleNamespace(
         method="ipopt",
         converged=converged,
@@ -57,8 +58,14 @@ def _optimum(converged=True, feasible=True, value=27.77, solver_value=27.78):
     )
     evaluation = SimpleNamespace(sthenic=value, energy=1.25, electrical=0.9)
     step = SimpleNamespace(period=0.6, step_length=0.18)
+    problem = SimpleNamespace(knots=knots, samples_per_half=SOLVER_SAMPLES[knots])
     return SimpleNamespace(
-        report=report, feasible=feasible, value=value, evaluation=evaluation, step=step
+        report=report,
+        feasible=feasible,
+        value=value,
+        evaluation=evaluation,
+        step=step,
+        problem=problem,
     )
 
 
@@ -77,6 +84,9 @@ def test_the_optimize_lines_name_both_values_of_the_criterion():
         len(optimum_line("rolling", "sthenic", 0.3, _optimum(solver_value=math.nan)).splitlines())
         == 2
     )
+    # a richer family's grids: 16 pieces of 27 and of 7 samples
+    richer = optimum_line("rolling", "sthenic", 0.3, _optimum(knots=15))
+    assert "check grid (432 samples per step" in richer and "(112 per step" in richer
 
 
 def test_only_a_final_optimum_is_called_certified():
