@@ -16,6 +16,7 @@ from biped.studies.converge import (
     KneeRung,
     RungRecord,
     convergence,
+    sentence,
     settled,
 )
 from biped_cli import main
@@ -65,8 +66,12 @@ def test_the_rule_stops_where_a_sequence_of_known_limit_has_settled():
     at = settled(values, errors)
     assert at == 4
     assert abs(values[at] - 10.0) <= errors[at]
-    verdict = convergence(_synthetic(values, [0.01] * 6))
+    records = _synthetic(values, [0.01] * 6)
+    verdict = convergence(records)
     assert verdict.converged_at == 31 and verdict.stops_improving == {"revolute": 31, "rolling": 31}
+    said = sentence(records, verdict, "N²·m·s")
+    assert said[-1].startswith("Converged at K = 31 (117 parameters)")
+    assert "by -2.00 % ± 0.01 %" in said[-1] and len(said) == 7
 
 
 def test_the_rule_does_not_stop_before_a_sequence_has_settled():
@@ -75,7 +80,9 @@ def test_the_rule_does_not_stop_before_a_sequence_has_settled():
     values = [10.0 * (1.0 + 1.0 / (k + 1)) for k in range(6)]
     assert settled(values, [1e-3] * 6) is None
     assert settled([1.0, 1.0, 1.0], [None, None, None]) is None
-    assert convergence(_synthetic(values, [0.01] * 6)).converged_at is None
+    records = _synthetic(values, [0.01] * 6)
+    assert convergence(records).converged_at is None
+    assert sentence(records, convergence(records), "N²·m·s")[-1].startswith("Not converged")
     flat = _synthetic([10.0] * 3, [0.01] * 3)
     moving = [
         RungRecord(r.knots, r.parameters, r.knees, -2.0 - 0.5 * i, 0.01) for i, r in enumerate(flat)
@@ -111,9 +118,10 @@ def test_converge_writes_its_record_figure_and_sentence(capsys, tmp_path):
     out = capsys.readouterr().out
     content = json.loads((tmp_path / "converge.json").read_text())
     assert (tmp_path / "converge.png").stat().st_size > 10_000
-    from biped.model.units import missing
+    from biped.model.units import is_unit, missing
 
     assert missing(content, content["units"]) == []
+    assert all(is_unit(unit) for unit in content["units"].values())
     rungs = content["rungs"]
     assert [r["knots"] for r in rungs] == [1, 3] and [r["parameters"] for r in rungs] == [21, 45]
     for r in rungs:

@@ -21,7 +21,6 @@ from biped.errors import BipedError
 from biped.model.gait import check_embedding, check_knots, parameter_names
 from biped.optimization.optimize import DEFAULT_STARTS, Optimum, checked, optimize, prepare
 from biped.optimization.problem import GaitProblem
-from biped.optimization.report import Report
 
 # A rung's optimum is no worse than the rung below's within this, relative.
 MONOTONE_TOLERANCE = 1e-9
@@ -116,4 +115,4 @@ def climb(
     return rungs
 
 
-__all__ = ["Report", "Rung", "check_ladder", "climb", "embedded_optimum"]
+__all__ = ["Rung", "check_ladder", "climb", "embedded_optimum"]

@@ -181,7 +181,7 @@ __all__ = [
 
 def content_of(problem, records: list, verdict: Convergence, robot, unit: str) -> dict:
     """The JSON of a ``biped converge`` run, with the unit of every number (``units``)."""
-    from biped.model.units import PERCENT, robot_unit
+    from biped.model.units import PERCENT, PURE, robot_unit
 
     content = {
         "format": "biped-converge/1",
@@ -193,11 +193,11 @@ def content_of(problem, records: list, verdict: Convergence, robot, unit: str) -
         **verdict.to_dict(),
     }
     units = {f"robot.{name}": robot_unit(name) for name in content["robot"] if name != "actuators"}
-    units.update({"speed": "m/s", "converged_at": "knots", "rungs[].knots": "knots"})
-    units.update({"rungs[].parameters": "parameters", "rungs[].difference": PERCENT})
+    units.update({"speed": "m/s", "converged_at": PURE, "rungs[].knots": PURE})
+    units.update({"rungs[].parameters": PURE, "rungs[].difference": PERCENT})
     units["rungs[].difference_error"] = PERCENT
     for knee in KNEES:
-        units[f"stops_improving.{knee}"] = "knots"
+        units[f"stops_improving.{knee}"] = PURE
         row = f"rungs[].knees.{knee}"
         units.update({f"{row}.value": unit, f"{row}.start_value": unit})
         units[f"{row}.uncertainty"] = PERCENT
@@ -212,14 +212,16 @@ def sentence(records: list, verdict: Convergence, unit: str) -> list[str]:
     lines = []
     for record in records:
         knees = "; ".join(
-            f"{knee} {rung.value:.4f} {unit} ± {_shown(rung.uncertainty)} %"
+            f"{knee} {rung.value:.4f} {unit} ± {_shown(rung.uncertainty)}"
             f"{'' if rung.certified else ' NOT CERTIFIED (' + rung.status + ')'}, "
             f"{rung.setup_seconds + rung.seconds:.1f} s"
             for knee, rung in record.knees.items()
         )
+        resolves = sum(rung.resolve_seconds for rung in record.knees.values())
         lines.append(
             f"K = {record.knots} ({record.parameters} parameters): {knees}; difference "
-            f"{record.difference:+.2f} % ± {_shown(record.difference_error)} %"
+            f"{record.difference:+.2f} % ± {_shown(record.difference_error)} (re-solves "
+            f"{resolves:.1f} s)"
         )
     stops = ", ".join(
         f"the {knee} knee's at {'no rung yet' if k is None else f'K = {k}'}"
@@ -229,7 +231,7 @@ def sentence(records: list, verdict: Convergence, unit: str) -> list[str]:
         last = records[-1]
         lines.append(
             f"Not converged over K = {', '.join(str(r.knots) for r in records)}: the last rung's "
-            f"difference is {last.difference:+.2f} % ± {_shown(last.difference_error)} %; the "
+            f"difference is {last.difference:+.2f} % ± {_shown(last.difference_error)}; the "
             f"optimum stops improving: {stops}."
         )
     else:
@@ -237,10 +239,11 @@ def sentence(records: list, verdict: Convergence, unit: str) -> list[str]:
         lines.append(
             f"Converged at K = {at.knots} ({at.parameters} parameters): the rolling knee's "
             f"optimum differs from the revolute knee's by {at.difference:+.2f} % ± "
-            f"{_shown(at.difference_error)} %; the optimum stops improving: {stops}."
+            f"{_shown(at.difference_error)}; the optimum stops improving: {stops}."
         )
     return lines
 
 
 def _shown(value) -> str:
-    return "unknown" if value is None else f"{value:.2g}"
+    """[%] An error bar as printed, or "unknown"."""
+    return "unknown" if value is None else f"{value:.2g} %"
