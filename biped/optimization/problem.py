@@ -81,8 +81,9 @@ CHECK_SAMPLES_PER_HALF = 100
 # pieces of an even number of intervals, where Simpson's rule is the plain composite one. A
 # gait embedded in a richer family (``biped.optimization.ladder``) has the same costs to
 # round-off where the two check grids coincide (K = 1 and 3: 1/200 of the step apart), to the
-# quadrature's error elsewhere (2e-7 relative of the sthenic criterion from K = 3 to 7 at
-# 0.3 m/s): a ladder compares a rung's optimum with the rung below's on the rung's own grid.
+# quadrature's error elsewhere (of the sthenic optima at 0.3 m/s, 1.5e-7 relative from K = 3
+# to 7, 3e-6 from 7 to 15): a ladder compares a rung's optimum with the rung below's on the
+# rung's own grid.
 SOLVER_SAMPLES_PER_STEP = 2 * SOLVER_SAMPLES_PER_HALF
 CHECK_SAMPLES_PER_STEP = 2 * CHECK_SAMPLES_PER_HALF
 MIN_SOLVER_SAMPLES = 6
