@@ -124,3 +124,20 @@ def test_trailing_foot_lift_is_the_stance_foot_velocity(model):
     qd_plus, _ = model.impact(q, qd)
     velocity = complex_step_velocity(model, q, qd_plus, ["stance_heel", "stance_toe"])[..., 1]
     np.testing.assert_allclose(trailing_foot_lift(model, q, qd_plus), velocity, atol=1e-12)
+
+
+def test_both_feet_impact_stops_both_feet_by_impulses_along_their_contacts(model):
+    """Both feet held (the start of double support): A q̇⁺ = 0 for the six rows of both feet
+    and D (q̇⁺ − q̇⁻) = Aᵀ I_R; the one-foot impact leaves the stance foot moving."""
+    from biped.model.impact import both_feet_impact
+
+    q, qd = touchdown_state(model, seed=33)
+    qd_plus, impulse = both_feet_impact(model, q, qd)
+    rows = np.concatenate([model.contact_jacobian(q, f) for f in ("stance", "swing")], axis=-2)
+    np.testing.assert_allclose((rows @ qd_plus[..., None])[..., 0], 0.0, atol=1e-12)
+    lhs = (model.mass_matrix(q) @ (qd_plus - qd)[..., None])[..., 0]
+    rhs = (np.swapaxes(rows, -1, -2) @ impulse[..., None])[..., 0]
+    np.testing.assert_allclose(lhs, rhs, atol=1e-10)
+    one_foot, _ = model.impact(q, qd)
+    stance = (model.contact_jacobian(q, "stance") @ one_foot[..., None])[..., 0]
+    assert np.max(np.abs(stance)) > 1e-3

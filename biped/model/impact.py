@@ -31,11 +31,32 @@ def flat_foot_impact(model, q, qd_minus, foot: str = "swing"):
     """
     q = np.asarray(q, dtype=float)
     qd_minus = np.asarray(qd_minus, dtype=float)
-    mass = model.mass_matrix(q)
-    jac = model.contact_jacobian(q, foot)
+    return _stopped(model.mass_matrix(q), model.contact_jacobian(q, foot), qd_minus)
+
+
+def both_feet_impact(model, q, qd_minus):
+    """Impact of the swing foot landing flat while the stance foot stays flat on the ground:
+    the start of a double support phase (``biped.model.double_support``).
+
+    Eqs. (21)-(24) with A the six rows of both feet's contact Jacobians (stance first): both
+    feet are at rest after it, A q̇⁺ = 0, and I_R (..., 6) holds the impulse of the ground on
+    the stance foot, then on the swing foot [N·s, N·s, N·m·s]. The stance foot stays on the
+    ground only if the ground pushes it, I_R,z >= 0 (index 1): its callers check that.
+    Returns q̇⁺ (..., 9) and I_R (..., 6).
+    """
+    q = np.asarray(q, dtype=float)
+    qd_minus = np.asarray(qd_minus, dtype=float)
+    jac = np.concatenate(
+        [model.contact_jacobian(q, "stance"), model.contact_jacobian(q, "swing")], axis=-2
+    )
+    return _stopped(model.mass_matrix(q), jac, qd_minus)
+
+
+def _stopped(mass, jac, qd_minus):
+    """q̇⁺ and I_R of eqs. (23)-(24) for the mass matrix D and the contact rows A."""
     # D⁻¹ Aᵀ through one factorisation of the symmetric positive-definite D.
     d_inv_jt = np.linalg.solve(mass, np.swapaxes(jac, -1, -2))
-    gram = jac @ d_inv_jt  # A D⁻¹ Aᵀ (..., 3, 3)
+    gram = jac @ d_inv_jt  # A D⁻¹ Aᵀ (..., k, k), k contact rows
     approach = (jac @ qd_minus[..., None])[..., 0]  # A q̇⁻
     impulse = -np.linalg.solve(gram, approach[..., None])[..., 0]
     qd_plus = qd_minus + (d_inv_jt @ impulse[..., None])[..., 0]
