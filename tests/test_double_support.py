@@ -169,3 +169,19 @@ def test_a_state_off_the_chain_or_a_null_duration_is_refused(model, phase):
     profiled = dataclasses.replace(biped.Robot.paper(), k1=0.5)
     with pytest.raises(BipedError, match="profiled"):
         ds.check_model(biped.Biped(profiled, "rolling"))
+
+
+def test_a_given_swing_wrench_fixes_the_rest_of_the_split(model, phase):
+    """``split_with_swing_wrench`` solves eq. (19') for any front-foot wrench, and with the
+    least-squared split's front wrench it gives that split back."""
+    q, qd, qdd = states(model, phase, np.linspace(0.0, phase.duration, 5))
+    torques, stance, swing = ds.split_load(model, q, qd, qdd)
+    again, rear = ds.split_with_swing_wrench(model, q, qd, qdd, swing)
+    np.testing.assert_allclose(again, torques, atol=1e-8)
+    np.testing.assert_allclose(rear, stance, atol=1e-8)
+    other = swing + np.array([30.0, -200.0, 4.0])
+    torques, stance = ds.split_with_swing_wrench(model, q, qd, qdd, other)
+    rows = ds.contact_rows(model, q)
+    wrenches = np.concatenate([stance, other], -1)
+    lhs = torques @ JOINT_MATRIX + (np.swapaxes(rows, -1, -2) @ wrenches[..., None])[..., 0]
+    np.testing.assert_allclose(lhs, model.generalized_forces(q, qd, qdd), atol=1e-9)

@@ -26,17 +26,22 @@ Load split (the actuation redundancy). Eq. (19) with both feet held,
     D q̈ + H + Q = B Γ + A_sᵀ F_s + A_wᵀ F_w                                   (19')
 
 is nine equations in twelve unknowns: the six motor torques Γ and the two ground wrenches
-F_s, F_w = [Fx, Fz, Cy] (moment about each foot's own ankle). The stated rule: at each instant
+F_s, F_w = [Fx, Fz, Cy] (moment about each foot's own ankle). A first rule: at each instant
 the split of least squared torque, min ΓᵀΓ subject to (19'), the integrand of the sthenic
-criterion (eq. 30). Its optimality conditions (a linear system, ``split_load``):
+criterion (eq. 30), unconstrained. Its optimality conditions (a linear system, ``split_load``):
 
     Γ = Bᵀλ,   A_s λ = 0 and A_w λ = 0 stacked (Aλ = 0),   B Γ + Aᵀ F = D q̈ + H + Q
 
-The rule does not look at the feet's constraints; they are checked on its result
-(``foot_margins``): each foot's normal force Fz > 0, its friction cone |Fx| <= μ Fz, and its
-ZMP inside its sole, x_ZMP = (Cy − h_p Fx) / Fz from its ankle (a flat foot at rest whose
-centre of mass lies below its ankle: its moment balance gives Cy = its ankle's torque, Γ1 for
-the stance foot, Γ6 for the swing foot).
+That rule does not look at the feet's constraints, and it pulls on the ground: at the
+landing of a walking step it asks the rear foot for −570 N (internal forces between the feet
+cost no torque). The split of the optimizer is therefore the other stated rule: the swing
+(front) foot's wrench is free at each instant (``split_with_swing_wrench``: the three numbers
+of the redundancy, the rest from eq. (19')) and the optimizer chooses it, so that with the
+sthenic criterion each instant's split is the least squared torque *within* the feet's
+constraints (``foot_margins``): each foot's normal force Fz > 0, its friction cone
+|Fx| <= μ Fz, and its ZMP inside its sole, x_ZMP = (Cy − h_p Fx) / Fz from its ankle (a flat
+foot at rest whose centre of mass lies below its ankle: its moment balance gives Cy = its
+ankle's torque, Γ1 for the stance foot, Γ6 for the swing foot).
 
 Only the knees of circles (revolute, and rolling on two circles): a profiled rolling knee
 (``Robot.profiled``) is refused.
@@ -156,6 +161,39 @@ def split_load(model: Biped, q, qd, qdd):
     rhs[..., 12:] = tau
     solution = np.linalg.solve(kkt, rhs[..., None])[..., 0]
     return solution[..., :6], solution[..., 6:9], solution[..., 9:12]
+
+
+# The rows q1..q5 of B = JOINT_MATRIXᵀ: the five joints Γ1..Γ5 (a triangular, invertible
+# 5 x 5 block) and the swing ankle's Γ6.
+JOINTS5 = [Q1, Q2, Q3, Q4, Q5]
+B5_SWING = JOINT_MATRIX.T[JOINTS5, 5]
+B5_INVERSE = np.linalg.inv(JOINT_MATRIX.T[JOINTS5, :5])
+
+
+def split_with_swing_wrench(model: Biped, q, qd, qdd, swing_wrench):
+    """Motor torques Γ (..., 6) [N·m] and the stance foot's wrench (..., 3) [N, N, N·m] when
+    the swing (front) foot's wrench is ``swing_wrench`` (..., 3): the redundancy's three
+    numbers given, eq. (19') fixes the rest.
+
+    The swing foot's angle row gives Γ6 = C_y,w − τ_qp2, the hip rows F_s = τ_H − F_w (x, z),
+    the rows q1..q5 the five other torques (a constant invertible 5 x 5 block of B), the
+    stance foot's angle row C_y,s = τ_qp1 + Γ1. The optimizer chooses the swing foot's wrench
+    (``biped.optimization.two_phase``); ``split_load`` is this split at the least squared
+    torque.
+    """
+    check_model(model)
+    tau = model.generalized_forces(q, qd, qdd)
+    rows = contact_rows(model, q)
+    front = np.asarray(swing_wrench, dtype=float)
+    g6 = front[..., 2] - tau[..., QP2]
+    rear_xz = tau[..., [XH, ZH]] - front[..., :2]
+    contact = np.einsum("...ij,...i->...j", rows[..., 0:2, JOINTS5], rear_xz) + np.einsum(
+        "...ij,...i->...j", rows[..., 3:5, JOINTS5], front[..., :2]
+    )
+    rest = tau[..., JOINTS5] - contact - B5_SWING * g6[..., None]
+    torques = np.concatenate([rest @ B5_INVERSE.T, g6[..., None]], axis=-1)
+    stance = np.concatenate([rear_xz, (tau[..., QP1] + torques[..., 0])[..., None]], axis=-1)
+    return torques, stance
 
 
 def zmp(wrench, ankle_height: float):

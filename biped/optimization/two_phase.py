@@ -1,0 +1,637 @@
+"""The gait of two phases, single then double support, as one NLP (``biped.model.two_phase``).
+
+What is built: the sthenic criterion over both phases, the paper's single support with the
+impact landing that holds both feet, the double support phase of ``biped.model.double_support``
+(its load split: least squared torque), IPOPT on a CasADi graph with exact derivatives, started
+from the single-support optimum of the same problem. What is not: the energy and electrical
+criteria, the zero-speed landing, richer spline families, the walkable constraints and the
+actuator limits, a knee design (``TwoPhaseProblem`` refuses them by name).
+
+Variables z (``variable_names``): the single-support problem's 21 (``problem.VARIABLES``: the
+knee bends and the trunk at lift-off, the rates before the landing, the accelerations, T),
+then
+
+    lift_rate_x_hip, _z_hip, _trunk   the hip's and the trunk's rates at lift-off [m/s, rad/s]
+    landing_rear_bend, _front_bend    the knee bends at landing [rad] (hip by eq. * of
+                                      ``biped.optimization.problem``, the ankles at 0 and S)
+    landing_trunk                     [rad]
+    double_support                    T_ds [s]
+    rear_bend_j, front_bend_j         the knee bends at the double support's interior samples
+                                      j = 1 .. n − 1 [rad], each tied to the hip's cubic by an
+                                      equality: reach²(bend) = |hip − ankle|²
+
+(the legs' angles then follow by forward geometry, no inverse model in the graph). The step
+length is S = V (T + T_ds) and the double support's share T_ds / (T + T_ds) is held in the
+problem's range by two linear constraints.
+
+Criterion: C_Γ = (∫ ΓᵀΓ dt over both phases) / S [N²·m·s], Simpson's rule on each phase.
+Constraints: the single support's as the single-support problem's (``StepGraph``); in double
+support at each sample each foot's normal force, friction cone (μ = ``FOOT_FRICTION``) and ZMP
+in its sole with the single support's margins, both knees' bends >= δ; the rear foot pushed at
+the landing's impact (I_z >= 0); the hip at landing at least ``MIN_HIP_HEIGHT`` above the
+ankles.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from biped.errors import BipedError, UnreachableError
+from biped.model import double_support
+from biped.model import two_phase as two_phase_model
+from biped.model.criteria import CONSTRAINT_SCALES, MARGINS, Safety
+from biped.model.double_support import B5_INVERSE, B5_SWING, JOINTS5
+from biped.model.dynamics import Biped
+from biped.model.gait import hermite
+from biped.model.kinematics import LEG_SWAP, NQ, Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH
+from biped.model.robot import FOOT_FRICTION
+from biped.optimization.problem import (
+    MIN_HIP_HEIGHT,
+    RATE_BOUND,
+    SOLVER_SAMPLES_PER_HALF,
+    VARIABLES,
+    GaitProblem,
+    bounds,
+    index,
+    scales,
+)
+from biped.optimization.solver import IPOPT_OPTIONS
+from biped.optimization.symbolic import (
+    StepGraph,
+    _Constants,
+    _leg_angles,
+    _mass_matrix,
+    _reach_squared,
+    _stance_state,
+)
+from biped.runtime.interrupts import kept_interrupts
+
+N_SINGLE = len(VARIABLES)  # 21: the single-support problem's variables come first
+# Samples of the double support phase (even: Simpson's rule), each end included.
+DOUBLE_SUPPORT_SAMPLES = 10
+EXTRAS = (
+    "lift_rate_x_hip",
+    "lift_rate_z_hip",
+    "lift_rate_trunk",
+    "landing_rear_bend",
+    "landing_front_bend",
+    "landing_trunk",
+    "double_support",
+)
+# The front foot's wrench at each double support sample, the redundancy's three numbers
+# (``biped.model.double_support.split_with_swing_wrench``) [N, N, N·m], their scales and bounds.
+WRENCH = ("fx", "fz", "cy")
+_WRENCH_SCALES = (100.0, 100.0, 10.0)
+_WRENCH_BOUNDS = ((-5000.0, 5000.0), (0.0, 5000.0), (-500.0, 500.0))
+# Scales of the extras in the solver's space and their bounds [m/s, rad/s, rad, s].
+_EXTRA_SCALES = {"rate": 0.3, "bend": 0.03, "landing_trunk": 0.03, "double_support": 0.05}
+_BEND_BOUNDS = (0.0, 1.5)
+_TRUNK_BOUNDS = (-0.6, 0.6)
+_DWELL_BOUNDS = (0.0, 3.0)
+# Scales of the double support's constraints: the landing's impulse [N·s], the closure [m²].
+IMPULSE_SCALE = 10.0
+MOMENT_SCALE = 100.0  # [N·m] the ZMP's constraints times Fz
+# [N²·m·s] The criterion is divided by this in the solver: the two-phase optima lie near
+# 1000, where IPOPT's tolerance on the dual infeasibility, 1e-9, is below the rounding of
+# the derivatives (it ended at its acceptable level without the division).
+OBJECTIVE_SCALE = 1000.0
+# [rad] Least knee bend at lift-off of the start (``start_from_single``): the single-support
+# optimum's legs are almost straight there (0.02 rad), where the double support's hip has no
+# room between the two legs' reaches.
+START_BEND = 0.2
+CLOSURE_SCALE = 0.01
+# The free coordinates of the closed chain and the six others (``biped.model.double_support``).
+FREE = [XH, ZH, Q5]
+BOUND = [QP1, QP2, Q1, Q2, Q3, Q4]
+
+
+def variable_names(samples: int = DOUBLE_SUPPORT_SAMPLES) -> tuple:
+    """The two-phase NLP's variables, in order (module docstring)."""
+    interior = tuple(f"{leg}_bend_{j}" for j in range(1, samples) for leg in ("rear", "front"))
+    wrenches = tuple(f"front_{part}_{j}" for j in range(samples + 1) for part in WRENCH)
+    return VARIABLES + EXTRAS + interior + wrenches
+
+
+def parse_share(text: str) -> tuple[float, float]:
+    """(least, largest) share of the step in double support from ``"LOW:HIGH"`` or one number
+    (both ends), each in [0, 0.5) with LOW <= HIGH and HIGH > 0."""
+    parts = text.split(":")
+    try:
+        values = [float(part) for part in parts]
+    except ValueError:
+        values = []
+    if len(values) == 1:
+        values = values * 2
+    if len(values) != 2 or not all(0.0 <= v < 0.5 for v in values) or values[0] > values[1]:
+        raise BipedError(
+            f"double support share = {text!r}: allowed LOW:HIGH with 0 <= LOW <= HIGH < 0.5 "
+            "(a share of the step), or one such number"
+        )
+    if values[1] == 0.0:
+        raise BipedError(f"double support share = {text!r}: allowed a largest share above 0")
+    return values[0], values[1]
+
+
+@dataclass(frozen=True)
+class TwoPhaseProblem:
+    """The best two-phase gait of ``single``'s robot, knee and speed (module docstring).
+
+    Attributes:
+        single: the single-support problem (its criterion, safety, samples).
+        share: (least, largest) T_ds / (T + T_ds) [-].
+        samples: samples of the double support phase (even).
+    """
+
+    single: GaitProblem
+    share: tuple
+    samples: int = DOUBLE_SUPPORT_SAMPLES
+
+    def __post_init__(self):
+        p = self.single
+        refused = []
+        if p.criterion != "sthenic":
+            refused.append(f"criterion = {p.criterion!r} (allowed 'sthenic')")
+        if p.knots != 1:
+            refused.append(f"knots = {p.knots} (allowed 1)")
+        if p.safety.walkable or p.safety.actuator_limits:
+            refused.append("walkable constraints or actuator limits (allowed none)")
+        if p.model.robot.profiled:
+            refused.append("a profiled knee (allowed circles)")
+        if p.samples_per_half != SOLVER_SAMPLES_PER_HALF:
+            refused.append(f"samples_per_half = {p.samples_per_half}")
+        if refused:
+            raise BipedError("double support is not built for " + "; ".join(refused))
+        low, high = self.share
+        if not (0.0 <= low <= high < 0.5 and high > 0.0):
+            raise BipedError(
+                f"double support share = {self.share!r}: allowed 0 <= low <= high < 0.5"
+            )
+        if self.samples < 2 or self.samples % 2:
+            raise BipedError(f"samples = {self.samples!r}: allowed an even number >= 2")
+
+
+class TwoPhaseGraph(StepGraph):
+    """The graph of ``StepGraph`` for the single support phase, its start and its landing
+    replaced by the two-phase step's, and the double support phase's samples added.
+
+    Attributes beyond ``StepGraph``'s (SX expressions of z, speed): sthenic (both phases),
+    ds_inequalities (>= 0 when met), ds_equalities (= 0), dwell T_ds, ds_torques (6, n + 1),
+    ds_stance_wrench, ds_swing_wrench (3, n + 1), ds_q (9, n + 1), landing_impulse (6,).
+    """
+
+    def __init__(self, model: Biped, safety: Safety, samples: int):
+        self.model, self.samples_per_half = model, SOLVER_SAMPLES_PER_HALF
+        self.safety, self.design, self.knots = safety, False, 1
+        self.motors, self.profile, self.radii = False, False, None
+        self.ds_samples = samples
+        c = _Constants(model)
+        self._contacts = _contact_functions(c)
+        self.z = ca.SX.sym("z", len(variable_names(samples)))
+        self.speed = ca.SX.sym("speed")
+        self.period = self.z[index("period")]
+        self.dwell = self._extra("double_support")
+        self.length = self.speed * (self.period + self.dwell)
+        start_angles = self._start_posture(c)
+        end_angles, end_rates, start_rates = self._landing(c, start_angles)
+        coefficients = self._splines(start_angles, start_rates, end_angles, end_rates)
+        self._samples(c, coefficients)
+        # Structural zeros (the lift-off's foot rates) would not substitute for the symbols.
+        self.head = ca.densify(self.head)
+        self._flat_quantities = ca.densify(self._flat_quantities)
+        self.on_symbols = self._criteria_and_constraints()
+        for name, value in self.on_symbols.items():
+            setattr(self, name, self.flat(value))
+        single = self.flat(self.weights @ self.rows("squared").T) * self.period
+        self._double_support(c)
+        self.sthenic = (single + self.ds_squared) / self.length
+
+    def _extra(self, name: str):
+        """The variable ``name`` of ``EXTRAS``."""
+        return self.z[N_SINGLE + EXTRAS.index(name)]
+
+    def _landing(self, c, start_angles):
+        """The landing posture from its bends, the rates before it, the impact holding both
+        feet, and the start rates of the single support (the chain's at lift-off)."""
+        z, length = self.z, self.length
+        bend_r, bend_f = self._extra("landing_rear_bend"), self._extra("landing_front_bend")
+        x, lift, self.landing_height = _hip_between(c, bend_r, bend_f, length)
+        q1, q2 = _leg_angles(c, bend_r, ca.vertcat(x, lift))
+        q4, q3 = _leg_angles(c, bend_f, ca.vertcat(x - length, lift))
+        end_angles = ca.vertcat(0.0, q1, q2, q3, q4, self._extra("landing_trunk"))
+        end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
+        q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
+        rows = self._contacts["rows"](q_end)
+        mass = _mass_matrix(c, q_end)
+        d_inv_rt = ca.solve(mass, rows.T)
+        impulse = -ca.solve(rows @ d_inv_rt, rows @ qd_end)
+        self.landing_impulse = impulse
+        self.impulse = impulse[3:]  # the landing foot's (``StepGraph``'s name)
+        self.touchdown = (rows @ qd_end)[3:5]
+        self.landing = (q_end, qd_end + d_inv_rt @ impulse)
+        # Lift-off, in the single support's labels: both feet at rest, ṡ given.
+        q_start, *_ = _stance_state(c, start_angles, ca.SX.zeros(6), ca.SX.zeros(6))
+        lift_rates = ca.vertcat(
+            *[self._extra(f"lift_rate_{a}") for a in ("x_hip", "z_hip", "trunk")]
+        )
+        qd_start = _chain_rates(self._contacts["rows"](q_start), lift_rates)
+        start_rates = qd_start[1:7]
+        # The same state in the double support's labels (legs swapped back, hip S ahead).
+        q_lift = ca.vertcat(*[q_start[LEG_SWAP[i]] for i in range(NQ)])
+        q_lift[XH] = q_lift[XH] + length
+        qd_lift = ca.vertcat(*[qd_start[LEG_SWAP[i]] for i in range(NQ)])
+        self.lift = (q_lift, qd_lift)
+        return end_angles, end_rates, start_rates
+
+    def _double_support(self, c):
+        """The phase's samples: the hip's and trunk's cubics, the legs from each sample's
+        bends, the chain's rates and accelerations, the load split; its criterion part and
+        constraints."""
+        n, dwell, length = self.ds_samples, self.dwell, self.length
+        (q0, qd0), (q1, qd1) = self.landing, self.lift
+        cubic = hermite(dwell, q0[FREE], qd0[FREE], q1[FREE], qd1[FREE])
+        names = variable_names(self.ds_samples)
+        bends = [(self._extra("landing_rear_bend"), self._extra("landing_front_bend"))]
+        for j in range(1, n):
+            bends.append(
+                (self.z[names.index(f"rear_bend_{j}")], self.z[names.index(f"front_bend_{j}")])
+            )
+        start_bend = self.z[index("stance_knee_bend")]  # the front leg at lift-off
+        swing_bend = self.z[index("swing_knee_bend")]  # the rear leg at lift-off
+        bends.append((swing_bend, start_bend))
+        hp = c.hp
+        weights = _simpson(n)
+        squared, inequalities, equalities = 0, [], []
+        self.ds_torques, self.ds_stance_wrench, self.ds_swing_wrench, self.ds_q = [], [], [], []
+        friction = FOOT_FRICTION
+        robot = self.model.robot
+        for j in range(n + 1):
+            t = dwell * j / n
+            s = sum(cubic[k] * t**k for k in range(4))
+            sd = sum(k * cubic[k] * t ** (k - 1) for k in range(1, 4))
+            sdd = 2 * cubic[2] + 6 * cubic[3] * t
+            rear, front = bends[j]
+            hip_rear = ca.vertcat(s[0], s[1] - hp)
+            hip_front = ca.vertcat(s[0] - length, s[1] - hp)
+            if 0 < j < n:
+                for bend, hip in ((rear, hip_rear), (front, hip_front)):
+                    equalities.append((_reach_squared(c, bend) - ca.sumsqr(hip)) / CLOSURE_SCALE)
+            a1, a2 = _leg_angles(c, rear, hip_rear)
+            a4, a3 = _leg_angles(c, front, hip_front)
+            q = ca.vertcat(0.0, 0.0, a1, a2, a3, a4, s[2], s[0], s[1])
+            rows = self._contacts["rows"](q)
+            qd = _chain_rates(rows, sd)
+            qdd = _chain_rates(rows, sdd, self._contacts["bias"](q, qd))
+            swing = ca.vertcat(*[self.z[names.index(f"front_{part}_{j}")] for part in WRENCH])
+            torques, stance = _split(_generalized_forces(c, q, qd, qdd), rows, swing)
+            squared = squared + weights[j] * ca.sumsqr(torques)
+            for wrench in (stance, swing):
+                margins = _foot_margins(robot, wrench, friction, self.safety.zmp_margin)
+                scale = [CONSTRAINT_SCALES[0]] * 3 + [MOMENT_SCALE] * 2
+                floor = [MARGINS[0]] * 3 + [MARGINS[1] * wrench[1]] * 2
+                inequalities += [(m - f) / k for m, f, k in zip(margins, floor, scale, strict=True)]
+            knee = MARGINS[3]
+            inequalities += [rear - knee - self.safety.knee_bend, front - knee]
+            self.ds_torques.append(torques)
+            self.ds_stance_wrench.append(stance)
+            self.ds_swing_wrench.append(swing)
+            self.ds_q.append(q)
+        self.ds_squared = dwell * squared
+        inequalities.append(self.landing_impulse[1] / IMPULSE_SCALE)  # rear foot pushed
+        inequalities.append(self.landing_height)
+        self.ds_inequalities = ca.vertcat(*inequalities)
+        self.ds_equalities = ca.vertcat(*equalities)
+        for name in ("ds_torques", "ds_stance_wrench", "ds_swing_wrench", "ds_q"):
+            setattr(self, name, ca.horzcat(*getattr(self, name)))
+
+
+def _hip_between(c, bend_rear, bend_front, length):
+    """Eq. (*) with the rear ankle at 0 and the front one at S: the hip (x, z − h_p) and the
+    hip-height constraint (>= 0)."""
+    d_r2, d_f2 = _reach_squared(c, bend_rear), _reach_squared(c, bend_front)
+    x = (d_r2 - d_f2 + length**2) / (2 * length)
+    height2 = d_r2 - x**2
+    lift = ca.sqrt(ca.fmax(height2, 1e-6))
+    return x, lift, (height2 - MIN_HIP_HEIGHT**2) / MIN_HIP_HEIGHT**2
+
+
+def _contact_functions(c) -> dict:
+    """A (6, 9) of both feet (stance rows, then swing) and the bias H_c (6,) of
+    A q̈ + H_c = 0, as CasADi functions of q (and q̇)."""
+    q, qd = ca.SX.sym("q", NQ), ca.SX.sym("qd", NQ)
+    phi = c.phi @ q[:7]
+    s, co = ca.sin(phi), ca.cos(phi)
+    places = []
+    for foot, angle in (("stance", QP1), ("swing", QP2)):
+        a, b = c.point(f"{foot}_ankle")
+        x = q[XH] + ca.dot(s, a) + ca.dot(co, b)
+        z = q[ZH] - ca.dot(co, a) + ca.dot(s, b)
+        places += [x, z, q[angle]]
+    places = ca.vertcat(*places)
+    rows = ca.jacobian(places, q)
+    bias = ca.jacobian(rows @ qd, q) @ qd
+    return {
+        "rows": ca.Function("contact_rows", [q], [rows]),
+        "bias": ca.Function("contact_bias", [q, qd], [bias]),
+    }
+
+
+def _chain_rates(rows, free, bias=None):
+    """q̇ (or q̈ with ``bias``) (9,) of the closed chain from ṡ (s̈) (3,): A x = −bias."""
+    bound, given = rows[:, BOUND], rows[:, FREE]
+    right = given @ free + (bias if bias is not None else 0)
+    solved = -ca.solve(bound, right)
+    x = ca.SX.zeros(NQ)
+    for i, k in enumerate(BOUND):
+        x[k] = solved[i]
+    for i, k in enumerate(FREE):
+        x[k] = free[i]
+    return x
+
+
+def _generalized_forces(c, q, qd, qdd):
+    """D q̈ + H + Q (9,) (``Biped.generalized_forces``)."""
+    phi, phid, phidd = c.phi @ q[:7], c.phi @ qd[:7], c.phi @ qdd[:7]
+    s, co = ca.sin(phi), ca.cos(phi)
+    rate2 = phid * phid
+    ax = co * phidd - s * rate2
+    az = s * phidd + co * rate2
+    hip_x, hip_z = qdd[XH], qdd[ZH] + c.gravity
+    tau_phi = co * (c.w @ ax + c.g * hip_x) + s * (c.w @ az + c.g * hip_z) + c.inertia * phidd
+    return ca.vertcat(
+        c.phi.T @ tau_phi, c.mass * hip_x + ca.dot(ax, c.g), c.mass * hip_z + ca.dot(az, c.g)
+    )
+
+
+def _split(tau, rows, swing):
+    """Γ (6,) and the stance foot's wrench (3,) given the swing foot's (3,)
+    (``biped.model.double_support.split_with_swing_wrench``, on expressions)."""
+    g6 = swing[2] - tau[QP2]
+    rear_xz = ca.vertcat(tau[XH], tau[ZH]) - swing[:2]
+    contact = rows[0:2, JOINTS5].T @ rear_xz + rows[3:5, JOINTS5].T @ swing[:2]
+    rest = ca.vertcat(*[tau[k] for k in JOINTS5]) - contact - ca.DM(B5_SWING) * g6
+    torques = ca.vertcat(ca.DM(B5_INVERSE) @ rest, g6)
+    return torques, ca.vertcat(rear_xz, tau[QP1] + torques[0])
+
+
+def _foot_margins(robot, wrench, friction, zmp_margin):
+    """``biped.model.double_support.foot_margins`` on expressions, the ZMP's two multiplied by
+    Fz (> 0 by the first): C_y − h_p Fx + (l_p − margin) Fz and (L_p − l_p − margin) Fz −
+    C_y + h_p Fx [N·m], smooth where Fz vanishes."""
+    fx, fz, cy = wrench[0], wrench[1], wrench[2]
+    moment = cy - robot.ankle_height * fx  # x_ZMP Fz
+    return [
+        fz,
+        friction * fz - fx,
+        friction * fz + fx,
+        moment + (robot.foot_heel - zmp_margin) * fz,
+        (robot.foot_length - robot.foot_heel - zmp_margin) * fz - moment,
+    ]
+
+
+def _simpson(n: int) -> np.ndarray:
+    """Simpson's weights on n + 1 equally spaced samples of [0, 1] (n even)."""
+    w = np.ones(n + 1)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    return w / (3.0 * n)
+
+
+@dataclass(frozen=True)
+class TwoPhaseOptimum:
+    """IPOPT's answer for a ``TwoPhaseProblem``.
+
+    Attributes:
+        variables: z (``variable_names``) at the end.
+        value: C_Γ over both phases [N²·m·s] on the solver's samples.
+        status: IPOPT's return status (``Solve_Succeeded`` when converged).
+        iterations: IPOPT's iterations.
+        constraint_violation: largest violation of a constraint or bound at the end, in the
+            solver's scaled units.
+        seconds: the solve's time [s], the graph's building not counted.
+        setup_seconds: the graph's and IPOPT's building [s].
+        single_value: the single-support optimum's C_Γ it started from [N²·m·s].
+    """
+
+    variables: np.ndarray
+    value: float
+    status: str
+    iterations: int
+    constraint_violation: float
+    seconds: float
+    setup_seconds: float
+    single_value: float
+
+    @property
+    def converged(self) -> bool:
+        return self.status == "Solve_Succeeded"
+
+    @property
+    def share(self) -> float:
+        """T_ds / (T + T_ds) [-]."""
+        period = self.variables[index("period")]
+        dwell = self.variables[N_SINGLE + EXTRAS.index("double_support")]
+        return float(dwell / (period + dwell))
+
+
+class TwoPhaseSolver:
+    """IPOPT on ``TwoPhaseGraph``: the objective, the single support's constraints and hip
+    height, the double support's inequalities and the share's two bounds (>= 0), the
+    closure's equalities (= 0); CasADi's exact derivatives of the whole graph."""
+
+    def __init__(self, problem: TwoPhaseProblem):
+        began = time.perf_counter()
+        self.problem = problem
+        with kept_interrupts():
+            graph = self.graph = TwoPhaseGraph(
+                problem.single.model, problem.single.safety, problem.samples
+            )
+            low, high = problem.share
+            total = graph.period + graph.dwell
+            share = ca.vertcat(graph.dwell - low * total, high * total - graph.dwell)
+            inequalities = ca.vertcat(
+                graph.constraints, graph.hip_height, graph.ds_inequalities, share
+            )
+            self.n_inequalities = inequalities.shape[0]
+            g = ca.vertcat(inequalities, graph.ds_equalities)
+            self.scales = _scales(problem.samples)
+            y = ca.SX.sym("y", len(self.scales))
+            objective = graph.sthenic / OBJECTIVE_SCALE
+            scaled = ca.substitute([objective, g], [graph.z], [ca.DM(self.scales) * y])
+            options = {f"ipopt.{k}": v for k, v in IPOPT_OPTIONS.items()}
+            self.nlp = ca.nlpsol(
+                "two_phase",
+                "ipopt",
+                {"x": y, "p": graph.speed, "f": scaled[0], "g": scaled[1]},
+                {**options, "print_time": False},
+            )
+            self.evaluate = ca.Function(
+                "two_phase_step",
+                [graph.z, graph.speed],
+                [graph.sthenic, g, graph.ds_torques, graph.ds_stance_wrench,
+                 graph.ds_swing_wrench, graph.ds_q, graph.landing_impulse],
+            )  # fmt: skip
+        self.lower, self.upper = _bounds(problem.samples)
+        self.setup_seconds = time.perf_counter() - began
+
+    def solve(self, start, single_value: float) -> TwoPhaseOptimum:
+        """IPOPT from the variables ``start``, clipped into the bounds."""
+        began = time.perf_counter()
+        z0 = np.clip(np.asarray(start, dtype=float), self.lower, self.upper)
+        n_eq = self.graph.ds_equalities.shape[0]
+        lbg = np.concatenate([np.zeros(self.n_inequalities), np.zeros(n_eq)])
+        ubg = np.concatenate([np.full(self.n_inequalities, np.inf), np.zeros(n_eq)])
+        with kept_interrupts():
+            answer = self.nlp(
+                x0=z0 / self.scales,
+                p=self.problem.single.speed,
+                lbx=self.lower / self.scales,
+                ubx=self.upper / self.scales,
+                lbg=lbg,
+                ubg=ubg,
+            )
+        stats = self.nlp.stats()
+        z = np.asarray(answer["x"]).ravel() * self.scales
+        g = np.asarray(answer["g"]).ravel()
+        violation = max(
+            float(np.max(np.maximum(lbg - g, 0.0))),
+            float(np.max(np.maximum(g - ubg, 0.0))),
+            float(np.max(np.maximum(self.lower - z, 0.0) / self.scales)),
+            float(np.max(np.maximum(z - self.upper, 0.0) / self.scales)),
+        )
+        return TwoPhaseOptimum(
+            variables=z,
+            value=float(answer["f"]) * OBJECTIVE_SCALE,
+            status=str(stats["return_status"]),
+            iterations=int(stats["iter_count"]),
+            constraint_violation=violation,
+            seconds=time.perf_counter() - began,
+            setup_seconds=self.setup_seconds,
+            single_value=single_value,
+        )
+
+
+def _scales(samples: int) -> np.ndarray:
+    extra = [_EXTRA_SCALES["rate"]] * 3 + [_EXTRA_SCALES["bend"]] * 2
+    extra += [_EXTRA_SCALES["landing_trunk"], _EXTRA_SCALES["double_support"]]
+    interior = [_EXTRA_SCALES["bend"]] * (2 * (samples - 1))
+    wrenches = list(_WRENCH_SCALES) * (samples + 1)
+    return np.concatenate([scales(1), extra, interior, wrenches])
+
+
+def _bounds(samples: int) -> tuple[np.ndarray, np.ndarray]:
+    lower, upper = bounds(1)
+    extra = [(-RATE_BOUND, RATE_BOUND)] * 3 + [_BEND_BOUNDS] * 2 + [_TRUNK_BOUNDS, _DWELL_BOUNDS]
+    extra += [_BEND_BOUNDS] * (2 * (samples - 1)) + list(_WRENCH_BOUNDS) * (samples + 1)
+    low, high = np.array(extra).T
+    return np.concatenate([lower, low]), np.concatenate([upper, high])
+
+
+def start_from_single(problem: TwoPhaseProblem, variables) -> np.ndarray:
+    """Two-phase variables from the single-support optimum's ``variables`` (21): its lift-off
+    posture (knee bends, trunk), rates before the landing, accelerations and T; T_ds at the
+    middle of the share's range; the hip moving at V through the double support (lift-off
+    rates (V, 0, 0), the landing's hip V T_ds behind the lift-off's, its knee bends from the
+    inverse geometric model) so that the phase's cubics start near a uniform motion; the
+    interior bends of the closed chain (``closed_bends``)."""
+    single = problem.single
+    model, speed = single.model, single.speed
+    z = np.array(variables, dtype=float)
+    for name in ("stance_knee_bend", "swing_knee_bend"):  # room for the hip's cubic
+        z[index(name)] = max(z[index(name)], START_BEND)
+    period = z[index("period")]
+    share = problem.share[1]
+    dwell = share * period / (1.0 - share)
+    length = speed * (period + dwell)
+    stance_bend, swing_bend = z[index("stance_knee_bend")], z[index("swing_knee_bend")]
+    # Lift-off in the double support's labels (rear ankle at 0, front at S): eq. (*).
+    d_r2, d_f2 = model.reach_squared(swing_bend), model.reach_squared(stance_bend)
+    x = (d_r2 - d_f2 + length**2) / (2 * length)
+    back = x - speed * dwell
+    longest = np.sqrt(model.reach_squared(START_BEND))  # both legs bent at landing
+    height = min(np.sqrt(d_r2 - x**2), np.sqrt(longest**2 - max(back, length - back) ** 2))
+    hip = np.array([back, height])
+    rear = model.leg_angles(hip)
+    front = model.leg_angles(hip - np.array([length, 0.0]))
+    extras = [speed, 0.0, 0.0, rear[1] - rear[0], front[1] - front[0], z[index("trunk")], dwell]
+    n = problem.samples
+    guess = np.concatenate([z, extras, np.zeros(2 * (n - 1) + len(WRENCH) * (n + 1))])
+    try:  # the lift-off's rates those after the landing's impact: no jump to bridge
+        step = two_phase_model.build_two_phase(model, speed, to_parameters(problem, guess))
+        guess[N_SINGLE : N_SINGLE + 3] = step.double.start[1][FREE]
+    except UnreachableError:
+        pass
+    guess = closed_bends(problem, guess)
+    try:
+        return shifted_weight(problem, guess)
+    except UnreachableError:
+        return guess
+
+
+def closed_bends(problem: TwoPhaseProblem, variables) -> np.ndarray:
+    """``variables`` with the double support's interior bends those of the closed chain
+    (``biped.model.double_support``: the inverse geometric model at the hip's cubic), which
+    meet the closure's equalities."""
+    z = np.array(variables, dtype=float)
+    model = problem.single.model
+    step = two_phase_model.build_two_phase(model, problem.single.speed, to_parameters(problem, z))
+    try:
+        samples = double_support.sample_phase(model, step.double, problem.samples)
+    except UnreachableError:  # the cubic's hip beyond a leg's reach: the bends of the ends
+        ends = np.array([z[N_SINGLE + 3 : N_SINGLE + 5], z[[index("swing_knee_bend"), 0]]])
+        n = problem.samples
+        between = np.ravel([ends[0] + (ends[1] - ends[0]) * j / n for j in range(1, n)])
+        at = N_SINGLE + len(EXTRAS)
+        z[at : at + between.size] = between
+        return z
+    q = samples.q[1:-1]
+    bends = np.column_stack([q[:, Q2] - q[:, Q1], q[:, Q3] - q[:, Q4]])
+    at = N_SINGLE + len(EXTRAS)
+    z[at : at + bends.size] = bends.ravel()
+    return z
+
+
+def shifted_weight(problem: TwoPhaseProblem, variables) -> np.ndarray:
+    """``variables`` with the front foot's wrench carrying a share of the load growing
+    linearly from 0 at the landing to all of it at lift-off, its ZMP below its ankle: a
+    first guess of the split (the variables' double support phase, its bends closed)."""
+    z = np.array(variables, dtype=float)
+    model = problem.single.model
+    step = two_phase_model.build_two_phase(model, problem.single.speed, to_parameters(problem, z))
+    samples = double_support.sample_phase(model, step.double, problem.samples)
+    tau = model.generalized_forces(samples.q, samples.qd, samples.qdd)
+    share = np.linspace(0.0, 1.0, problem.samples + 1)
+    fx, fz = share * tau[:, XH], share * tau[:, ZH]
+    front = np.column_stack([fx, fz, model.robot.ankle_height * fx])
+    z[-front.size :] = front.ravel()
+    return z
+
+
+def to_parameters(problem: TwoPhaseProblem, variables) -> np.ndarray:
+    """The parameters of ``biped.model.two_phase`` (impact landing) of the variables: the
+    hips at lift-off and landing from the knee bends (eq. *), the rest as they are."""
+    model, speed = problem.single.model, problem.single.speed
+    z = np.asarray(variables, dtype=float)
+    value = dict(zip(variable_names(problem.samples), z, strict=True))
+    period, dwell = value["period"], value["double_support"]
+    length = speed * (period + dwell)
+    hp = model.robot.ankle_height
+
+    def hip(rear_bend, front_bend):  # eq. (*), the rear ankle at 0 and the front at S
+        d_r2, d_f2 = model.reach_squared(rear_bend), model.reach_squared(front_bend)
+        x = (d_r2 - d_f2 + length**2) / (2 * length)
+        return x, hp + np.sqrt(d_r2 - x**2)
+
+    # At lift-off the single support's stance leg is the front one, its ankle at x = 0.
+    x_lift, z_lift = hip(value["swing_knee_bend"], value["stance_knee_bend"])
+    x_land, z_land = hip(value["landing_rear_bend"], value["landing_front_bend"])
+    named = {
+        "x_hip": x_lift - length,
+        "z_hip": z_lift,
+        "landing_x_hip": x_land,
+        "landing_z_hip": z_land,
+        **value,
+    }
+    return np.array([named[name] for name in two_phase_model.parameter_names("impact")])

@@ -1,0 +1,115 @@
+"""The two-phase gait's NLP: its graph is the numeric model, its options are checked."""
+
+import functools
+
+import numpy as np
+import pytest
+
+import biped
+from biped.errors import BipedError
+from biped.model import double_support as ds
+from biped.model import two_phase as tp
+from biped.model.criteria import Safety, simpson_weights
+from biped.model.gait import sample
+from biped.optimization import two_phase as tpo
+from biped.optimization.problem import GaitProblem
+from tests.conftest import optimal_gait
+
+SPEED = 0.3  # [m/s]
+
+
+@functools.cache
+def solver_of(knee: str) -> tpo.TwoPhaseSolver:
+    """The two-phase solver of ``knee`` at 0.3 m/s, a tenth to a fifth of the step in double
+    support (built once per session)."""
+    single = GaitProblem(biped.Biped(biped.Robot.paper(), knee), SPEED)
+    return tpo.TwoPhaseSolver(tpo.TwoPhaseProblem(single, (0.1, 0.2)))
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_graph_is_the_numeric_model_over_both_phases(knee):
+    """At the start the solver takes from the single-support optimum, the graph's double
+    support (postures, torques, both wrenches for the front foot's wrench of the variables,
+    the landing's impulses) and its criterion over both phases equal the numeric model's
+    (``biped.model.two_phase``, ``split_with_swing_wrench``), and the closure's equalities
+    hold."""
+    solver = solver_of(knee)
+    problem = solver.problem
+    z = tpo.start_from_single(problem, optimal_gait(knee).variables)
+    value, g, torques, stance, swing, q, impulse = (
+        np.asarray(x) for x in solver.evaluate(z, SPEED)
+    )
+    model = problem.single.model
+    step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, z))
+    samples = ds.sample_phase(model, step.double, problem.samples)
+    front = z[-3 * (problem.samples + 1) :].reshape(-1, 3)
+    expected, rear = ds.split_with_swing_wrench(model, samples.q, samples.qd, samples.qdd, front)
+    np.testing.assert_allclose(q.T, samples.q, atol=1e-9)
+    np.testing.assert_allclose(torques.T, expected, atol=1e-6)
+    np.testing.assert_allclose(stance.T, rear, atol=1e-5)
+    np.testing.assert_allclose(swing.T, front, atol=0.0)
+    np.testing.assert_allclose(impulse.ravel(), step.impulse, atol=1e-9)
+    assert np.max(np.abs(g[solver.n_inequalities :])) < 1e-9
+    n = problem.single.samples_per_half
+    *_, single_torques, _, _ = sample(model, step.single, n)
+    single = step.single.period * simpson_weights(n) @ (single_torques**2).sum(1)
+    double = step.double.duration * tpo._simpson(problem.samples) @ (expected**2).sum(1)
+    assert value.item() == pytest.approx((single + double) / step.step_length, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("0.3:0.1", "LOW <= HIGH"),
+        ("0.6", "< 0.5"),
+        ("0:0", "above 0"),
+        ("a:b", "allowed LOW:HIGH"),
+    ],
+)
+def test_a_wrong_share_is_refused(text, message):
+    """The share LOW:HIGH: 0 <= LOW <= HIGH < 0.5, HIGH > 0; anything else named."""
+    with pytest.raises(BipedError, match=message):
+        tpo.parse_share(text)
+
+
+def test_share_is_parsed():
+    """One number is both ends; two are the range."""
+    assert tpo.parse_share("0.1:0.2") == (0.1, 0.2)
+    assert tpo.parse_share("0.15") == (0.15, 0.15)
+
+
+def test_what_is_not_built_is_refused():
+    """The energy criteria, the walkable constraints and richer families are refused by
+    name, not solved as something else."""
+    model = biped.Biped(biped.Robot.paper(), "rolling")
+    for single, word in (
+        (GaitProblem(model, SPEED, "energy"), "criterion"),
+        (GaitProblem(model, SPEED, safety=Safety(friction=0.6)), "walkable"),
+        (GaitProblem(model, SPEED, knots=3), "knots"),
+    ):
+        with pytest.raises(BipedError, match=word):
+            tpo.TwoPhaseProblem(single, (0.1, 0.2))
+
+
+def test_two_phase_optimum_converges_and_holds_on_the_numeric_model():
+    """IPOPT converges from the single-support optimum (rolling knee, 0.3 m/s, a tenth to a
+    fifth of the step in double support), and on the numeric model the optimum's double
+    support holds: both feet pushed, in their friction cones, their ZMPs in their soles (at
+    the solver's samples, to its tolerance), the rear foot pushed at the landing, the share
+    in its range."""
+    solver = solver_of("rolling")
+    problem = solver.problem
+    single = optimal_gait("rolling")
+    optimum = solver.solve(tpo.start_from_single(problem, single.variables), single.value)
+    assert optimum.converged, optimum.status
+    assert 0.1 - 1e-8 <= optimum.share <= 0.2 + 1e-8
+    model = problem.single.model
+    step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, optimum.variables))
+    samples = ds.sample_phase(model, step.double, problem.samples)
+    front = optimum.variables[-3 * (problem.samples + 1) :].reshape(-1, 3)
+    _, rear = ds.split_with_swing_wrench(model, samples.q, samples.qd, samples.qdd, front)
+    for wrench in (rear, front):
+        margins = ds.foot_margins(model.robot, wrench)
+        assert np.min(margins[:, :3]) > 0.0  # pushed, inside the friction cone
+        assert np.min(margins[:, 3:]) > -1e-6  # ZMP in the sole [m]
+    assert step.impulse[1] > -1e-6  # the rear foot is not pulled at the landing
