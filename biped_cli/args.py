@@ -229,6 +229,16 @@ def add_knots(parser) -> None:
     )
 
 
+def double_support_share(text: str) -> tuple[float, float]:
+    """``LOW:HIGH``, the least and largest share of the step in double support."""
+    from biped.optimization.two_phase import parse_share
+
+    try:
+        return parse_share(text)
+    except BipedError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
 def speed(text: str) -> float:
     try:
         value = float(text)

@@ -154,6 +154,12 @@ def cmd_optimize(args) -> int:
     problem = GaitProblem(model, args.speed, args.criterion, safety(args), knots=args.knots)
     check_output(args.out)
     given = budget(args)  # an option the method would not use: refused before any work
+    if args.double_support is not None:  # what the two-phase problem does not build
+        from biped.optimization.two_phase import TwoPhaseProblem
+
+        if args.method != "ipopt":
+            raise BipedError(f"--double-support with --method {args.method}: allowed ipopt")
+        TwoPhaseProblem(problem, args.double_support)
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
     setup = prepare(problem) if args.method == "ipopt" else 0.0
     optimum = confirm(problem, optimize(problem, **given))
@@ -191,6 +197,8 @@ def cmd_optimize(args) -> int:
             file=sys.stderr,
         )
         return 1
+    if args.double_support is not None:
+        return cmd_double_support(args, problem, optimum)
     path = gait_file.Gait.from_optimum(optimum, robot).write(args.out)
     print(f"wrote {path}")
     return 0
@@ -205,6 +213,43 @@ def add_optimize(commands) -> None:
     types.add_budget(opt)
     types.add_knots(opt)
     types.add_robot(opt)
+    types.add_options(
+        opt,
+        ("--double-support", types.double_support_share, None, "LOW:HIGH",
+         "also optimize the gait of two phases, single then double support (both feet flat), "
+         "started from the single-support optimum, its double support a share of the step "
+         "from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share): sthenic "
+         "criterion, IPOPT with --method ipopt only; --out then receives the two-phase "
+         "optimum's file (not a gait file, see docs/gaits.md); default: single support only"),
+    )  # fmt: skip
+
+
+def cmd_double_support(args, problem, optimum) -> int:
+    """The two-phase optimum from the single-support ``optimum`` of ``problem``, printed
+    beside it and written to ``args.out``; 1 when IPOPT did not converge (no file)."""
+    from biped.optimization.two_phase import TwoPhaseProblem, TwoPhaseSolver, start_from_single
+    from biped.records import two_phase_file
+
+    two = TwoPhaseProblem(problem, args.double_support)
+    solver = TwoPhaseSolver(two)
+    answer = solver.solve(start_from_single(two, optimum.variables), optimum.value)
+    low, high = two.share
+    print(
+        f"two phases (double support {low:g} to {high:g} of the step): C = {answer.value:.6g} "
+        f"N²·m·s at a share of {answer.share:.4f}, single support alone {optimum.value:.6g} "
+        f"({answer.value / optimum.value:.3g} times); IPOPT {answer.status} in "
+        f"{answer.iterations} iterations"
+    )
+    print(f"time: setup {answer.setup_seconds:.2f} s, solve {answer.seconds:.2f} s")
+    if not answer.converged:
+        print(
+            f"biped optimize: the two-phase solve did not converge ({answer.status}); "
+            "no file written",
+            file=sys.stderr,
+        )
+        return 1
+    print(f"wrote {two_phase_file.write(args.out, two, answer)}")
+    return 0
 
 
 def cmd_sweep(args) -> int:

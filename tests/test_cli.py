@@ -22,11 +22,20 @@ def test_demo_prints_both_knees(capsys):
     assert [float(v) for v in fz] == pytest.approx([70.0 * 9.81] * 2)
 
 
+# optimize with the options a double support's bad input is given beside.
+_TWO_PHASE = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "logs/never.json"]
+
+
 @pytest.mark.parametrize(
     "argv, needle",
     [
         (["demo", "--hip-height", "2.0"], "out of reach"),
         (["demo", "--robot", "missing.toml"], "missing.toml"),
+        (_TWO_PHASE + ["--double-support", "0.7"], "'0.7'"),
+        (_TWO_PHASE + ["--double-support", "0.3:0.1"], "'0.3:0.1'"),
+        (_TWO_PHASE + ["--double-support", "0.1", "--criterion", "energy"], "'energy'"),
+        (_TWO_PHASE + ["--double-support", "0.1", "--knots", "3"], "knots = 3"),
+        (_TWO_PHASE + ["--double-support", "0.1", "--method", "nelder-mead"], "nelder-mead"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):

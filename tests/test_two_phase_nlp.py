@@ -113,3 +113,27 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model():
         assert np.min(margins[:, :3]) > 0.0  # pushed, inside the friction cone
         assert np.min(margins[:, 3:]) > -1e-6  # ZMP in the sole [m]
     assert step.impulse[1] > -1e-6  # the rear foot is not pulled at the landing
+
+
+def test_optimize_double_support_writes_the_two_phase_optimum(tmp_path, capsys):
+    """``biped optimize --double-support`` prints both optima and writes the two-phase one:
+    every variable with its unit, converged, the share in its range; the single-support gait
+    file is not written in its place."""
+    import json
+
+    from biped_cli import main
+
+    out = tmp_path / "two.json"
+    argv = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", str(out)]
+    assert main([*argv, "--starts", "1", "--double-support", "0.1:0.2"]) == 0
+    printed = capsys.readouterr().out
+    assert "two phases (double support 0.1 to 0.2 of the step)" in printed
+    content = json.loads(out.read_text())
+    assert content["format"] == "biped two-phase optimum"
+    assert content["status"] == "Solve_Succeeded"
+    assert 0.1 - 1e-8 <= content["share"] <= 0.2 + 1e-8
+    assert set(content["units"]["variables"]) == set(content["variables"])
+    assert content["units"]["variables"]["front_fz_0"] == "N"
+    assert content["units"]["variables"]["double_support"] == "s"
+    assert content["units"]["variables"]["lift_rate_x_hip"] == "m/s"
+    assert content["units"]["variables"]["lift_rate_trunk"] == "rad/s"
