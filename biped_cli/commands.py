@@ -15,6 +15,7 @@ from biped.errors import BipedError, UnreachableError
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
+from biped.model.two_phase import LANDINGS
 from biped_cli import args as types
 from biped_cli.args import (
     budget,
@@ -222,6 +223,14 @@ def add_optimize(commands) -> None:
          "criterion, IPOPT with --method ipopt only; --out then receives the two-phase "
          "optimum's file (not a gait file, see docs/gaits.md); default: single support only"),
     )  # fmt: skip
+    opt.add_argument(
+        "--landing",
+        choices=LANDINGS,
+        default="impact",
+        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
+        "it, the paper's impact map with both feet held) or zero-speed (it arrives at rest, no "
+        "impact) (default %(default)s)",
+    )
 
 
 def cmd_double_support(args, problem, optimum) -> int:
@@ -230,12 +239,13 @@ def cmd_double_support(args, problem, optimum) -> int:
     from biped.optimization.two_phase import TwoPhaseProblem, TwoPhaseSolver, start_from_single
     from biped.records import two_phase_file
 
-    two = TwoPhaseProblem(problem, args.double_support)
+    two = TwoPhaseProblem(problem, args.double_support, landing=args.landing)
     solver = TwoPhaseSolver(two)
     answer = solver.solve(start_from_single(two, optimum.variables), optimum.value)
     low, high = two.share
     print(
-        f"two phases (double support {low:g} to {high:g} of the step): C = {answer.value:.6g} "
+        f"two phases (double support {low:g} to {high:g} of the step, {args.landing} landing): "
+        f"C = {answer.value:.6g} "
         f"N²·m·s at a share of {answer.share:.4f}, single support alone {optimum.value:.6g} "
         f"({answer.value / optimum.value:.3g} times); IPOPT {answer.status} in "
         f"{answer.iterations} iterations"

@@ -19,28 +19,30 @@ SPEED = 0.3  # [m/s]
 
 
 @functools.cache
-def solver_of(knee: str) -> tpo.TwoPhaseSolver:
+def solver_of(knee: str, landing: str = "impact") -> tpo.TwoPhaseSolver:
     """The two-phase solver of ``knee`` at 0.3 m/s, a tenth to a fifth of the step in double
     support (built once per session)."""
     single = GaitProblem(biped.Biped(biped.Robot.paper(), knee), SPEED)
-    return tpo.TwoPhaseSolver(tpo.TwoPhaseProblem(single, (0.1, 0.2)))
+    return tpo.TwoPhaseSolver(tpo.TwoPhaseProblem(single, (0.1, 0.2), landing=landing))
 
 
-@pytest.mark.parametrize("knee", biped.KNEES)
-def test_graph_is_the_numeric_model_over_both_phases(knee):
+@pytest.mark.parametrize(
+    "knee, landing", [("revolute", "impact"), ("rolling", "impact"), ("rolling", "zero-speed")]
+)
+def test_graph_is_the_numeric_model_over_both_phases(knee, landing):
     """At the start the solver takes from the single-support optimum, the graph's double
     support (postures, torques, both wrenches for the front foot's wrench of the variables,
     the landing's impulses) and its criterion over both phases equal the numeric model's
     (``biped.model.two_phase``, ``split_with_swing_wrench``), and the closure's equalities
     hold."""
-    solver = solver_of(knee)
+    solver = solver_of(knee, landing)
     problem = solver.problem
     z = tpo.start_from_single(problem, optimal_gait(knee).variables)
     value, g, torques, stance, swing, q, impulse = (
         np.asarray(x) for x in solver.evaluate(z, SPEED)
     )
     model = problem.single.model
-    step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, z))
+    step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, z), landing)
     samples = ds.sample_phase(model, step.double, problem.samples)
     front = z[-3 * (problem.samples + 1) :].reshape(-1, 3)
     expected, rear = ds.split_with_swing_wrench(model, samples.q, samples.qd, samples.qdd, front)
@@ -127,7 +129,7 @@ def test_optimize_double_support_writes_the_two_phase_optimum(tmp_path, capsys):
     argv = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", str(out)]
     assert main([*argv, "--starts", "1", "--double-support", "0.1:0.2"]) == 0
     printed = capsys.readouterr().out
-    assert "two phases (double support 0.1 to 0.2 of the step)" in printed
+    assert "two phases (double support 0.1 to 0.2 of the step, impact landing)" in printed
     content = json.loads(out.read_text())
     assert content["format"] == "biped two-phase optimum"
     assert content["status"] == "Solve_Succeeded"

@@ -1,11 +1,12 @@
 """The gait of two phases, single then double support, as one NLP (``biped.model.two_phase``).
 
-What is built: the sthenic criterion over both phases, the paper's single support with the
-impact landing that holds both feet, the double support phase of ``biped.model.double_support``
-(its load split: least squared torque), IPOPT on a CasADi graph with exact derivatives, started
-from the single-support optimum of the same problem. What is not: the energy and electrical
-criteria, the zero-speed landing, richer spline families, the walkable constraints and the
-actuator limits, a knee design (``TwoPhaseProblem`` refuses them by name).
+What is built: the sthenic criterion over both phases; the paper's single support with the
+impact landing that holds both feet, or the zero-speed landing; the double support phase of
+``biped.model.double_support`` with the front foot's wrench chosen by the criterion within
+both feet's constraints; IPOPT on a CasADi graph with exact derivatives, started from the
+single-support optimum of the same problem. What is not: the energy and electrical criteria,
+richer spline families, the walkable constraints and the actuator limits, a knee design
+(``TwoPhaseProblem`` refuses them by name).
 
 Variables z (``variable_names``): the single-support problem's 21 (``problem.VARIABLES``: the
 knee bends and the trunk at lift-off, the rates before the landing, the accelerations, T),
@@ -16,6 +17,8 @@ then
                                       ``biped.optimization.problem``, the ankles at 0 and S)
     landing_trunk                     [rad]
     double_support                    T_ds [s]
+    landing_rate_x_hip, _z_hip, _trunk (zero-speed landing only) the chain's rates at landing
+                                      [m/s, rad/s]; the rates before it (end_rate_*) held at 0
     rear_bend_j, front_bend_j         the knee bends at the double support's interior samples
                                       j = 1 .. n − 1 [rad], each tied to the hip's cubic by an
                                       equality: reach²(bend) = |hip − ankle|²
@@ -49,6 +52,7 @@ from biped.model.dynamics import Biped
 from biped.model.gait import hermite
 from biped.model.kinematics import LEG_SWAP, NQ, Q1, Q2, Q3, Q4, Q5, QP1, QP2, XH, ZH
 from biped.model.robot import FOOT_FRICTION
+from biped.model.two_phase import check_landing
 from biped.optimization.problem import (
     MIN_HIP_HEIGHT,
     RATE_BOUND,
@@ -82,6 +86,8 @@ EXTRAS = (
     "landing_trunk",
     "double_support",
 )
+# The closed chain's rates at a zero-speed landing [m/s, m/s, rad/s].
+LANDING_RATES = ("landing_rate_x_hip", "landing_rate_z_hip", "landing_rate_trunk")
 # The front foot's wrench at each double support sample, the redundancy's three numbers
 # (``biped.model.double_support.split_with_swing_wrench``) [N, N, N·m], their scales and bounds.
 WRENCH = ("fx", "fz", "cy")
@@ -109,11 +115,14 @@ FREE = [XH, ZH, Q5]
 BOUND = [QP1, QP2, Q1, Q2, Q3, Q4]
 
 
-def variable_names(samples: int = DOUBLE_SUPPORT_SAMPLES) -> tuple:
-    """The two-phase NLP's variables, in order (module docstring)."""
+def variable_names(samples: int = DOUBLE_SUPPORT_SAMPLES, landing: str = "impact") -> tuple:
+    """The two-phase NLP's variables, in order (module docstring); with the zero-speed
+    landing the closed chain's rates at landing follow ``EXTRAS`` (the rates before the
+    landing, ``end_rate_*``, are then held at 0 and unused)."""
+    rates = LANDING_RATES if check_landing(landing) == "zero-speed" else ()
     interior = tuple(f"{leg}_bend_{j}" for j in range(1, samples) for leg in ("rear", "front"))
     wrenches = tuple(f"front_{part}_{j}" for j in range(samples + 1) for part in WRENCH)
-    return VARIABLES + EXTRAS + interior + wrenches
+    return VARIABLES + EXTRAS + rates + interior + wrenches
 
 
 def parse_share(text: str) -> tuple[float, float]:
@@ -144,13 +153,17 @@ class TwoPhaseProblem:
         single: the single-support problem (its criterion, safety, samples).
         share: (least, largest) T_ds / (T + T_ds) [-].
         samples: samples of the double support phase (even).
+        landing: ``"impact"`` (both feet stopped by it) or ``"zero-speed"`` (the swing foot
+            arrives at rest, no impact; ``biped.model.two_phase``).
     """
 
     single: GaitProblem
     share: tuple
     samples: int = DOUBLE_SUPPORT_SAMPLES
+    landing: str = "impact"
 
     def __post_init__(self):
+        check_landing(self.landing)
         p = self.single
         refused = []
         if p.criterion != "sthenic":
@@ -183,14 +196,15 @@ class TwoPhaseGraph(StepGraph):
     ds_stance_wrench, ds_swing_wrench (3, n + 1), ds_q (9, n + 1), landing_impulse (6,).
     """
 
-    def __init__(self, model: Biped, safety: Safety, samples: int):
+    def __init__(self, model: Biped, safety: Safety, samples: int, landing: str = "impact"):
         self.model, self.samples_per_half = model, SOLVER_SAMPLES_PER_HALF
         self.safety, self.design, self.knots = safety, False, 1
         self.motors, self.profile, self.radii = False, False, None
-        self.ds_samples = samples
+        self.ds_samples, self.landing_kind = samples, landing
+        self.names = variable_names(samples, landing)
         c = _Constants(model)
         self._contacts = _contact_functions(c)
-        self.z = ca.SX.sym("z", len(variable_names(samples)))
+        self.z = ca.SX.sym("z", len(self.names))
         self.speed = ca.SX.sym("speed")
         self.period = self.z[index("period")]
         self.dwell = self._extra("double_support")
@@ -222,16 +236,24 @@ class TwoPhaseGraph(StepGraph):
         q1, q2 = _leg_angles(c, bend_r, ca.vertcat(x, lift))
         q4, q3 = _leg_angles(c, bend_f, ca.vertcat(x - length, lift))
         end_angles = ca.vertcat(0.0, q1, q2, q3, q4, self._extra("landing_trunk"))
-        end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
-        q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
-        rows = self._contacts["rows"](q_end)
-        mass = _mass_matrix(c, q_end)
-        d_inv_rt = ca.solve(mass, rows.T)
-        impulse = -ca.solve(rows @ d_inv_rt, rows @ qd_end)
-        self.landing_impulse = impulse
-        self.impulse = impulse[3:]  # the landing foot's (``StepGraph``'s name)
-        self.touchdown = (rows @ qd_end)[3:5]
-        self.landing = (q_end, qd_end + d_inv_rt @ impulse)
+        if self.landing_kind == "zero-speed":  # the chain's rates: both feet at rest
+            q_end, *_ = _stance_state(c, end_angles, ca.SX.zeros(6), ca.SX.zeros(6))
+            rates = ca.vertcat(*[z[self.names.index(name)] for name in LANDING_RATES])
+            qd_end = _chain_rates(self._contacts["rows"](q_end), rates)
+            end_rates = qd_end[1:7]
+            self.landing_impulse = ca.SX.zeros(6)
+            self.impulse, self.touchdown = ca.SX.zeros(3), ca.SX.zeros(2)
+            self.landing = (q_end, qd_end)
+        else:
+            end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
+            q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
+            rows = self._contacts["rows"](q_end)
+            d_inv_rt = ca.solve(_mass_matrix(c, q_end), rows.T)
+            impulse = -ca.solve(rows @ d_inv_rt, rows @ qd_end)
+            self.landing_impulse = impulse
+            self.impulse = impulse[3:]  # the landing foot's (``StepGraph``'s name)
+            self.touchdown = (rows @ qd_end)[3:5]
+            self.landing = (q_end, qd_end + d_inv_rt @ impulse)
         # Lift-off, in the single support's labels: both feet at rest, ṡ given.
         q_start, *_ = _stance_state(c, start_angles, ca.SX.zeros(6), ca.SX.zeros(6))
         lift_rates = ca.vertcat(
@@ -253,7 +275,7 @@ class TwoPhaseGraph(StepGraph):
         n, dwell, length = self.ds_samples, self.dwell, self.length
         (q0, qd0), (q1, qd1) = self.landing, self.lift
         cubic = hermite(dwell, q0[FREE], qd0[FREE], q1[FREE], qd1[FREE])
-        names = variable_names(self.ds_samples)
+        names = self.names
         bends = [(self._extra("landing_rear_bend"), self._extra("landing_front_bend"))]
         for j in range(1, n):
             bends.append(
@@ -446,7 +468,7 @@ class TwoPhaseSolver:
         self.problem = problem
         with kept_interrupts():
             graph = self.graph = TwoPhaseGraph(
-                problem.single.model, problem.single.safety, problem.samples
+                problem.single.model, problem.single.safety, problem.samples, problem.landing
             )
             low, high = problem.share
             total = graph.period + graph.dwell
@@ -456,7 +478,7 @@ class TwoPhaseSolver:
             )
             self.n_inequalities = inequalities.shape[0]
             g = ca.vertcat(inequalities, graph.ds_equalities)
-            self.scales = _scales(problem.samples)
+            self.scales = _scales(problem.samples, problem.landing)
             y = ca.SX.sym("y", len(self.scales))
             objective = graph.sthenic / OBJECTIVE_SCALE
             scaled = ca.substitute([objective, g], [graph.z], [ca.DM(self.scales) * y])
@@ -473,7 +495,7 @@ class TwoPhaseSolver:
                 [graph.sthenic, g, graph.ds_torques, graph.ds_stance_wrench,
                  graph.ds_swing_wrench, graph.ds_q, graph.landing_impulse],
             )  # fmt: skip
-        self.lower, self.upper = _bounds(problem.samples)
+        self.lower, self.upper = _bounds(problem.samples, problem.landing)
         self.setup_seconds = time.perf_counter() - began
 
     def solve(self, start, single_value: float) -> TwoPhaseOptimum:
@@ -513,17 +535,23 @@ class TwoPhaseSolver:
         )
 
 
-def _scales(samples: int) -> np.ndarray:
+def _scales(samples: int, landing: str) -> np.ndarray:
     extra = [_EXTRA_SCALES["rate"]] * 3 + [_EXTRA_SCALES["bend"]] * 2
     extra += [_EXTRA_SCALES["landing_trunk"], _EXTRA_SCALES["double_support"]]
+    if landing == "zero-speed":
+        extra += [_EXTRA_SCALES["rate"]] * len(LANDING_RATES)
     interior = [_EXTRA_SCALES["bend"]] * (2 * (samples - 1))
     wrenches = list(_WRENCH_SCALES) * (samples + 1)
     return np.concatenate([scales(1), extra, interior, wrenches])
 
 
-def _bounds(samples: int) -> tuple[np.ndarray, np.ndarray]:
+def _bounds(samples: int, landing: str) -> tuple[np.ndarray, np.ndarray]:
     lower, upper = bounds(1)
     extra = [(-RATE_BOUND, RATE_BOUND)] * 3 + [_BEND_BOUNDS] * 2 + [_TRUNK_BOUNDS, _DWELL_BOUNDS]
+    if landing == "zero-speed":  # the rates before the landing are the chain's: unused
+        unused = slice(index("end_rate_q1"), index("end_rate_q5") + 1)
+        lower[unused] = upper[unused] = 0.0
+        extra += [(-RATE_BOUND, RATE_BOUND)] * len(LANDING_RATES)
     extra += [_BEND_BOUNDS] * (2 * (samples - 1)) + list(_WRENCH_BOUNDS) * (samples + 1)
     low, high = np.array(extra).T
     return np.concatenate([lower, low]), np.concatenate([upper, high])
@@ -532,7 +560,7 @@ def _bounds(samples: int) -> tuple[np.ndarray, np.ndarray]:
 def start_from_single(problem: TwoPhaseProblem, variables) -> np.ndarray:
     """Two-phase variables from the single-support optimum's ``variables`` (21): its lift-off
     posture (knee bends, trunk), rates before the landing, accelerations and T; T_ds at the
-    middle of the share's range; the hip moving at V through the double support (lift-off
+    largest share; the hip moving at V through the double support (lift-off
     rates (V, 0, 0), the landing's hip V T_ds behind the lift-off's, its knee bends from the
     inverse geometric model) so that the phase's cubics start near a uniform motion; the
     interior bends of the closed chain (``closed_bends``)."""
@@ -557,9 +585,14 @@ def start_from_single(problem: TwoPhaseProblem, variables) -> np.ndarray:
     front = model.leg_angles(hip - np.array([length, 0.0]))
     extras = [speed, 0.0, 0.0, rear[1] - rear[0], front[1] - front[0], z[index("trunk")], dwell]
     n = problem.samples
+    if problem.landing == "zero-speed":
+        z[index("end_rate_q1") : index("end_rate_q5") + 1] = 0.0
+        extras += [speed, 0.0, 0.0]  # the hip at V through the landing
     guess = np.concatenate([z, extras, np.zeros(2 * (n - 1) + len(WRENCH) * (n + 1))])
-    try:  # the lift-off's rates those after the landing's impact: no jump to bridge
-        step = two_phase_model.build_two_phase(model, speed, to_parameters(problem, guess))
+    try:  # the lift-off's rates those after the landing: no jump to bridge
+        step = two_phase_model.build_two_phase(
+            model, speed, to_parameters(problem, guess), problem.landing
+        )
         guess[N_SINGLE : N_SINGLE + 3] = step.double.start[1][FREE]
     except UnreachableError:
         pass
@@ -576,19 +609,19 @@ def closed_bends(problem: TwoPhaseProblem, variables) -> np.ndarray:
     meet the closure's equalities."""
     z = np.array(variables, dtype=float)
     model = problem.single.model
-    step = two_phase_model.build_two_phase(model, problem.single.speed, to_parameters(problem, z))
+    parameters = to_parameters(problem, z)
+    step = two_phase_model.build_two_phase(model, problem.single.speed, parameters, problem.landing)
+    at = variable_names(problem.samples, problem.landing).index("rear_bend_1")
     try:
         samples = double_support.sample_phase(model, step.double, problem.samples)
     except UnreachableError:  # the cubic's hip beyond a leg's reach: the bends of the ends
         ends = np.array([z[N_SINGLE + 3 : N_SINGLE + 5], z[[index("swing_knee_bend"), 0]]])
         n = problem.samples
         between = np.ravel([ends[0] + (ends[1] - ends[0]) * j / n for j in range(1, n)])
-        at = N_SINGLE + len(EXTRAS)
         z[at : at + between.size] = between
         return z
     q = samples.q[1:-1]
     bends = np.column_stack([q[:, Q2] - q[:, Q1], q[:, Q3] - q[:, Q4]])
-    at = N_SINGLE + len(EXTRAS)
     z[at : at + bends.size] = bends.ravel()
     return z
 
@@ -599,7 +632,8 @@ def shifted_weight(problem: TwoPhaseProblem, variables) -> np.ndarray:
     first guess of the split (the variables' double support phase, its bends closed)."""
     z = np.array(variables, dtype=float)
     model = problem.single.model
-    step = two_phase_model.build_two_phase(model, problem.single.speed, to_parameters(problem, z))
+    parameters = to_parameters(problem, z)
+    step = two_phase_model.build_two_phase(model, problem.single.speed, parameters, problem.landing)
     samples = double_support.sample_phase(model, step.double, problem.samples)
     tau = model.generalized_forces(samples.q, samples.qd, samples.qdd)
     share = np.linspace(0.0, 1.0, problem.samples + 1)
@@ -610,11 +644,11 @@ def shifted_weight(problem: TwoPhaseProblem, variables) -> np.ndarray:
 
 
 def to_parameters(problem: TwoPhaseProblem, variables) -> np.ndarray:
-    """The parameters of ``biped.model.two_phase`` (impact landing) of the variables: the
+    """The parameters of ``biped.model.two_phase`` (the problem's landing) of the variables: the
     hips at lift-off and landing from the knee bends (eq. *), the rest as they are."""
     model, speed = problem.single.model, problem.single.speed
     z = np.asarray(variables, dtype=float)
-    value = dict(zip(variable_names(problem.samples), z, strict=True))
+    value = dict(zip(variable_names(problem.samples, problem.landing), z, strict=True))
     period, dwell = value["period"], value["double_support"]
     length = speed * (period + dwell)
     hp = model.robot.ankle_height
@@ -634,4 +668,5 @@ def to_parameters(problem: TwoPhaseProblem, variables) -> np.ndarray:
         "landing_z_hip": z_land,
         **value,
     }
-    return np.array([named[name] for name in two_phase_model.parameter_names("impact")])
+    names = two_phase_model.parameter_names(problem.landing)
+    return np.array([named[name] for name in names])

@@ -43,13 +43,14 @@ def unit_of(name: str) -> str:
 def record(problem: TwoPhaseProblem, optimum: TwoPhaseOptimum) -> dict:
     """The file's content: the problem, the answer, the variables by name with their units."""
     single = problem.single
-    names = variable_names(problem.samples)
+    names = variable_names(problem.samples, problem.landing)
     return {
         "format": FORMAT,
         "knee": single.knee,
         "speed": single.speed,
         "criterion": single.criterion,
         "share_range": list(problem.share),
+        "landing": problem.landing,
         "double_support_samples": problem.samples,
         "value": optimum.value,
         "share": optimum.share,
