@@ -81,3 +81,26 @@ def test_knee_forces_agree_with_mujoco_on_random_motions(model, stance):
     np.testing.assert_allclose(found.axis, expected.axis, atol=1e-12)
     np.testing.assert_allclose(found.normal, expected.normal, atol=1e-9)
     np.testing.assert_allclose(found.tangential, expected.tangential, atol=1e-9)
+
+
+@pytest.mark.parametrize("stance", ["left", "right"])
+def test_double_support_split_agrees_with_mujoco(model, stance):
+    """Along a double support phase, with the front foot's wrench given (the least-squared
+    split's, then one moved by 200 N), MuJoCo's Newton-Euler gives the model's six torques
+    and the rear foot's wrench (``split_with_swing_wrench``) to 1e-8: both feet's forces
+    cross-checked; a front wrench MuJoCo is not told of moves its answer by newtons."""
+    from biped.model import double_support as ds
+    from tests.test_two_phase import guess_step
+
+    phase = guess_step(model, "impact").double
+    time = np.linspace(0.0, phase.duration, 9)
+    q, qd, qdd = ds.chain_state(model, phase.step_length, *ds.phase_coordinates(phase, time))
+    _, _, least = ds.split_load(model, q, qd, qdd)
+    exact = load_model(model, exact=True)
+    for front in (least, least + np.array([40.0, -200.0, 3.0])):
+        torques, rear = ds.split_with_swing_wrench(model, q, qd, qdd, front)
+        result = mujoco_inverse_dynamics(exact, model, q, qd, qdd, stance, swing_wrench=front)
+        np.testing.assert_allclose(result.torques, torques, atol=1e-8)
+        np.testing.assert_allclose(result.wrench, rear, atol=1e-8)
+    blind = mujoco_inverse_dynamics(exact, model, q, qd, qdd, stance, swing_wrench=0 * least)
+    assert np.max(np.abs(blind.wrench[:, :2] - rear[:, :2])) > 100.0

@@ -98,7 +98,7 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model():
     fifth of the step in double support), and on the numeric model the optimum's double
     support holds: both feet pushed, in their friction cones, their ZMPs in their soles (at
     the solver's samples, to its tolerance), the rear foot pushed at the landing, the share
-    in its range."""
+    in its range; MuJoCo agrees with both feet's forces."""
     solver = solver_of("rolling")
     problem = solver.problem
     single = optimal_gait("rolling")
@@ -115,6 +115,16 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model():
         assert np.min(margins[:, :3]) > 0.0  # pushed, inside the friction cone
         assert np.min(margins[:, 3:]) > -1e-6  # ZMP in the sole [m]
     assert step.impulse[1] > -1e-6  # the rear foot is not pulled at the landing
+    # MuJoCo's Newton-Euler, told the front foot's wrench, finds the same torques and rear
+    # foot's wrench: both feet's forces of the optimum cross-checked.
+    from validate.crosscheck import load_model, mujoco_inverse_dynamics
+
+    torques, _ = ds.split_with_swing_wrench(model, samples.q, samples.qd, samples.qdd, front)
+    result = mujoco_inverse_dynamics(
+        load_model(model, exact=True), model, samples.q, samples.qd, samples.qdd, "left", front
+    )
+    np.testing.assert_allclose(result.torques, torques, atol=1e-7)
+    np.testing.assert_allclose(result.wrench, rear, atol=1e-7)
 
 
 def test_optimize_double_support_writes_the_two_phase_optimum(tmp_path, capsys):

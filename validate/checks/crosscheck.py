@@ -101,8 +101,15 @@ class InverseDynamics:
     coupling: np.ndarray  # (N, neq) equality forces [N·m]
 
 
-def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, stance="left"):
+def mujoco_inverse_dynamics(
+    model: mujoco.MjModel, biped: Biped, q, qd, qdd, stance="left", swing_wrench=None
+):
     """Solve τ = Bᵀu + J_cᵀλ + J_eqᵀμ sample by sample (see the module docstring).
+
+    With ``swing_wrench`` (N, 3) [Fx, Fz, Cy] the swing foot is on the ground too (double
+    support, ``biped.model.double_support``): its wrench, given, joins the known side,
+    τ − J_wᵀ F_w = Bᵀu + J_cᵀλ + J_eqᵀμ, and the system stays square: MuJoCo's torques and
+    stance wrench for the model's split of the load.
 
     Raises ModelError when the system is not square (a rolling knee without its two
     equalities leaves its hinges free: no unique solution).
@@ -121,6 +128,7 @@ def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, sta
             "equalities (one per rolling knee: knee_lower = (r2 / r1) knee_upper)"
         )
     site = model.site(f"{stance}_ankle").id
+    swing_site = model.site(f"{other(stance)}_ankle").id
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
     qpos, qvel, qacc = mapped.qpos(q), mapped.qvel(q, qd), mapped.qacc(q, qd, qdd)
     n = len(qpos)
@@ -134,10 +142,15 @@ def mujoco_inverse_dynamics(model: mujoco.MjModel, biped: Biped, q, qd, qdd, sta
         mujoco.mj_rne(model, data, 1, tau)
         mujoco.mj_jacSite(model, data, jacp, jacr, site)
         contact = np.stack([jacp[0], jacp[2], -jacr[1]])
+        known = tau
+        if swing_wrench is not None:
+            mujoco.mj_jacSite(model, data, jacp, jacr, swing_site)
+            held = np.stack([jacp[0], jacp[2], -jacr[1]])
+            known = tau - held.T @ swing_wrench[k]
         rows = equality_jacobian(model, data) if j_eq is None else j_eq
         system = np.concatenate([moments, contact, rows]).T
         try:
-            solution = np.linalg.solve(system, tau)
+            solution = np.linalg.solve(system, known)
         except np.linalg.LinAlgError:
             raise ModelError(
                 "MuJoCo's model gives a singular inverse dynamics (motors, ground and "
