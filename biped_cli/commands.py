@@ -236,18 +236,24 @@ def add_optimize(commands) -> None:
 def cmd_double_support(args, problem, optimum) -> int:
     """The two-phase optimum from the single-support ``optimum`` of ``problem``, printed
     beside it and written to ``args.out``; 1 when IPOPT did not converge (no file)."""
-    from biped.optimization.two_phase import TwoPhaseProblem, TwoPhaseSolver, start_from_single
+    from biped.optimization.two_phase import (
+        TwoPhaseProblem,
+        TwoPhaseSolver,
+        check,
+        start_from_single,
+    )
     from biped.records import two_phase_file
 
     two = TwoPhaseProblem(problem, args.double_support, landing=args.landing)
     solver = TwoPhaseSolver(two)
     answer = solver.solve(start_from_single(two, optimum.variables), optimum.value)
+    checked = check(two, answer.variables)
     low, high = two.share
     print(
         f"two phases (double support {low:g} to {high:g} of the step, {args.landing} landing): "
-        f"C = {answer.value:.6g} "
-        f"N²·m·s at a share of {answer.share:.4f}, single support alone {optimum.value:.6g} "
-        f"({answer.value / optimum.value:.3g} times); IPOPT {answer.status} in "
+        f"C = {checked.value:.6g} N²·m·s (single support on the check grid) at a share of "
+        f"{answer.share:.4f}, single support alone {optimum.value:.6g} "
+        f"({checked.value / optimum.value:.3g} times); IPOPT {answer.status} in "
         f"{answer.iterations} iterations"
     )
     print(f"time: setup {answer.setup_seconds:.2f} s, solve {answer.seconds:.2f} s")
@@ -258,7 +264,14 @@ def cmd_double_support(args, problem, optimum) -> int:
             file=sys.stderr,
         )
         return 1
-    print(f"wrote {two_phase_file.write(args.out, two, answer)}")
+    if not checked.feasible:
+        print(
+            "biped optimize: the two-phase optimum is infeasible on the numeric model "
+            f"(Ψ < 0: {checked.violations_line()}); no file written",
+            file=sys.stderr,
+        )
+        return 1
+    print(f"wrote {two_phase_file.write(args.out, two, answer, checked)}")
     return 0
 
 

@@ -115,6 +115,13 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model():
         assert np.min(margins[:, :3]) > 0.0  # pushed, inside the friction cone
         assert np.min(margins[:, 3:]) > -1e-6  # ZMP in the sole [m]
     assert step.impulse[1] > -1e-6  # the rear foot is not pulled at the landing
+    checked = tpo.check(problem, optimum.variables)
+    assert checked.feasible, checked.violations_line()
+    assert checked.value == pytest.approx(optimum.value, rel=1e-3)  # check grid vs solver's
+    # A front foot pulled instead of pushed at one sample is named.
+    wrong = optimum.variables.copy()
+    wrong[tpo.variable_names().index("front_fz_5")] = -10.0
+    assert "front normal_force" in tpo.check(problem, wrong).violations()
     # MuJoCo's Newton-Euler, told the front foot's wrench, finds the same torques and rear
     # foot's wrench: both feet's forces of the optimum cross-checked.
     from validate.crosscheck import load_model, mujoco_inverse_dynamics
@@ -142,6 +149,8 @@ def test_optimize_double_support_writes_the_two_phase_optimum(tmp_path, capsys):
     assert "two phases (double support 0.1 to 0.2 of the step, impact landing)" in printed
     content = json.loads(out.read_text())
     assert content["format"] == "biped two-phase optimum"
+    assert content["feasible"] is True
+    assert content["value"] == pytest.approx(content["solver_value"], rel=1e-3)
     assert content["status"] == "Solve_Succeeded"
     assert 0.1 - 1e-8 <= content["share"] <= 0.2 + 1e-8
     assert set(content["units"]["variables"]) == set(content["variables"])

@@ -46,7 +46,14 @@ import numpy as np
 from biped.errors import BipedError, UnreachableError
 from biped.model import double_support
 from biped.model import two_phase as two_phase_model
-from biped.model.criteria import CONSTRAINT_SCALES, MARGINS, Safety
+from biped.model.criteria import (
+    CONSTRAINT_SCALES,
+    MARGINS,
+    Safety,
+    StepEvaluation,
+    evaluate_step,
+    simpson_weights,
+)
 from biped.model.double_support import B5_INVERSE, B5_SWING, JOINTS5
 from biped.model.dynamics import Biped
 from biped.model.gait import hermite
@@ -54,6 +61,7 @@ from biped.model.kinematics import LEG_SWAP, NQ, Q1, Q2, Q3, Q4, Q5, QP1, QP2, X
 from biped.model.robot import FOOT_FRICTION
 from biped.model.two_phase import check_landing
 from biped.optimization.problem import (
+    CHECK_SAMPLES_PER_HALF,
     MIN_HIP_HEIGHT,
     RATE_BOUND,
     SOLVER_SAMPLES_PER_HALF,
@@ -100,6 +108,7 @@ _TRUNK_BOUNDS = (-0.6, 0.6)
 _DWELL_BOUNDS = (0.0, 3.0)
 # Scales of the double support's constraints: the landing's impulse [N·s], the closure [m²].
 IMPULSE_SCALE = 10.0
+IMPULSE_MARGIN = 1e-3  # [N·s] δ of the rear foot's impulse at an impact landing
 MOMENT_SCALE = 100.0  # [N·m] the ZMP's constraints times Fz
 # [N²·m·s] The criterion is divided by this in the solver: the two-phase optima lie near
 # 1000, where IPOPT's tolerance on the dual infeasibility, 1e-9, is below the rounding of
@@ -322,7 +331,8 @@ class TwoPhaseGraph(StepGraph):
             self.ds_swing_wrench.append(swing)
             self.ds_q.append(q)
         self.ds_squared = dwell * squared
-        inequalities.append(self.landing_impulse[1] / IMPULSE_SCALE)  # rear foot pushed
+        rear_pushed = self.landing_impulse[1] - IMPULSE_MARGIN  # the rear foot pushed
+        inequalities.append(rear_pushed / IMPULSE_SCALE)
         inequalities.append(self.landing_height)
         self.ds_inequalities = ca.vertcat(*inequalities)
         self.ds_equalities = ca.vertcat(*equalities)
@@ -670,3 +680,74 @@ def to_parameters(problem: TwoPhaseProblem, variables) -> np.ndarray:
     }
     names = two_phase_model.parameter_names(problem.landing)
     return np.array([named[name] for name in names])
+
+
+@dataclass(frozen=True)
+class TwoPhaseCheck:
+    """A two-phase optimum on the numeric model (``biped.model.two_phase``).
+
+    Attributes:
+        single: the single support phase on the check grid (``CHECK_SAMPLES_PER_HALF`` per
+            piece, 202 samples): its constraints and criteria, as a single-support gait's.
+        double_margins: (n + 1, 2, 5) both feet's Ψ (stance, swing; ``FOOT_CONSTRAINTS``
+            [N, N, N, m, m]) at the double support's samples, where the front foot's wrench
+            is defined: not between them.
+        rear_impulse: I_z of the ground on the rear foot at the landing [N·s] (0 for the
+            zero-speed landing).
+        value: C_Γ [N²·m·s], the single support's integral on the check grid, the double
+            support's on its samples.
+    """
+
+    single: StepEvaluation
+    double_margins: np.ndarray
+    rear_impulse: float
+    value: float
+
+    @property
+    def feasible(self) -> bool:
+        return self.single.feasible and not self.violations()
+
+    def violations(self) -> dict:
+        """The double support's violated constraints: name -> worst value."""
+        found = {}
+        for side, foot in enumerate(("rear", "front")):
+            for k, name in enumerate(double_support.FOOT_CONSTRAINTS):
+                worst = float(np.min(self.double_margins[:, side, k]))
+                if not worst >= 0.0:
+                    found[f"{foot} {name}"] = worst
+        if not self.rear_impulse >= 0.0:
+            found["rear impulse"] = self.rear_impulse
+        return found
+
+    def violations_line(self) -> str:
+        """The violated constraints of both phases, one line."""
+        parts = [self.single.violations_line()] if not self.single.feasible else []
+        parts += [f"{k} = {v:.3g}" for k, v in self.violations().items()]
+        return ", ".join(parts)
+
+
+def check(problem: TwoPhaseProblem, variables) -> TwoPhaseCheck:
+    """``variables`` on the numeric model: the single support on the check grid with the
+    single-support problem's safety, the double support at its samples."""
+    single, model = problem.single, problem.single.model
+    z = np.asarray(variables, dtype=float)
+    parameters = to_parameters(problem, z)
+    step = two_phase_model.build_two_phase(model, single.speed, parameters, problem.landing)
+    evaluation = evaluate_step(model, step.single, CHECK_SAMPLES_PER_HALF, safety=single.safety)
+    samples = double_support.sample_phase(model, step.double, problem.samples)
+    front = z[-len(WRENCH) * (problem.samples + 1) :].reshape(-1, len(WRENCH))
+    torques, rear = double_support.split_with_swing_wrench(
+        model, samples.q, samples.qd, samples.qdd, front
+    )
+    margins = np.stack(
+        [double_support.foot_margins(model.robot, w) for w in (rear, front)], axis=-2
+    )
+    weights = step.single.period * simpson_weights(CHECK_SAMPLES_PER_HALF)
+    single_part = float(weights @ (evaluation.torques**2).sum(-1))
+    double_part = step.double.duration * float(_simpson(problem.samples) @ (torques**2).sum(-1))
+    return TwoPhaseCheck(
+        single=evaluation,
+        double_margins=margins,
+        rear_impulse=float(step.impulse[1]),
+        value=(single_part + double_part) / step.step_length,
+    )

@@ -12,7 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
-from biped.optimization.two_phase import TwoPhaseOptimum, TwoPhaseProblem, variable_names
+from biped.optimization.two_phase import (
+    TwoPhaseCheck,
+    TwoPhaseOptimum,
+    TwoPhaseProblem,
+    variable_names,
+)
 from biped.records.gait_file import write_json
 from biped.records.provenance import provenance
 
@@ -40,8 +45,9 @@ def unit_of(name: str) -> str:
     raise KeyError(name)
 
 
-def record(problem: TwoPhaseProblem, optimum: TwoPhaseOptimum) -> dict:
-    """The file's content: the problem, the answer, the variables by name with their units."""
+def record(problem: TwoPhaseProblem, optimum: TwoPhaseOptimum, checked: TwoPhaseCheck) -> dict:
+    """The file's content: the problem, the answer, its check on the numeric model, the
+    variables by name with their units."""
     single = problem.single
     names = variable_names(problem.samples, problem.landing)
     return {
@@ -52,7 +58,9 @@ def record(problem: TwoPhaseProblem, optimum: TwoPhaseOptimum) -> dict:
         "share_range": list(problem.share),
         "landing": problem.landing,
         "double_support_samples": problem.samples,
-        "value": optimum.value,
+        "value": checked.value,
+        "solver_value": optimum.value,
+        "feasible": checked.feasible,
         "share": optimum.share,
         "single_support_value": optimum.single_value,
         "status": optimum.status,
@@ -64,6 +72,7 @@ def record(problem: TwoPhaseProblem, optimum: TwoPhaseOptimum) -> dict:
         "units": {
             "speed": "m/s",
             "value": "N²·m·s",
+            "solver_value": "N²·m·s",
             "single_support_value": "N²·m·s",
             "share": "1",
             "seconds": "s",
@@ -74,6 +83,8 @@ def record(problem: TwoPhaseProblem, optimum: TwoPhaseOptimum) -> dict:
     }
 
 
-def write(path: str | Path, problem: TwoPhaseProblem, optimum: TwoPhaseOptimum) -> Path:
+def write(
+    path: str | Path, problem: TwoPhaseProblem, optimum: TwoPhaseOptimum, checked: TwoPhaseCheck
+) -> Path:
     """Write the file atomically; returns its path."""
-    return write_json(path, record(problem, optimum))
+    return write_json(path, record(problem, optimum, checked))
