@@ -93,20 +93,22 @@ def test_what_is_not_built_is_refused():
             tpo.TwoPhaseProblem(single, (0.1, 0.2))
 
 
-def test_two_phase_optimum_converges_and_holds_on_the_numeric_model():
+@pytest.mark.parametrize("landing", ["impact", "zero-speed"])
+def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
     """IPOPT converges from the single-support optimum (rolling knee, 0.3 m/s, a tenth to a
     fifth of the step in double support), and on the numeric model the optimum's double
     support holds: both feet pushed, in their friction cones, their ZMPs in their soles (at
     the solver's samples, to its tolerance), the rear foot pushed at the landing, the share
     in its range; MuJoCo agrees with both feet's forces."""
-    solver = solver_of("rolling")
+    solver = solver_of("rolling", landing)
     problem = solver.problem
     single = optimal_gait("rolling")
     optimum = solver.solve(tpo.start_from_single(problem, single.variables), single.value)
     assert optimum.converged, optimum.status
     assert 0.1 - 1e-8 <= optimum.share <= 0.2 + 1e-8
     model = problem.single.model
-    step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, optimum.variables))
+    parameters = tpo.to_parameters(problem, optimum.variables)
+    step = tp.build_two_phase(model, SPEED, parameters, landing)
     samples = ds.sample_phase(model, step.double, problem.samples)
     front = optimum.variables[-3 * (problem.samples + 1) :].reshape(-1, 3)
     _, rear = ds.split_with_swing_wrench(model, samples.q, samples.qd, samples.qdd, front)
@@ -120,7 +122,7 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model():
     assert checked.value == pytest.approx(optimum.value, rel=1e-3)  # check grid vs solver's
     # A front foot pulled instead of pushed at one sample is named.
     wrong = optimum.variables.copy()
-    wrong[tpo.variable_names().index("front_fz_5")] = -10.0
+    wrong[tpo.variable_names(problem.samples, landing).index("front_fz_5")] = -10.0
     assert "front normal_force" in tpo.check(problem, wrong).violations()
     # MuJoCo's Newton-Euler, told the front foot's wrench, finds the same torques and rear
     # foot's wrench: both feet's forces of the optimum cross-checked.

@@ -331,8 +331,9 @@ class TwoPhaseGraph(StepGraph):
             self.ds_swing_wrench.append(swing)
             self.ds_q.append(q)
         self.ds_squared = dwell * squared
-        rear_pushed = self.landing_impulse[1] - IMPULSE_MARGIN  # the rear foot pushed
-        inequalities.append(rear_pushed / IMPULSE_SCALE)
+        if self.landing_kind == "impact":  # the rear foot pushed by the impact
+            rear_pushed = self.landing_impulse[1] - IMPULSE_MARGIN
+            inequalities.append(rear_pushed / IMPULSE_SCALE)
         inequalities.append(self.landing_height)
         self.ds_inequalities = ca.vertcat(*inequalities)
         self.ds_equalities = ca.vertcat(*equalities)
