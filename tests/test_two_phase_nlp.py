@@ -160,3 +160,18 @@ def test_optimize_double_support_writes_the_two_phase_optimum(tmp_path, capsys):
     assert content["units"]["variables"]["double_support"] == "s"
     assert content["units"]["variables"]["lift_rate_x_hip"] == "m/s"
     assert content["units"]["variables"]["lift_rate_trunk"] == "rad/s"
+
+
+def test_several_starts_keep_the_best_feasible_optimum():
+    """``optimize_two_phase``: the best of three seeded starts is feasible on the numeric
+    model, no worse than the first start's (the single-support optimum's) alone, and the
+    counts hold together; the same seed gives the same optimum."""
+    solver = solver_of("rolling")
+    single = optimal_gait("rolling")
+    result = tpo.optimize_two_phase(solver, single.variables, single.value, starts=3, seed=0)
+    first = solver.solve(tpo.start_from_single(solver.problem, single.variables), single.value)
+    assert result.best is not None and result.checked.feasible
+    assert result.best.value <= first.value
+    assert 1 <= result.at_best <= result.feasible <= result.converged <= result.starts == 3
+    again = tpo.optimize_two_phase(solver, single.variables, single.value, starts=3, seed=0)
+    np.testing.assert_array_equal(again.best.variables, result.best.variables)
