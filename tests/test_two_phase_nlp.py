@@ -126,7 +126,7 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
     assert "front normal_force" in tpo.check(problem, wrong).violations()
     # MuJoCo's Newton-Euler, told the front foot's wrench, finds the same torques and rear
     # foot's wrench: both feet's forces of the optimum cross-checked.
-    from validate.crosscheck import load_model, mujoco_inverse_dynamics
+    from validate.checks.crosscheck import load_model, mujoco_inverse_dynamics
 
     torques, _ = ds.split_with_swing_wrench(model, samples.q, samples.qd, samples.qdd, front)
     result = mujoco_inverse_dynamics(
