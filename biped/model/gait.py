@@ -200,7 +200,7 @@ def build_step(model: Biped, speed: float, p, knots: int = 1) -> Step:
     start_rates = qd_start[1:7]
     ends = (start_angles, start_rates, end_angles, end_rates)
     if knots == 1:
-        pieces = _paper_pieces(period, *ends, p[8:14], p[14:20])
+        pieces = paper_pieces(period, *ends, p[8:14], p[14:20])
     else:
         pieces = _hermite_pieces(period, *ends, p[8:-1].reshape(knots, 2, 6))
     return Step(
@@ -214,7 +214,7 @@ def build_step(model: Biped, speed: float, p, knots: int = 1) -> Step:
     )
 
 
-def _paper_pieces(period, start_angles, start_rates, end_angles, end_rates, acc0, acc1):
+def paper_pieces(period, start_angles, start_rates, end_angles, end_rates, acc0, acc1):
     """The coefficients a, b (2, 6, 4) of eqs. (25)-(26): the ends' angles, rates and
     accelerations, C⁰ and C¹ at t_n = 0.5."""
     a = np.empty((6, 4))

@@ -52,8 +52,7 @@ from biped.model.double_support import (
     check_model,
 )
 from biped.model.dynamics import Biped
-from biped.model.gait import Step
-from biped.model.gait import _paper_pieces as paper_pieces
+from biped.model.gait import Step, paper_pieces
 from biped.model.impact import both_feet_impact
 from biped.model.kinematics import swap_legs
 

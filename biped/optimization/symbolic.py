@@ -65,7 +65,7 @@ from biped.optimization.problem import CHECK_SAMPLES, MIN_HIP_HEIGHT, index, var
 BETWEEN_SAMPLES_MARGIN = 1e-6
 
 
-class _Constants:
+class Constants:
     """The numeric model's constants as CasADi matrices.
 
     With ``radii`` (an SX of two symbols r1, r2) the constants that depend on the knee
@@ -149,7 +149,7 @@ def _sparse(array):
     return ca.sparsify(ca.DM(np.asarray(array, dtype=float)))
 
 
-def _stance_state(c: _Constants, angles, rates, accels):
+def stance_state(c: Constants, angles, rates, accels):
     """q, q̇, q̈ (9,) and φ̇, φ̈, sin φ, cos φ of a stance-foot-fixed motion
     (``Chain.stance_state``); a profiled knee's q, q̇, q̈ and None."""
     if c.profile:
@@ -166,7 +166,7 @@ def _stance_state(c: _Constants, angles, rates, accels):
     return q, qd, qdd, phid, phidd, s, co
 
 
-def _torques_and_wrench(c: _Constants, qdd, phid, phidd, s, co):
+def _torques_and_wrench(c: Constants, qdd, phid, phidd, s, co):
     """Γ (6,) and F_e (3,) in one pass, as ``Biped.inverse_dynamics``."""
     rate2 = phid * phid
     ax = co * phidd - s * rate2
@@ -189,7 +189,7 @@ def _torques_and_wrench(c: _Constants, qdd, phid, phidd, s, co):
     return ca.vertcat(g1, g2, g3, g4, g5, g6), ca.vertcat(fx, fz, cy)
 
 
-def _sole_heights(c: _Constants, angles):
+def _sole_heights(c: Constants, angles):
     """Heights (n, 2) [m] of the swing heel and toe at the free angles ``angles`` (n, 6),
     the stance foot flat and fixed (``sample_function``'s Ψ6, Ψ7 without the margins)."""
     if c.profile:
@@ -205,7 +205,7 @@ def _sole_heights(c: _Constants, angles):
     return ca.horzcat(*rows)
 
 
-def _mass_matrix(c: _Constants, q):
+def mass_matrix(c: Constants, q):
     """D(q) (9, 9) (``Biped.mass_matrix``)."""
     if c.profile:
         return profile_graph.mass_matrix(c, q)
@@ -225,7 +225,7 @@ def _mass_matrix(c: _Constants, q):
     return c.p.T @ dy @ c.p
 
 
-def _swing_contact_jacobian(c: _Constants, q):
+def _swing_contact_jacobian(c: Constants, q):
     """A_c (3, 9) of the swing foot (``Chain.contact_jacobian(q, "swing")``)."""
     if c.profile:
         return profile_graph.swing_contact_jacobian(c, q)
@@ -241,7 +241,7 @@ def _swing_contact_jacobian(c: _Constants, q):
     return ca.horzcat(row_x, row_z, row_angle).T
 
 
-def _leg_angles(c: _Constants, bend, hip_from_ankle):
+def leg_angles(c: Constants, bend, hip_from_ankle):
     """(shank, thigh) angles of a leg with knee flexion ``bend`` and the hip at
     ``hip_from_ankle`` (``Chain.leg_angles`` with the flexion known)."""
     if c.profile:
@@ -260,7 +260,7 @@ def _leg_angles(c: _Constants, bend, hip_from_ankle):
     return angle, angle + bend
 
 
-def _reach_squared(c: _Constants, bend):
+def reach_squared(c: Constants, bend):
     """|hip − ankle|² at knee flexion ``bend`` (``Chain.reach_squared``)."""
     if c.profile:
         return profile_graph.reach_squared(c, bend)
@@ -304,7 +304,7 @@ N_MOTOR_QUANTITIES = _COUNT
 SAMPLE_MOTION = 18
 
 
-def sample_function(c: _Constants, robot, safety, radii=None, motors=False) -> ca.Function:
+def sample_function(c: Constants, robot, safety, radii=None, motors=False) -> ca.Function:
     """One sample of the step as a CasADi function: v = [angles, d/dt_n, d²/dt_n² (6 each),
     T (, r1, r2)] -> the ``QUANTITIES`` (41,), with ``motors`` also the ``MOTOR_QUANTITIES``
     of ``robot.drive_actuators`` (53,). Every sample of a step is this function of a
@@ -313,7 +313,7 @@ def sample_function(c: _Constants, robot, safety, radii=None, motors=False) -> c
     motion, period = ca.SX.sym("motion", SAMPLE_MOTION), ca.SX.sym("period")
     angles = motion[:6]
     rates, accels = motion[6:12] / period, motion[12:] / period**2
-    q, qd, qdd, phid, phidd, s, co = _stance_state(c, angles, rates, accels)
+    q, qd, qdd, phid, phidd, s, co = stance_state(c, angles, rates, accels)
     if c.profile:
         torques, wrench = profile_graph.torques_and_wrench(c, q, qd, qdd)
         heel, toe = (profile_graph.point_height(c, q, f"swing_{e}") for e in ("heel", "toe"))
@@ -391,7 +391,7 @@ class StepGraph:
         # k1, k2) with ``profile``.
         self.profile = profile if design else isinstance(model, ProfileBiped)
         self.radii = ca.SX.sym("radii", 4 if self.profile else 2) if design else None
-        c = (profile_graph.ProfileConstants if self.profile else _Constants)(model, self.radii)
+        c = (profile_graph.ProfileConstants if self.profile else Constants)(model, self.radii)
         self.z = ca.SX.sym("z", len(variable_names(knots)))
         self.speed = ca.SX.sym("speed")
         self.period = self.z[-1]  # T [s]
@@ -404,32 +404,32 @@ class StepGraph:
         for name, value in self.on_symbols.items():
             setattr(self, name, self.flat(value))
 
-    def _start_posture(self, c: _Constants):
+    def _start_posture(self, c: Constants):
         """1. The hip at the start of the step from the knee bends (``biped.optimization.problem``,
         eq. *), the legs' angles by the forward geometry of each leg (no inverse model, no
         square root at a straight knee): the six free angles at the start. Sets
         ``hip_height`` and ``parameters``."""
         z, length = self.z, self.length
         bend_s, bend_w = z[index("stance_knee_bend")], z[index("swing_knee_bend")]
-        d_s2, d_w2 = _reach_squared(c, bend_s), _reach_squared(c, bend_w)
+        d_s2, d_w2 = reach_squared(c, bend_s), reach_squared(c, bend_w)
         x_hip = (d_w2 - d_s2 - length**2) / (2 * length)
         height2 = d_s2 - x_hip**2
         self.hip_height = (height2 - MIN_HIP_HEIGHT**2) / MIN_HIP_HEIGHT**2
         lift = ca.sqrt(ca.fmax(height2, 1e-6))
-        q1, q2 = _leg_angles(c, bend_s, ca.vertcat(x_hip, lift))
-        q4, q3 = _leg_angles(c, bend_w, ca.vertcat(x_hip + length, lift))
+        q1, q2 = leg_angles(c, bend_s, ca.vertcat(x_hip, lift))
+        q4, q3 = leg_angles(c, bend_w, ca.vertcat(x_hip + length, lift))
         self.parameters = ca.vertcat(x_hip, c.hp + lift, z[index("trunk") :])
         return ca.vertcat(0.0, q1, q2, q3, q4, z[index("trunk")])
 
-    def _impact(self, c: _Constants, start_angles):
+    def _impact(self, c: Constants, start_angles):
         """2. The end state (the start posture with the legs swapped, ``FREE_SWAP``), the
         impact map (23) and the start velocities, the legs swapped again (``LEG_SWAP``):
         (end angles, end rates, start rates), each (6,). Sets ``impulse``."""
         z = self.z
         end_angles = ca.vertcat(*[start_angles[i] for i in FREE_SWAP])
         end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
-        q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
-        mass = _mass_matrix(c, q_end)
+        q_end, qd_end, *_ = stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
+        mass = mass_matrix(c, q_end)
         jac = _swing_contact_jacobian(c, q_end)
         d_inv_jt = ca.solve(mass, jac.T)
         gram = jac @ d_inv_jt
@@ -466,7 +466,7 @@ class StepGraph:
         b3 = 2 * r2 / 3 - 4 * r1
         return ca.horzcat(a0, a1, a2, a3, b0, b1, b2, b3).T
 
-    def _samples(self, c: _Constants, coefficients):
+    def _samples(self, c: Constants, coefficients):
         """3. The head (coefficients, T (, radii), hip height), the constant ``basis`` that
         maps it to each sample's inputs, the ``sample`` function, and the samples'
         ``QUANTITIES`` as a symbol (``quantities``) and as expressions (``flat``)."""

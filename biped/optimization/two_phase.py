@@ -74,12 +74,12 @@ from biped.optimization.problem import (
 )
 from biped.optimization.solver import IPOPT_OPTIONS
 from biped.optimization.symbolic import (
+    Constants,
     StepGraph,
-    _Constants,
-    _leg_angles,
-    _mass_matrix,
-    _reach_squared,
-    _stance_state,
+    leg_angles,
+    mass_matrix,
+    reach_squared,
+    stance_state,
 )
 from biped.runtime.interrupts import kept_interrupts
 
@@ -212,7 +212,7 @@ class TwoPhaseGraph(StepGraph):
         self.motors, self.profile, self.radii = False, False, None
         self.ds_samples, self.landing_kind = samples, landing
         self.names = variable_names(samples, landing)
-        c = _Constants(model)
+        c = Constants(model)
         self._contacts = _contact_functions(c)
         self.z = ca.SX.sym("z", len(self.names))
         self.speed = ca.SX.sym("speed")
@@ -243,11 +243,11 @@ class TwoPhaseGraph(StepGraph):
         z, length = self.z, self.length
         bend_r, bend_f = self._extra("landing_rear_bend"), self._extra("landing_front_bend")
         x, lift, self.landing_height = _hip_between(c, bend_r, bend_f, length)
-        q1, q2 = _leg_angles(c, bend_r, ca.vertcat(x, lift))
-        q4, q3 = _leg_angles(c, bend_f, ca.vertcat(x - length, lift))
+        q1, q2 = leg_angles(c, bend_r, ca.vertcat(x, lift))
+        q4, q3 = leg_angles(c, bend_f, ca.vertcat(x - length, lift))
         end_angles = ca.vertcat(0.0, q1, q2, q3, q4, self._extra("landing_trunk"))
         if self.landing_kind == "zero-speed":  # the chain's rates: both feet at rest
-            q_end, *_ = _stance_state(c, end_angles, ca.SX.zeros(6), ca.SX.zeros(6))
+            q_end, *_ = stance_state(c, end_angles, ca.SX.zeros(6), ca.SX.zeros(6))
             rates = ca.vertcat(*[z[self.names.index(name)] for name in LANDING_RATES])
             qd_end = _chain_rates(self._contacts["rows"](q_end), rates)
             end_rates = qd_end[1:7]
@@ -256,16 +256,16 @@ class TwoPhaseGraph(StepGraph):
             self.landing = (q_end, qd_end)
         else:
             end_rates = ca.vertcat(0.0, z[index("end_rate_q1") : index("end_rate_q5") + 1])
-            q_end, qd_end, *_ = _stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
+            q_end, qd_end, *_ = stance_state(c, end_angles, end_rates, ca.SX.zeros(6))
             rows = self._contacts["rows"](q_end)
-            d_inv_rt = ca.solve(_mass_matrix(c, q_end), rows.T)
+            d_inv_rt = ca.solve(mass_matrix(c, q_end), rows.T)
             impulse = -ca.solve(rows @ d_inv_rt, rows @ qd_end)
             self.landing_impulse = impulse
             self.impulse = impulse[3:]  # the landing foot's (``StepGraph``'s name)
             self.touchdown = (rows @ qd_end)[3:5]
             self.landing = (q_end, qd_end + d_inv_rt @ impulse)
         # Lift-off, in the single support's labels: both feet at rest, ṡ given.
-        q_start, *_ = _stance_state(c, start_angles, ca.SX.zeros(6), ca.SX.zeros(6))
+        q_start, *_ = stance_state(c, start_angles, ca.SX.zeros(6), ca.SX.zeros(6))
         lift_rates = ca.vertcat(
             *[self._extra(f"lift_rate_{a}") for a in ("x_hip", "z_hip", "trunk")]
         )
@@ -310,9 +310,9 @@ class TwoPhaseGraph(StepGraph):
             hip_front = ca.vertcat(s[0] - length, s[1] - hp)
             if 0 < j < n:
                 for bend, hip in ((rear, hip_rear), (front, hip_front)):
-                    equalities.append((_reach_squared(c, bend) - ca.sumsqr(hip)) / CLOSURE_SCALE)
-            a1, a2 = _leg_angles(c, rear, hip_rear)
-            a4, a3 = _leg_angles(c, front, hip_front)
+                    equalities.append((reach_squared(c, bend) - ca.sumsqr(hip)) / CLOSURE_SCALE)
+            a1, a2 = leg_angles(c, rear, hip_rear)
+            a4, a3 = leg_angles(c, front, hip_front)
             q = ca.vertcat(0.0, 0.0, a1, a2, a3, a4, s[2], s[0], s[1])
             rows = self._contacts["rows"](q)
             qd = _chain_rates(rows, sd)
@@ -345,7 +345,7 @@ class TwoPhaseGraph(StepGraph):
 def _hip_between(c, bend_rear, bend_front, length):
     """Eq. (*) with the rear ankle at 0 and the front one at S: the hip (x, z − h_p) and the
     hip-height constraint (>= 0)."""
-    d_r2, d_f2 = _reach_squared(c, bend_rear), _reach_squared(c, bend_front)
+    d_r2, d_f2 = reach_squared(c, bend_rear), reach_squared(c, bend_front)
     x = (d_r2 - d_f2 + length**2) / (2 * length)
     height2 = d_r2 - x**2
     lift = ca.sqrt(ca.fmax(height2, 1e-6))
