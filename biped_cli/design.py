@@ -211,8 +211,9 @@ def cmd_design_map(args) -> int:
     from biped.model.criteria import CRITERION_UNITS
     from biped.optimization.comparison import DIFFERENCE_VS_REVOLUTE
     from biped.optimization.design import bound_notes
+    from biped.pages.design_map_figures import draw
     from biped.runtime.runner import check_dask
-    from biped.studies.design_map import MANIFEST, draw, load, run_design_map, speed_summaries
+    from biped.studies.design_map import MANIFEST, load, run_design_map, speed_summaries
 
     robot = types.robot_of(args)
     problem = design_problem(args, robot, float(args.speeds[0]))

@@ -192,7 +192,7 @@ def _rho(orbit) -> str:
 
 def _write(out: Path, name: str, content: dict, figure) -> None:
     """<out>/<name>.json and .png, both or neither."""
-    from biped.pages.orbit_figures import DPI
+    from biped.pages.style import save
     from biped.records.provenance import provenance
     from biped.runtime.files import atomic_set
 
@@ -200,7 +200,7 @@ def _write(out: Path, name: str, content: dict, figure) -> None:
     with atomic_set(out, f"orbit-{name}") as staging:
         text = json.dumps(content, indent=1, allow_nan=False)
         (staging / f"{name}.json").write_text(text, encoding="utf-8")
-        figure.savefig(staging / f"{name}.png", dpi=DPI)
+        save(figure, staging / f"{name}.png")
 
 
 def cmd_orbit(args) -> int:
@@ -222,6 +222,7 @@ def cmd_orbit(args) -> int:
     validation's controller is not stable (without --vary), 0 otherwise.
     """
     from biped.pages.orbit_figures import knob_figure, multipliers_figure, speeds_figure
+    from biped.pages.style import save
     from biped_cli.commands import read_gaits
     from biped_cli.progress import Progress
     from validate.checks.orbit import RATE_STEP, STEP, Steps
@@ -269,17 +270,9 @@ def cmd_orbit(args) -> int:
             for s in studies
         ]
         figure = speeds_figure(rows, "the optimal gaits' walks in MuJoCo")
-        _save_figure(out / KNEES_FIGURE, figure)
+        save(figure, out / KNEES_FIGURE)
         print(f"wrote {out / KNEES_FIGURE}")
     if unstable:
         print(f"biped orbit: not shown stable: {', '.join(unstable)}", file=sys.stderr)
         return 1
     return 0
-
-
-def _save_figure(path: Path, figure) -> None:
-    from biped.pages.orbit_figures import DPI
-    from biped.runtime.files import atomic_path
-
-    with atomic_path(path) as staging:
-        figure.savefig(staging, dpi=DPI, format="png")

@@ -105,6 +105,7 @@ def cmd_profile_speeds(args) -> int:
     (.png beside). Exits 1 when a knee at a speed is not certified."""
     from biped.model.criteria import CRITERION_UNITS
     from biped.pages.profile_figures import speeds_figure
+    from biped.pages.style import save
     from biped.records.gait_file import Gait, write_json
     from biped.studies.profile_speeds import row_at, table
     from biped_cli import args as types
@@ -136,7 +137,7 @@ def cmd_profile_speeds(args) -> int:
     }
     content["units"] = units(content, CRITERION_UNITS[gait.criterion])
     print(f"wrote {write_json(out, content)}")
-    speeds_figure(rows, gait.criterion, gait.speed).savefig(figure_path, dpi=120)
+    save(speeds_figure(rows, gait.criterion, gait.speed), figure_path)
     print(f"wrote {figure_path}")
     bad = [row.speed for row in rows if not row.all_certified]
     if bad:

@@ -152,9 +152,10 @@ def comparison_lines(maps: dict) -> list[str]:
 def _write_map(out: Path, name: str, mapped) -> None:
     """Write a gait's robustness map (``validate.studies.robustness.GaitMap``) as
     <out>/<name>.json and .png, both or neither."""
+    from biped.pages.style import save
     from biped.records.provenance import provenance
     from biped.runtime.files import atomic_set
-    from validate.studies.robustness_figure import DPI, robustness_figure
+    from validate.studies.robustness_figure import robustness_figure
 
     content = {**mapped.to_dict(), "provenance": provenance()}
     title = f"{mapped.gait}: {mapped.knee} knee, {mapped.speed} m/s"
@@ -162,7 +163,7 @@ def _write_map(out: Path, name: str, mapped) -> None:
     with atomic_set(out, f"robustness-{name}") as staging:  # both or neither
         text = json.dumps(content, indent=1, allow_nan=False)
         (staging / f"{name}.json").write_text(text, encoding="utf-8")
-        figure.savefig(staging / f"{name}.png", dpi=DPI)
+        save(figure, staging / f"{name}.png")
 
 
 def cmd_robustness(args) -> int:

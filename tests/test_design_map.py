@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import biped
+from biped.pages.design_map_figures import draw
 from biped.studies.design_map import (
     MANIFEST,
     MapPoint,
-    draw,
     load,
     run_design_map,
     speed_summaries,
@@ -93,7 +93,7 @@ def test_map_legend_lies_outside_the_plot(small_map):
     radii near r = 0 among them): it lies below the axes."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from biped.studies.design_map import map_figure
+    from biped.pages.design_map_figures import map_figure
 
     settings, results = load(small_map)
     figure = map_figure(settings, speed_summaries(settings, results)[0], results)
@@ -159,7 +159,7 @@ def test_a_coarse_map_puts_the_table_1_radii_on_their_measured_side():
     from matplotlib.contour import ContourSet
     from matplotlib.path import Path
 
-    from biped.studies.design_map import map_figure
+    from biped.pages.design_map_figures import map_figure
 
     def grid_value(a, b):  # the hinges on the axes cost what the revolute knee does
         return 30.0 + (0.5 if a > 0 and b > 0 else 0.0)
@@ -184,7 +184,7 @@ def test_a_coarse_map_puts_the_table_1_radii_on_their_measured_side():
 def test_a_map_of_one_radius_each_says_why_it_is_empty():
     """A 1 x 1 grid has no map to draw: the figure says so and why, and gives each certified
     point's value and its change against the revolute knee."""
-    from biped.studies.design_map import map_figure
+    from biped.pages.design_map_figures import map_figure
 
     settings, results = _made_up_map((0.08,), (0.08,), lambda a, b: 29.0, table1=29.8)
     (summary,) = speed_summaries(settings, results)

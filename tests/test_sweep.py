@@ -14,7 +14,8 @@ import biped
 from biped.optimization.optimize import CONFIRM, MONOTONE, apart_from_table, optimize
 from biped.optimization.problem import GaitProblem
 from biped.optimization.table import OTHER_KNEE_START
-from biped.pages.figures import LABELS, make_figures
+from biped.pages.figures import make_figures
+from biped.pages.style import KNEE_LABELS
 from biped.records import gait_file
 from biped.records.gait_file import Costs
 from biped.studies import campaign
@@ -423,7 +424,7 @@ def test_a_gait_not_certified_is_marked_apart_from_the_curves():
     assert "revolute: not certified\n(solver: Maximum_Iterations_Exceeded)" in texts
     assert "not certified" in texts  # the legend
     panel = _panel(figure, "optimal sthenic criterion")
-    curve = next(line for line in panel.get_lines() if line.get_label() == LABELS["revolute"])
+    curve = next(line for line in panel.get_lines() if line.get_label() == KNEE_LABELS["revolute"])
     assert gait.speed not in list(curve.get_xdata())
 
 

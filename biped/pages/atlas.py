@@ -19,7 +19,8 @@ import numpy as np
 
 from biped.model.criteria import CRITERION_UNITS
 from biped.model.kinematics import KNEES
-from biped.runtime.files import atomic_path, atomic_write_text
+from biped.pages.style import ATLAS_DPI, save
+from biped.runtime.files import atomic_write_text
 from biped.studies.atlas import (
     MEASURES,
     RICHER_KNOTS,
@@ -634,8 +635,6 @@ def write(folder, out=None, walked: bool = True) -> list[Path]:
     written = [atomic_write_text(out / "atlas.csv", csv_text(table, settings.robot.weight))]
     for criterion in settings.criteria:
         path = out / f"atlas-{criterion}.png"
-        with atomic_path(path) as tmp:
-            figure(settings, table, criterion, walked).savefig(tmp, dpi=110, format="png")
-        written.append(path)
+        written.append(save(figure(settings, table, criterion, walked), path, ATLAS_DPI))
     written.append(atomic_write_text(out / "atlas.md", sentences(settings, table, walked)))
     return written

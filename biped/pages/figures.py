@@ -50,6 +50,7 @@ from biped.optimization.comparison import (
     SOLVER_GRID,
     relative_change,
 )
+from biped.pages.style import KNEE_LABELS, KNEE_STYLE, save
 from biped.records.gait_file import Gait
 from biped.runtime.files import atomic_set
 from biped.studies.paper_method import spread_lines
@@ -63,11 +64,6 @@ PAPER = {
     "energy_difference": -11.0,
 }
 DETAIL_SPEED = 0.3  # [m/s] of Figs. 5-7
-LABELS = {"revolute": "revolute knee", "rolling": "rolling knee"}
-STYLE = {
-    "revolute": dict(color="tab:blue", marker="o"),
-    "rolling": dict(color="tab:red", marker="s"),
-}
 FLAGGED_COLOR = "0.35"
 FLAGGED_MARK = dict(linestyle="none", marker="x", markersize=9, markeredgewidth=2)
 # A value is off the bulk of its panel beyond FENCE interquartile ranges below the first
@@ -79,7 +75,6 @@ MIN_BULK = 5
 SQUASH = 3.0
 # Room around the bulk, a fraction of its span on each side.
 PAD = 0.08
-DPI = 120
 CRITERION_AXES = {
     "sthenic": rf"sthenic criterion $C_\Gamma$ per metre walked [{CRITERION_UNITS['sthenic']}]",
     "energy": rf"energy criterion $C_E$ per step [{CRITERION_UNITS['energy']}]",
@@ -237,10 +232,10 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
         for knee in KNEES:
             v, c = _curve(series, knee, criterion, cost)
             outside = (c < limits[0]) | (c > limits[1])
-            ax.plot(v, np.where(outside, np.nan, c), label=LABELS[knee], **STYLE[knee])
+            ax.plot(v, np.where(outside, np.nan, c), label=KNEE_LABELS[knee], **KNEE_STYLE[knee])
             for x, value in zip(v[outside], c[outside], strict=True):
                 text = f"{knee} {x:.3f} m/s:\n{value:.4g} {unit}, off scale"
-                _mark_off_scale(ax, x, value, limits, STYLE[knee]["color"], text)
+                _mark_off_scale(ax, x, value, limits, KNEE_STYLE[knee]["color"], text)
         for i, gait in enumerate(crosses):
             x, value = gait.speed, gait.costs.criterion(cost)
             status = gait.optimizer.status
@@ -341,7 +336,7 @@ def _friction_marks(ax, gaits) -> None:
         ratio = friction_needed(gait)
         i = int(np.argmax(ratio))
         t = gait.samples.t[i] / gait.period
-        color = STYLE[knee]["color"]
+        color = KNEE_STYLE[knee]["color"]
         ax.plot([t], [ratio[i]], marker="o", markersize=8, fillstyle="none", color=color)
         text = f"largest |Fx|/Fz {ratio[i]:.3f}"
         note(ax, text, (t, ratio[i]), (-8, 8 + 12 * row), ha="right", color=color)
@@ -387,8 +382,8 @@ def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
             ax.plot(
                 s.t / gait.period,
                 panel.values(gait),
-                color=STYLE[knee]["color"],
-                label=LABELS[knee],
+                color=KNEE_STYLE[knee]["color"],
+                label=KNEE_LABELS[knee],
             )
         if panel.decorate is not None:
             panel.decorate(ax, gaits)
@@ -700,7 +695,7 @@ def make_figures(sweep_folder: str | Path, out_folder: str | Path, stream=None) 
     out = Path(out_folder)
     with atomic_set(out, "figures") as staging:
         for name, figure in figures.items():
-            figure.savefig(staging / name, dpi=DPI)
+            save(figure, staging / name)
         (staging / "comparison.md").write_text(table, encoding="utf-8")
     for name in left_out_figures(criteria):  # an earlier set's, of another sweep
         (out / name).unlink(missing_ok=True)

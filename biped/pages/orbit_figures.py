@@ -15,9 +15,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from biped.optimization.comparison import relative_change
-from biped.pages.figures import DIFFERENCE_AXIS, STYLE
+from biped.pages.figures import DIFFERENCE_AXIS
+from biped.pages.style import KNEE_STYLE
 
-DPI = 120
 # How many spreads of ρ the uncertainty bands span (the orbit check's margin).
 SPREADS = 2.0
 FALLS = dict(linestyle="none", marker="x", markersize=9, markeredgewidth=2)
@@ -142,7 +142,7 @@ def speeds_figure(rows: list[dict], title: str) -> Figure:
     for column, criterion in enumerate(criteria):
         top, bottom = axes[0, column], axes[1, column]
         by_knee = {}
-        for knee, style in STYLE.items():
+        for knee, style in KNEE_STYLE.items():
             chosen = sorted(
                 (r for r in rows if r["criterion"] == criterion and r["knee"] == knee),
                 key=lambda r: r["speed"],

@@ -42,9 +42,7 @@ from biped.optimization.comparison import GAINS, RADII
 from biped.optimization.problem import CHECK_SAMPLES, SOLVER_SAMPLES
 from biped.pages.figures import (
     ANGLE_PANELS,
-    DPI,
     GROUND_PANELS,
-    STYLE,
     TORQUE_PANELS,
     Panel,
     certified,
@@ -54,6 +52,7 @@ from biped.pages.figures import (
 )
 from biped.pages.orbit_figures import multipliers_figure
 from biped.pages.profile_figures import PROFILE_FIGURE, profile_figure
+from biped.pages.style import KNEE_STYLE, save
 from biped.pages.walk_figures import TORQUES_FIGURE, has_profiles, torques_figure
 from biped.pages.walk_figures import walk_lines as mujoco_walk_lines
 from biped.records.gait_file import Gait
@@ -417,7 +416,7 @@ def _constraint_panels(gait: Gait) -> tuple:
     def panel(i, name):
         def mark(ax, gaits):
             k = int(np.nanargmin(psi[:, i]))
-            color = STYLE[gait.knee]["color"]
+            color = KNEE_STYLE[gait.knee]["color"]
             ax.plot(t_n, delta[:, i], color="0.4", linestyle=":", linewidth=1.2, label="δ")
             ax.plot([t_n[k]], [psi[k, i]], marker="o", markersize=8, fillstyle="none", color=color)
             side = "right" if t_n[k] > 0.7 else "left" if t_n[k] < 0.3 else "center"
@@ -883,7 +882,7 @@ def write_pages(pages: list[Page], out: str | Path) -> list[Path]:
         for page, figures, text in rendered:
             (staging / page.name).mkdir()
             for name, figure in figures.items():
-                figure.savefig(staging / page.name / name, dpi=DPI)
+                save(figure, staging / page.name / name)
             (staging / f"{page.name}.md").write_text(text, encoding="utf-8")
     return [
         path

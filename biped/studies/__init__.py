@@ -6,5 +6,5 @@ profile over the speeds (``profile_speeds``: a table of optimizations, no folder
 and both knees over nested gait families until their comparison converges (``converge``).
 
 May import: ``biped.model``, ``biped.optimization``, ``biped.records``, ``biped.runtime``,
-``biped.errors``, numpy, and matplotlib (the design map's figures).
+``biped.errors``, numpy (the design map's figures are ``biped.pages.design_map_figures``).
 """

@@ -144,17 +144,15 @@ def _meets(row: dict) -> bool:
 def figure(rows: list[dict], knob: str):
     """Both figures against the knob, a line per point and knee, the targets dashed and the
     chosen setting marked."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     values = KNOBS[knob]["values"]
     unit = KNOBS[knob]["unit"]
     # Unbounded drawn left of the others (a landing bound: the loosest is the largest).
     positions = {v: i for i, v in enumerate(values)}
     labels = ["none" if v is None else f"{v:g}" for v in values]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5.0), layout="constrained")
+    fig = Figure(figsize=(11, 5.0), layout="constrained")
+    axes = fig.subplots(1, 2)
     panels = (
         ("feedback_share", "servos' share of the joint torque", 1.0),
         ("energy_error", "MuJoCo's energy per step / model's − 1 [%]", 100.0),
@@ -212,7 +210,7 @@ def figure(rows: list[dict], knob: str):
 
 
 def main(argv=None) -> int:
-    from biped.pages.figures import DPI
+    from biped.pages.style import save
     from biped.runtime.runner import run_tasks
 
     parser = argparse.ArgumentParser(
@@ -239,7 +237,7 @@ def main(argv=None) -> int:
         "rows": rows,
     }
     atomic_write_text(out / f"{args.knob}.json", json.dumps(record, indent=1))
-    figure(rows, args.knob).savefig(out / f"{args.knob}.png", dpi=DPI)
+    save(figure(rows, args.knob), out / f"{args.knob}.png")
     for r in rows:
         print(
             f"{r['knee']:8} {r['speed']:.2f} m/s {100 * r['clearance']:g} cm  {args.knob} "

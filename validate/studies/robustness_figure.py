@@ -18,7 +18,6 @@ if TYPE_CHECKING:  # the figure draws without MuJoCo
 WALKS = "#2a9d8f"
 UNSURE_BAR = dict(color="#e9c46a", hatch="///", edgecolor="0.3")
 BRACKET = "0.6"
-DPI = 120
 
 # Rows: title, the limits at the low and the high end (None: the nominal value is that end),
 # the factor of the drawn values, the axis scale.
