@@ -10,9 +10,7 @@ with ``--vary`` ρ against the gain), written together; given gaits of both knee
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +21,6 @@ DEFAULT_ORBIT = "logs/orbit"
 MAX_PHASES = 256
 # Bounds of the central differences' step on the angles [rad].
 STEP_RANGE = (1e-4, 0.02)
-KNEES_FIGURE = "knees.png"
 # Most scales of one --vary (each an orbit: a few hundred walks).
 MAX_SCALES = 100
 
@@ -81,6 +78,7 @@ def add_parser(commands) -> None:
 
 def _add_arguments(parser) -> None:
     from validate.checks.orbit import PHASES, RATE_STEP, STEP
+    from validate.studies.orbit_files import KNEES_FIGURE
     from validate.studies.orbit_study import KNOBS
 
     types.add_gaits(parser)
@@ -149,36 +147,25 @@ def boundary_lines(study) -> list[str]:
 def knee_lines(studies: list) -> list[str]:
     """The knees side by side at each criterion and speed both were given at, and per
     criterion the mean difference over the speeds with its spread (``studies``: each an
-    ``OrbitStudy`` under the validation's controller)."""
-    from biped.pages.orbit_figures import SPREADS, rho_difference
+    ``OrbitStudy`` under the validation's controller; ``validate.studies.orbit_files``)."""
+    from biped.pages.orbit_figures import SPREADS
+    from validate.studies.orbit_files import knee_means, knee_pairs
 
-    rows = {}
-    for study in studies:
-        rows[study.criterion, study.speed, study.knee] = study.orbits[0]
+    pairs = knee_pairs(studies)
     out = ["knees compared: ρ ± spread; (rolling − revolute) / revolute ± 2 spreads"]
-    differences: dict = {}
-    for criterion, speed in sorted({(c, v) for c, v, _ in rows}):
-        pair = [rows.get((criterion, speed, knee)) for knee in ("revolute", "rolling")]
-        if None in pair:
-            continue
-        revolute, rolling = pair
-        shown = [f"{knee} {_rho(o)}" for knee, o in (("revolute", revolute), ("rolling", rolling))]
-        line = f"  {criterion} {speed:.3f} m/s: {', '.join(shown)}"
-        if revolute.found and rolling.found:
-            difference, spread = rho_difference(rolling.to_dict(), revolute.to_dict())
-            distinct = abs(difference) > SPREADS * spread
-            differences.setdefault(criterion, []).append((difference, spread, distinct))
+    for pair in pairs:
+        shown = f"revolute {_rho(pair.revolute)}, rolling {_rho(pair.rolling)}"
+        line = f"  {pair.criterion} {pair.speed:.3f} m/s: {shown}"
+        if pair.difference is not None:
             line += (
-                f": {difference:+.0f} ± {SPREADS * spread:.0f} % "
-                f"({'distinct' if distinct else 'not distinguishable'})"
+                f": {pair.difference:+.0f} ± {SPREADS * pair.spread:.0f} % "
+                f"({'distinct' if pair.distinct else 'not distinguishable'})"
             )
         out.append(line)
-    for criterion, found in differences.items():
-        values, spreads, distinct = (np.array(column) for column in zip(*found, strict=True))
-        mean_spread = float(np.sqrt(np.sum(spreads**2))) / len(values)
+    for mean in knee_means(pairs):
         out.append(
-            f"  {criterion}: mean difference over {len(values)} speeds {values.mean():+.1f} ± "
-            f"{SPREADS * mean_spread:.1f} %, {int(distinct.sum())} of {len(values)} distinct"
+            f"  {mean.criterion}: mean difference over {mean.speeds} speeds {mean.mean:+.1f} ± "
+            f"{SPREADS * mean.spread:.1f} %, {mean.distinct} of {mean.speeds} distinct"
         )
     return out
 
@@ -188,19 +175,6 @@ def _rho(orbit) -> str:
     if not orbit.found:
         return f"no orbit ({figures.verdict})"
     return f"{figures.spectral_radius:.3f} ± {figures.spectral_radius_spread:.3f}"
-
-
-def _write(out: Path, name: str, content: dict, figure) -> None:
-    """<out>/<name>.json and .png, both or neither."""
-    from biped.pages.style import save
-    from biped.records.provenance import provenance
-    from biped.runtime.files import atomic_set
-
-    content = {**content, "provenance": provenance()}
-    with atomic_set(out, f"orbit-{name}") as staging:
-        text = json.dumps(content, indent=1, allow_nan=False)
-        (staging / f"{name}.json").write_text(text, encoding="utf-8")
-        save(figure, staging / f"{name}.png")
 
 
 def cmd_orbit(args) -> int:
@@ -221,13 +195,11 @@ def cmd_orbit(args) -> int:
     <out>/knees.png, ρ against speed with the knees' difference. Exits 1 if an orbit under the
     validation's controller is not stable (without --vary), 0 otherwise.
     """
-    from biped.pages.orbit_figures import knob_figure, multipliers_figure, speeds_figure
-    from biped.pages.style import save
     from biped_cli.commands import read_gaits
     from biped_cli.progress import Progress
     from validate.checks.orbit import RATE_STEP, STEP, Steps
     from validate.outputs.outputs import output_name
-    from validate.studies.orbit_study import OrbitStudy, study
+    from validate.studies.orbit_files import run_orbits, title
 
     types.check_folder(args.out, "--out")
     gaits = read_gaits(args.gait, args.model)
@@ -235,44 +207,26 @@ def cmd_orbit(args) -> int:
     types.distinct_outputs(names, "result")
     types.claim_outputs(args.out, names)
     knob, values = args.vary if args.vary is not None else (None, [None])
-
     steps = Steps(angle=args.step, rate=args.step * RATE_STEP / STEP, phases=args.phases)
-    out, studies, unstable = Path(args.out), [], []
-    began = time.perf_counter()
     with Progress(len(gaits) * len(values), "orbit") as bar:
-        results = study(gaits, knob, values, args.model, steps, args.jobs, progress=bar)
-    wall = time.perf_counter() - began
-    for path, gait, name, orbits in zip(args.gait, gaits, names, results, strict=True):
-        found = OrbitStudy.of(path, gait, knob, values, orbits)
-        studies.append(found)
-        body = found.to_dict()
-        label = f"{path}: {gait.knee} knee, {gait.criterion}, {gait.speed} m/s"
-        print(label)
-        for orbit in orbits:
+        run = run_orbits(
+            args.gait, gaits, names, args.out, knob, values, args.model, steps, args.jobs, bar
+        )
+    out = Path(args.out)
+    for found, name in zip(run.studies, names, strict=True):
+        print(title(found))
+        for orbit in found.orbits:
             print(orbit_line(knob, orbit))
-        if knob is None:
-            figure = multipliers_figure(body["orbits"][0], label)
-            if orbits[0].figures.verdict != "stable":
-                unstable.append(path)
-        else:
-            figure = knob_figure(body, label)
+        if knob is not None:
             for line in boundary_lines(found):
                 print(line)
-        _write(out, name, body, figure)
         print(f"  wrote {out / (name + '.json')}, {out / (name + '.png')}", flush=True)
-    walks = sum(o.figures.walks for found in studies for o in found.orbits)
-    print(f"{walks} walks in {wall:.1f} s on {args.jobs} process{'es' * (args.jobs > 1)}")
-    if knob is None and len({found.knee for found in studies}) == 2:
-        for line in knee_lines(studies):
+    print(f"{run.walks} walks in {run.wall:.1f} s on {args.jobs} process{'es' * (args.jobs > 1)}")
+    if run.knees_figure is not None:
+        for line in knee_lines(list(run.studies)):
             print(line)
-        rows = [
-            {**s.orbits[0].to_dict(), "knee": s.knee, "criterion": s.criterion, "speed": s.speed}
-            for s in studies
-        ]
-        figure = speeds_figure(rows, "the optimal gaits' walks in MuJoCo")
-        save(figure, out / KNEES_FIGURE)
-        print(f"wrote {out / KNEES_FIGURE}")
-    if unstable:
-        print(f"biped orbit: not shown stable: {', '.join(unstable)}", file=sys.stderr)
+        print(f"wrote {run.knees_figure}")
+    if run.unstable:
+        print(f"biped orbit: not shown stable: {', '.join(run.unstable)}", file=sys.stderr)
         return 1
     return 0

@@ -7,9 +7,7 @@ The files are named from the gait file's path as its recording is (``validate.ou
 
 from __future__ import annotations
 
-import json
 import sys
-import time
 from pathlib import Path
 
 from biped.errors import BipedError
@@ -72,17 +70,13 @@ def _settings(args):
     return RobustnessSettings(args.steps, args.push_step, args.iterations, args.jobs)
 
 
-def model_source(gait, model: str | None) -> str:
-    """What the map's walks were played on: ``model`` as given, the committed model, or the
-    one generated from the gait's robot."""
-    from validate.scene.model import committed_model
-
-    if model is not None:
-        return model
-    committed = committed_model(gait.biped)
-    if committed is None:
-        return "generated from the gait's robot (validate.scene.mjcf)"
-    return f"mjcf/{committed.name}"  # the committed model, wherever this copy keeps it
+def heading(mapped) -> str:
+    """The line naming a gait file's map (``validate.studies.robustness.GaitMap``): the file,
+    its knee, criterion and speed, the model its walks were played on."""
+    return (
+        f"{mapped.gait}: {mapped.knee} knee, {mapped.criterion}, {mapped.speed} m/s, "
+        f"on {mapped.model}"
+    )
 
 
 def _value(name: str, value: float | None) -> str:
@@ -149,23 +143,6 @@ def comparison_lines(maps: dict) -> list[str]:
     return out
 
 
-def _write_map(out: Path, name: str, mapped) -> None:
-    """Write a gait's robustness map (``validate.studies.robustness.GaitMap``) as
-    <out>/<name>.json and .png, both or neither."""
-    from biped.pages.style import save
-    from biped.records.provenance import provenance
-    from biped.runtime.files import atomic_set
-    from validate.studies.robustness_figure import robustness_figure
-
-    content = {**mapped.to_dict(), "provenance": provenance()}
-    title = f"{mapped.gait}: {mapped.knee} knee, {mapped.speed} m/s"
-    figure = robustness_figure(mapped.map, title)
-    with atomic_set(out, f"robustness-{name}") as staging:  # both or neither
-        text = json.dumps(content, indent=1, allow_nan=False)
-        (staging / f"{name}.json").write_text(text, encoding="utf-8")
-        save(figure, staging / f"{name}.png")
-
-
 def cmd_robustness(args) -> int:
     """Map how far each gait still walks in MuJoCo from its nominal conditions: the largest
     forward and backward push on the trunk [N·s] at mid-step of --push-step, the lowest
@@ -183,7 +160,8 @@ def cmd_robustness(args) -> int:
     from biped_cli.commands import read_gaits
     from biped_cli.progress import Progress
     from validate.outputs.outputs import output_name
-    from validate.studies import robustness
+    from validate.studies.robustness import LIMITS
+    from validate.studies.robustness_files import map_gaits
 
     settings = _settings(args)
     types.check_folder(args.out, "--out")  # before the gait files' checks, which take time
@@ -192,30 +170,22 @@ def cmd_robustness(args) -> int:
     types.distinct_outputs(names, "map")
     types.claim_outputs(args.out, names)
     out, failed, mapped = Path(args.out), [], {}
-    with Progress(len(gaits) * (1 + len(robustness.LIMITS)), "robustness") as bar:
-        for path, gait, name in zip(args.gait, gaits, names, strict=True):
-            bar.update(note=path)
-            began = time.perf_counter()
-            with types.naming(f"gait file {path!r}"):
-                result = robustness.robustness_map(gait, args.model, settings, progress=bar)
-            wall = time.perf_counter() - began
-            source = model_source(gait, args.model)
+    with Progress(len(gaits) * (1 + len(LIMITS)), "robustness") as bar:
+        maps = map_gaits(args.gait, gaits, names, args.out, args.model, settings, progress=bar)
+        for found, name in zip(maps, names, strict=True):
             bar.clear()
-            print(f"{path}: {gait.knee} knee, {gait.criterion}, {gait.speed} m/s, on {source}")
-            if not result.passed:
+            path, result = found.mapped.gait, found.mapped.map
+            print(heading(found.mapped))
+            if not found.written:
                 print(f"  FAIL  the nominal walk: {', '.join(result.nominal_failures)}; no map")
                 failed.append(path)
                 continue
-            found = robustness.GaitMap(
-                str(path), gait.knee, gait.criterion, gait.speed, source, result
-            )
-            _write_map(out, name, found)
             mapped[path] = result
             for line in lines(result):
                 print(line)
             print(
                 f"  wrote {out / (name + '.json')}, {out / (name + '.png')} ({result.walks} walks, "
-                f"{wall:.1f} s, {settings.jobs} process{'es' if settings.jobs > 1 else ''})",
+                f"{found.wall:.1f} s, {settings.jobs} process{'es' if settings.jobs > 1 else ''})",
                 flush=True,
             )
     if len(mapped) > 1:
