@@ -13,6 +13,7 @@ from pathlib import Path
 
 from biped.errors import BipedError
 from biped.model.units import unit_field
+from biped.pages.robustness_figure import robustness_figure
 from biped.pages.style import save
 from biped.records.gait_file import Gait
 from biped.records.provenance import provenance
@@ -20,7 +21,6 @@ from biped.runtime.files import atomic_set
 from biped.runtime.runner import ProgressBar
 from validate.scene.model import committed_model
 from validate.studies.robustness import GaitMap, RobustnessSettings, robustness_map
-from validate.studies.robustness_figure import robustness_figure
 
 
 @dataclass(frozen=True)

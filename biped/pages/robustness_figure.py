@@ -1,19 +1,16 @@
 """The figure of a robustness map (``validate.studies.robustness``): one row per condition.
 
-Drawn from the map (``RobustnessMap``; one written earlier read back by
-``RobustnessMap.from_dict``). Each row: the range the gait walks over (a bar from one limit to
-the other), the bisection's uncertainty beyond each limit up to the first value that failed
-(hatched), the bracket searched (grey line) and the nominal walk's value (black line).
+Drawn from the map (a ``validate.studies.robustness.RobustnessMap``, read by its fields:
+``limits``, ``settings``, ``push_time``; one written earlier read back by
+``RobustnessMap.from_dict``), without MuJoCo. Each row: the range the gait walks over (a bar
+from one limit to the other), the bisection's uncertainty beyond each limit up to the first
+value that failed (hatched), the bracket searched (grey line) and the nominal walk's value
+(black line).
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from matplotlib.figure import Figure
-
-if TYPE_CHECKING:  # the figure draws without MuJoCo
-    from validate.studies.robustness import Limit, RobustnessMap
 
 WALKS = "#2a9d8f"
 UNSURE_BAR = dict(color="#e9c46a", hatch="///", edgecolor="0.3")
@@ -29,7 +26,7 @@ ROWS = (
 )
 
 
-def _end(limit: Limit, factor: float) -> tuple:
+def _end(limit, factor: float) -> tuple:
     """A limit's end of its row: (the value found to walk, the first value found to fail or
     None, the bracket's far end), each times ``factor``."""
     fails = limit.fails_at
@@ -40,8 +37,8 @@ def _end(limit: Limit, factor: float) -> tuple:
     )
 
 
-def robustness_figure(result: RobustnessMap, title: str) -> Figure:
-    """The figure of a map whose nominal walk walked."""
+def robustness_figure(result, title: str) -> Figure:
+    """The figure of a map (``RobustnessMap``) whose nominal walk walked."""
     limits = result.limits
     figure = Figure(figsize=(8.0, 6.0), layout="constrained")
     axes = figure.subplots(len(ROWS), 1)
