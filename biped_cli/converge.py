@@ -100,6 +100,7 @@ def _progress(knee: str):
 def _report(args, problem, records, verdict, robot) -> int:
     from biped.model.criteria import CRITERION_UNITS
     from biped.pages.converge_figures import converge_figure
+    from biped.pages.style import save
     from biped.records.gait_file import write_json
     from biped.studies.converge import content_of, sentence
 
@@ -108,9 +109,7 @@ def _report(args, problem, records, verdict, robot) -> int:
     content = content_of(problem, records, verdict, robot, unit)
     print(f"wrote {write_json(folder / f'{NAME}.json', content)}")
     figure = converge_figure(records, args.criterion, args.speed, verdict.converged_at)
-    path = folder / f"{NAME}.png"
-    figure.savefig(path, dpi=120)
-    print(f"wrote {path}")
+    print(f"wrote {save(figure, folder / f'{NAME}.png')}")
     for line in sentence(records, verdict, unit):
         print(line)
     failed = [r.knots for r in records if not r.certified]

@@ -9,12 +9,8 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
 from biped.model.criteria import CRITERION_UNITS
+from biped.pages.style import KNEE_STYLE
 
-# Each knee's colour and marker.
-STYLES = {
-    "revolute": dict(color="tab:blue", marker="o"),
-    "rolling": dict(color="tab:red", marker="s"),
-}
 PAPER_PARAMETERS = 21  # the paper's spline, one interior knot
 
 
@@ -26,7 +22,7 @@ def converge_figure(records, criterion: str, speed: float, converged_at) -> Figu
     fig = Figure(figsize=(8, 6.4), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True)
     size = np.array([record.parameters for record in records], dtype=float)
-    for knee, style in STYLES.items():
+    for knee, style in KNEE_STYLE.items():
         values = np.array([record.knees[knee].value for record in records])
         errors = np.array([_known(record.knees[knee].error) for record in records])
         top.errorbar(size, values, yerr=errors, label=f"{knee} knee", capsize=3, **style)
