@@ -485,7 +485,7 @@ def cmd_validate(args) -> int:
                     source=path,
                     model=args.model,
                 )
-            written = write_json(report_path(rrd), {**reports[path], "gait": path})
+            written = write_json(report_path(rrd), reports[path].with_files(gait=path).to_dict())
             passed += result.passed
             bar.clear()
             if not args.json:
@@ -493,7 +493,8 @@ def cmd_validate(args) -> int:
                 print(f"report {written} (biped report {path} reads it)", flush=True)
             bar.advance()
     if args.json:
-        print(json.dumps(reports[args.gait[0]] if len(args.gait) == 1 else reports, indent=1))
+        content = {path: report.to_dict() for path, report in reports.items()}
+        print(json.dumps(content[args.gait[0]] if len(args.gait) == 1 else content, indent=1))
     elif len(args.gait) > 1:
         print(f"{passed} of {len(args.gait)} gaits pass every check")
     return 0 if passed == len(args.gait) else 1
@@ -539,7 +540,7 @@ def _recordings(args) -> list:
     return recordings
 
 
-def _print_validation(path: str, gait, result, report: dict) -> None:
+def _print_validation(path: str, gait, result, report) -> None:
     """The table of a gait's checks and the files written for it."""
     from validate.workflows import files_lines
 

@@ -48,34 +48,46 @@ def validation_file(gait_path: str | Path) -> Path | None:
     return found if found.exists() and belongs_to(recording, gait_path) else None
 
 
-def read_validation(path: Path | None) -> dict | None:
-    """A validation report's content, None if there is none; BipedError if it is not one."""
+def read_validation(path: Path | None):
+    """A validation report (``biped.records.validation_report.ValidationReport``), None if
+    there is none; BipedError if it is not one. A report from before the ``units`` map gets
+    the units of ``validate.checks.units``."""
+    from dataclasses import replace
+
+    from biped.records.validation_report import ValidationReport, is_report
+    from validate.checks.units import figure_units
+
     if path is None or not path.exists():
         return None
     try:
         content = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as error:
         raise BipedError(f"validation report {str(path)!r} cannot be read: {error}") from None
-    if not isinstance(content, dict) or not isinstance(content.get("passed"), bool):
+    if not is_report(content):
         raise BipedError(
             f"validation report {str(path)!r} is not one: allowed the JSON of 'biped validate "
             "--json' (with 'passed')"
         )
-    return content
+    try:
+        report = ValidationReport.from_dict(content)
+    except ValueError as error:
+        raise BipedError(f"validation report {str(path)!r} is not one: {error}") from None
+    if isinstance(content.get("units"), dict):
+        return report
+    checks = tuple(replace(c, units=figure_units(c.name, c.figures)) for c in report.checks)
+    return replace(report, checks=checks)
 
 
-def links(gait_path: Path, validation: dict | None) -> list:
+def links(gait_path: Path, validation) -> list:
     """The recording and videos of a gait that exist and were made from it as it is now."""
     from biped.pages.page import Link
     from validate.outputs.outputs import belongs_to, open_command, output_name
 
     found = []
-    recording = (validation or {}).get("recording")
-    if not isinstance(recording, str):
+    recording = None if validation is None else validation.recording
+    if recording is None:
         recording = str(Path(DEFAULT_RECORDINGS) / f"{output_name(gait_path)}.rrd")
-    videos = (validation or {}).get("video") or []
-    if not isinstance(videos, list):
-        videos = []
+    videos = () if validation is None else validation.video or ()
     recording = Path(recording)
     if recording.exists():
         owned = belongs_to(recording, gait_path)
@@ -87,7 +99,7 @@ def links(gait_path: Path, validation: dict | None) -> list:
     else:
         owned_videos = True  # a video named by the report, the recording gone
     for video in videos:
-        if isinstance(video, str) and Path(video).exists() and owned_videos:
+        if Path(video).exists() and owned_videos:
             found.append(Link(f"video ({Path(video).suffix[1:]})", Path(video)))
     return found
 
@@ -111,10 +123,6 @@ def cmd_report(args) -> int:
         gait = gait_file.read_consistent(path)  # its figures its parameters'
         found = validation_file(path)
         validation = read_validation(found)
-        if validation is not None and not isinstance(validation.get("units"), dict):
-            from validate.checks.units import report_units  # a report from before the units map
-
-            validation["units"] = report_units(validation)
         pages.append(
             Page(
                 name=output_name(path),

@@ -110,7 +110,7 @@ def _other_files() -> dict:
     from biped.model.criteria import PAPER_SAFETY
     from biped.studies import design_map, paper_method, sweep
     from validate.checks.checks import Check
-    from validate.checks.validation import as_json
+    from validate.checks.validation import validation_report
     from validate.studies import robustness
 
     robot = Robot.paper()
@@ -121,9 +121,9 @@ def _other_files() -> dict:
     walked = robustness.RobustnessMap(
         robustness.RobustnessSettings(), 0.6, 1.5, 1.0, 30.0, (), limits
     )
-    report = as_json(
+    report = validation_report(
         [Check("model", True, {}), Check("inverse_dynamics", True, {"max_zmp_error": 0.0})]
-    )
+    ).to_dict()
     point = design_map.MapPoint("revolute", 0.3)
     return {
         "a sweep's record": sweep.Settings(robot, PAPER_SAFETY, (0.3,), 0, 1).to_dict(),

@@ -132,13 +132,13 @@ def test_page_links_no_recording_of_another_gait(written, tmp_path):
     """A recording whose owner is another gait file is not linked; without a report beside
     the gait, the page says it is not validated."""
     from biped.pages.page import Page, markdown
-    from biped_cli.report import links
+    from biped_cli.report import links, read_validation
 
     gait_path, _, _ = written
     copy = tmp_path / "sweep" / f"{NAME}.json"
     copy.parent.mkdir()
     copy.write_bytes(gait_path.read_bytes())
-    report = json.loads(gait_path.with_name(f"{NAME}.report.json").read_text())
+    report = read_validation(gait_path.with_name(f"{NAME}.report.json"))
     assert links(copy, report) == []  # the recording and video are the pipeline gait's
     assert [link.label for link in links(gait_path, report)] == ["recording", "video (mp4)"]
     page = Page(f"sweep-{NAME}", copy, gait_file.read(copy))
@@ -160,6 +160,20 @@ def test_report_is_all_or_none(written, tmp_path, capsys):
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
     assert main(["report", str(gait_path), str(gait_path), "--out", str(out)]) == 2
     assert "share the page" in capsys.readouterr().err
+
+
+def test_a_report_whose_verdict_is_not_its_checks_is_refused(written, tmp_path, capsys):
+    """A validation report that says it passed while a check failed is not read onto the
+    page: exit 2, one line naming the report and the failed check."""
+    gait_path, _, _ = written
+    copy = tmp_path / f"{NAME}.json"
+    copy.write_bytes(gait_path.read_bytes())
+    content = json.loads(gait_path.with_name(f"{NAME}.report.json").read_text())
+    copy.with_name(f"{NAME}.report.json").write_text(json.dumps({**content, "passed": True}))
+    assert main(["report", str(copy), "--out", str(tmp_path / "pages")]) == 2
+    err = capsys.readouterr().err
+    assert f"{NAME}.report.json" in err and "failed are: forward" in err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "pages").exists()
 
 
 @pytest.fixture(scope="module")
@@ -304,8 +318,7 @@ def walked_page(tmp_path_factory):
     from biped.pages.page import Page, markdown, page_figures
     from tests.conftest import gait_of, optimal_gait
     from validate.checks import checks
-    from validate.checks.units import report_units
-    from validate.checks.validation import as_json
+    from validate.checks.validation import validation_report
     from validate.scene.model import model_spec
     from validate.walk.samples import GaitSamples
     from validate.walk.simulate import Walker
@@ -314,8 +327,7 @@ def walked_page(tmp_path_factory):
     spec = model_spec(gait.biped)
     replay = checks.check_feedforward(spec, gait.biped, GaitSamples.from_gait(gait))
     forward, _, _ = checks.check_forward(Walker(gait, spec), 10, gait.costs.energy)
-    report = as_json([replay, forward])
-    report["units"] = report_units(report)
+    report = validation_report([replay, forward])
     path = tmp_path_factory.mktemp("walked") / f"{NAME}.json"
     page = Page(NAME, path, gait, report)
     return report, markdown(page, path.parent), page_figures(page)
@@ -330,7 +342,7 @@ def test_page_shows_mujocos_walk_beside_the_models(walked_page):
     from biped.pages.figures import joint_label
 
     report, text, _ = walked_page
-    forward, replay = report["forward"], report["feedforward"]
+    forward, replay = report.check("forward").figures, report.check("feedforward").figures
     assert "### MuJoCo's walk beside the model's" in text
     for j, joint in enumerate(JOINTS):
         cells = [f"{forward[name][j]:.3g}" for name in ("gait_torque_rms", "mujoco_torque_rms")]
@@ -379,6 +391,7 @@ def test_a_walk_not_measured_is_unknown_on_the_page():
     """A per-joint figure the walk could not measure (null in the report) is n/a on the page,
     never 0; a report without the walk's per-joint figures has no such section."""
     from biped.pages.walk_figures import walk_lines
+    from biped.records.validation_report import CheckResult, ValidationReport
 
     forward = {
         "steps": 0,
@@ -390,7 +403,7 @@ def test_a_walk_not_measured_is_unknown_on_the_page():
         "analytic_energy_per_step": 1.5,
         "energy_ratio": None,
     }
-    text = "\n".join(walk_lines({"forward": forward}))
+    text = "\n".join(walk_lines(ValidationReport((CheckResult("forward", False, forward),))))
     assert "| Γ1 stance ankle | n/a | n/a | n/a | n/a | n/a | n/a | n/a |" in text
     assert "| 1.5 | n/a | n/a | J |" in text and "| 0 |" not in text
-    assert walk_lines({"forward": {"steps": 3}}) == []
+    assert walk_lines(ValidationReport((CheckResult("forward", False, {"steps": 3}),))) == []

@@ -152,12 +152,12 @@ def test_a_page_prints_units_per_column_as_units_never_a_list():
 
     from biped.model.units import unit_text
     from biped.pages.page import Page, _validation_lines
-    from validate.checks.units import SECTION_UNITS, report_units
+    from validate.checks.units import SECTION_UNITS
+    from validate.checks.validation import Check, validation_report
 
     assert unit_text(SECTION_UNITS) == "rad (1-6), rad/s (7-12)"
     assert unit_text(["N", "N", "N·m"]) == "N (1-2), N·m (3)" and unit_text(["m"] * 3) == "m"
-    report = {"orbit": {"passed": True, "fixed_point": [0.0] * 12}, "passed": True}
-    report["units"] = report_units(report)
+    report = validation_report([Check("orbit", True, {"fixed_point": [0.0] * 12})])
     gait = Gait.from_optimum(small_optimum("rolling"), Robot.paper())
     lines = _validation_lines(Page("p", Path("g.json"), gait, report), Path("."))
     row = next(line for line in lines if line.startswith("| fixed_point |"))

@@ -390,3 +390,23 @@ def test_the_knee_loads_check_fails_a_wrong_radius_or_lower_leg_mass(table_1_mod
     assert check_knee_loads(table_1, gait.biped, samples).notes == [
         "the gait file has no knee_loads: computed from its samples"
     ]
+
+
+def test_the_report_reads_back_as_the_record_it_was_written_from(report):
+    """The report's JSON is ``ValidationReport.to_dict``'s: read back (``from_dict``) it is the
+    same record, each check with its figures, units, notes and causes; a report whose
+    verdict is not its checks' is refused, naming the failed ones."""
+    from biped.records.validation_report import ValidationReport
+
+    _, content, _ = report
+    record = ValidationReport.from_dict(content)
+    assert record.to_dict() == content and record.passed is content["passed"]
+    forward = record.check("forward")
+    assert (
+        forward.units["max_slip"] == "m" and forward.figures["steps"] == content["forward"]["steps"]
+    )
+    assert record.check("no such check") is None
+    failed = {**content, "forward": {**content["forward"], "passed": False}}
+    with pytest.raises(ValueError, match="failed are: forward"):
+        ValidationReport.from_dict({**failed, "passed": True})
+    assert ValidationReport.from_dict({**failed, "passed": False}).failed() == ("forward",)

@@ -20,6 +20,7 @@ import numpy as np
 from biped.model.criteria import Safety
 from biped.model.robot import Robot
 from biped.records.gait_file import Gait, write_json
+from biped.records.validation_report import ValidationReport
 
 
 def validate_and_record(
@@ -39,12 +40,11 @@ def validate_and_record(
     ``connect``) and, if asked, the video of its walk at ``video`` (MP4) and ``gif``.
     ``source``: the gait file, named as the recording's owner (``validate.outputs.outputs``).
 
-    Returns the validation and its report (the checks as JSON with their ``units``, the
-    recording's and video's paths).
+    Returns the validation and its report (``biped.records.validation_report``: the checks
+    with their units, the recording's and video's paths).
     """
     from biped.records.provenance import provenance
     from validate.checks import validation
-    from validate.checks.units import report_units
     from validate.outputs.outputs import claim
     from validate.outputs.record import record
 
@@ -52,29 +52,28 @@ def validate_and_record(
     written = record(rrd, result, spawn=spawn, connect=connect)
     if source is not None:
         claim(written, source)
-    checks = validation.as_json(result.checks)
-    report = {
-        **checks,
-        "units": report_units(checks),
-        "recording": str(written),
-        "provenance": provenance(),
-    }
+    report = validation.validation_report(result.checks).with_files(
+        recording=str(written), provenance=provenance()
+    )
     if video is not None or gif is not None:
         from validate.outputs import video as videos
 
-        report["video"] = [str(path) for path in videos.write_video(video, result, gif=gif)]
+        paths = videos.write_video(video, result, gif=gif)
+        report = report.with_files(video=tuple(str(path) for path in paths))
     return result, report
 
 
-def files_lines(report: dict, gait_path: Path | None = None, report_path=None) -> list[str]:
+def files_lines(
+    report: ValidationReport, gait_path: Path | None = None, report_path=None
+) -> list[str]:
     """What a workflow prints of the files it wrote for a gait: the gait file and its
     report (if given), the recording (and its owner record), the videos."""
     from validate.outputs.outputs import recording_lines
 
     return [
         *([f"gait {gait_path}, report {report_path}"] if gait_path is not None else []),
-        *recording_lines(report["recording"]),
-        *(f"video {video}" for video in report.get("video", [])),
+        *recording_lines(report.recording),
+        *(f"video {video}" for video in report.video or ()),
     ]
 
 
@@ -121,7 +120,7 @@ class Pipeline:
         for check in result.checks:
             say(f"[{label}]   " + check.line())
         report_path = write_json(
-            self.out / f"{name}.report.json", {**report, "gait": str(gait_path)}
+            self.out / f"{name}.report.json", report.with_files(gait=str(gait_path)).to_dict()
         )
         return result.passed, files_lines(report, gait_path, report_path)
 

@@ -56,6 +56,7 @@ from biped.pages.style import KNEE_STYLE, save
 from biped.pages.walk_figures import TORQUES_FIGURE, has_profiles, torques_figure
 from biped.pages.walk_figures import walk_lines as mujoco_walk_lines
 from biped.records.gait_file import Gait
+from biped.records.validation_report import ValidationReport
 from biped.runtime.files import atomic_set
 
 # What each constraint of eq. (28) keeps.
@@ -490,13 +491,13 @@ class Link:
 @dataclass
 class Page:
     """One gait's page: its name (files ``<name>.md`` and ``<name>/``), the gait file's path
-    and record (``Gait.read``), its validation report (JSON content, or None) and the
+    and record (``Gait.read``), its validation report (``ValidationReport``, or None) and the
     report's path, and links (recording, video)."""
 
     name: str
     source: Path
     gait: Gait
-    validation: dict | None = None
+    validation: ValidationReport | None = None
     validation_source: Path | None = None
     links: list[Link] = field(default_factory=list)
 
@@ -531,7 +532,7 @@ def markdown(page: Page, folder: Path) -> str:
     lines = [f"# {title}", ""]
     lines += [f"Gait file [`{page.source}`]({_relative(page.source, folder)}): {optimum}."]
     if page.validation is not None:
-        verdict = "PASS" if page.validation.get("passed") else "FAIL"
+        verdict = "PASS" if page.validation.passed else "FAIL"
         lines += [f"Validation in MuJoCo: **{verdict}** (below)."]
     else:
         lines += [
@@ -829,30 +830,25 @@ def _knee_sentence(gait: Gait) -> str:
 
 def _validation_lines(page: Page, folder: Path) -> list[str]:
     report = page.validation
-    units = report.get("units") or {}
-    verdict = "PASS" if report.get("passed") else "FAIL"
+    verdict = "PASS" if report.passed else "FAIL"
     lines = ["## Validation in MuJoCo", ""]
     if page.validation_source is not None:
         where = _relative(page.validation_source, folder)
         lines += [f"Report [`{page.validation_source}`]({where}): **{verdict}**.", ""]
     figure = f"{page.name}/{TORQUES_FIGURE}" if has_profiles(report) else None
     lines += mujoco_walk_lines(report, figure)
-    for check, figures in report.items():
-        if not isinstance(figures, dict) or "passed" not in figures:
-            continue
-        causes = figures.get("causes") or []
-        said = f" ({', '.join(causes)})" if causes else ""
-        lines += [f"### {check}: {'PASS' if figures['passed'] else 'FAIL'}{said}", ""]
+    for check in report.checks:
+        said = f" ({', '.join(check.causes)})" if check.causes else ""
+        lines += [f"### {check.name}: {'PASS' if check.passed else 'FAIL'}{said}", ""]
         lines += ["| figure | value | unit |", "|---|---|---|"]
-        for name, value in figures.items():
+        for name, value in check.figures.items():
             if name not in NOT_TABLED:
-                unit = unit_text(units.get(f"{check}.{name}", ""))
+                unit = unit_text(check.units.get(name, ""))
                 lines += [f"| {name} | {_number(value)} | {unit} |"]
         lines += [""]
-        notes = figures.get("notes") or []
-        if notes:  # sentences, one a line (a list of two figures is a range: "low to high")
-            lines += [f"- {note}" for note in notes] + [""]
-        if check == "orbit":
+        if check.notes:  # sentences, one a line (a list of two figures is a range: "low to high")
+            lines += [f"- {note}" for note in check.notes] + [""]
+        if check.name == "orbit":
             lines += [f"![Floquet multipliers]({page.name}/{ORBIT_FIGURE})", ""]
     return lines
 
@@ -863,11 +859,11 @@ def page_figures(page: Page) -> dict[str, Figure]:
     has the torques over one step, MuJoCo's beside the model's (``TORQUES_FIGURE``)."""
     figures = gait_figures(page.gait)
     title = f"{page.gait.knee} knee, {page.gait.criterion}, {page.gait.speed:.3f} m/s"
-    orbit = (page.validation or {}).get("orbit")
-    if isinstance(orbit, dict):
-        figures[ORBIT_FIGURE] = multipliers_figure(orbit, title)
+    orbit = None if page.validation is None else page.validation.check("orbit")
+    if orbit is not None:
+        figures[ORBIT_FIGURE] = multipliers_figure(orbit.figures, title)
     if has_profiles(page.validation):
-        figures[TORQUES_FIGURE] = torques_figure(page.validation["forward"], title)
+        figures[TORQUES_FIGURE] = torques_figure(page.validation.check("forward").figures, title)
     if profile_lines(page.gait, page.name):
         figures[PROFILE_FIGURE] = profile_figure(page.gait, _circles_of(page))
     return figures

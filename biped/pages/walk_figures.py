@@ -21,6 +21,7 @@ from matplotlib.figure import Figure
 
 from biped.model.dynamics import JOINTS
 from biped.pages.figures import TIME_AXIS, bulk_limits, joint_label, note
+from biped.records.validation_report import ValidationReport
 
 # The page's figure of the torques over one step.
 TORQUES_FIGURE = "walk_torques.png"
@@ -58,18 +59,24 @@ def _over(a, b):
     return a / b
 
 
-def has_walk(report: dict | None) -> bool:
+def _figures(report: ValidationReport | None, check: str) -> dict:
+    """The figures of ``report``'s check ``check`` ({} without it)."""
+    found = None if report is None else report.check(check)
+    return {} if found is None else dict(found.figures)
+
+
+def has_walk(report: ValidationReport | None) -> bool:
     """Whether ``report`` holds the forward check's per-joint figures."""
-    forward = (report or {}).get("forward")
-    return isinstance(forward, dict) and all(name in forward for name in PER_JOINT)
+    forward = _figures(report, "forward")
+    return all(name in forward for name in PER_JOINT)
 
 
-def walk_lines(report: dict, figure: str | None = None) -> list[str]:
+def walk_lines(report: ValidationReport, figure: str | None = None) -> list[str]:
     """The page's section of MuJoCo's walk beside the model's (``has_walk``: none without
     it); ``figure``: the link to ``torques_figure``'s file."""
     if not has_walk(report):
         return []
-    forward, replay = report["forward"], report.get("feedforward") or {}
+    forward, replay = _figures(report, "forward"), _figures(report, "feedforward")
     steps = forward.get("steps")
     lines = [
         "### MuJoCo's walk beside the model's",
@@ -127,12 +134,10 @@ def walk_lines(report: dict, figure: str | None = None) -> list[str]:
     return lines
 
 
-def has_profiles(report: dict | None) -> bool:
+def has_profiles(report: ValidationReport | None) -> bool:
     """Whether ``report``'s forward check holds the torque profiles ``torques_figure`` draws."""
-    forward = (report or {}).get("forward")
-    return isinstance(forward, dict) and all(
-        name in forward for name in ("profile_phase", *PROFILES)
-    )
+    forward = _figures(report, "forward")
+    return all(name in forward for name in ("profile_phase", *PROFILES))
 
 
 def _array(rows) -> np.ndarray:

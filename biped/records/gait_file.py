@@ -73,6 +73,7 @@ from biped.optimization.problem import (
 )
 from biped.optimization.report import Report
 from biped.records.provenance import provenance as make_provenance
+from biped.records.validation_report import is_report
 from biped.runtime.files import atomic_write_text
 
 if TYPE_CHECKING:  # reading a gait file needs no solver (CasADi)
@@ -846,12 +847,8 @@ def other_kind(content) -> str | None:
 
 
 def _validation_report(content) -> bool:
-    """Whether ``content`` is a validation report (``validate.checks.validation.as_json``)."""
-    return (
-        isinstance(content, dict)
-        and "passed" in content
-        and isinstance(content.get("inverse_dynamics"), dict)
-    )
+    """Whether ``content`` is a validation report (``biped.records.validation_report``)."""
+    return is_report(content) and isinstance(content.get("inverse_dynamics"), dict)
 
 
 def _check_scalars(content: dict, bad) -> None:

@@ -183,15 +183,8 @@ FIGURE_UNITS = {
 }
 
 
-def report_units(report: dict) -> dict:
-    """The ``units`` map of a report (``validate.checks.validation.as_json``): the unit of each
-    figure of its checks that ``FIGURE_UNITS`` names."""
-    units = {}
-    for check, figures in report.items():
-        if not isinstance(figures, dict):
-            continue
-        for name in figures:
-            unit = FIGURE_UNITS.get(check, {}).get(name)
-            if unit is not None:
-                units[f"{check}.{name}"] = unit
-    return units
+def figure_units(check: str, figures) -> dict:
+    """The unit of each figure of the check ``check`` that ``FIGURE_UNITS`` names, in the
+    figures' order (figure name -> unit)."""
+    known = FIGURE_UNITS.get(check, {})
+    return {name: known[name] for name in figures if name in known}

@@ -4,7 +4,8 @@
 ``validate.walk.contact``) and the orbit check of ``validate.checks.orbit``, and returns them,
 with the gait and what the recording and the video draw, as one ``Validation``
 (``validate.outputs.record.record`` and ``validate.outputs.video.write_video`` take it whole);
-``as_json`` gives the report: one object per check with its ``passed``, ``notes`` and
+``validation_report`` gives the report (``biped.records.validation_report.ValidationReport``):
+one ``CheckResult`` per check with its figures and their units, ``passed``, ``notes`` and
 ``causes`` (why it fails, in words of ``validate.checks.checks.CAUSES``; ``Check.line`` prints
 one line per check, its causes first).
 """
@@ -19,15 +20,17 @@ import numpy as np
 
 from biped.model.dynamics import Biped
 from biped.records.gait_file import Gait
+from biped.records.validation_report import CheckResult, ValidationReport
 from validate import DEFAULT_STEPS
 from validate.checks import checks as c
 from validate.checks.checks import EXACT, Check
 from validate.checks.orbit import Orbit, check_orbit
+from validate.checks.units import figure_units
 from validate.scene.model import compile_spec, model_spec
 from validate.walk.samples import GaitSamples
 from validate.walk.simulate import Simulation, Walker
 
-__all__ = ["EXACT", "Check", "Validation", "as_json", "validate"]
+__all__ = ["EXACT", "Check", "Validation", "validate", "validation_report"]
 
 
 @dataclass
@@ -74,28 +77,34 @@ def validate(
     return Validation(gait, results + [orbit], biped, samples, sim, reaction, found)
 
 
-def as_json(checks) -> dict:
-    """One object per check (its figures, ``passed``, ``notes`` and ``causes``), and
-    ``passed``."""
+def validation_report(checks) -> ValidationReport:
+    """The report of ``checks`` (``biped.records.validation_report``): each check's figures
+    (NaN, a figure that could not be measured, as None: JSON has none) with their units
+    (``validate.checks.units.figure_units``), verdict, notes and causes."""
+    return ValidationReport(tuple(check_result(check) for check in checks))
 
-    def clean(value):  # JSON has no NaN: a figure that could not be measured is null
-        if isinstance(value, (np.bool_, bool)):
-            return bool(value)
-        if isinstance(value, (np.integer, int)):
-            return int(value)
-        if isinstance(value, (float, np.floating)):
-            return None if np.isnan(value) else float(value)
-        if isinstance(value, (list, tuple)):
-            return [clean(v) for v in value]
-        return value
 
-    content = {}
-    for check in checks:
-        content[check.name] = {
-            **{k: clean(v) for k, v in check.figures.items()},
-            "passed": bool(check.passed),
-            "notes": list(check.notes),
-            "causes": list(check.causes),  # why it fails, among validate.checks.checks.CAUSES
-        }
-    content["passed"] = all(check.passed for check in checks)
-    return content
+def check_result(check: Check) -> CheckResult:
+    """A check as its report holds it, its figures as JSON values."""
+    figures = {name: _clean(value) for name, value in check.figures.items()}
+    return CheckResult(
+        check.name,
+        bool(check.passed),
+        figures,
+        figure_units(check.name, figures),
+        tuple(check.notes),
+        tuple(check.causes),  # why it fails, among validate.checks.checks.CAUSES
+    )
+
+
+def _clean(value):
+    """A figure as a JSON value: Python's numbers, None for NaN (not measured)."""
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, int)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return None if np.isnan(value) else float(value)
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    return value

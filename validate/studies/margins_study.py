@@ -76,7 +76,7 @@ def measure(setting: Setting) -> dict:
     from biped.optimization.optimize import optimize
     from biped.optimization.problem import GaitProblem
     from biped.records.gait_file import Gait
-    from validate.checks.validation import as_json, validate
+    from validate.checks.validation import validate, validation_report
 
     robot = biped.Robot.paper()
     problem = GaitProblem(biped.Biped(robot, setting.knee), setting.speed, safety=setting.safety())
@@ -85,18 +85,16 @@ def measure(setting: Setting) -> dict:
     row["criterion"] = float(optimum.value)
     if not optimum.certified:
         return {**row, "passed": False, "feedback_share": None, "energy_error": None}
-    report = as_json(validate(Gait.from_optimum(optimum, robot)).checks)
-    forward = report["forward"]
+    report = validation_report(validate(Gait.from_optimum(optimum, robot)).checks)
+    forward = report.check("forward").figures
     modelled = forward["analytic_energy_per_step"]
     return {
         **row,
-        "passed": report["passed"],
-        "failed": [
-            name for name, check in report.items() if name != "passed" and not check["passed"]
-        ],
+        "passed": report.passed,
+        "failed": list(report.failed()),
         "feedback_share": forward["feedback_share"],
         "energy_error": forward["energy_per_step"] / modelled - 1.0,
-        "touchdown_speed": report["impact"]["landing_speed"],
+        "touchdown_speed": report.check("impact").figures["landing_speed"],
         "swing_clearance": forward["swing_clearance"],
     }
 
