@@ -82,6 +82,39 @@ def test_the_csv_gives_the_cost_of_transport_of_the_energies_per_metre_only():
             assert float(value) == pytest.approx(expected, rel=1e-5)
 
 
+def test_a_csv_line_is_its_record_and_reads_back_to_the_same_line():
+    """A line of atlas.csv is ``AtlasLine.to_csv``'s, each field in its column with its unit
+    (a knee's cost in its criterion's); read back (``from_csv``) it writes the same line. A
+    cell without a difference leaves the costs, the verdict and the uncertainty empty, never
+    0, and says why; a line of another width is refused."""
+    from biped.model.units import declared_units
+    from biped.pages.atlas_line import COLUMNS, AtlasLine
+
+    diff = Difference(-1.25, 0.1, -2e-8, 0.0, -0.5, why="")
+    finals = [{"costs": {"electrical": v}, "starts_at_best": 3} for v in (310.0, 306.125)]
+    rows = [
+        pages.Row("electrical", Cell(0.4, 0.01, 0.1), diff, *finals),
+        pages.Row(
+            "sthenic", Cell(0.3, 0.0, 0.0), Difference(None, *[None] * 4, 'a "X"'), None, None
+        ),
+    ]
+    for row in rows:
+        text = pages.line(row, ROBOT.weight).to_csv()
+        assert text == pages.csv_text([row], ROBOT.weight).splitlines()[1]
+        record = AtlasLine.from_csv(text)
+        assert record.to_csv() == text  # the figures to the digits the line gives
+    full, empty = (AtlasLine.from_csv(pages.line(row, ROBOT.weight).to_csv()) for row in rows)
+    assert full.cost_of_transport_rolling == pytest.approx(306.125 / ROBOT.weight, rel=1e-5)
+    assert full.distinguishable is True and full.starts_at_best_rolling == 3
+    assert empty.revolute is None and empty.distinguishable is None and empty.uncertainty is None
+    assert empty.why_empty == 'a "X"' and empty.walks_rolling == "not walked"
+    units = declared_units(AtlasLine, criterion="electrical")
+    assert units["revolute"] == "J/m" and units["speed"] == "m/s" and units["difference"] == "%"
+    assert len(COLUMNS) == len(units) + 6  # criterion, unit, verdict and three sentences
+    with pytest.raises(ValueError, match="cells in a line"):
+        AtlasLine.from_csv("0.300,0.000")
+
+
 @pytest.fixture(scope="module")
 def small(tmp_path_factory):
     folder = tmp_path_factory.mktemp("atlas")

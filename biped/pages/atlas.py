@@ -19,6 +19,7 @@ import numpy as np
 
 from biped.model.criteria import CRITERION_UNITS
 from biped.model.kinematics import KNEES
+from biped.pages.atlas_line import COLUMNS, AtlasLine
 from biped.pages.style import ATLAS_DPI, save
 from biped.runtime.files import atomic_write_text
 from biped.studies.atlas import (
@@ -109,79 +110,58 @@ def rows(folder, settings: Settings, walked: bool = True) -> list[Row]:
     return found
 
 
-COLUMNS = (
-    "speed [m/s]",
-    "clearance [m]",
-    "knee bend [rad]",
-    "knots",
-    "criterion",
-    "unit",
-    "revolute",
-    "rolling",
-    "difference [%]",
-    "uncertainty [%]",
-    "distinguishable",
-    "discretization [%]",
-    "tolerance [%]",
-    "starts spread [%]",
-    "starts at best revolute",
-    "starts at best rolling",
-    f"difference with {RICHER_KNOTS} knots [%]",
-    "cost of transport revolute",
-    "cost of transport rolling",
-    "why empty",
-    "walks revolute",
-    "walks rolling",
-)
 # The criteria that are an energy per metre walked: their cost of transport is the value over
 # the robot's weight m g (dimensionless).
 PER_METRE_ENERGIES = ("energy-per-metre", "electrical")
 
 
+def line(row: Row, weight: float) -> AtlasLine:
+    """The line of ``atlas.csv`` of ``row``; ``weight`` [N] is the robot's, m g, for the cost
+    of transport of the per-metre energies. A knee's cost is there only with a difference."""
+    d = row.difference
+    revolute, rolling = (
+        None if r is None or d.value is None else r["costs"][row.criterion]
+        for r in (row.revolute, row.rolling)
+    )
+
+    def transport(cost):
+        return None if cost is None or row.criterion not in PER_METRE_ENERGIES else cost / weight
+
+    return AtlasLine(
+        speed=row.cell.speed,
+        clearance=row.cell.clearance,
+        knee_bend=row.cell.knee_bend,
+        knots=1,
+        criterion=row.criterion,
+        unit=CRITERION_UNITS[row.criterion],
+        revolute=revolute,
+        rolling=rolling,
+        difference=d.value,
+        uncertainty=d.uncertainty,
+        distinguishable=None if d.value is None else d.distinguishable,
+        discretization=d.discretization,
+        tolerance=d.tolerance,
+        starts_spread=d.starts,
+        starts_at_best_revolute=_starts(row.revolute),
+        starts_at_best_rolling=_starts(row.rolling),
+        richer_difference=d.richer,
+        cost_of_transport_revolute=transport(revolute),
+        cost_of_transport_rolling=transport(rolling),
+        why_empty=why_empty(d),
+        walks_revolute=walk_words(row, "revolute"),
+        walks_rolling=walk_words(row, "rolling"),
+    )
+
+
+def _starts(final: dict | None) -> int | None:
+    """The starts that reached a knee's final optimum (its record's), None without one."""
+    return None if final is None else int(final["starts_at_best"])
+
+
 def csv_text(table: list[Row], weight: float) -> str:
-    """``atlas.csv``: one line per cell and criterion, in ``COLUMNS``; ``weight`` [N] is the
-    robot's, m g, for the cost of transport of the per-metre energies."""
-
-    def number(value, digits):
-        return "" if value is None else f"{value:.{digits}g}"
-
-    lines = [",".join(COLUMNS)]
-    for row in table:
-        d = row.difference
-        costs = [
-            None if r is None or d.value is None else r["costs"][row.criterion]
-            for r in (row.revolute, row.rolling)
-        ]
-        starts = [
-            "" if r is None else str(r["starts_at_best"]) for r in (row.revolute, row.rolling)
-        ]
-        cells = [
-            f"{row.cell.speed:.3f}",
-            f"{row.cell.clearance:.3f}",
-            f"{row.cell.knee_bend:.3f}",
-            "1",
-            row.criterion,
-            CRITERION_UNITS[row.criterion],
-            number(costs[0], 10),
-            number(costs[1], 10),
-            number(d.value, 6),
-            number(d.uncertainty, 3),
-            "" if d.value is None else ("yes" if d.distinguishable else "no"),
-            number(d.discretization, 3),
-            number(d.tolerance, 3),
-            number(d.starts, 3),
-            *starts,
-            number(d.richer, 6),
-            *(
-                number(
-                    None if c is None or row.criterion not in PER_METRE_ENERGIES else c / weight, 6
-                )
-                for c in costs
-            ),
-            _quoted(why_empty(d)),
-            *(_quoted(walk_words(row, knee)) for knee in KNEES),
-        ]
-        lines.append(",".join(cells))
+    """``atlas.csv``: its header (``COLUMNS``) and one line per cell and criterion
+    (``line``); ``weight`` [N] is the robot's, m g."""
+    lines = [",".join(COLUMNS), *(line(row, weight).to_csv() for row in table)]
     return "\n".join(lines) + "\n"
 
 
@@ -202,10 +182,6 @@ def why_empty(d: Difference) -> str:
     if d.why:
         return d.why
     return "; ".join(f"{what} not measured ({why})" for what, why in d.unmeasured)
-
-
-def _quoted(text: str) -> str:
-    return "" if not text else '"' + text.replace('"', '""') + '"'
 
 
 def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = False):
