@@ -297,7 +297,7 @@ def test_a_re_solve_that_did_not_converge_measures_nothing(tmp_path):
 
 def _walk(passed: bool, cause: str = "") -> atlas.Walk:
     """A made-up walk of the forward walk alone."""
-    return atlas.Walk(False, {"forward": {"passed": passed, "cause": cause, "notes": []}}, {})
+    return atlas.Walk(False, {"forward": atlas.WalkCheck(passed, cause)}, {})
 
 
 def _drawn_figure(speeds, clearances, criterion):
@@ -425,10 +425,11 @@ def test_every_certified_optimum_gets_a_walk_record(small, walked):
             content = json.loads((folder / point.at(atlas.WALKS).filename()).read_text())
             walk = atlas.read_walk(folder, point)
             assert walk.every_check and list(walk.checks) == EVERY_CHECK
-            assert walk.walks == all(c["passed"] for c in walk.checks.values())
+            assert walk.walks == all(c.passed for c in walk.checks.values())
             assert content["walks"] == walk.walks and content["gait"] == point.gait_filename()
-            assert walk.checks["orbit"]["passed"] == (walk.figures["orbit_verdict"] == "stable")
-            assert all(bool(c["cause"]) != c["passed"] for c in walk.checks.values())
+            assert walk.checks["orbit"].passed == (walk.figures["orbit_verdict"] == "stable")
+            assert all(bool(c.cause) != c.passed for c in walk.checks.values())
+            assert {n: c.to_dict() for n, c in walk.checks.items()} == content["checks"]
             assert 0 <= walk.figures["steps"] <= 20 and walk.figures["spectral_radius"] > 0
             for name in ("max_slip", "feedback_share", "replay_feedback_share"):
                 assert content["units"][f"figures.{name}"] and walk.figures[name] >= 0

@@ -35,6 +35,7 @@ import dataclasses
 import json
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -630,23 +631,40 @@ WALK_FORMAT = "biped-atlas-walk/1"
 
 
 @dataclass(frozen=True)
+class WalkCheck:
+    """One check of a walk as its record holds it: its verdict, why it failed in one note
+    (the orbit's verdict, another check's first note; "" if it passed) and all its notes."""
+
+    passed: bool
+    cause: str = ""
+    notes: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        return {"passed": bool(self.passed), "cause": self.cause, "notes": list(self.notes)}
+
+    @classmethod
+    def from_dict(cls, content: dict) -> WalkCheck:
+        notes = tuple(str(note) for note in content.get("notes") or ())
+        return cls(bool(content["passed"]), str(content.get("cause") or ""), notes)
+
+
+@dataclass(frozen=True)
 class Walk:
     """What MuJoCo's walk of one final optimum says, as its record holds it.
 
     Attributes:
         every_check: every check of ``biped validate`` was run (the corners, the best
             pay-off), else the forward walk with contact and the feedforward replay.
-        checks: each check run, by name: {"passed": bool, "cause": why it failed, in one
-            note ("" if it passed), "notes": [all its notes]}.
+        checks: each check run, by name, in the order run (``WalkCheck``).
         figures: the key figures (steps walked, fell, slip, feedback shares, energies per
             step, the orbit's spectral radius and verdict where checked), None where not
-            measured.
+            measured; their units in the record's ``units``.
         error: why the walk could not be measured (then it neither walks nor fails).
         steps: the steps of the forward walk asked.
     """
 
     every_check: bool
-    checks: dict
+    checks: Mapping[str, WalkCheck]
     figures: dict
     error: str | None = None
     steps: int | None = None
@@ -656,7 +674,7 @@ class Walk:
         """Every check run passes (an orbit only 'undecided' does not); None: not measured."""
         if self.error is not None or not self.checks:
             return None
-        return all(check["passed"] for check in self.checks.values())
+        return all(check.passed for check in self.checks.values())
 
     def causes(self) -> str:
         """Why the gait does not walk: each failed check with its cause ("" when it walks),
@@ -664,16 +682,16 @@ class Walk:
         if self.error is not None:
             return f"not measured: {self.error}"
         return "; ".join(
-            f"{name}: {check.get('cause') or 'failed'}"
+            f"{name}: {check.cause or 'failed'}"
             for name, check in self.checks.items()
-            if not check["passed"]
+            if not check.passed
         )
 
     @classmethod
     def from_dict(cls, content: dict) -> Walk:
         return cls(
             bool(content["every_check"]),
-            dict(content["checks"]),
+            {name: WalkCheck.from_dict(check) for name, check in content["checks"].items()},
             dict(content["figures"]),
             content.get("error"),
             content.get("steps_asked"),

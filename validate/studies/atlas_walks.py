@@ -117,14 +117,10 @@ def content(walk: WalkPoint, checks: list | None, error: str | None = None) -> d
         figures["energy_error"] = energies[0] / energies[1] - 1.0
         units["figures.energy_error"] = PURE
     checked = {
-        name: {
-            "passed": bool(check.passed),
-            "cause": _cause(check),
-            "notes": [str(n) for n in check.notes],
-        }
+        name: atlas.WalkCheck(bool(check.passed), _cause(check), tuple(map(str, check.notes)))
         for name, check in by_name.items()
     }
-    walks = None if error is not None or not checked else all(c["passed"] for c in checked.values())
+    walks = None if error is not None or not checked else all(c.passed for c in checked.values())
     cell = point.cell
     return {
         "format": atlas.WALK_FORMAT,
@@ -136,7 +132,7 @@ def content(walk: WalkPoint, checks: list | None, error: str | None = None) -> d
         "steps_asked": STEPS,
         "walks": walks,
         "error": error,
-        "checks": checked,
+        "checks": {name: check.to_dict() for name, check in checked.items()},
         "figures": figures,
         "units": {
             "cell.speed": "m/s",
