@@ -67,6 +67,16 @@ def test_a_difference_no_larger_than_its_uncertainty_is_not_distinguishable():
     assert line[pages.COLUMNS.index("distinguishable")] == "no"
 
 
+def test_the_csv_names_the_atlas_gait_family():
+    """The knots column is the family the atlas solved (--knots), not always the paper's."""
+    diff = Difference(-1.0, discretization=0.1, tolerance=0.0, starts=0.1, richer=None, why="")
+    row = pages.Row("sthenic", Cell(0.3, 0.0, 0.0), diff, None, None)
+    column = pages.COLUMNS.index("knots")
+    for knots in (1, 7):
+        line = pages.csv_text([row], ROBOT.weight, knots).splitlines()[1].split(",")
+        assert line[column] == str(knots)
+
+
 def test_the_csv_gives_the_cost_of_transport_of_the_energies_per_metre_only():
     """The cost of transport of a per-metre energy is its value over m g; the sthenic
     criterion has none."""

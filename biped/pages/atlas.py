@@ -115,9 +115,10 @@ def rows(folder, settings: Settings, walked: bool = True) -> list[Row]:
 PER_METRE_ENERGIES = ("energy-per-metre", "electrical")
 
 
-def line(row: Row, weight: float) -> AtlasLine:
+def line(row: Row, weight: float, knots: int = 1) -> AtlasLine:
     """The line of ``atlas.csv`` of ``row``; ``weight`` [N] is the robot's, m g, for the cost
-    of transport of the per-metre energies. A knee's cost is there only with a difference."""
+    of transport of the per-metre energies; ``knots`` the interior knots of the atlas's gait
+    family. A knee's cost is there only with a difference."""
     d = row.difference
     revolute, rolling = (
         None if r is None or d.value is None else r["costs"][row.criterion]
@@ -131,7 +132,7 @@ def line(row: Row, weight: float) -> AtlasLine:
         speed=row.cell.speed,
         clearance=row.cell.clearance,
         knee_bend=row.cell.knee_bend,
-        knots=1,
+        knots=knots,
         criterion=row.criterion,
         unit=CRITERION_UNITS[row.criterion],
         revolute=revolute,
@@ -158,10 +159,10 @@ def _starts(final: dict | None) -> int | None:
     return None if final is None else int(final["starts_at_best"])
 
 
-def csv_text(table: list[Row], weight: float) -> str:
+def csv_text(table: list[Row], weight: float, knots: int = 1) -> str:
     """``atlas.csv``: its header (``COLUMNS``) and one line per cell and criterion
     (``line``); ``weight`` [N] is the robot's, m g."""
-    lines = [",".join(COLUMNS), *(line(row, weight).to_csv() for row in table)]
+    lines = [",".join(COLUMNS), *(line(row, weight, knots).to_csv() for row in table)]
     return "\n".join(lines) + "\n"
 
 
@@ -608,7 +609,8 @@ def write(folder, out=None, walked: bool = True) -> list[Path]:
     out = Path(folder if out is None else out)
     out.mkdir(parents=True, exist_ok=True)
     table = rows(folder, settings, walked)
-    written = [atomic_write_text(out / "atlas.csv", csv_text(table, settings.robot.weight))]
+    text = csv_text(table, settings.robot.weight, settings.knots)
+    written = [atomic_write_text(out / "atlas.csv", text)]
     for criterion in settings.criteria:
         path = out / f"atlas-{criterion}.png"
         written.append(save(figure(settings, table, criterion, walked), path, ATLAS_DPI))
