@@ -53,32 +53,52 @@ def _stand_in(*args, **kwargs):
     raise WorkStarted
 
 
+# The work a command may start, by module: every name bound to one of these functions in a
+# module of the project (``from x import optimize`` binds its own) is replaced.
+WORK = [
+    ("biped.optimization.optimize", "optimize"),
+    ("biped.optimization.optimize", "multistart"),
+    ("biped.optimization.design", "compare"),
+    ("biped.optimization.design", "optimize_design"),
+    ("biped.optimization.profile_design", "compare_profile"),
+    ("biped.optimization.profile_design", "optimize_profile"),
+    ("biped.optimization.two_phase", "optimize_two_phase"),
+    ("biped.optimization.ladder", "climb"),
+    ("biped.studies.sweep", "run_sweep"),
+    ("biped.studies.design_map", "run_design_map"),
+    ("biped.studies.atlas", "run_atlas"),
+    ("biped.pages.figures", "make_figures"),
+    ("validate.checks.validation", "validate"),
+    ("validate.studies.robustness", "robustness_map"),
+    ("validate.studies.orbit_study", "study"),
+]
+
+
 @pytest.fixture
 def no_work(monkeypatch):
-    """The optimiser, the sweep, the design map, the atlas, the figures, the MuJoCo validation, the
-    robustness map and the orbit study stop the command."""
-    import biped.optimization.design
-    import biped.optimization.optimize
-    import biped.pages.figures
-    import biped.studies.atlas
-    import biped.studies.design_map
-    import biped.studies.sweep
-    import validate.checks.validation
-    import validate.studies.orbit_study
-    import validate.studies.robustness
+    """The optimisers (single and two-phase, knee design and profile, the ladder of gait
+    families), the sweep, the design map, the atlas, the figures, the MuJoCo validation, the
+    robustness map and the orbit study stop the command, wherever a module bound them."""
+    import importlib
+    import pkgutil
+    import sys
 
-    for module, name in [
-        (biped.optimization.optimize, "optimize"),
-        (biped.studies.sweep, "run_sweep"),
-        (biped.optimization.design, "compare"),
-        (biped.studies.design_map, "run_design_map"),
-        (biped.studies.atlas, "run_atlas"),
-        (biped.pages.figures, "make_figures"),
-        (validate.checks.validation, "validate"),
-        (validate.studies.robustness, "robustness_map"),
-        (validate.studies.orbit_study, "study"),
-    ]:
-        monkeypatch.setattr(module, name, _stand_in)
+    import biped
+    import biped_cli
+    import validate
+
+    for package in (biped, biped_cli, validate):
+        for module in pkgutil.walk_packages(package.__path__, package.__name__ + "."):
+            if not module.name.endswith("__main__"):
+                importlib.import_module(module.name)
+    work = {id(getattr(importlib.import_module(m), name)) for m, name in WORK}
+    assert len(work) == len(WORK)
+    for name, module in list(sys.modules.items()):
+        if name.split(".")[0] not in ("biped", "biped_cli", "validate"):
+            continue
+        for attribute, value in list(vars(module).items()):
+            if id(value) in work:
+                monkeypatch.setattr(module, attribute, _stand_in)
 
 
 @pytest.fixture
