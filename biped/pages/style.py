@@ -8,11 +8,12 @@ written, whoever reads the folder meanwhile.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from biped.runtime.files import atomic_path
+from biped.runtime.files import atomic_path, atomic_set
 
 DPI = 120  # [dots/inch] of every figure written
 # [dots/inch] of the atlas's maps: wide figures of one panel per knee bend, kept at the
@@ -32,3 +33,12 @@ def save(figure: Figure, path: str | Path, dpi: float = DPI) -> Path:
     with atomic_path(path) as staging:
         figure.savefig(staging, dpi=dpi, format="png")
     return path
+
+
+def save_with_json(out: str | Path, name: str, kind: str, content: dict, figure: Figure) -> None:
+    """``<out>/<name>.json`` (``content``) and ``<out>/<name>.png`` (``figure``), both or
+    neither (``atomic_set`` under the label ``<kind>-<name>``)."""
+    with atomic_set(out, f"{kind}-{name}") as staging:
+        text = json.dumps(content, indent=1, allow_nan=False)
+        (staging / f"{name}.json").write_text(text, encoding="utf-8")
+        save(figure, staging / f"{name}.png")

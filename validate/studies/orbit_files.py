@@ -6,7 +6,6 @@ both were given at (``KneePair``, and per criterion ``KneeMean``) and ``<out>/kn
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,10 +15,9 @@ import numpy as np
 from biped.model.units import unit_field
 from biped.pages.orbit_figures import SPREADS, knob_figure, multipliers_figure, rho_difference
 from biped.pages.orbit_figures import speeds_figure as knees_figure
-from biped.pages.style import save
+from biped.pages.style import save, save_with_json
 from biped.records.gait_file import Gait
 from biped.records.provenance import provenance
-from biped.runtime.files import atomic_set
 from biped.runtime.runner import ProgressBar
 from validate.checks.orbit import Steps
 from validate.studies.orbit_study import OrbitStudy, StudiedOrbit, study
@@ -97,10 +95,7 @@ def write(out: Path, name: str, found: OrbitStudy) -> None:
     else:
         figure = knob_figure(body, title(found))
     content = {**body, "provenance": provenance()}
-    with atomic_set(out, f"orbit-{name}") as staging:
-        text = json.dumps(content, indent=1, allow_nan=False)
-        (staging / f"{name}.json").write_text(text, encoding="utf-8")
-        save(figure, staging / f"{name}.png")
+    save_with_json(out, name, "orbit", content, figure)
 
 
 def run_orbits(

@@ -5,7 +5,6 @@ none where the nominal walk fails.
 
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -14,10 +13,9 @@ from pathlib import Path
 from biped.errors import BipedError
 from biped.model.units import unit_field
 from biped.pages.robustness_figure import robustness_figure
-from biped.pages.style import save
+from biped.pages.style import save_with_json
 from biped.records.gait_file import Gait
 from biped.records.provenance import provenance
-from biped.runtime.files import atomic_set
 from biped.runtime.runner import ProgressBar
 from validate.scene.model import committed_model
 from validate.studies.robustness import GaitMap, RobustnessSettings, robustness_map
@@ -52,10 +50,7 @@ def write(out: Path, name: str, mapped: GaitMap) -> None:
     content = {**mapped.to_dict(), "provenance": provenance()}
     title = f"{mapped.gait}: {mapped.knee} knee, {mapped.speed} m/s"
     figure = robustness_figure(mapped.map, title)
-    with atomic_set(out, f"robustness-{name}") as staging:
-        text = json.dumps(content, indent=1, allow_nan=False)
-        (staging / f"{name}.json").write_text(text, encoding="utf-8")
-        save(figure, staging / f"{name}.png")
+    save_with_json(out, name, "robustness", content, figure)
 
 
 def map_gaits(
