@@ -430,13 +430,14 @@ def test_a_pipeline_without_video_removes_the_earlier_runs_video(tmp_path, monke
     from types import SimpleNamespace
 
     from biped.model.criteria import PAPER_SAFETY
+    from biped.records.validation_report import ValidationReport
     from validate import workflows
 
     def validated(gait, rrd, *, steps, video, source):
         assert video is None
         Path(rrd).write_bytes(b"a recording")
         result = SimpleNamespace(checks=[], passed=True)
-        return result, {"recording": str(rrd)}
+        return result, ValidationReport(checks=(), recording=str(rrd))
 
     monkeypatch.setattr(workflows, "validate_and_record", validated)
     recordings = tmp_path / "recordings"
