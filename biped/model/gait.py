@@ -169,11 +169,41 @@ class StepBuildError(BipedError):
         self.excess = excess  # how far outside the allowed set, for a graded penalty
 
 
-def build_step(model: Biped, speed: float, p, knots: int = 1) -> Step:
-    """Spline coefficients of one step from the parameters (``parameter_names(knots)``; the
-    paper's 21 for 1 knot) at walking speed ``speed``."""
+@dataclass(frozen=True)
+class StepEnds:
+    """The ends of one step fixed by the parameters every family shares (the hip, the trunk,
+    the end rates and the period): the conditions of §3.2 (flat feet, leg swap, impact map).
+
+    Attributes:
+        period: T [s].
+        step_length: S = V T [m].
+        start_angles, start_rates: the six free angles [rad] and their rates [rad/s] just
+            after the impact at t = 0.
+        end_angles, end_rates: the same just before the impact at t = T.
+        start: q, q̇ (9,) at t = 0; end: q, q̇⁻ (9,) at t = T.
+        impulse: I_R (3,) of the landing at t = T [N·s, N·s, N·m·s].
+    """
+
+    period: float
+    step_length: float
+    start_angles: np.ndarray
+    start_rates: np.ndarray
+    end_angles: np.ndarray
+    end_rates: np.ndarray
+    start: tuple
+    end: tuple
+    impulse: np.ndarray
+
+    @property
+    def conditions(self) -> tuple:
+        """(start angles, start rates, end angles, end rates), each (6,)."""
+        return (self.start_angles, self.start_rates, self.end_angles, self.end_rates)
+
+
+def step_ends(model: Biped, speed: float, p, size: int) -> StepEnds:
+    """The ends of the step of the parameters ``p`` (``size`` of them: the hip, the trunk
+    and the five end rates first, the period last) at walking speed ``speed``."""
     p = np.asarray(p, dtype=float)
-    size = len(parameter_names(knots))
     if p.shape != (size,):
         raise BipedError(f"gait parameters have shape {p.shape}: allowed ({size},)")
     if not np.all(np.isfinite(p)):
@@ -197,20 +227,37 @@ def build_step(model: Biped, speed: float, p, knots: int = 1) -> Step:
     q_end, qd_end, _ = model.stance_state(end_angles, end_rates)
     qd_plus, impulse = model.impact(q_end, qd_end)
     q_start, qd_start = swap_legs(model, q_end, qd_plus)
-    start_rates = qd_start[1:7]
-    ends = (start_angles, start_rates, end_angles, end_rates)
-    if knots == 1:
-        pieces = paper_pieces(period, *ends, p[8:14], p[14:20])
-    else:
-        pieces = _hermite_pieces(period, *ends, p[8:-1].reshape(knots, 2, 6))
-    return Step(
-        pieces=pieces,
-        knots=knots,
+    return StepEnds(
         period=float(period),
         step_length=float(length),
+        start_angles=start_angles,
+        start_rates=qd_start[1:7],
+        end_angles=end_angles,
+        end_rates=end_rates,
         start=(q_start, qd_start),
         end=(q_end, qd_end),
         impulse=impulse,
+    )
+
+
+def build_step(model: Biped, speed: float, p, knots: int = 1) -> Step:
+    """Spline coefficients of one step from the parameters (``parameter_names(knots)``; the
+    paper's 21 for 1 knot) at walking speed ``speed``."""
+    p = np.asarray(p, dtype=float)
+    ends = step_ends(model, speed, p, len(parameter_names(knots)))
+    period = ends.period
+    if knots == 1:
+        pieces = paper_pieces(period, *ends.conditions, p[8:14], p[14:20])
+    else:
+        pieces = _hermite_pieces(period, *ends.conditions, p[8:-1].reshape(knots, 2, 6))
+    return Step(
+        pieces=pieces,
+        knots=knots,
+        period=period,
+        step_length=ends.step_length,
+        start=ends.start,
+        end=ends.end,
+        impulse=ends.impulse,
     )
 
 

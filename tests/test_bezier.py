@@ -1,0 +1,169 @@
+"""The Bézier gait family (``biped.model.bezier``): its curves meet the step's end
+conditions (flat feet, leg swap, impact map) exactly, a degree's curve is the same motion
+in every higher degree (a nested ladder), and its rates and accelerations are the
+derivatives of its angles."""
+
+import numpy as np
+import pytest
+
+import biped
+from biped.model.bezier import (
+    DEGREES,
+    MAX_DEGREE,
+    MIN_DEGREE,
+    bernstein,
+    build_bezier_step,
+    check_degree,
+    elevate,
+    embedded,
+    embedded_parameters,
+    evaluate,
+    parameter_names,
+    sample,
+)
+from biped.model.gait import FREE_SWAP
+from biped.model.kinematics import swap_legs
+from biped.optimization.problem import GaitProblem
+
+SPEED = 0.3
+
+
+def _model(knee="rolling"):
+    return biped.Biped(biped.Robot.paper(), knee=knee)
+
+
+def _parameters(model, degree, seed=0):
+    """A step of ``degree``: the paper's first guess's ends, interior points spread evenly
+    between the fixed ones and perturbed by 0.05 rad (seeded)."""
+    paper = GaitProblem(model, SPEED).first_parameters()
+    p = np.concatenate([paper[:8], np.zeros(6 * (degree - 3)), paper[-1:]])
+    ends = build_bezier_step(model, SPEED, np.concatenate([paper[:8], paper[-1:]]), 3)
+    line = np.linspace(ends.control[1], ends.control[2], degree - 1)[1:-1]
+    noise = 0.05 * np.random.default_rng(seed).standard_normal(line.shape)
+    p[8:-1] = (line + noise).ravel()
+    return p
+
+
+def test_the_degrees_are_named_and_others_refused():
+    assert DEGREES == tuple(range(MIN_DEGREE, MAX_DEGREE + 1)) and MIN_DEGREE == 3
+    assert [len(parameter_names(n)) for n in (3, 5, 9)] == [9, 21, 45]
+    assert parameter_names(5)[8:14] == tuple(
+        f"control2_{a}" for a in ("qp2", "q1", "q2", "q3", "q4", "q5")
+    )
+    for bad in (2, MAX_DEGREE + 1, True, "5", 5.0):
+        with pytest.raises(biped.BipedError, match="degree = .*allowed an integer from 3 to"):
+            check_degree(bad)
+    model = _model()
+    with pytest.raises(biped.BipedError, match=r"shape \(20,\): allowed \(21,\)"):
+        build_bezier_step(model, SPEED, np.zeros(20), 5)
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+@pytest.mark.parametrize("degree", [3, 5, 9])
+def test_a_curve_meets_the_steps_end_conditions(knee, degree):
+    """At t = 0 and T the angles and rates are the step's states (the stance foot's angle
+    0, both feet flat), the end posture is the start's with the legs swapped, and the start
+    rates are the impact map of the end rates, the legs swapped: computed here from the end
+    state alone."""
+    model = _model(knee)
+    step = build_bezier_step(model, SPEED, _parameters(model, degree), degree)
+    angles, rates, _ = evaluate(step, np.array([0.0, 1.0]))
+    (q0, qd0), (q1, qd1) = step.start, step.end
+    np.testing.assert_allclose(angles[0], q0[1:7], atol=1e-14)
+    np.testing.assert_allclose(rates[0], qd0[1:7], atol=1e-12)
+    np.testing.assert_allclose(angles[1], q1[1:7], atol=1e-14)
+    np.testing.assert_allclose(rates[1], qd1[1:7], atol=1e-12)
+    assert angles[1][0] == 0.0 and rates[1][0] == 0.0  # swing foot flat and at rest
+    np.testing.assert_allclose(angles[1], angles[0][FREE_SWAP], atol=1e-14)
+    qd_plus, _ = model.impact(q1, qd1)
+    _, start = swap_legs(model, q1, qd_plus)
+    np.testing.assert_allclose(rates[0], start[1:7], atol=1e-12)
+    # the end state is the stance state of those angles and rates (the hip from them)
+    q_end, qd_end, _ = model.stance_state(angles[1], rates[1])
+    np.testing.assert_allclose(q_end, q1, atol=1e-14)
+    np.testing.assert_allclose(qd_end, qd1, atol=1e-12)
+
+
+def test_a_wrong_end_point_breaks_the_start_rates():
+    """The check above fails a curve whose second control point is not q(0) + T q̇(0) / n."""
+    model = _model()
+    step = build_bezier_step(model, SPEED, _parameters(model, 5), 5)
+    control = np.array(step.control)
+    control[1] *= 1.0 + 1.0 / 5  # as if the slope were T q̇ / (n − 1)
+    rates = (bernstein(5, [0.0])[1] @ control) / step.period
+    assert not np.allclose(rates[0], step.start[1][1:7], atol=1e-6)
+
+
+@pytest.mark.parametrize("degree, higher", [(3, 4), (5, 6), (5, 9), (9, 20)])
+def test_a_higher_degree_holds_the_curve(degree, higher):
+    """Degree elevation: the curve of ``degree`` given to ``higher`` is the same motion
+    (angles, rates, accelerations to 1e-12 of their size on a fine grid) and the same
+    inverse dynamics; the nested ladder's rungs are never worse than the one below."""
+    model = _model()
+    p = _parameters(model, degree)
+    step = build_bezier_step(model, SPEED, p, degree)
+    rich = build_bezier_step(model, SPEED, embedded_parameters(step, p, higher), higher)
+    assert rich.degree == higher and rich.control.shape == (higher + 1, 6)
+    t = np.linspace(0.0, 1.0, 641)
+    for found, expected in zip(evaluate(rich, t), evaluate(step, t), strict=True):
+        np.testing.assert_allclose(found, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+    motion = zip(sample(model, rich, 40)[:6], sample(model, step, 40)[:6], strict=True)
+    for found, expected in motion:  # t, q, q̇, q̈, torques, wrench
+        np.testing.assert_allclose(found, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
+
+
+def test_a_wrong_elevation_is_another_curve():
+    """The shares of the elevation swapped (P'_i = (1 − i/(n+1)) P_(i−1) + i/(n+1) P_i) give
+    another motion: the check above would fail it."""
+    model = _model()
+    step = build_bezier_step(model, SPEED, _parameters(model, 5), 5)
+    control = step.control
+    n = control.shape[0] - 1
+    share = (np.arange(n + 2) / (n + 1))[:, None]
+    padded = np.vstack([np.zeros((1, 6)), control])
+    upper = np.vstack([control, np.zeros((1, 6))])
+    wrong = (1.0 - share) * padded + share * upper
+    t = np.linspace(0.0, 1.0, 33)
+    right = bernstein(n + 1, t)[0] @ elevate(control)
+    np.testing.assert_allclose(right, bernstein(n, t)[0] @ control, atol=1e-14)
+    assert np.abs(bernstein(n + 1, t)[0] @ wrong - right).max() > 1e-3
+
+
+def test_a_lower_degree_is_refused():
+    model = _model()
+    step = build_bezier_step(model, SPEED, _parameters(model, 7), 7)
+    with pytest.raises(biped.BipedError, match="degree = 5: a curve of degree 7 is held by"):
+        embedded(step, 5)
+
+
+@pytest.mark.parametrize("degree", [3, 7, 12])
+def test_rates_and_accelerations_are_the_angles_derivatives(degree):
+    """Central differences (h = 1e-5 s) of the angles and of the rates in physical time
+    match the rates and accelerations."""
+    model = _model()
+    step = build_bezier_step(model, SPEED, _parameters(model, degree, seed=degree), degree)
+    h = 1e-5 / step.period  # in normalised time
+    t = np.linspace(0.01, 0.99, 23)
+    angles, rates, accels = evaluate(step, t)
+    above, below = evaluate(step, t + h), evaluate(step, t - h)
+    dt = 2e-5
+    np.testing.assert_allclose((above[0] - below[0]) / dt, rates, atol=1e-7 * np.abs(rates).max())
+    np.testing.assert_allclose((above[1] - below[1]) / dt, accels, atol=1e-6 * np.abs(accels).max())
+
+
+def test_the_basis_sums_to_one_and_the_samples_are_the_curve():
+    """The Bernstein polynomials are a partition of unity (their derivatives sum to 0), and
+    ``sample``'s angles are ``evaluate``'s."""
+    t = np.linspace(0.0, 1.0, 17)
+    for n in (3, 8, MAX_DEGREE):
+        values, rates, accels = bernstein(n, t)
+        np.testing.assert_allclose(values.sum(axis=1), 1.0, atol=1e-14)
+        np.testing.assert_allclose(rates.sum(axis=1), 0.0, atol=1e-9)
+        np.testing.assert_allclose(accels.sum(axis=1), 0.0, atol=1e-7)
+    model = _model()
+    step = build_bezier_step(model, SPEED, _parameters(model, 6), 6)
+    time, q, qd, qdd, *_ = sample(model, step, 16)
+    angles, rates, accels = evaluate(step, t)
+    np.testing.assert_allclose(time, t * step.period, atol=1e-15)
+    np.testing.assert_allclose(q[:, 1:7], angles, atol=1e-14)
+    np.testing.assert_allclose(qd[:, 1:7], rates, atol=1e-12)
