@@ -229,6 +229,48 @@ def add_knots(parser) -> None:
     )
 
 
+FAMILIES = ("spline", "bezier")
+
+
+def add_bezier(parser) -> None:
+    """``--family spline|bezier`` and ``--degree n``: the Bézier family
+    (``biped.model.bezier``) beside the splines' ``--knots``."""
+    from biped.model.bezier import MAX_DEGREE, MIN_DEGREE
+
+    parser.add_argument(
+        "--family",
+        choices=FAMILIES,
+        default="spline",
+        help="the gait family: spline, a cubic spline per angle (--knots); bezier, one Bézier "
+        "curve per angle over the whole step (--degree), its ends as the spline's "
+        "(default %(default)s)",
+    )
+    parser.add_argument(
+        "--degree",
+        type=bounded(MIN_DEGREE, MAX_DEGREE),
+        default=None,
+        metavar="N",
+        help=f"degree of the Bézier curves, {MIN_DEGREE} to {MAX_DEGREE}: 9 + 6 (N − 3) "
+        "parameters, each degree holding the ones below (with --family bezier)",
+    )
+
+
+def gait_family(args):
+    """The gait family ``--family``, ``--knots`` and ``--degree`` name; a clear error for a
+    degree without a Bézier family or knots with one."""
+    from biped.model.bezier import Bezier
+
+    if args.family == "spline":
+        if args.degree is not None:
+            raise BipedError(f"--degree {args.degree} with --family spline: allowed with bezier")
+        return args.knots
+    if args.knots != 1:
+        raise BipedError(f"--knots {args.knots} with --family bezier: allowed --degree N")
+    if args.degree is None:
+        raise BipedError("--family bezier without --degree: allowed --degree N")
+    return Bezier(args.degree)
+
+
 def double_support_share(text: str) -> tuple[float, float]:
     """``LOW:HIGH``, the least and largest share of the step in double support."""
     from biped.optimization.two_phase import parse_share

@@ -107,11 +107,12 @@ def optimum_line(knee: str, criterion: str, speed: float, optimum) -> str:
     its gait file, what the comparisons use); its criterion on the solver's samples
     (``optimizer.value``, what ranked the starts; left out for a result without it)."""
     from biped.model.criteria import CRITERION_UNITS
+    from biped.model.gait import pieces as family_pieces
     from biped.optimization.comparison import NELDER_MEAD_SAMPLES_PER_STEP
     from biped.optimization.problem import CHECK_SAMPLES
 
     problem = optimum.problem
-    pieces = problem.knots + 1  # each piece closed: its ends counted on both sides
+    pieces = family_pieces(problem.knots)  # each piece closed: its ends counted on both sides
     check_per_step = pieces * (CHECK_SAMPLES[problem.knots] + 1)
     solver_per_step = pieces * (problem.samples_per_half + 1)
     ev = optimum.evaluation
@@ -152,7 +153,8 @@ def cmd_optimize(args) -> int:
 
     robot = robot_of(args)
     model = Biped(robot, args.knee)
-    problem = GaitProblem(model, args.speed, args.criterion, safety(args), knots=args.knots)
+    family = types.gait_family(args)
+    problem = GaitProblem(model, args.speed, args.criterion, safety(args), knots=family)
     check_output(args.out)
     given = budget(args)  # an option the method would not use: refused before any work
     if args.double_support is not None:  # what the two-phase problem does not build
@@ -213,6 +215,7 @@ def add_optimize(commands) -> None:
     types.add_gait_out(opt)
     types.add_budget(opt)
     types.add_knots(opt)
+    types.add_bezier(opt)
     types.add_robot(opt)
     types.add_options(
         opt,

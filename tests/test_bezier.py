@@ -7,25 +7,32 @@ import numpy as np
 import pytest
 
 import biped
-from biped.model.bezier import (
-    DEGREES,
-    MAX_DEGREE,
-    MIN_DEGREE,
-    bernstein,
-    build_bezier_step,
-    check_degree,
-    elevate,
+from biped.model.bezier import DEGREES, MAX_DEGREE, MIN_DEGREE, Bezier, bernstein, elevate
+from biped.model.gait import (
+    FREE_SWAP,
+    build_step,
+    check_embedding,
     embedded,
-    embedded_parameters,
-    evaluate,
     parameter_names,
     sample,
 )
-from biped.model.gait import FREE_SWAP
+from biped.model.gait import evaluate as evaluate_at
 from biped.model.kinematics import swap_legs
 from biped.optimization.problem import GaitProblem
 
 SPEED = 0.3
+
+
+def build_bezier_step(model, speed, p, degree):
+    return build_step(model, speed, p, Bezier(degree))
+
+
+def evaluate(step, t):
+    return evaluate_at(step, t, 0)
+
+
+def embedded_parameters(step, p, degree):
+    return np.concatenate([p[:8], embedded(step, Bezier(degree)).ravel(), p[-1:]])
 
 
 def _model(knee="rolling"):
@@ -38,7 +45,7 @@ def _parameters(model, degree, seed=0):
     paper = GaitProblem(model, SPEED).first_parameters()
     p = np.concatenate([paper[:8], np.zeros(6 * (degree - 3)), paper[-1:]])
     ends = build_bezier_step(model, SPEED, np.concatenate([paper[:8], paper[-1:]]), 3)
-    line = np.linspace(ends.control[1], ends.control[2], degree - 1)[1:-1]
+    line = np.linspace(ends.coefficients[1], ends.coefficients[2], degree - 1)[1:-1]
     noise = 0.05 * np.random.default_rng(seed).standard_normal(line.shape)
     p[8:-1] = (line + noise).ravel()
     return p
@@ -46,13 +53,13 @@ def _parameters(model, degree, seed=0):
 
 def test_the_degrees_are_named_and_others_refused():
     assert DEGREES == tuple(range(MIN_DEGREE, MAX_DEGREE + 1)) and MIN_DEGREE == 3
-    assert [len(parameter_names(n)) for n in (3, 5, 9)] == [9, 21, 45]
-    assert parameter_names(5)[8:14] == tuple(
+    assert [len(parameter_names(Bezier(n))) for n in (3, 5, 9)] == [9, 21, 45]
+    assert parameter_names(Bezier(5))[8:14] == tuple(
         f"control2_{a}" for a in ("qp2", "q1", "q2", "q3", "q4", "q5")
     )
     for bad in (2, MAX_DEGREE + 1, True, "5", 5.0):
         with pytest.raises(biped.BipedError, match="degree = .*allowed an integer from 3 to"):
-            check_degree(bad)
+            Bezier(bad)
     model = _model()
     with pytest.raises(biped.BipedError, match=r"shape \(20,\): allowed \(21,\)"):
         build_bezier_step(model, SPEED, np.zeros(20), 5)
@@ -88,7 +95,7 @@ def test_a_wrong_end_point_breaks_the_start_rates():
     """The check above fails a curve whose second control point is not q(0) + T q̇(0) / n."""
     model = _model()
     step = build_bezier_step(model, SPEED, _parameters(model, 5), 5)
-    control = np.array(step.control)
+    control = np.array(step.coefficients)
     control[1] *= 1.0 + 1.0 / 5  # as if the slope were T q̇ / (n − 1)
     rates = (bernstein(5, [0.0])[1] @ control) / step.period
     assert not np.allclose(rates[0], step.start[1][1:7], atol=1e-6)
@@ -103,7 +110,7 @@ def test_a_higher_degree_holds_the_curve(degree, higher):
     p = _parameters(model, degree)
     step = build_bezier_step(model, SPEED, p, degree)
     rich = build_bezier_step(model, SPEED, embedded_parameters(step, p, higher), higher)
-    assert rich.degree == higher and rich.control.shape == (higher + 1, 6)
+    assert rich.knots == Bezier(higher) and rich.coefficients.shape == (higher + 1, 6)
     t = np.linspace(0.0, 1.0, 641)
     for found, expected in zip(evaluate(rich, t), evaluate(step, t), strict=True):
         np.testing.assert_allclose(found, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
@@ -117,7 +124,7 @@ def test_a_wrong_elevation_is_another_curve():
     another motion: the check above would fail it."""
     model = _model()
     step = build_bezier_step(model, SPEED, _parameters(model, 5), 5)
-    control = step.control
+    control = step.coefficients
     n = control.shape[0] - 1
     share = (np.arange(n + 2) / (n + 1))[:, None]
     padded = np.vstack([np.zeros((1, 6)), control])
@@ -129,11 +136,29 @@ def test_a_wrong_elevation_is_another_curve():
     assert np.abs(bernstein(n + 1, t)[0] @ wrong - right).max() > 1e-3
 
 
-def test_a_lower_degree_is_refused():
+def test_a_lower_degree_or_a_spline_is_refused():
+    """A Bézier curve is held by the Bézier families of no lower degree, and by a spline
+    family only as a single cubic; a spline with a knot by no Bézier family."""
     model = _model()
     step = build_bezier_step(model, SPEED, _parameters(model, 7), 7)
-    with pytest.raises(biped.BipedError, match="degree = 5: a curve of degree 7 is held by"):
-        embedded(step, 5)
+    with pytest.raises(biped.BipedError, match="Bézier of degree 5 does not hold the Bézier of"):
+        embedded(step, Bezier(5))
+    for below, above in ((Bezier(5), 7), (1, Bezier(9)), (3, Bezier(5))):
+        with pytest.raises(biped.BipedError, match="does not hold"):
+            check_embedding(below, above)
+    check_embedding(Bezier(3), 1)  # a single cubic is a spline of every family
+
+
+def test_a_single_cubic_is_a_spline_of_the_papers_family():
+    """Degree 3 given to the paper's spline (its knot's angles and rates, through
+    ``at_knots``) and to 3 knots: the same motion."""
+    model = _model()
+    step = build_bezier_step(model, SPEED, _parameters(model, 3), 3)
+    p = _parameters(model, 3)
+    spline = build_step(model, SPEED, np.concatenate([p[:8], embedded(step, 3).ravel(), p[-1:]]), 3)
+    t = np.linspace(0.0, 0.25, 9)
+    for found, expected in zip(evaluate_at(spline, t, 0), evaluate(step, t), strict=True):
+        np.testing.assert_allclose(found, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
 
 
 @pytest.mark.parametrize("degree", [3, 7, 12])

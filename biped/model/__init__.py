@@ -5,9 +5,9 @@ rolling knee's line of centres (``knee_loads``), knee surfaces beyond circles (`
 family of profiles and their rolling; ``profile_biped``: the biped of such a knee), the
 flat-foot impact (``impact``), the double support phase, a closed chain with both feet flat,
 and the split of its load (``double_support``), a step of single then double support
-(``two_phase``), the spline gait of one step (``gait``, section 3), the Bézier family the paper names for
-its future work (``bezier``), their criteria and
-constraints (``criteria``, section 4),
+(``two_phase``), the spline gait of one step (``gait``, section 3), the Bézier family the
+paper names for its future work (``bezier``), their criteria and constraints (``criteria``,
+section 4),
 and the unit of every number, declared beside the fields of the records that hold them
 (``units``); ours: the joints' motors and gears and what they draw (``actuators``), the
 vendors' datasheets they are read from (``datasheets``, ``catalog.json``: the catalog, of

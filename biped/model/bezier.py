@@ -12,17 +12,19 @@ P_0 with slope n (P_1 − P_0) and ends at P_n with slope n (P_n − P_(n−1)),
 
     P_0 = q(0),  P_1 = q(0) + T q̇(0⁺) / n,    P_(n−1) = q(T) − T q̇(T⁻) / n,  P_n = q(T).
 
-Parameters (``parameter_names``): the hip, the trunk and the five end rates as the paper's
-(8), the interior control points P_2..P_(n−2) of each angle [rad] (6 (n − 3)), the period
-T [s]: 9 + 6 (n − 3), for n from ``MIN_DEGREE`` (a single cubic, its ends alone) to
-``MAX_DEGREE``.
+Parameters (``biped.model.gait.parameter_names(Bezier(n))``): the hip, the trunk and the
+five end rates as the paper's (8), the interior control points P_2..P_(n−2) of each angle
+[rad] (6 (n − 3)), the period T [s]: 9 + 6 (n − 3), for n from ``MIN_DEGREE`` (a single
+cubic, its ends alone) to ``MAX_DEGREE``. This module holds the curves' mathematics and the
+family's name (``Bezier``); ``biped.model.gait`` builds, evaluates and samples its steps as it
+does the splines' (a ``Step`` of one piece, its coefficients the control points).
 
 What the family holds. A curve of degree n is a polynomial of degree n over the whole step,
 with no knot: it does not hold the paper's spline (two cubics joined C¹ at t_n = 0.5, its
 second derivative jumping there), nor any K-knot family's members beyond the single cubic
 (n = 3 holds nothing else). It holds every curve of lower degree: a curve of degree n is
 the curve of degree n + 1 of the elevated control points (``elevate``), the same motion,
-its ends' points still those above (so ``embedded`` gives a degree n's gait as parameters
+its ends' points still those above (so ``raised`` gives a degree n's gait as parameters
 of any higher degree), and the degrees 3, 4, 5, ... are a nested ladder whose optima can
 only improve.
 """
@@ -36,8 +38,6 @@ import numpy as np
 from scipy.special import comb
 
 from biped.errors import BipedError
-from biped.model.dynamics import Biped
-from biped.model.gait import FREE_ANGLES, PARAMETERS, step_ends
 
 # The least degree: the two end points and the two beside them fixed by the ends' angles
 # and rates, no free control point (a single cubic).
@@ -58,14 +58,23 @@ def check_degree(degree) -> int:
     return int(degree)
 
 
-@functools.cache
-def parameter_names(degree: int) -> tuple:
-    """The parameters of the family of ``degree``, in order: the paper's first 8 (hip, trunk,
-    end rates), the interior control points ``control{i}_{angle}`` [rad], the period [s]."""
-    interior = tuple(
-        f"control{i}_{a}" for i in range(2, check_degree(degree) - 1) for a in FREE_ANGLES
-    )
-    return PARAMETERS[:8] + interior + ("period",)
+@dataclass(frozen=True)
+class Bezier:
+    """The Bézier family of ``degree`` n: a gait family as ``biped.model.gait`` names them
+    (beside a spline's number of interior knots)."""
+
+    degree: int
+
+    def __post_init__(self):
+        object.__setattr__(self, "degree", check_degree(self.degree))
+
+    def __str__(self) -> str:
+        return f"Bézier of degree {self.degree}"
+
+    @property
+    def interior(self) -> int:
+        """The free control points of each angle, n − 3."""
+        return self.degree - 3
 
 
 def control_points(degree, period, start_angles, start_rates, end_angles, end_rates, interior):
@@ -75,50 +84,6 @@ def control_points(degree, period, start_angles, start_rates, end_angles, end_ra
     first = [start_angles, start_angles + period * start_rates / degree]
     last = [end_angles - period * end_rates / degree, end_angles]
     return first + list(interior) + last
-
-
-@dataclass(frozen=True)
-class BezierStep:
-    """One step of the Bézier family built from the parameters.
-
-    Attributes:
-        control: (n + 1, 6) control points of each free angle [rad].
-        degree: n.
-        period: T [s].
-        step_length: S [m].
-        start: q, q̇ (9,) just after the impact at t = 0 (stance foot fixed).
-        end: q, q̇⁻ (9,) just before the impact at t = T.
-        impulse: I_R (3,) of the landing at t = T [N·s, N·s, N·m·s].
-    """
-
-    control: np.ndarray
-    degree: int
-    period: float
-    step_length: float
-    start: tuple
-    end: tuple
-    impulse: np.ndarray
-
-
-def build_bezier_step(model: Biped, speed: float, p, degree: int) -> BezierStep:
-    """The step of the parameters ``p`` (``parameter_names(degree)``) at walking speed
-    ``speed``: its ends as the spline families' (``step_ends``), its control points
-    (``control_points``)."""
-    degree = check_degree(degree)
-    p = np.asarray(p, dtype=float)
-    ends = step_ends(model, speed, p, len(parameter_names(degree)))
-    interior = p[8:-1].reshape(degree - 3, 6)
-    control = np.array(control_points(degree, ends.period, *ends.conditions, interior))
-    control.setflags(write=False)
-    return BezierStep(
-        control=control,
-        degree=degree,
-        period=ends.period,
-        step_length=ends.step_length,
-        start=ends.start,
-        end=ends.end,
-        impulse=ends.impulse,
-    )
 
 
 def bernstein(degree: int, t_n) -> tuple:
@@ -152,15 +117,6 @@ def _difference(degree: int) -> np.ndarray:
     return np.eye(degree, degree + 1, k=1) - np.eye(degree, degree + 1)
 
 
-def evaluate(step: BezierStep, t_n):
-    """Angles, rates, accelerations (N, 6) of the free angles at normalised times t_n (N,),
-    derivatives with respect to physical time [rad, rad/s, rad/s²]."""
-    values, rates, accels = bernstein(step.degree, np.atleast_1d(t_n))
-    period = step.period
-    control = step.control
-    return values @ control, (rates @ control) / period, (accels @ control) / period**2
-
-
 @functools.cache
 def bezier_basis(samples: int, degree: int):
     """The normalised times of ``samples`` + 1 samples over the step (one piece, closed) and
@@ -171,20 +127,6 @@ def bezier_basis(samples: int, degree: int):
         block.setflags(write=False)
     t_n.setflags(write=False)
     return t_n, bases
-
-
-def sample(model: Biped, step: BezierStep, samples: int, points=()):
-    """Motion and inverse dynamics at ``samples`` + 1 times over the step.
-
-    Returns:
-        t [s] (N,), q, q̇, q̈ (N, 9), torques (N, 6), wrench (N, 3), positions of ``points``
-        (N, P, 2).
-    """
-    t_n, (values, rates, accels) = bezier_basis(samples, step.degree)
-    period, control = step.period, step.control
-    return (t_n * period,) + model.single_support(
-        values @ control, (rates @ control) / period, (accels @ control) / period**2, points
-    )
 
 
 def elevate(control: np.ndarray) -> np.ndarray:
@@ -198,43 +140,30 @@ def elevate(control: np.ndarray) -> np.ndarray:
     return share * padded + (1.0 - share) * upper
 
 
-def embedded(step: BezierStep, degree: int) -> np.ndarray:
-    """The interior control points (n' − 3, 6) of ``step``'s curve raised to ``degree`` n' >=
-    its own (``elevate``): with ``step``'s other parameters, the parameters of the same
-    motion in the family of ``degree``."""
+def raised(control: np.ndarray, degree: int) -> np.ndarray:
+    """The control points (``degree`` + 1, 6) of the same curve as ``control`` (n + 1, 6) at
+    ``degree`` >= n (``elevate`` repeated)."""
     degree = check_degree(degree)
-    if degree < step.degree:
+    control = np.asarray(control, dtype=float)
+    if degree < control.shape[0] - 1:
         raise BipedError(
-            f"degree = {degree}: a curve of degree {step.degree} is held by degrees "
-            f"{step.degree} to {MAX_DEGREE} only"
+            f"degree = {degree}: a curve of degree {control.shape[0] - 1} is held by degrees "
+            f"{control.shape[0] - 1} to {MAX_DEGREE} only"
         )
-    control = step.control
-    for _ in range(degree - step.degree):
+    while control.shape[0] - 1 < degree:
         control = elevate(control)
-    return control[2:-2]
-
-
-def embedded_parameters(step: BezierStep, parameters, degree: int) -> np.ndarray:
-    """``parameters`` of ``step`` (its family's) as parameters of the family of ``degree``:
-    the same hip, trunk, end rates and period, the elevated interior points."""
-    p = np.asarray(parameters, dtype=float)
-    return np.concatenate([p[:8], embedded(step, degree).ravel(), p[-1:]])
+    return control
 
 
 __all__ = [
     "DEGREES",
     "MAX_DEGREE",
     "MIN_DEGREE",
-    "BezierStep",
+    "Bezier",
     "bernstein",
     "bezier_basis",
-    "build_bezier_step",
     "check_degree",
     "control_points",
     "elevate",
-    "embedded",
-    "embedded_parameters",
-    "evaluate",
-    "parameter_names",
-    "sample",
+    "raised",
 ]

@@ -34,7 +34,7 @@ from biped.errors import BipedError
 from biped.model import walkable
 from biped.model.actuators import LIMITS, Actuators, Drive, drive, limit_margins
 from biped.model.dynamics import JOINTS, Biped, zmp_from
-from biped.model.gait import Step, breakpoints, piece_grid, sample
+from biped.model.gait import Step, breakpoints, piece_grid, pieces, sample
 from biped.model.kinematics import Q1, Q2, Q3, Q4
 
 CONSTRAINTS = (
@@ -301,7 +301,7 @@ def simpson_weights(samples_per_half: int, knots: int = 1) -> np.ndarray:
         piece[:odd] += np.array([1.0] + [4.0, 2.0] * ((odd - 3) // 2) + [4.0, 1.0]) * h / 3
         if odd < n:
             piece[-3:] += np.array([-1.0, 8.0, 5.0]) * h / 12
-    weights = np.concatenate([piece] * (knots + 1))
+    weights = np.concatenate([piece] * pieces(knots))
     weights.setflags(write=False)  # cached: shared by every caller
     return weights
 
@@ -429,7 +429,7 @@ def penalty_rate(psi, checked) -> np.ndarray:
 @functools.cache
 def checked_mask(samples_per_half: int, knots: int = 1) -> np.ndarray:
     """Which Ψ_i are checked at which sample (N, 7): all but the swing foot at t = 0, T."""
-    mask = np.ones(((knots + 1) * (samples_per_half + 1), len(CONSTRAINTS)), dtype=bool)
+    mask = np.ones((pieces(knots) * (samples_per_half + 1), len(CONSTRAINTS)), dtype=bool)
     mask[[0, -1], 5:] = False  # both feet on the ground by construction
     mask.setflags(write=False)
     return mask

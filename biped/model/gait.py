@@ -49,6 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model.bezier import Bezier, bernstein, bezier_basis, control_points, raised
 from biped.model.dynamics import Biped
 from biped.model.kinematics import LEG_SWAP, Q1, Q5, swap_legs
 
@@ -69,8 +70,11 @@ MAX_KNOTS = 31
 KNOTS = tuple(range(1, MAX_KNOTS + 1))
 
 
-def check_knots(knots) -> int:
-    """``knots`` if it names a family (``KNOTS``), else a clear error."""
+def check_knots(knots) -> int | Bezier:
+    """``knots`` if it names a family (``KNOTS``, or a ``Bezier`` family), else a clear
+    error."""
+    if isinstance(knots, Bezier):
+        return knots
     integer = isinstance(knots, (int, np.integer)) and not isinstance(knots, bool)
     if not integer or knots not in KNOTS:
         raise BipedError(
@@ -93,6 +97,9 @@ def parameter_names(knots: int = 1) -> tuple:
     and rates [rad/s]."""
     if check_knots(knots) == 1:
         return PARAMETERS
+    if isinstance(knots, Bezier):
+        interior = tuple(f"control{i}_{a}" for i in range(2, knots.degree - 1) for a in FREE_ANGLES)
+        return PARAMETERS[:8] + interior + ("period",)
     at_knots = tuple(
         f"knot{k}_{kind}{a}"
         for k in range(1, knots + 1)
@@ -102,9 +109,14 @@ def parameter_names(knots: int = 1) -> tuple:
     return PARAMETERS[:8] + at_knots + ("period",)
 
 
+def pieces(knots: int = 1) -> int:
+    """The pieces of a family: K + 1 for a spline of K interior knots, 1 for a Bézier."""
+    return 1 if isinstance(check_knots(knots), Bezier) else knots + 1
+
+
 def breakpoints(knots: int = 1) -> np.ndarray:
-    """Normalised times [0, knots..., 1] of the pieces' ends."""
-    return np.linspace(0.0, 1.0, check_knots(knots) + 2)
+    """Normalised times [0, knots..., 1] of the pieces' ends ([0, 1] for a Bézier)."""
+    return np.linspace(0.0, 1.0, pieces(knots) + 1)
 
 
 # The leg swap (``biped.model.kinematics.LEG_SWAP``) of the free angles: the end posture is
@@ -242,16 +254,21 @@ def step_ends(model: Biped, speed: float, p, size: int) -> StepEnds:
 
 def build_step(model: Biped, speed: float, p, knots: int = 1) -> Step:
     """Spline coefficients of one step from the parameters (``parameter_names(knots)``; the
-    paper's 21 for 1 knot) at walking speed ``speed``."""
+    paper's 21 for 1 knot) at walking speed ``speed``; a Bézier family's control points as
+    its one piece's coefficients."""
     p = np.asarray(p, dtype=float)
     ends = step_ends(model, speed, p, len(parameter_names(knots)))
     period = ends.period
-    if knots == 1:
-        pieces = paper_pieces(period, *ends.conditions, p[8:14], p[14:20])
+    if isinstance(knots, Bezier):
+        interior = p[8:-1].reshape(knots.interior, 6)
+        control = control_points(knots.degree, period, *ends.conditions, interior)
+        found = np.array(control).T[None]  # one piece, its coefficients the control points
+    elif knots == 1:
+        found = paper_pieces(period, *ends.conditions, p[8:14], p[14:20])
     else:
-        pieces = _hermite_pieces(period, *ends.conditions, p[8:-1].reshape(knots, 2, 6))
+        found = _hermite_pieces(period, *ends.conditions, p[8:-1].reshape(knots, 2, 6))
     return Step(
-        pieces=pieces,
+        pieces=found,
         knots=knots,
         period=period,
         step_length=ends.step_length,
@@ -324,6 +341,8 @@ def evaluate(step: Step, t_n, piece):
             (t_n in [0, 0.5]) and ``"right"`` for eq. (26).
     Derivatives are with respect to physical time [rad/s, rad/s²].
     """
+    if isinstance(step.knots, Bezier):
+        return _evaluate_bezier(step, t_n, piece)
     t_n = np.asarray(t_n, dtype=float)[..., None]
     index = {"left": 0, "right": 1}.get(piece, piece) if step.knots == 1 else piece
     if isinstance(index, str) or not (isinstance(index, int) and 0 <= index <= step.knots):
@@ -339,6 +358,20 @@ def evaluate(step: Step, t_n, piece):
     return value, rate, accel
 
 
+def _evaluate_bezier(step: Step, t_n, piece):
+    """``evaluate`` of a Bézier family's step (one piece, 0)."""
+    if piece != 0 or isinstance(piece, bool):
+        raise BipedError(f"piece = {piece!r}: allowed 0 (a Bézier curve is one piece)")
+    t_n = np.asarray(t_n, dtype=float)
+    values, rates, accels = (
+        m @ step.coefficients for m in bernstein(step.knots.degree, t_n.ravel())
+    )
+    shape = t_n.shape + (6,)
+    period = step.period
+    rates, accels = rates / period, accels / period**2
+    return values.reshape(shape), rates.reshape(shape), accels.reshape(shape)
+
+
 @functools.cache
 def spline_basis(samples_per_piece: int, knots: int = 1):
     """The normalised times of every piece of ``piece_grid`` ((K + 1) (n + 1),) and the
@@ -347,8 +380,11 @@ def spline_basis(samples_per_piece: int, knots: int = 1):
     (t_n, (values, rates, accels)).
 
     A piece's polynomial is in u = sign (t_n − origin) (``piece_variable``), so d/dt_n =
-    sign d/du there (the paper's second piece: u = 1 − t_n).
+    sign d/du there (the paper's second piece: u = 1 − t_n). A Bézier family's: its one
+    piece's Bernstein matrices (``biped.model.bezier.bezier_basis``) on its control points.
     """
+    if isinstance(knots, Bezier):
+        return bezier_basis(samples_per_piece, knots.degree)
     grids = piece_grid(samples_per_piece, knots)
     n, pieces = len(grids[0]), len(grids)
     bases = [np.zeros((pieces * n, 4 * pieces)) for _ in range(3)]
@@ -390,7 +426,8 @@ def sample(model: Biped, step: Step, samples_per_half: int, points=()):
 def embedded(step: Step, knots: int) -> np.ndarray:
     """The knots' angles and rates (``knots``, 2, 6) of ``step``'s spline: the parameters
     beyond the ends' of the family of ``knots`` interior knots that holds it (its knots
-    include ``step``'s: ``check_embedding``), the same motion."""
+    include ``step``'s: ``check_embedding``), the same motion; for a Bézier family holding
+    ``step``'s curve, its interior control points (n − 3, 6) raised to that degree."""
     check_embedding(step.knots, knots)
     return at_knots(step, knots)
 
@@ -398,23 +435,74 @@ def embedded(step: Step, knots: int) -> np.ndarray:
 def at_knots(step: Step, knots: int) -> np.ndarray:
     """``step``'s angles and rates (``knots``, 2, 6) at the interior knots of the family of
     ``knots``: its embedding where that family holds it (``embedded``), otherwise the
-    Hermite spline through them, an approximation of it (a first guess)."""
+    Hermite spline through them, an approximation of it (a first guess). For a Bézier
+    family, the interior control points (n − 3, 6): ``step``'s raised where it is a Bézier
+    curve of lower degree, else the least-squares fit of ``step``'s angles (``fitted``)."""
     check_knots(knots)
+    if isinstance(knots, Bezier):
+        return fitted(step, knots)
     times = breakpoints(knots)[1:-1]
     ends = breakpoints(step.knots)
+    last = pieces(step.knots) - 1
     rows = []
     for t in times:
-        piece = min(int(np.searchsorted(ends, t, side="right")) - 1, step.knots)
+        piece = min(int(np.searchsorted(ends, t, side="right")) - 1, last)
         angles, rates, _ = evaluate(step, t, piece)
         rows.append([angles, rates])
     return np.array(rows)
 
 
+# Samples per step of the least-squares fit of a gait by a Bézier curve (``fitted``).
+FIT_SAMPLES = 400
+
+
+def fitted(step: Step, family: Bezier) -> np.ndarray:
+    """The interior control points (n − 3, 6) of the Bézier curve of ``family`` with
+    ``step``'s ends (angles and rates) closest to ``step``'s angles in least squares over
+    the step: ``step``'s own curve raised where ``step`` is of that family's degree or
+    lower (the same motion)."""
+    if isinstance(step.knots, Bezier) and step.knots.degree <= family.degree:
+        return raised(step.coefficients, family.degree)[2:-2]
+    t, angles = [], []
+    ends = breakpoints(step.knots)
+    for j in range(pieces(step.knots)):
+        grid = np.linspace(ends[j], ends[j + 1], FIT_SAMPLES // pieces(step.knots) + 1)
+        t.append(grid)
+        angles.append(evaluate(step, grid, j)[0])
+    t, angles = np.concatenate(t), np.concatenate(angles)
+    basis = bernstein(family.degree, t)[0]
+    start, start_rate, _ = evaluate(step, 0.0, 0)
+    end, end_rate, _ = evaluate(step, 1.0, pieces(step.knots) - 1)
+    fixed = control_points(family.degree, step.period, start, start_rate, end, end_rate, [])
+    fixed_part = basis[:, [0, 1]] @ np.array(fixed[:2]) + basis[:, [-2, -1]] @ np.array(fixed[2:])
+    interior, *_ = np.linalg.lstsq(basis[:, 2:-2], angles - fixed_part, rcond=None)
+    return interior
+
+
 def check_embedding(knots: int, richer: int) -> None:
-    """Raise unless the family of ``richer`` interior knots holds that of ``knots``."""
+    """Raise unless the family of ``richer`` interior knots holds that of ``knots``: a
+    spline's knots include the other's; a Bézier of a degree no lower (a Bézier curve has
+    no knot: it holds no spline but a single cubic, and is held by no spline family but as
+    a single cubic)."""
+    if isinstance(knots, Bezier) or isinstance(richer, Bezier):
+        holds = (
+            isinstance(knots, Bezier)
+            and isinstance(richer, Bezier)
+            and knots.degree <= richer.degree
+        ) or (knots == Bezier(3) and not isinstance(richer, Bezier))
+        if not holds:
+            raise BipedError(
+                f"the {_family_name(richer)} does not hold the {_family_name(knots)}: "
+                "allowed a Bézier of no lower degree"
+            )
+        return
     small, large = breakpoints(knots)[1:-1], breakpoints(richer)[1:-1]
     if not all(np.any(np.isclose(t, large, rtol=0.0, atol=1e-12)) for t in small):
         raise BipedError(
             f"knots = {richer}: its knots do not include those of {knots} knot(s), so its "
             "family does not hold the other's"
         )
+
+
+def _family_name(knots) -> str:
+    return str(knots) if isinstance(knots, Bezier) else f"spline of {knots} knot(s)"

@@ -368,7 +368,7 @@ def prepare(problem: GaitProblem) -> float:
         else {problem.criterion}
     )
     for criterion in sorted(criteria):
-        for knots in sorted({problem.knots, 1}):
+        for knots in dict.fromkeys((1, problem.knots)):  # the paper's spline first
             family = dataclasses.replace(
                 problem, criterion=criterion, knots=knots, samples_per_half=None
             )
@@ -582,7 +582,8 @@ def _paper_start(
         kind = PAPER_START if below.problem.knots == 1 else BELOW_START
     if not below.report.converged:
         return []
-    exact = below.problem.knots != 1 or problem.knots % 2 == 1
+    odd = isinstance(problem.knots, int) and problem.knots % 2 == 1
+    exact = below.problem.knots != 1 or odd  # else fitted: a Bézier, or an even K
     start = problem.embedded(below.variables, below.problem.knots, exact=exact)
     return [Candidate(kind, start)]
 

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model.bezier import DEGREES, Bezier
 from biped.model.criteria import ALL_CRITERIA, PAPER_SAFETY, Safety
 from biped.model.dynamics import Biped
 from biped.model.gait import (
@@ -45,6 +46,7 @@ from biped.model.gait import (
     check_knots,
     embedded,
     parameter_names,
+    pieces,
 )
 
 # Decision variables of the solvers: the paper's parameters with the hip replaced by the
@@ -93,18 +95,21 @@ MIN_CHECK_SAMPLES = 26
 def solver_samples(knots: int) -> int:
     """Samples per piece where the solvers impose the constraints in the family of ``knots``
     interior knots (25 for the paper's spline, 13 for 3 knots, 7 for 7, 6 for 15)."""
-    return max(math.ceil(SOLVER_SAMPLES_PER_STEP / (knots + 1)), MIN_SOLVER_SAMPLES)
+    return max(math.ceil(SOLVER_SAMPLES_PER_STEP / pieces(knots)), MIN_SOLVER_SAMPLES)
 
 
 def check_samples(knots: int) -> int:
     """Samples per piece of the check grid of the family of ``knots`` interior knots, an even
     number (100 for the paper's spline, 50 for 3 knots, 34 for 5, 26 for 7 and more)."""
-    per_piece = max(math.ceil(CHECK_SAMPLES_PER_STEP / (knots + 1)), MIN_CHECK_SAMPLES)
+    per_piece = max(math.ceil(CHECK_SAMPLES_PER_STEP / pieces(knots)), MIN_CHECK_SAMPLES)
     return per_piece + per_piece % 2
 
 
-SOLVER_SAMPLES = {knots: solver_samples(knots) for knots in KNOTS}
-CHECK_SAMPLES = {knots: check_samples(knots) for knots in KNOTS}
+# The gait families: the splines' (``KNOTS``) and the Bézier curves' (one piece, as many
+# samples as the paper's spline's two, ``biped.model.bezier``).
+FAMILIES = KNOTS + tuple(Bezier(degree) for degree in DEGREES)
+SOLVER_SAMPLES = {knots: solver_samples(knots) for knots in FAMILIES}
+CHECK_SAMPLES = {knots: check_samples(knots) for knots in FAMILIES}
 # Scales and bounds of a richer family's knot angles [rad] and rates [rad/s].
 KNOT_SCALES = {"": 0.03, "rate_": 0.3}
 KNOT_ANGLE_BOUND = np.pi
@@ -137,6 +142,8 @@ def scales(knots: int = 1) -> np.ndarray:
     (those of the curvature alone, 1.5 and 0.5, left it at 1e-8)."""
     if knots == 1:
         return SCALES
+    if isinstance(knots, Bezier):
+        return bezier_scales(knots)
     at_knots = [KNOT_SCALES[kind] for _ in range(knots) for kind in KNOT_SCALES for _ in range(6)]
     found = np.concatenate([SCALES[:8], at_knots, SCALES[-1:]])
     if knots <= SCALED_FROM_KNOTS:
@@ -148,13 +155,28 @@ def scales(knots: int = 1) -> np.ndarray:
     return found
 
 
+# Scale of a Bézier curve's interior control point [rad]: as a knot's angle.
+CONTROL_SCALE = 0.03
+
+
+@functools.cache
+def bezier_scales(family: Bezier) -> np.ndarray:
+    """``SCALES`` of a Bézier family: the paper's first 8 and period, ``CONTROL_SCALE`` for
+    each interior control point."""
+    found = np.concatenate([SCALES[:8], np.full(6 * family.interior, CONTROL_SCALE), SCALES[-1:]])
+    found.setflags(write=False)
+    return found
+
+
 def bounds(knots: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper bounds of the variables, in ``variable_names(knots)`` order."""
     names = variable_names(knots)
     lower = np.empty(len(names))
     upper = np.empty(len(names))
     for i, name in enumerate(names):
-        if name.startswith("knot"):
+        if name.startswith("control"):
+            lower[i], upper[i] = -KNOT_ANGLE_BOUND, KNOT_ANGLE_BOUND
+        elif name.startswith("knot"):
             limit = RATE_BOUND if "_rate_" in name else KNOT_ANGLE_BOUND
             lower[i], upper[i] = -limit, limit
         elif name.startswith("end_rate"):
@@ -281,6 +303,8 @@ class GaitProblem:
                 margins += ", within the actuators' limits"
             margins += walkable_description(self.safety)
         family = f", {self.knots} knots" if self.knots != 1 else ""
+        if isinstance(self.knots, Bezier):
+            family = f", {self.knots}"
         return (
             f"{self.knee} knee, {self.criterion} criterion, {self.speed:.3f} m/s{margins}{family}"
         )

@@ -28,6 +28,7 @@ import numpy as np
 
 from biped.model import walkable
 from biped.model.actuators import LIMITS, drive, limit_margins
+from biped.model.bezier import Bezier, control_points
 from biped.model.criteria import (
     ACTUATOR_MARGIN,
     CONSTRAINT_SCALES,
@@ -443,8 +444,14 @@ class StepGraph:
         """3. The spline coefficients (``biped.model.gait.Step.coefficients``, 4 (K + 1) x 6)
         of the free angles in normalised time, as in ``biped.model.gait.build_step``: eqs.
         (25)-(26) [a0..a3, b0..b3] for the paper's spline, the Hermite pieces of a richer
-        family's."""
+        family's, the control points (n + 1) x 6 of a Bézier family's
+        (``biped.model.bezier.control_points``)."""
         z, period = self.z, self.period
+        if isinstance(self.knots, Bezier):
+            degree = self.knots.degree
+            interior = [z[8 + 6 * i : 8 + 6 * (i + 1)] for i in range(self.knots.interior)]
+            ends = (start_angles, start_rates, end_angles, end_rates)
+            return ca.horzcat(*control_points(degree, period, *ends, interior)).T
         if self.knots != 1:
             knots = [z[8 + 12 * k : 8 + 12 * (k + 1)] for k in range(self.knots)]
             values = [start_angles, *(knot[:6] for knot in knots), end_angles]

@@ -37,6 +37,7 @@ from biped.errors import BipedError
 from biped.model import walkable
 from biped.model.actuators import KINDS, Actuators
 from biped.model.actuators import UNITS as ACTUATOR_UNITS
+from biped.model.bezier import Bezier
 from biped.model.criteria import (
     ALL_CRITERIA,
     CONSTRAINTS,
@@ -498,7 +499,9 @@ class Gait:
     provenance: dict
     samples: Samples = unit_field(Samples)
     design: dict | None = None  # a designed knee's (``biped design``)
-    knots: int = 1  # interior knots of the gait's spline family (1: the paper's; written if not)
+    # The gait family: interior knots of a spline (1: the paper's; written if not), or a
+    # Bézier family, written {"bezier": degree} (``family_of``).
+    knots: int | Bezier = 1
 
     @classmethod
     def from_optimum(cls, optimum: Optimum, robot: Robot, provenance: dict | None = None) -> Gait:
@@ -583,7 +586,7 @@ class Gait:
             raise bad(f"safety {content.get('safety')!r}: {error}") from None
         _check_kinds(content, bad)
         try:
-            knots = check_knots(content.get("knots", 1))
+            knots = family_of(content.get("knots", 1))
             robot = _robot(content)
             names = set(content["parameters"])
         except (KeyError, TypeError) as error:
@@ -655,7 +658,7 @@ class Gait:
                     units[f"robot.actuators.{kind}.{name}"] = unit
         if knots == 1:
             return units
-        units["knots"] = PURE
+        units["knots.bezier" if isinstance(knots, Bezier) else "knots"] = PURE
         for prefix, names in (
             ("parameters.", parameter_names(knots)),
             ("optimizer.variables.", variable_names(knots)),
@@ -690,7 +693,9 @@ class Gait:
             value = getattr(self, f.name)
             if (f.name, value) in (("design", None), ("knots", 1)):  # the paper's: unwritten
                 continue
-            if hasattr(value, "to_dict"):  # the samples, records, robot
+            if isinstance(value, Bezier):
+                value = {"bezier": value.degree}
+            elif hasattr(value, "to_dict"):  # the samples, records, robot
                 value = value.to_dict()
             elif dataclasses.is_dataclass(value):  # the safety margins, a knee bend if asked
                 value = safety_dict(value)
@@ -860,6 +865,16 @@ def _check_scalars(content: dict, bad) -> None:
         value = content[key]
         if not (_finite_number(value) and value > 0):
             raise bad(f"{key} = {value!r}, allowed a number > 0")
+
+
+def family_of(written) -> int | Bezier:
+    """The gait family of a file's ``knots``: a number of interior knots, or {"bezier":
+    degree}."""
+    if isinstance(written, dict):
+        if set(written) != {"bezier"}:
+            raise BipedError(f"knots = {written!r}: allowed K or {{'bezier': degree}}")
+        return Bezier(written["bezier"])
+    return check_knots(written)
 
 
 def _check_kinds(content: dict, bad) -> None:
