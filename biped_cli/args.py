@@ -251,7 +251,8 @@ def add_bezier(parser) -> None:
         default=None,
         metavar="N",
         help=f"degree of the Bézier curves, {MIN_DEGREE} to {MAX_DEGREE}: 9 + 6 (N − 3) "
-        "parameters, each degree holding the ones below (with --family bezier)",
+        "parameters, each degree holding the ones below (with --family bezier, which asks "
+        "for it: no default)",
     )
 
 

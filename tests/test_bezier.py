@@ -3,11 +3,14 @@ conditions (flat feet, leg swap, impact map) exactly, a degree's curve is the sa
 in every higher degree (a nested ladder), and its rates and accelerations are the
 derivatives of its angles."""
 
+import json
+
 import numpy as np
 import pytest
 
 import biped
 from biped.model.bezier import DEGREES, MAX_DEGREE, MIN_DEGREE, Bezier, bernstein, elevate
+from biped.model.criteria import Safety, evaluate_step
 from biped.model.gait import (
     FREE_SWAP,
     build_step,
@@ -18,7 +21,17 @@ from biped.model.gait import (
 )
 from biped.model.gait import evaluate as evaluate_at
 from biped.model.kinematics import swap_legs
-from biped.optimization.problem import GaitProblem
+from biped.optimization.optimize import BELOW_START, optimize
+from biped.optimization.problem import (
+    CHECK_SAMPLES,
+    SOLVER_SAMPLES,
+    GaitProblem,
+    bounds,
+    scales,
+    variable_names,
+)
+from biped.optimization.symbolic import StepGraph
+from biped.records.gait_file import Gait
 
 SPEED = 0.3
 
@@ -192,3 +205,81 @@ def test_the_basis_sums_to_one_and_the_samples_are_the_curve():
     np.testing.assert_allclose(time, t * step.period, atol=1e-15)
     np.testing.assert_allclose(q[:, 1:7], angles, atol=1e-14)
     np.testing.assert_allclose(qd[:, 1:7], rates, atol=1e-12)
+
+
+def test_the_family_has_one_piece_and_its_own_samples_and_scales():
+    """One piece of as many solver and check intervals as the paper's spline's two, the
+    control points scaled and bounded as angles."""
+    family = Bezier(7)
+    assert SOLVER_SAMPLES[family] == 50 and CHECK_SAMPLES[family] == 200
+    assert len(variable_names(family)) == len(scales(family)) == 33
+    assert np.array_equal(scales(family)[:8], scales(1)[:8]) and scales(family)[-1] == scales(1)[-1]
+    lower, upper = bounds(family)
+    assert np.all(upper[8:-1] == np.pi) and np.all(lower[8:-1] == -np.pi)
+    assert GaitProblem(_model(), SPEED, knots=family).describe().endswith("Bézier of degree 7")
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_the_graph_is_the_numeric_model(knee):
+    """The CasADi graph of a Bézier gait gives the numeric model's torques, constraints and
+    criteria to 1e-12 at random variables (clearance on: its between-sample rows too)."""
+    safety = Safety(clearance=0.02)
+    family = Bezier(6)
+    problem = GaitProblem(_model(knee), SPEED, safety=safety, knots=family)
+    function = StepGraph(problem.model, problem.samples_per_half, safety, knots=family).function()
+    rng = np.random.default_rng(6)
+    z = problem.first_guess() + 0.3 * scales(family) * rng.standard_normal(27)
+    z[:2] = rng.uniform(0.05, 0.3, 2)
+    out = function(z=z, speed=problem.speed)
+    step = build_step(problem.model, problem.speed, problem.to_parameters(z), family)
+    ev = evaluate_step(problem.model, step, problem.samples_per_half, safety=safety)
+    checked = ~np.isnan(ev.constraints)
+    for found, expected in (
+        (out["torques"].full().T, ev.torques),
+        (out["psi"].full().T[checked], ev.constraints[checked]),
+        (float(out["sthenic"]), ev.sthenic),
+        (float(out["energy"]), ev.energy),
+    ):
+        scale = np.max(np.abs(expected))
+        np.testing.assert_allclose(found, expected, rtol=1e-12, atol=1e-12 * scale)
+
+
+def test_the_first_guess_is_the_papers_fitted():
+    """The first guess's curves have the paper's first guess's ends, and fit its angles
+    better as the degree grows (least squares over the step)."""
+    model = _model()
+    paper = GaitProblem(model, SPEED)
+    reference = build_step(model, SPEED, paper.first_parameters())
+    t = np.linspace(0.0, 1.0, 101)
+    expected = np.concatenate(
+        [evaluate_at(reference, t[:51], 0)[0], evaluate_at(reference, t[50:], 1)[0]]
+    )
+    errors = []
+    for degree in (4, 6, 10):
+        problem = GaitProblem(model, SPEED, knots=Bezier(degree))
+        step = build_step(model, SPEED, problem.first_parameters(), Bezier(degree))
+        np.testing.assert_allclose(step.start[1], reference.start[1], atol=1e-12)
+        found = evaluate(step, np.concatenate([t[:51], t[50:]]))[0]
+        errors.append(np.abs(found - expected).max())
+    assert errors[0] >= errors[1] >= errors[2]
+
+
+def test_an_optimum_is_certified_and_a_higher_degree_never_worse(tmp_path):
+    """At 0.3 m/s the sthenic optimum of degree 7 is certified; degree 9 started from it
+    (its curves raised, the same motion) is certified and no worse; its gait file reads
+    back the family, and a file naming no family is refused."""
+    model = _model("revolute")
+    low = optimize(GaitProblem(model, SPEED, knots=Bezier(7)))
+    high = optimize(GaitProblem(model, SPEED, knots=Bezier(9)), below=low)
+    assert low.certified and high.certified
+    assert BELOW_START in [s.kind for s in high.report.history]
+    assert high.value <= low.value * (1 + 1e-9)
+    path = Gait.from_optimum(high, model.robot).write(tmp_path / "gait.json")
+    content = json.loads(path.read_text())
+    assert content["knots"] == {"bezier": 9} and content["units"]["knots.bezier"] == "1"
+    gait = Gait.read(path)
+    assert gait.knots == Bezier(9) and gait.costs.sthenic == pytest.approx(high.value, rel=1e-12)
+    content["knots"] = {"bezier": 2}
+    (tmp_path / "bad.json").write_text(json.dumps(content))
+    with pytest.raises(biped.BipedError, match="degree = 2: allowed an integer from 3"):
+        Gait.read(tmp_path / "bad.json")

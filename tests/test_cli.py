@@ -36,6 +36,11 @@ _TWO_PHASE = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "logs/
         (_TWO_PHASE + ["--double-support", "0.1", "--criterion", "energy"], "'energy'"),
         (_TWO_PHASE + ["--double-support", "0.1", "--knots", "3"], "knots = 3"),
         (_TWO_PHASE + ["--double-support", "0.1", "--method", "nelder-mead"], "nelder-mead"),
+        (_TWO_PHASE + ["--family", "bezier"], "without --degree"),
+        (_TWO_PHASE + ["--degree", "5"], "--degree 5 with --family spline"),
+        (_TWO_PHASE + ["--family", "bezier", "--degree", "5", "--knots", "3"], "--knots 3"),
+        (_TWO_PHASE + ["--family", "bezier", "--degree", "2"], "'2': allowed an integer from 3"),
+        (_TWO_PHASE + ["--family", "cartesian", "--degree", "5"], "'cartesian'"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):

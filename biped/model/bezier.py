@@ -32,10 +32,10 @@ only improve.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import comb
 
 from biped.errors import BipedError
 
@@ -103,7 +103,7 @@ def _basis(degree: int, t: np.ndarray) -> np.ndarray:
     numpy's power (whose kernels differ in the last bit between CPUs)."""
     columns = []
     for i in range(degree + 1):
-        term = np.full_like(t, comb(degree, i, exact=True), dtype=float)
+        term = np.full_like(t, math.comb(degree, i), dtype=float)
         for _ in range(i):
             term = term * t
         for _ in range(degree - i):
