@@ -21,6 +21,7 @@ from biped.model.gait import (
 )
 from biped.model.gait import evaluate as evaluate_at
 from biped.model.kinematics import swap_legs
+from biped.optimization.ladder import check_ladder
 from biped.optimization.optimize import BELOW_START, optimize
 from biped.optimization.problem import (
     CHECK_SAMPLES,
@@ -283,3 +284,17 @@ def test_an_optimum_is_certified_and_a_higher_degree_never_worse(tmp_path):
     (tmp_path / "bad.json").write_text(json.dumps(content))
     with pytest.raises(biped.BipedError, match="degree = 2: allowed an integer from 3"):
         Gait.read(tmp_path / "bad.json")
+
+
+def test_a_ladder_of_degrees_is_nested_or_refused():
+    """Increasing degrees make a ladder; a repeated degree, or splines and Bézier curves
+    mixed, do not."""
+    ladder = (Bezier(3), Bezier(5), Bezier(9))
+    assert check_ladder(ladder) == ladder
+    for bad, why in (
+        ([Bezier(5), Bezier(5)], "allowed increasing knots or degrees"),
+        ([1, Bezier(5)], "does not hold the spline of 1"),
+        ([Bezier(5), 3], "does not hold the Bézier of degree 5"),
+    ):
+        with pytest.raises(biped.BipedError, match=why):
+            check_ladder(bad)

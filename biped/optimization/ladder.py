@@ -18,6 +18,7 @@ import time
 from dataclasses import dataclass
 
 from biped.errors import BipedError
+from biped.model.bezier import Bezier
 from biped.model.gait import check_embedding, check_knots, parameter_names
 from biped.optimization.optimize import DEFAULT_STARTS, Optimum, checked, optimize, prepare
 from biped.optimization.problem import GaitProblem
@@ -69,15 +70,23 @@ class Rung:
 
 def check_ladder(knots) -> tuple:
     """``knots`` if a ladder: at least one family, each holding the one before
-    (``biped.model.gait.check_embedding``), else a clear error."""
+    (``biped.model.gait.check_embedding``: splines of more knots, or Bézier curves of higher
+    degrees), else a clear error."""
     rungs = tuple(check_knots(k) for k in knots)
     if not rungs:
         raise BipedError("ladder = (): allowed one family or more, such as 1,3,7,15")
     for below, above in zip(rungs, rungs[1:], strict=False):
-        if above <= below:
-            raise BipedError(f"ladder {rungs}: {above} after {below}, allowed increasing knots")
-        check_embedding(below, above)
+        check_embedding(below, above)  # a spline and a Bézier: refused (but a single cubic)
+        if _size(above) <= _size(below):
+            raise BipedError(
+                f"ladder {rungs}: {above} after {below}, allowed increasing knots or degrees"
+            )
     return rungs
+
+
+def _size(family) -> int:
+    """The order of a family on a ladder: its knots, or a Bézier's degree."""
+    return family.degree if isinstance(family, Bezier) else family
 
 
 def embedded_optimum(problem: GaitProblem, below: Optimum) -> Optimum:
