@@ -76,11 +76,12 @@ def check_ladder(knots) -> tuple:
     if not rungs:
         raise BipedError("ladder = (): allowed one family or more, such as 1,3,7,15")
     for below, above in zip(rungs, rungs[1:], strict=False):
-        check_embedding(below, above)  # a spline and a Bézier: refused (but a single cubic)
-        if _size(above) <= _size(below):
+        same = isinstance(above, Bezier) == isinstance(below, Bezier)
+        if same and _size(above) <= _size(below):
             raise BipedError(
                 f"ladder {rungs}: {above} after {below}, allowed increasing knots or degrees"
             )
+        check_embedding(below, above)  # a spline and a Bézier: refused (but a single cubic)
     return rungs
 
 
