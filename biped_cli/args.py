@@ -232,19 +232,24 @@ def add_knots(parser) -> None:
 FAMILIES = ("spline", "bezier")
 
 
+def add_family(parser, then: str = "--degree") -> None:
+    """``--family spline|bezier``: the splines' family (``--knots``) or the Bézier curves'
+    (``biped.model.bezier``), whose size ``then`` names."""
+    parser.add_argument(
+        "--family",
+        choices=FAMILIES,
+        default="spline",
+        help=f"the gait family: spline, a cubic spline per angle; bezier, one Bézier curve per "
+        f"angle over the whole step ({then}), its ends as the spline's (default %(default)s)",
+    )
+
+
 def add_bezier(parser) -> None:
     """``--family spline|bezier`` and ``--degree n``: the Bézier family
     (``biped.model.bezier``) beside the splines' ``--knots``."""
     from biped.model.bezier import MAX_DEGREE, MIN_DEGREE
 
-    parser.add_argument(
-        "--family",
-        choices=FAMILIES,
-        default="spline",
-        help="the gait family: spline, a cubic spline per angle (--knots); bezier, one Bézier "
-        "curve per angle over the whole step (--degree), its ends as the spline's "
-        "(default %(default)s)",
-    )
+    add_family(parser)
     parser.add_argument(
         "--degree",
         type=bounded(MIN_DEGREE, MAX_DEGREE),

@@ -10,24 +10,41 @@ from pathlib import Path
 from biped_cli import args as types
 
 DEFAULT_LADDER = (1, 3, 7, 15)
+# The Bézier family's (``--family bezier``): degrees, each holding the one below.
+DEFAULT_BEZIER_LADDER = (5, 7, 9, 13)
 DEFAULT_OUT = "logs/converge"
 # The outputs' name in the folder: converge.json and converge.png.
 NAME = "converge"
 
 
 def ladder(text: str) -> tuple:
-    """'1,3,7,15': the interior knots of each rung, each family holding the one before."""
+    """'1,3,7,15': the sizes of each rung (interior knots, or a Bézier family's degrees),
+    integers; ``ladder_of`` checks them with the family."""
+    try:
+        return tuple(int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"ladder = {text!r}: not integers; allowed increasing knots, each family holding "
+            "the one before, such as 1,3,7,15 (or degrees with --family bezier, such as 5,7,9)"
+        ) from None
+
+
+def ladder_of(args) -> tuple:
+    """The families of ``--ladder`` in ``--family`` (its default ladder when not given),
+    each holding the one before; a clear error otherwise."""
     from biped.errors import BipedError
+    from biped.model.bezier import Bezier
     from biped.optimization.ladder import check_ladder
 
+    bezier = args.family == "bezier"
+    sizes = args.ladder or (DEFAULT_BEZIER_LADDER if bezier else DEFAULT_LADDER)
     try:
-        knots = tuple(int(part) for part in text.split(","))
-        return check_ladder(knots)
-    except (ValueError, BipedError) as error:
-        why = str(error) if isinstance(error, BipedError) else "not integers"
-        raise argparse.ArgumentTypeError(
-            f"ladder = {text!r}: {why}; allowed increasing knots, each family holding the one "
-            "before, such as 1,3,7,15"
+        return check_ladder(tuple(Bezier(n) for n in sizes) if bezier else sizes)
+    except BipedError as error:
+        allowed = "increasing degrees from 3 to 20" if bezier else "increasing knots"
+        raise BipedError(
+            f"ladder = {','.join(map(str, sizes))}: {error}; allowed {allowed}, each family "
+            "holding the one before, such as " + ("5,7,9" if bezier else "1,3,7,15")
         ) from None
 
 
@@ -38,12 +55,14 @@ def add_parser(commands) -> None:
     types.add_criterion(parser)
     types.add_safety(parser)
     types.add_robot(parser)
+    types.add_family(parser, then="--ladder's degrees")
     types.add_folder(parser, "--out", DEFAULT_OUT, "folder of the results",
                      f": {NAME}.json and its figure {NAME}.png")  # fmt: skip
     types.add_options(
         parser,
-        ("--ladder", ladder, DEFAULT_LADDER, "K1,K2,...", "interior knots of each rung, each "
-         "family holding the one before (default 1,3,7,15: 21, 45, 93, 189 parameters)"),
+        ("--ladder", ladder, None, "K1,K2,...", "interior knots of each rung, each "
+         "family holding the one before (default 1,3,7,15: 21, 45, 93, 189 parameters); with "
+         "--family bezier the degrees (default 5,7,9,13: 21, 33, 45, 69 parameters)"),
         ("--starts", types.starts, 3, "N", "IPOPT's own starts at each rung (default 3), the "
          "rung below's optimum among them; " + types.CERTIFIED_HELP),
         ("--seed", types.non_negative, 0, "N", "seed of the perturbed starts (default 0)"),
@@ -53,13 +72,15 @@ def add_parser(commands) -> None:
 
 def cmd_converge(args) -> int:
     """Each knee's optimal gait at --speed in each family of --ladder (1, 3, 7, 15 interior
-    knots: each family holds the one below, and each rung starts from the rung below's
+    knots, or with --family bezier the Bézier degrees 5, 7, 9, 13: each family holds the one
+    below, and each rung starts from the rung below's
     optimum), the knees compared at each rung with the difference's error bar and each
     optimum's uncertainty (finer grid, tighter tolerance, starts). The comparison has
     converged at the first rung where each optimum and the difference changed by less than
     its error bar. Writes converge.json and converge.png in --out, prints a sentence. Exits 1
     when a rung is not certified or a rung's optimum is worse than the one below's."""
     from biped.model.dynamics import Biped
+    from biped.model.gait import family_label
     from biped.optimization.knees import KNEES
     from biped.optimization.ladder import climb
     from biped.optimization.problem import GaitProblem
@@ -70,26 +91,29 @@ def cmd_converge(args) -> int:
     problems = {
         knee: GaitProblem(Biped(robot, knee), args.speed, args.criterion, safety) for knee in KNEES
     }
+    families = ladder_of(args)
     types.check_folder(args.out, "--out")
     types.claim_outputs(args.out, [NAME])
-    print(f"converging {problems['rolling'].describe()} over K = {args.ladder}...", file=sys.stderr)
+    shown = ", ".join(map(family_label, families))
+    print(f"converging {problems['rolling'].describe()} over {shown}...", file=sys.stderr)
     rungs = {}
     for knee, problem in problems.items():
-        rungs[knee] = climb(
-            problem, args.ladder, args.seed, args.starts, args.jobs, _progress(knee)
-        )
+        rungs[knee] = climb(problem, families, args.seed, args.starts, args.jobs, _progress(knee))
     records = []
-    for i, _ in enumerate(args.ladder):
+    for i, _ in enumerate(families):
         records.append(rung_record({knee: rungs[knee][i] for knee in KNEES}))
-        print(f"  K = {records[-1].knots}: compared", file=sys.stderr)
+        print(f"  {family_label(records[-1].knots)}: compared", file=sys.stderr)
     verdict = convergence(records)
     return _report(args, problems["rolling"], records, verdict, robot)
 
 
 def _progress(knee: str):
+    from biped.model.gait import family_label
+
     def say(rung) -> None:
         print(
-            f"  {knee}, K = {rung.knots}: {rung.value:.6g} ({rung.optimum.report.status}, "
+            f"  {knee}, {family_label(rung.knots)}: {rung.value:.6g} "
+            f"({rung.optimum.report.status}, "
             f"{rung.seconds:.1f} s)",
             file=sys.stderr,
         )
@@ -99,6 +123,7 @@ def _progress(knee: str):
 
 def _report(args, problem, records, verdict, robot) -> int:
     from biped.model.criteria import CRITERION_UNITS
+    from biped.model.gait import family_label
     from biped.pages.converge_figures import converge_figure
     from biped.pages.style import save
     from biped.records.gait_file import write_json
@@ -112,17 +137,19 @@ def _report(args, problem, records, verdict, robot) -> int:
     print(f"wrote {save(figure, folder / f'{NAME}.png')}")
     for line in sentence(records, verdict, unit):
         print(line)
-    failed = [r.knots for r in records if not r.certified]
-    worse = [r.knots for r in records if not all(k.monotone for k in r.knees.values())]
+    failed = [family_label(r.knots) for r in records if not r.certified]
+    worse = [
+        family_label(r.knots) for r in records if not all(k.monotone for k in r.knees.values())
+    ]
     if failed:
         print(
-            f"biped converge: NOT CERTIFIED at K = {', '.join(map(str, failed))}: those rungs' "
+            f"biped converge: NOT CERTIFIED at {', '.join(failed)}: those rungs' "
             "optima are not converged and feasible, their figures are not an answer",
             file=sys.stderr,
         )
     if worse:
         print(
-            f"biped converge: at K = {', '.join(map(str, worse))} an optimum is worse than the "
+            f"biped converge: at {', '.join(worse)} an optimum is worse than the "
             "rung below's embedded in its family (1e-9 relative)",
             file=sys.stderr,
         )

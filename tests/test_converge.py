@@ -98,6 +98,9 @@ def test_the_rule_does_not_stop_before_a_sequence_has_settled():
         (["--ladder", "3,1"], "increasing"),
         (["--ladder", "1,x"], "not integers"),
         (["--ladder", "1,64"], "from 1 to 31"),
+        (["--family", "bezier", "--ladder", "7,5"], "increasing degrees"),
+        (["--family", "bezier", "--ladder", "2,5"], "degree = 2: allowed an integer from 3"),
+        (["--family", "cartesian"], "'cartesian'"),
         (["--speed", "-1"], "speed"),
         (["--starts", "0"], "'0'"),
         (["--clearance", "2"], "clearance"),
@@ -134,3 +137,24 @@ def test_converge_writes_its_record_figure_and_sentence(capsys, tmp_path):
     )
     assert "K = 3 (45 parameters)" in out and "difference" in out.splitlines()[-1]
     assert np.isfinite(rungs[1]["difference_error"])
+
+
+def test_converge_climbs_bezier_degrees(capsys, tmp_path):
+    """With --family bezier the ladder is of degrees: each rung certified and no worse than
+    the one below (its curve raised), the JSON naming each family {"bezier": n} with its
+    unit, the sentence naming the degree."""
+    argv = ["converge", "--speed", "0.3", "--family", "bezier", "--ladder", "5,7"]
+    assert main([*argv, "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    content = json.loads((tmp_path / "converge.json").read_text())
+    from biped.model.units import missing
+
+    assert missing(content, content["units"]) == []
+    rungs = content["rungs"]
+    assert [r["knots"] for r in rungs] == [{"bezier": 5}, {"bezier": 7}]
+    assert [r["parameters"] for r in rungs] == [21, 33]
+    for knee in ("revolute", "rolling"):
+        low, high = (r["knees"][knee] for r in rungs)
+        assert low["certified"] and high["certified"] and high["monotone"]
+        assert high["value"] <= high["start_value"] * (1 + 1e-9)
+    assert "n = 7 (33 parameters)" in out

@@ -72,6 +72,15 @@ class Bezier:
         return f"Bézier of degree {self.degree}"
 
     @property
+    def label(self) -> str:
+        """How a ladder's rung names it: "n = 7" (a spline's: "K = 3")."""
+        return f"n = {self.degree}"
+
+    def to_dict(self) -> dict:
+        """As files write it: {"bezier": degree} (a spline's family: its knots K)."""
+        return {"bezier": self.degree}
+
+    @property
     def interior(self) -> int:
         """The free control points of each angle, n − 3."""
         return self.degree - 3

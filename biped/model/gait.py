@@ -109,6 +109,17 @@ def parameter_names(knots: int = 1) -> tuple:
     return PARAMETERS[:8] + at_knots + ("period",)
 
 
+def family_label(knots) -> str:
+    """How a ladder's rung names a family: "K = 3" (interior knots) or "n = 7" (a Bézier's
+    degree)."""
+    return check_knots(knots).label if isinstance(knots, Bezier) else f"K = {knots}"
+
+
+def family_json(knots):
+    """A family as files write it: K, or {"bezier": degree}."""
+    return check_knots(knots).to_dict() if isinstance(knots, Bezier) else knots
+
+
 def pieces(knots: int = 1) -> int:
     """The pieces of a family: K + 1 for a spline of K interior knots, 1 for a Bézier."""
     return 1 if isinstance(check_knots(knots), Bezier) else knots + 1

@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
 from biped.model.criteria import CRITERION_UNITS
+from biped.model.gait import family_label
 from biped.pages.style import KNEE_STYLE
 
 PAPER_PARAMETERS = 21  # the paper's spline, one interior knot
@@ -34,10 +35,12 @@ def converge_figure(records, criterion: str, speed: float, converged_at) -> Figu
         bottom.annotate(shown, (n, difference), textcoords="offset points", xytext=(6, 6),
                         fontsize=8)  # fmt: skip
     bottom.axhline(0.0, color="0.5", lw=0.6)
+    paper = any(record.knots == 1 for record in records)  # no rung of a Bézier ladder
     for ax in (top, bottom):
-        ax.axvline(PAPER_PARAMETERS, color="0.6", ls=":", lw=1.0)
-        ax.text(PAPER_PARAMETERS, 0.97, " paper's family (K = 1)", fontsize=8, va="top",
-                transform=ax.get_xaxis_transform())  # fmt: skip
+        if paper:
+            ax.axvline(PAPER_PARAMETERS, color="0.6", ls=":", lw=1.0)
+            ax.text(PAPER_PARAMETERS, 0.97, " paper's family (K = 1)", fontsize=8, va="top",
+                    transform=ax.get_xaxis_transform())  # fmt: skip
         if converged_at is not None:
             at = next(r.parameters for r in records if r.knots == converged_at)
             ax.axvline(at, color="tab:green", lw=1.0)
@@ -45,12 +48,16 @@ def converge_figure(records, criterion: str, speed: float, converged_at) -> Figu
         ax.set_xscale("log")
         ax.xaxis.set_minor_locator(NullLocator())
     ax = bottom
-    ax.set_xticks(size, [f"{int(n)}\n(K = {r.knots})" for n, r in zip(size, records, strict=True)])
+    labels = [f"{int(n)}\n({family_label(r.knots)})" for n, r in zip(size, records, strict=True)]
+    ax.set_xticks(size, labels)
     top.set_ylabel(f"{criterion} optimum [{CRITERION_UNITS[criterion]}]")
     top.legend(title="error bars: finer grid, tighter tolerance, starts", title_fontsize=8)
     bottom.set_ylabel("rolling vs revolute [%]")
-    bottom.set_xlabel("parameters of the gait family (interior knots K)")
-    verdict = "not converged" if converged_at is None else f"converged at K = {converged_at}"
+    kind = "interior knots K" if paper or isinstance(records[0].knots, int) else "Bézier degree n"
+    bottom.set_xlabel(f"parameters of the gait family ({kind})")
+    verdict = (
+        "not converged" if converged_at is None else f"converged at {family_label(converged_at)}"
+    )
     top.set_title(f"optima over nested gait families, {speed:g} m/s ({verdict})")
     return fig
 

@@ -693,9 +693,7 @@ class Gait:
             value = getattr(self, f.name)
             if (f.name, value) in (("design", None), ("knots", 1)):  # the paper's: unwritten
                 continue
-            if isinstance(value, Bezier):
-                value = {"bezier": value.degree}
-            elif hasattr(value, "to_dict"):  # the samples, records, robot
+            if hasattr(value, "to_dict"):  # the samples, records, robot, a Bézier family
                 value = value.to_dict()
             elif dataclasses.is_dataclass(value):  # the safety margins, a knee bend if asked
                 value = safety_dict(value)

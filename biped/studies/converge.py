@@ -19,6 +19,7 @@ import math
 import time
 from dataclasses import dataclass
 
+from biped.model.gait import family_json, family_label
 from biped.optimization.comparison import relative_change
 from biped.optimization.knees import KNEES, compare_knees, optimum_uncertainty, resolved
 from biped.optimization.ladder import Rung
@@ -64,7 +65,7 @@ class KneeRung:
 class RungRecord:
     """Both knees at one rung of the ladder."""
 
-    knots: int  # interior knots K
+    knots: int  # the family: interior knots K, or a ``Bezier``
     parameters: int  # of the family (21 for the paper's spline)
     knees: dict  # knee -> KneeRung
     difference: float  # (rolling − revolute) / revolute [%]
@@ -76,7 +77,7 @@ class RungRecord:
 
     def to_dict(self) -> dict:
         return {
-            "knots": self.knots,
+            "knots": family_json(self.knots),
             "parameters": self.parameters,
             "difference": self.difference,
             "difference_error": self.difference_error,
@@ -134,11 +135,15 @@ def rung_record(rungs: dict) -> RungRecord:
 class Convergence:
     """The ladder's verdict (module docstring)."""
 
-    converged_at: int | None  # knots K of the rung where the comparison converged
-    stops_improving: dict  # knee -> knots K where its optimum settles (None: not yet)
+    converged_at: int | None  # the family (knots K) of the rung where the comparison converged
+    stops_improving: dict  # knee -> the family where its optimum settles (None: not yet)
 
     def to_dict(self) -> dict:
-        return {"converged_at": self.converged_at, "stops_improving": self.stops_improving}
+        def written(family):
+            return None if family is None else family_json(family)
+
+        stops = {knee: written(family) for knee, family in self.stops_improving.items()}
+        return {"converged_at": written(self.converged_at), "stops_improving": stops}
 
 
 def convergence(records: list[RungRecord]) -> Convergence:
@@ -193,11 +198,14 @@ def content_of(problem, records: list, verdict: Convergence, robot, unit: str) -
         **verdict.to_dict(),
     }
     units = {f"robot.{name}": robot_unit(name) for name in content["robot"] if name != "actuators"}
-    units.update({"speed": "m/s", "converged_at": PURE, "rungs[].knots": PURE})
+    family = "" if isinstance(records[0].knots, int) else ".bezier"  # {"bezier": n}
+    units.update({"speed": "m/s", f"rungs[].knots{family}": PURE})
+    units[_unit_key("converged_at", content["converged_at"])] = PURE
     units.update({"rungs[].parameters": PURE, "rungs[].difference": PERCENT})
     units["rungs[].difference_error"] = PERCENT
     for knee in KNEES:
-        units[f"stops_improving.{knee}"] = PURE
+        key = f"stops_improving.{knee}"
+        units[_unit_key(key, content["stops_improving"][knee])] = PURE
         row = f"rungs[].knees.{knee}"
         units.update({f"{row}.value": unit, f"{row}.start_value": unit})
         units[f"{row}.uncertainty"] = PERCENT
@@ -205,6 +213,12 @@ def content_of(problem, records: list, verdict: Convergence, robot, unit: str) -
             units[f"{row}.{name}"] = "s"
     content["units"] = units
     return content
+
+
+def _unit_key(key: str, written) -> str:
+    """The unit's key of a family as written (``family_json``): ``key`` for K or none,
+    ``key.bezier`` for {"bezier": n}."""
+    return f"{key}.bezier" if isinstance(written, dict) else key
 
 
 def sentence(records: list, verdict: Convergence, unit: str) -> list[str]:
@@ -219,25 +233,27 @@ def sentence(records: list, verdict: Convergence, unit: str) -> list[str]:
         )
         resolves = sum(rung.resolve_seconds for rung in record.knees.values())
         lines.append(
-            f"K = {record.knots} ({record.parameters} parameters): {knees}; difference "
+            f"{family_label(record.knots)} ({record.parameters} parameters): {knees}; difference "
             f"{record.difference:+.2f} % ± {_shown(record.difference_error)} (re-solves "
             f"{resolves:.1f} s)"
         )
     stops = ", ".join(
-        f"the {knee} knee's at {'no rung yet' if k is None else f'K = {k}'}"
+        f"the {knee} knee's at {'no rung yet' if k is None else family_label(k)}"
         for knee, k in verdict.stops_improving.items()
     )
     if verdict.converged_at is None:
         last = records[-1]
         lines.append(
-            f"Not converged over K = {', '.join(str(r.knots) for r in records)}: the last rung's "
+            f"Not converged over {', '.join(family_label(r.knots) for r in records)}: the last "
+            "rung's "
             f"difference is {last.difference:+.2f} % ± {_shown(last.difference_error)}; the "
             f"optimum stops improving: {stops}."
         )
     else:
         at = next(r for r in records if r.knots == verdict.converged_at)
         lines.append(
-            f"Converged at K = {at.knots} ({at.parameters} parameters): the rolling knee's "
+            f"Converged at {family_label(at.knots)} ({at.parameters} parameters): the rolling "
+            "knee's "
             f"optimum differs from the revolute knee's by {at.difference:+.2f} % ± "
             f"{_shown(at.difference_error)}; the optimum stops improving: {stops}."
         )
