@@ -3,6 +3,7 @@ conditions (flat feet, leg swap, impact map) exactly, a degree's curve is the sa
 in every higher degree (a nested ladder), and its rates and accelerations are the
 derivatives of its angles."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -280,6 +281,15 @@ def test_an_optimum_is_certified_and_a_higher_degree_never_worse(tmp_path):
     assert content["knots"] == {"bezier": 9} and content["units"]["knots.bezier"] == "1"
     gait = Gait.read(path)
     assert gait.knots == Bezier(9) and gait.costs.sthenic == pytest.approx(high.value, rel=1e-12)
+    from validate.walk.samples import GaitSamples
+
+    samples = GaitSamples.from_gait(gait)  # one curve: one piece, each time once
+    ((rows, t0, t1),) = samples.pieces()
+    assert (t0, t1) == (0.0, pytest.approx(high.step.period, rel=1e-12))
+    assert rows == slice(0, len(samples.t))
+    spline = dataclasses.replace(samples, one_piece=False)  # a spline's samples need a knot
+    with pytest.raises(biped.BipedError, match="has no knot"):
+        spline.pieces()
     content["knots"] = {"bezier": 2}
     (tmp_path / "bad.json").write_text(json.dumps(content))
     with pytest.raises(biped.BipedError, match="degree = 2: allowed an integer from 3"):

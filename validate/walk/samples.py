@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model.bezier import Bezier
 from biped.records.gait_file import Gait
 
 FIELDS = ("q", "qd", "qdd", "torques", "wrench", "zmp")
@@ -36,6 +37,8 @@ class GaitSamples:
         torques: (N, 6) Γ1..Γ6 [N·m].
         wrench: (N, 3) ground wrench on the stance foot [Fx, Fz, Cy] [N, N, N·m].
         zmp: (N, 1) x of the ZMP from the stance ankle [m].
+        one_piece: the gait is one polynomial over the step (a Bézier family's), its times
+            each once; a spline's hold each knot's time twice.
     """
 
     period: float
@@ -47,19 +50,25 @@ class GaitSamples:
     torques: np.ndarray
     wrench: np.ndarray
     zmp: np.ndarray
+    one_piece: bool = False
 
     @classmethod
     def from_gait(cls, gait: Gait) -> GaitSamples:
         """The samples of a gait."""
         arrays = {key: np.asarray(getattr(gait.samples, key), float) for key in ("t", *FIELDS)}
         arrays["zmp"] = arrays["zmp"].reshape(-1, 1)
-        return cls(period=float(gait.period), step_length=float(gait.step_length), **arrays)
+        one_piece = isinstance(gait.knots, Bezier)
+        return cls(float(gait.period), float(gait.step_length), **arrays, one_piece=one_piece)
 
     def pieces(self) -> list[tuple[slice, float, float]]:
         """(rows, start [s], end [s]) of each spline piece: the samples between two knots,
         where the file holds a time twice (the left and right limits at the knot; the
         paper's spline has one, at T/2)."""
         knots = np.flatnonzero(np.diff(self.t) == 0.0)
+        if self.one_piece:
+            if len(knots):
+                raise BipedError("samples.t of one curve holds a time twice: allowed each once")
+            return [(slice(0, len(self.t)), self.t[0], self.t[-1])]
         if len(knots) == 0:
             raise BipedError("samples.t has no knot: allowed each knot's time twice (T/2 once)")
         firsts = [0, *(k + 1 for k in knots)]
