@@ -134,3 +134,29 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if {item.nodeid.split("[")[0], item.nodeid.split("::")[0]} & _SLOW:
             item.add_marker(pytest.mark.slow)
+
+
+def assert_graph_is_the_model(problem, safety, family, seed: int) -> None:
+    """The CasADi graph of ``problem``'s gait family gives the numeric model's torques,
+    constraints and criteria to 1e-12 at random variables drawn with ``seed``."""
+    from biped.model.criteria import evaluate_step
+    from biped.model.gait import build_step
+    from biped.optimization.problem import scales
+    from biped.optimization.symbolic import StepGraph
+
+    function = StepGraph(problem.model, problem.samples_per_half, safety, knots=family).function()
+    rng = np.random.default_rng(seed)
+    z = problem.first_guess() + 0.3 * scales(family) * rng.standard_normal(len(scales(family)))
+    z[:2] = rng.uniform(0.05, 0.3, 2)
+    out = function(z=z, speed=problem.speed)
+    step = build_step(problem.model, problem.speed, problem.to_parameters(z), family)
+    ev = evaluate_step(problem.model, step, problem.samples_per_half, safety=safety)
+    checked = ~np.isnan(ev.constraints)
+    for found, expected in (
+        (out["torques"].full().T, ev.torques),
+        (out["psi"].full().T[checked], ev.constraints[checked]),
+        (float(out["sthenic"]), ev.sthenic),
+        (float(out["energy"]), ev.energy),
+    ):
+        scale = np.max(np.abs(expected))
+        np.testing.assert_allclose(found, expected, rtol=1e-12, atol=1e-12 * scale)

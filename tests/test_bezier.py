@@ -11,7 +11,7 @@ import pytest
 
 import biped
 from biped.model.bezier import DEGREES, MAX_DEGREE, MIN_DEGREE, Bezier, bernstein, elevate
-from biped.model.criteria import Safety, evaluate_step
+from biped.model.criteria import Safety
 from biped.model.gait import (
     FREE_SWAP,
     build_step,
@@ -32,8 +32,8 @@ from biped.optimization.problem import (
     scales,
     variable_names,
 )
-from biped.optimization.symbolic import StepGraph
 from biped.records.gait_file import Gait
+from tests.conftest import assert_graph_is_the_model
 
 SPEED = 0.3
 
@@ -228,22 +228,7 @@ def test_the_graph_is_the_numeric_model(knee):
     safety = Safety(clearance=0.02)
     family = Bezier(6)
     problem = GaitProblem(_model(knee), SPEED, safety=safety, knots=family)
-    function = StepGraph(problem.model, problem.samples_per_half, safety, knots=family).function()
-    rng = np.random.default_rng(6)
-    z = problem.first_guess() + 0.3 * scales(family) * rng.standard_normal(27)
-    z[:2] = rng.uniform(0.05, 0.3, 2)
-    out = function(z=z, speed=problem.speed)
-    step = build_step(problem.model, problem.speed, problem.to_parameters(z), family)
-    ev = evaluate_step(problem.model, step, problem.samples_per_half, safety=safety)
-    checked = ~np.isnan(ev.constraints)
-    for found, expected in (
-        (out["torques"].full().T, ev.torques),
-        (out["psi"].full().T[checked], ev.constraints[checked]),
-        (float(out["sthenic"]), ev.sthenic),
-        (float(out["energy"]), ev.energy),
-    ):
-        scale = np.max(np.abs(expected))
-        np.testing.assert_allclose(found, expected, rtol=1e-12, atol=1e-12 * scale)
+    assert_graph_is_the_model(problem, safety, family, seed=6)
 
 
 def test_the_first_guess_is_the_papers_fitted():

@@ -22,8 +22,7 @@ from biped.model.gait import (
 from biped.optimization.ladder import check_ladder
 from biped.optimization.optimize import CHECK_SAMPLES, PAPER_START, optimize
 from biped.optimization.problem import SCALES, SOLVER_SAMPLES, GaitProblem, scales, variable_names
-from biped.optimization.symbolic import StepGraph
-from tests.conftest import optimal_gait
+from tests.conftest import assert_graph_is_the_model, optimal_gait
 
 ROBOT = biped.Robot.paper()
 
@@ -140,22 +139,7 @@ def test_richer_graph_equals_the_numeric_model(knee):
     )
     safety = Safety(clearance=0.02)
     problem = GaitProblem(biped.Biped(robot, knee), 0.3, safety=safety, knots=3)
-    function = StepGraph(problem.model, problem.samples_per_half, safety, knots=3).function()
-    rng = np.random.default_rng(5)
-    z = problem.first_guess() + 0.3 * scales(3) * rng.standard_normal(45)
-    z[:2] = rng.uniform(0.05, 0.3, 2)
-    out = function(z=z, speed=problem.speed)
-    step = build_step(problem.model, problem.speed, problem.to_parameters(z), 3)
-    ev = evaluate_step(problem.model, step, problem.samples_per_half, safety=safety)
-    checked = ~np.isnan(ev.constraints)
-    for found, expected in (
-        (out["torques"].full().T, ev.torques),
-        (out["psi"].full().T[checked], ev.constraints[checked]),
-        (float(out["sthenic"]), ev.sthenic),
-        (float(out["energy"]), ev.energy),
-    ):
-        scale = np.max(np.abs(expected))
-        np.testing.assert_allclose(found, expected, rtol=1e-12, atol=1e-12 * scale)
+    assert_graph_is_the_model(problem, safety, 3, seed=5)
 
 
 @pytest.mark.parametrize("speed", [0.2, 0.3, 0.4])
