@@ -107,7 +107,7 @@ def cmd_profile_speeds(args) -> int:
     from biped.pages.profile_figures import speeds_figure
     from biped.pages.style import save
     from biped.records.gait_file import Gait, write_json
-    from biped.studies.profile_speeds import row_at, table
+    from biped.studies.profile_speeds import content_of, machined_circles, row_at, table
     from biped_cli import args as types
 
     gait = Gait.read(args.gait, consistent=True)
@@ -120,22 +120,14 @@ def cmd_profile_speeds(args) -> int:
     types.check_output(str(out))
     figure_path = out.with_suffix(".png")
     types.check_output(str(figure_path))
-    machined = _machined_circles(gait, args.gait)
+    machined = machined_circles(gait, args.gait)
     rows = []
     for speed in args.speeds:
         print(f"at {speed:.3f} m/s ...", file=sys.stderr)
         settings = (gait.criterion, gait.safety, args.seed, args.starts)
         rows.append(row_at(gait.robot, machined, float(speed), *settings))
     print(table(rows, CRITERION_UNITS[gait.criterion]))
-    content = {
-        "gait": str(args.gait),
-        "robot": gait.robot.to_dict(),
-        "criterion": gait.criterion,
-        "designed_at": gait.speed,
-        "machined_circles": dict(zip(("r1", "r2"), machined, strict=True)),
-        "rows": [row.to_dict() for row in rows],
-    }
-    content["units"] = units(content, CRITERION_UNITS[gait.criterion])
+    content = content_of(str(args.gait), gait, machined, rows)
     print(f"wrote {write_json(out, content)}")
     save(speeds_figure(rows, gait.criterion, gait.speed), figure_path)
     print(f"wrote {figure_path}")
@@ -148,31 +140,3 @@ def cmd_profile_speeds(args) -> int:
         )
         return 1
     return 0
-
-
-def units(content: dict, criterion_unit: str) -> dict:
-    """The ``units`` map of a profile-speeds file (``biped.model.units``): every number's."""
-    from biped.model.units import PERCENT, robot_unit
-    from biped.studies.profile_speeds import CHANGES, KNEES
-
-    found = {f"robot.{name}": robot_unit(name) for name in content["robot"] if name != "actuators"}
-    found.update({"designed_at": "m/s", "rows[].speed": "m/s"})
-    found.update({f"machined_circles.{name}": "m" for name in ("r1", "r2")})
-    found.update({f"rows[].values.{knee}": criterion_unit for knee in KNEES})
-    found.update({f"rows[].circles_radii.{name}": "m" for name in ("r1", "r2")})
-    for name in CHANGES:
-        found[f"rows[].{name}"] = PERCENT
-    return found
-
-
-def _machined_circles(gait, path) -> tuple:
-    """(r1, r2) [m] of the circles designed at the profile's speed: its design block's row
-    of the designed circles."""
-    rows = (gait.design or {}).get("compared") if isinstance(gait.design, dict) else None
-    for row in rows or []:
-        if row.get("knee") == "rolling, optimal radii" and row.get("radii"):
-            return float(row["radii"]["r1"]), float(row["radii"]["r2"])
-    raise BipedError(
-        f"gait file {path!r} has no designed circles in its design block: allowed the gait "
-        "file of biped design --profile"
-    )

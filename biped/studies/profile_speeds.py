@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from biped.model.criteria import Safety
+from biped.errors import BipedError
+from biped.model.criteria import CRITERION_UNITS, Safety
 from biped.model.dynamics import Biped
 from biped.model.robot import Robot
 from biped.optimization.comparison import relative_change
@@ -147,3 +148,46 @@ def table(rows: list[SpeedRow], unit: str) -> str:
             f"{shown(row.change('profile', 'revolute'), '.2f'):>13}{flag}"
         )
     return "\n".join(lines)
+
+
+def content_of(path: str, gait, machined: tuple, rows: list[SpeedRow]) -> dict:
+    """The JSON of ``biped profile-speeds``: the profile's gait file (``path``, read as
+    ``gait``), its robot, criterion and speed of design, the machined circles (r1, r2) [m],
+    each speed's row and the units of every number."""
+    content = {
+        "gait": path,
+        "robot": gait.robot.to_dict(),
+        "criterion": gait.criterion,
+        "designed_at": gait.speed,
+        "machined_circles": dict(zip(("r1", "r2"), machined, strict=True)),
+        "rows": [row.to_dict() for row in rows],
+    }
+    content["units"] = units(content, CRITERION_UNITS[gait.criterion])
+    return content
+
+
+def units(content: dict, criterion_unit: str) -> dict:
+    """The ``units`` map of a profile-speeds file (``biped.model.units``): every number's."""
+    from biped.model.units import PERCENT, robot_unit
+
+    found = {f"robot.{name}": robot_unit(name) for name in content["robot"] if name != "actuators"}
+    found.update({"designed_at": "m/s", "rows[].speed": "m/s"})
+    found.update({f"machined_circles.{name}": "m" for name in ("r1", "r2")})
+    found.update({f"rows[].values.{knee}": criterion_unit for knee in KNEES})
+    found.update({f"rows[].circles_radii.{name}": "m" for name in ("r1", "r2")})
+    for name in CHANGES:
+        found[f"rows[].{name}"] = PERCENT
+    return found
+
+
+def machined_circles(gait, path) -> tuple:
+    """(r1, r2) [m] of the circles designed at the profile's speed: its design block's row
+    of the designed circles."""
+    rows = (gait.design or {}).get("compared") if isinstance(gait.design, dict) else None
+    for row in rows or []:
+        if row.get("knee") == "rolling, optimal radii" and row.get("radii"):
+            return float(row["radii"]["r1"]), float(row["radii"]["r2"])
+    raise BipedError(
+        f"gait file {path!r} has no designed circles in its design block: allowed the gait "
+        "file of biped design --profile"
+    )
