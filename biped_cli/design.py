@@ -187,16 +187,21 @@ def cmd_design(args) -> int:
         return 1
     path = Gait.from_design(comparison).write(args.out)
     print(f"wrote {path}")
-    bad = comparison.uncertified()
-    if bad:
-        print(
-            "biped design: compared with knees that are not certified optima ("
-            + "; ".join(bad)
-            + "): the changes in % are not between certified optima",
-            file=sys.stderr,
-        )
-        return 1
-    return 0
+    return certified_exit(comparison.uncertified())
+
+
+def certified_exit(bad) -> int:
+    """0 when every knee compared is a certified optimum; else 1, after one line on stderr
+    naming the others (``bad``, a design comparison's ``uncertified()``)."""
+    if not bad:
+        return 0
+    print(
+        "biped design: compared with knees that are not certified optima ("
+        + "; ".join(bad)
+        + "): the changes in % are not between certified optima",
+        file=sys.stderr,
+    )
+    return 1
 
 
 def cmd_design_map(args) -> int:

@@ -24,6 +24,7 @@ def run_profile(args, problem) -> int:
     from biped.optimization.profile_design import ProfileProblem, compare_profile
     from biped.records.gait_file import Gait
     from biped_cli import args as types
+    from biped_cli.design import certified_exit
 
     out = Path(args.out)
     circles_path = out.with_name(f"{out.stem}{CIRCLES_SUFFIX}")
@@ -53,16 +54,7 @@ def run_profile(args, problem) -> int:
     print(f"wrote {path}")
     written = Gait.from_design(comparison.circles).write(circles_path)
     print(f"wrote {written} (the designed circles' gait, which the page draws beside)")
-    bad = comparison.circles.uncertified()
-    if bad:
-        print(
-            "biped design: compared with knees that are not certified optima ("
-            + "; ".join(bad)
-            + "): the changes in % are not between certified optima",
-            file=sys.stderr,
-        )
-        return 1
-    return 0
+    return certified_exit(comparison.circles.uncertified())
 
 
 def check_profile_options(args) -> None:
