@@ -64,7 +64,7 @@ def cmd_atlas(args) -> int:
             tuple(float(v) for v in args.clearances),
             tuple(float(v) for v in args.knee_bends),
             tuple(args.criteria),
-            args.knots,
+            types.gait_family(args),
             args.seed,
             args.starts,
             actuator_limits=args.actuator_limits,
@@ -117,6 +117,7 @@ def add_parser(commands) -> None:
     )  # fmt: skip
     types.add_criterion(parser, several=True, default=DEFAULT_CRITERIA)
     types.add_knots(parser)
+    types.add_bezier(parser)
     types.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
     parser.add_argument(
         "--no-walks", action="store_true", help="skip walking the certified optima in MuJoCo"

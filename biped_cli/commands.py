@@ -297,7 +297,8 @@ def cmd_sweep(args) -> int:
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
-    sweep = sweep_settings(robot, args.speeds, args.seed, args.starts, safety(args), args.knots)
+    family = types.gait_family(args)
+    sweep = sweep_settings(robot, args.speeds, args.seed, args.starts, safety(args), family)
     check_sweep(args.out, sweep)
     if args.paper_seeds:  # refused before the sweep runs, not after
         paper = paper_method.paper_settings(robot, paper_speed, args.paper_seeds, safety(args))
@@ -335,6 +336,7 @@ def add_sweep(commands) -> None:
     types.add_jobs(sweep)
     types.add_budget(sweep, sweep=True)
     types.add_knots(sweep)
+    types.add_bezier(sweep)
     types.add_robot(sweep)
     types.add_dask(sweep)
     types.add_options(
@@ -616,12 +618,19 @@ def cmd_pipeline(args) -> int:
     from functools import partial
     from pathlib import Path
 
+    from biped.model.gait import family_label
     from biped.optimization.optimize import check_speed
     from biped_cli.design import design_problem
     from validate.outputs.outputs import check_owner
     from validate.workflows import Pipeline, run_pipeline
 
     robot = robot_of(args)
+    family = types.gait_family(args)
+    if args.design and family != 1:
+        raise BipedError(
+            f"--design with the family {family_label(family)}: allowed with the paper's spline "
+            "(--knots 1, --family spline), the knee design's"
+        )
     for knee in args.knees:
         check_speed(Biped(robot, knee), args.speed)
     for knee in args.knees:
@@ -640,6 +649,7 @@ def cmd_pipeline(args) -> int:
         budget(args),
         video=not args.no_video,
         design=design_problem(args, robot, args.speed) if args.design else None,
+        family=family,
     )
     for name in map(pipeline.name, args.knees):  # never another gait's recording
         check_owner(
@@ -664,6 +674,8 @@ def add_pipeline(commands) -> None:
         help="skip the videos of the walks (<recordings>/<gait>.mp4; an earlier run's is removed)",
     )
     types.add_budget(pipe)
+    types.add_knots(pipe)
+    types.add_bezier(pipe)
     types.add_robot(pipe)
     pipe.add_argument(
         "--design",

@@ -97,6 +97,8 @@ class Pipeline:
     budget: dict  # ``optimize``'s keyword arguments: seed, starts, method...
     video: bool = True  # an MP4 of each walk
     design: object = None  # a ``biped.optimization.design.DesignProblem``, or None
+    # the gaits' family (``biped.model.gait``): a spline's interior knots, or a ``Bezier``
+    family: object = 1
 
     def name(self, knee: str) -> str:
         """The name of a knee's files ('design' for the designed gait)."""
@@ -163,7 +165,9 @@ def _optimum(pipeline: Pipeline, knee: str, optima: dict, say: Callable):
 
     say(f"[{knee}] optimizing at {pipeline.speed} m/s ({pipeline.criterion})...")
     model = Biped(pipeline.robot, knee)
-    problem = GaitProblem(model, pipeline.speed, pipeline.criterion, pipeline.safety)
+    problem = GaitProblem(
+        model, pipeline.speed, pipeline.criterion, pipeline.safety, knots=pipeline.family
+    )
     given = [o.variables for o in optima.values() if np.all(np.isfinite(o.variables))]
     optimum = confirm(problem, optimize(problem, given=given, **pipeline.budget), given)
     ev = optimum.evaluation

@@ -115,6 +115,19 @@ def family_label(knots) -> str:
     return check_knots(knots).label if isinstance(knots, Bezier) else f"K = {knots}"
 
 
+def family_words(knots) -> str:
+    """A family in a sentence: "the paper's spline (21 parameters)", "cubic splines of 3
+    interior knots (45 parameters)", "Bézier curves of degree 11 (57 parameters)"."""
+    size = f"({len(parameter_names(knots))} parameters)"
+    if isinstance(check_knots(knots), Bezier):
+        return f"Bézier curves of degree {knots.degree} {size}"
+    return (
+        "the paper's spline " + size
+        if knots == 1
+        else f"cubic splines of {knots} interior knots {size}"
+    )
+
+
 def family_json(knots):
     """A family as files write it: K, or {"bezier": degree}."""
     return check_knots(knots).to_dict() if isinstance(knots, Bezier) else knots

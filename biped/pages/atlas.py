@@ -17,7 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
+from biped.model.bezier import Bezier
 from biped.model.criteria import CRITERION_UNITS
+from biped.model.gait import family_words
 from biped.model.kinematics import KNEES
 from biped.pages.atlas_line import COLUMNS, AtlasLine
 from biped.pages.style import ATLAS_DPI, save
@@ -115,10 +117,10 @@ def rows(folder, settings: Settings, walked: bool = True) -> list[Row]:
 PER_METRE_ENERGIES = ("energy-per-metre", "electrical")
 
 
-def line(row: Row, weight: float, knots: int = 1) -> AtlasLine:
+def line(row: Row, weight: float, knots: int | Bezier = 1) -> AtlasLine:
     """The line of ``atlas.csv`` of ``row``; ``weight`` [N] is the robot's, m g, for the cost
-    of transport of the per-metre energies; ``knots`` the interior knots of the atlas's gait
-    family. A knee's cost is there only with a difference."""
+    of transport of the per-metre energies; ``knots`` the atlas's gait family (a spline's
+    interior knots, or a ``Bezier``). A knee's cost is there only with a difference."""
     d = row.difference
     revolute, rolling = (
         None if r is None or d.value is None else r["costs"][row.criterion]
@@ -159,7 +161,7 @@ def _starts(final: dict | None) -> int | None:
     return None if final is None else int(final["starts_at_best"])
 
 
-def csv_text(table: list[Row], weight: float, knots: int = 1) -> str:
+def csv_text(table: list[Row], weight: float, knots: int | Bezier = 1) -> str:
     """``atlas.csv``: its header (``COLUMNS``) and one line per cell and criterion
     (``line``); ``weight`` [N] is the robot's, m g."""
     lines = [",".join(COLUMNS), *(line(row, weight, knots).to_csv() for row in table)]
@@ -387,8 +389,8 @@ def sentences(settings: Settings, table: list[Row], walked: bool = False) -> str
     clearances = [100 * c for c in settings.clearances]
     bends = settings.knee_bends
     lines.append(
-        f"Optimal gaits of both knees (Table 1 robot unless the record says otherwise) under "
-        f"{settings.constraints_words()}, over "
+        f"Optimal gaits of both knees (Table 1 robot unless the record says otherwise), "
+        f"{family_words(settings.knots)}, under {settings.constraints_words()}, over "
         f"{_count(len(settings.speeds), 'speed')} ({_span(settings.speeds, 'm/s')}), "
         f"{_count(len(clearances), 'swing-foot clearance')} ({_span(clearances, 'cm')}) and "
         + ("a least stance-knee bend" if len(bends) == 1 else "least stance-knee bends")

@@ -13,6 +13,7 @@ import csv
 import dataclasses
 from dataclasses import dataclass
 
+from biped.model.bezier import Bezier
 from biped.model.criteria import CRITERION_UNITS
 from biped.model.units import PURE, unit_field
 from biped.studies.atlas import RICHER_KNOTS
@@ -21,7 +22,8 @@ from biped.studies.atlas import RICHER_KNOTS
 def _column(header: str, form: str, unit=None, **kwargs):
     """A field written in the column ``header`` as ``form``: "f3" (3 decimals), "g6" (6
     significant digits), "int", "text", "yes/no" (a verdict, empty when not known),
-    "quoted" (a sentence, in double quotes, empty when there is none)."""
+    "quoted" (a sentence, in double quotes, empty when there is none), "family" (a gait
+    family: K, or "bezier N")."""
     return unit_field(unit, metadata={"header": header, "form": form}, **kwargs)
 
 
@@ -38,7 +40,8 @@ class AtlasLine:
     speed: float = _column("speed [m/s]", "f3", "m/s")
     clearance: float = _column("clearance [m]", "f3", "m")  # the swing foot's, least
     knee_bend: float = _column("knee bend [rad]", "f3", "rad")  # the stance knee's, least
-    knots: int = _column("knots", "int", PURE)  # interior knots of the gaits' splines
+    # the gaits' family: a spline's interior knots K, or "bezier N" (a Bézier of degree N)
+    knots: int | Bezier = _column("knots", "family", PURE)
     criterion: str = _column("criterion", "text")
     unit: str = _column("unit", "text")  # of the knees' costs (``CRITERION_UNITS``)
     # the knees' certified costs on the check grid, None without a difference
@@ -86,6 +89,8 @@ def _cell(value, form: str) -> str:
         return "" if not value else '"' + value.replace('"', '""') + '"'
     if form == "yes/no":
         return "" if value is None else ("yes" if value else "no")
+    if form == "family":
+        return f"bezier {value.degree}" if isinstance(value, Bezier) else str(value)
     if value is None:
         return ""
     if form in ("int", "text"):
@@ -100,6 +105,9 @@ def _value(cell: str, form: str):
         if cell not in ("", "yes", "no"):
             raise ValueError(f"{cell!r} in a verdict's column of atlas.csv: allowed yes, no, ''")
         return None if cell == "" else cell == "yes"
+    if form == "family":
+        kind, _, degree = cell.partition(" ")
+        return Bezier(int(degree)) if kind == "bezier" else int(cell)
     if cell == "":
         return None
     return int(cell) if form == "int" else float(cell)

@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model.bezier import Bezier
 from biped.model.criteria import (
     ALL_CRITERIA,
     CRITERION_UNITS,
@@ -51,7 +52,7 @@ from biped.model.criteria import (
     Safety,
 )
 from biped.model.dynamics import Biped
-from biped.model.gait import check_knots
+from biped.model.gait import check_knots, family_words
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization.comparison import relative_change
@@ -137,7 +138,7 @@ class Settings(campaign.Settings):
     clearances: tuple  # [m] of the swing foot (Safety.clearance)
     knee_bends: tuple  # [rad] least flexion of the stance knee (Safety.knee_bend)
     criteria: tuple
-    knots: int  # interior knots of the spline family
+    knots: int | Bezier  # the gaits' family: a spline's interior knots, or a ``Bezier``
     seed: int
     starts: int
     actuator_limits: bool = False  # Safety.actuator_limits; recorded only when asked
@@ -459,11 +460,12 @@ def run_atlas(folder, settings: Settings, **where) -> Settings:
         total = len(settings.cells()) * len(settings.criteria) * len(KNEES) * 4
         total += len(settings.corners()) * len(settings.criteria) * len(KNEES)
         remaining = sum(map(len, tasks))
+        corners = f", {RICHER_KNOTS} knots at the corners" if settings.corners() else ""
         plan = (
             f"atlas under {settings.constraints_words()}: {total} optimizations of "
             f"{len(settings.cells())} cells x {len(settings.criteria)} criteria x 2 knees in "
-            f"{folder} (own starts, final, finer grid, tighter tolerance, {RICHER_KNOTS} knots "
-            f"at the corners): {total - remaining} already done, {remaining} to run"
+            f"{folder}, {family_words(settings.knots)} (own starts, final, finer grid, tighter "
+            f"tolerance{corners}): {total - remaining} already done, {remaining} to run"
         )
         ATLAS.run(plan, tasks, lambda: summarize(folder, settings), **where)
     return settings

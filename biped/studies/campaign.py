@@ -25,10 +25,11 @@ import numpy as np
 
 from biped.errors import BipedError
 from biped.model.criteria import Safety, safety_dict
-from biped.model.gait import KNOTS
+from biped.model.gait import family_json
 from biped.model.robot import Robot
 from biped.optimization import table
-from biped.optimization.problem import variable_names
+from biped.optimization.problem import FAMILIES, variable_names
+from biped.records.gait_file import family_of
 from biped.records.provenance import version
 from biped.runtime.files import atomic_write_text, clean_stale_temporaries, distinct_values
 from biped.runtime.runner import ProgressBar, run_tasks
@@ -42,6 +43,8 @@ _READ = {
     "bool": bool,
     "float": float,
     "str": lambda value: value,
+    # a gait family: K interior knots, or {"bezier": degree} (``family_of``)
+    "int | Bezier": family_of,
 }
 
 
@@ -69,6 +72,8 @@ class Settings:
                 value = value.to_dict()
             elif isinstance(value, Safety):  # what is asked (as the records before)
                 value = safety_dict(value, kept=("knee_bend",))
+            elif field.name == "knots":  # a gait family: K, or {"bezier": degree}
+                value = family_json(value)
             content[field.name] = list(value) if isinstance(value, tuple) else value
         return {**content, **self.stamp()}
 
@@ -110,7 +115,7 @@ def variables(named: dict) -> np.ndarray | None:
     """The solver's variables from {name: value} in the order of its family
     (``biped.optimization.problem.variable_names``), None if it ended without them."""
     names = tuple(named)
-    if not any(names == variable_names(knots) for knots in KNOTS):
+    if not any(names == variable_names(knots) for knots in FAMILIES):
         raise BipedError(f"variables {', '.join(names[:3])}, ...: allowed a gait family's")
     values = list(named.values())
     return None if any(v is None for v in values) else np.array(values, float)

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from biped.errors import BipedError
+from biped.model.bezier import Bezier
 from biped.model.criteria import (
     ALL_CRITERIA,
     CRITERIA,
@@ -39,7 +40,7 @@ from biped.model.criteria import (
     Safety,
 )
 from biped.model.dynamics import Biped
-from biped.model.gait import check_knots
+from biped.model.gait import check_knots, family_label
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization import table
@@ -89,7 +90,8 @@ class Settings(campaign.Settings):
     speeds: tuple  # [m/s], sorted
     seed: int  # of every optimization's perturbed starts
     starts: int  # every point's own starts
-    knots: int = 1  # interior knots of the gaits' spline family (``biped.model.gait``)
+    # the gaits' family (``biped.model.gait``): a spline's interior knots, or a ``Bezier``
+    knots: int | Bezier = 1
 
 
 def _problem(settings: Settings, point: Point) -> GaitProblem:
@@ -184,7 +186,7 @@ def sweep_settings(
     seed: int = 0,
     starts: int = DEFAULT_STARTS,
     safety: Safety = PAPER_SAFETY,
-    knots: int = 1,
+    knots: int | Bezier = 1,
 ) -> Settings:
     """The settings of a sweep (``run_sweep``), its speeds sorted, each walkable by either knee
     and with its own file name; a clear error if not. ``seed`` and ``starts`` go to
@@ -305,8 +307,8 @@ def optima_table(folder) -> dict:
     settings = Settings.from_dict(found)
     if settings.knots != 1:
         raise BipedError(
-            f"{folder / MANIFEST}: a sweep of {settings.knots} knots: allowed a sweep of the "
-            "paper's spline (knots 1), whose variables the table holds"
+            f"{folder / MANIFEST}: a sweep of the family {family_label(settings.knots)}: allowed "
+            "a sweep of the paper's spline (knots 1), whose variables the table holds"
         )
     series: dict = {}
     for criterion in ALL_CRITERIA:
