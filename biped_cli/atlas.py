@@ -1,7 +1,8 @@
 """``biped atlas``: where the rolling knee pays off, over speed x clearance (x a least knee bend),
 each difference with its error bar (``biped.studies.atlas``), under the walkable constraints
 or the paper's; every certified optimum walked in MuJoCo (``validate.studies.atlas_walks``); then
-its CSV, figures and ``atlas.md`` (``biped.pages.atlas``)."""
+its CSV, figures and ``atlas.md`` (``biped.pages.atlas``). ``biped compare-atlas``: two atlases
+of one problem in two gait families, cell by cell (``biped.studies.atlas_families``)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from biped.model.criteria import MAX_CLEARANCE, MAX_KNEE_BEND
 from biped_cli import args as types
 
 DEFAULT_ATLAS = "logs/atlas"
+DEFAULT_FAMILIES = "logs/atlas-families"
 MAX_VALUES = 100
 
 
@@ -132,3 +134,43 @@ def add_parser(commands) -> None:
     types.add_robot(parser)
     types.add_jobs(parser)
     types.add_dask(parser)
+
+
+def cmd_compare(args) -> int:
+    """Two atlases of the same problem (robot, margins, criteria, knee bends) in two gait
+    families, on their common cells: per cell and criterion the difference between the knees
+    in each family with its error bar, the shift (rich less base) and whether the base family
+    hides or invents a pay-off of the rolling knee (a shift beyond both error bars), agrees
+    within them, or is unknown (an error bar not measured). Writes families.json,
+    families.png and families.md in --out; prints a sentence per criterion. Exits 0 when
+    every cell is compared, 1 when one is unknown, 2 for atlases that do not compare."""
+    from biped.pages import atlas_families as pages
+    from biped.studies.atlas_families import compare_atlases
+
+    comparison = compare_atlases(args.base, args.rich)  # reads only: refused before a claim
+    types.claim_folder(args.out)
+    for path in pages.write(comparison, args.out):
+        print(f"wrote {path}")
+    for criterion in comparison.criteria:
+        print(pages.sentence(comparison, criterion))
+    unknown = sum(comparison.counts(c)["unknown"] for c in comparison.criteria)
+    if unknown:
+        print(f"{unknown} cells unknown (an error bar not measured): see families.md")
+    return 1 if unknown else 0
+
+
+def add_compare_parser(commands) -> None:
+    help = "two atlases in two gait families, cell by cell"
+    parser = types.add_command(commands, "compare-atlas", help, cmd_compare)
+    parser.add_argument(
+        "base",
+        metavar="BASE_DIR",
+        help="folder of the base atlas (biped atlas --out), e.g. the paper's spline",
+    )
+    parser.add_argument(
+        "rich",
+        metavar="RICH_DIR",
+        help="folder of the atlas of the same problem in a richer family (biped atlas "
+        "--family bezier --degree N --out)",
+    )
+    types.add_folder(parser, "--out", DEFAULT_FAMILIES, "folder of the comparison")

@@ -293,11 +293,11 @@ def cmd_sweep(args) -> int:
     )
 
     robot = robot_of(args)
+    family = types.gait_family(args)
     claim_folder(args.out)
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
-    family = types.gait_family(args)
     sweep = sweep_settings(robot, args.speeds, args.seed, args.starts, safety(args), family)
     check_sweep(args.out, sweep)
     if args.paper_seeds:  # refused before the sweep runs, not after

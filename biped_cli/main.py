@@ -92,6 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
         commands.add_figures,
         commands.add_table,
         atlas.add_parser,
+        atlas.add_compare_parser,
         converge.add_parser,
         design.add_parsers,
         profile.add_parser,

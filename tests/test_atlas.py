@@ -18,6 +18,7 @@ from biped.optimization.optimize import Report, checked, optimize
 from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 from biped.pages import atlas as pages
+from biped.pages.atlas_line import AtlasLine
 from biped.records.gait_file import Gait
 from biped.studies import atlas
 from biped.studies.atlas import Cell, Difference
@@ -68,13 +69,17 @@ def test_a_difference_no_larger_than_its_uncertainty_is_not_distinguishable():
 
 
 def test_the_csv_names_the_atlas_gait_family():
-    """The knots column is the family the atlas solved (--knots), not always the paper's."""
+    """The knots column is the family the atlas solved (--knots, --family bezier --degree),
+    not always the paper's, and reads back as that family."""
+    from biped.model.bezier import Bezier
+
     diff = Difference(-1.0, discretization=0.1, tolerance=0.0, starts=0.1, richer=None, why="")
     row = pages.Row("sthenic", Cell(0.3, 0.0, 0.0), diff, None, None)
     column = pages.COLUMNS.index("knots")
-    for knots in (1, 7):
-        line = pages.csv_text([row], ROBOT.weight, knots).splitlines()[1].split(",")
-        assert line[column] == str(knots)
+    for knots, written in ((1, "1"), (7, "7"), (Bezier(11), "bezier 11")):
+        line = pages.csv_text([row], ROBOT.weight, knots).splitlines()[1]
+        assert line.split(",")[column] == written
+        assert AtlasLine.from_csv(line).knots == knots
 
 
 def test_the_csv_gives_the_cost_of_transport_of_the_energies_per_metre_only():
@@ -606,3 +611,30 @@ def test_an_atlas_stopped_by_signals_while_it_walks_resumes_to_the_same(small, w
         assert stop.seconds < PROMPTLY
     assert numbers(out / atlas.WALKS) == numbers(walked[0] / atlas.WALKS)
     assert "walks revolute" in (out / "atlas.csv").read_text()
+
+
+def test_a_bezier_atlas_is_certified_in_its_family_and_kept_apart(tmp_path):
+    """An atlas of Bézier gaits (--family bezier): its optima and gait files are of that
+    family, it has no 3-knot re-solve (that family does not hold it), its CSV and atlas.md
+    name the family, and the folder resumed in the paper's spline is refused."""
+    from biped.model.bezier import Bezier
+
+    family = Bezier(5)
+    settings = atlas.Settings(ROBOT, (0.3,), (0.0,), (0.0,), ("sthenic",), family, 0, 1)
+    log = io.StringIO()
+    atlas.run_atlas(tmp_path, settings, jobs=1, stream=log)
+    assert "2 of 2 points certified" in log.getvalue() and "3 knots" not in log.getvalue()
+    assert settings.corners() == [] and not list((tmp_path / "richer").glob("*.json"))
+    for knee in KNEES:
+        point = atlas.Point("final", knee, "sthenic", settings.cells()[0])
+        gait = Gait.read(tmp_path / point.gait_filename(), consistent=True)
+        assert gait.knots == family
+    (row,) = pages.rows(tmp_path, settings, walked=False)
+    assert row.difference.uncertainty is not None  # finer grid and tighter tolerance measured
+    pages.write(tmp_path, walked=False)
+    (line,) = (tmp_path / "atlas.csv").read_text().splitlines()[1:]
+    assert AtlasLine.from_csv(line).knots == family
+    assert "Bézier curves of degree 5 (21 parameters)" in (tmp_path / "atlas.md").read_text()
+    paper = dataclasses.replace(settings, knots=1)
+    with pytest.raises(biped.BipedError, match="atlas was made with knots"):
+        atlas.run_atlas(tmp_path, paper, jobs=1, stream=io.StringIO())

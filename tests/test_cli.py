@@ -268,6 +268,18 @@ OPTIMIZE = ["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "x.json"
         ([*OPTIMIZE, "--starts", "100000"], ["--starts", "'100000'", "1 to 100"]),
         (["sweep", "--nelder-mead-starts", "2"], ["unrecognized", "--nelder-mead-starts"]),
         (["atlas", "--starts", "101"], ["--starts", "'101'", "1 to 100"]),
+        # a gait family named by options that do not go together, or not taken there
+        (["sweep", "--degree", "7"], ["--degree 7 with --family spline", "allowed with bezier"]),
+        (["atlas", "--family", "bezier"], ["--family bezier without --degree", "allowed"]),
+        (
+            ["pipeline", "--knots", "3", "--family", "bezier", "--degree", "7"],
+            ["--knots 3 with --family bezier", "allowed --degree N"],
+        ),
+        (
+            ["pipeline", "--design", "--family", "bezier", "--degree", "7"],
+            ["--design with the family n = 7", "allowed with the paper's spline"],
+        ),
+        (["atlas", "--family", "bezier", "--degree", "21"], ["--degree", "'21'", "3 to 20"]),
         (["figures", "--sweep", "/nonexistent"], ["'/nonexistent' does not exist", "allowed"]),
         (["figures", "--sweep", "README.md"], ["'README.md' is a file", "allowed a folder"]),
         # an abbreviated option is not read as the option it begins

@@ -664,3 +664,30 @@ def test_comparison_claims_a_fall_to_the_slowest_speed_only_where_the_data_falls
     assert rising  # the sthenic optima per metre fall with the speed here
     assert "falls at every step of the sweep" in comparison_table(series)
     assert "slowest speed" not in comparison_table(_series((0.25, 0.3), swapped=True))
+
+
+def test_a_bezier_sweep_writes_bezier_gaits_and_a_resume_in_another_family_is_refused(
+    tmp_path, capsys
+):
+    """`biped sweep --family bezier --degree 5`: its gait files are Bézier gaits whose every
+    figure is their parameters' (read back consistent), its record names the family, and
+    the folder resumed in the paper's spline or another degree is refused naming the
+    family, nothing written."""
+    from biped.model.bezier import Bezier
+    from biped_cli import main
+
+    out = tmp_path / "sweep"
+    common = ["sweep", "--speeds", "0.3", "--knees", "rolling", "--criteria", "sthenic"]
+    common += ["--starts", "1", "--paper-seeds", "0", "--jobs", "1", "--out", str(out)]
+    assert main([*common, "--family", "bezier", "--degree", "5"]) == 0
+    gait = gait_file.Gait.read(out / "rolling-sthenic-0.300.json", consistent=True)
+    assert gait.knots == Bezier(5) and gait.feasible
+    assert len(gait.parameters) == 9 + 6 * (5 - 3)
+    assert json.loads((out / MANIFEST).read_text())["knots"] == {"bezier": 5}
+    capsys.readouterr()
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*")}
+    for other in ([], ["--family", "bezier", "--degree", "6"]):
+        assert main([*common, *other]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "knots = {'bezier': 5}" in err[0], err
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*")} == before

@@ -25,6 +25,13 @@ KNEE_STYLE = {
     "rolling": dict(color="tab:red", marker="s"),
 }
 
+# Two gait families side by side (``atlas_families``): the base (the paper's spline) and the
+# rich one, apart from the knees' colours.
+FAMILY_STYLE = {
+    "base": dict(color="0.35", marker="o"),
+    "rich": dict(color="tab:purple", marker="D"),
+}
+
 
 def save(figure: Figure, path: str | Path, dpi: float = DPI) -> Path:
     """Write ``figure`` as the PNG ``path`` at ``dpi``, atomically (``atomic_path``: the
