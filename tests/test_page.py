@@ -210,6 +210,29 @@ def test_page_says_why_the_torques_jump_at_the_knot(optimal_page):
         assert any(t.get_text().startswith(f"jump {jump:+.3g}") for t in ax.texts), ax.get_title()
 
 
+def test_a_bezier_gaits_page_marks_no_knot_and_no_jump(tmp_path):
+    """A Bézier gait (one curve over the step, its accelerations continuous) has no knot: its
+    page draws no knot line and says no jump, where a spline's marks its knots."""
+    from matplotlib.lines import Line2D
+
+    from biped.model.bezier import Bezier
+    from biped.model.dynamics import Biped
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
+    from biped.pages.page import Page, gait_figures, markdown
+
+    problem = GaitProblem(Biped(Robot.paper(), "rolling"), 0.3, knots=Bezier(5))
+    path = tmp_path / f"{NAME}.json"
+    Gait.from_optimum(optimize(problem, starts=1), Robot.paper()).write(path)
+    gait = gait_file.read(path)
+    assert gait.knots == Bezier(5)
+    text, figures = markdown(Page(NAME, path, gait), tmp_path), gait_figures(gait)
+    assert "jump at" not in text
+    assert "no knot, no jump" in figures["torques.png"].texts[0].get_text()
+    for ax in figures["torques.png"].axes:
+        assert not [ln for ln in ax.findobj(Line2D) if list(ln.get_xdata()) == [0.5, 0.5]]
+
+
 def test_page_says_where_constraints_dip_below_the_solver_margin(optimal_page):
     """Each constraint below its margin δ on the check grid (only between the solver's
     samples, which hold δ) is named on the page with its smallest value, and its panel

@@ -36,7 +36,7 @@ from matplotlib.ticker import FuncFormatter
 from biped.model.actuators import Actuators
 from biped.model.criteria import CONSTRAINTS, evaluate_step, margin_profile
 from biped.model.dynamics import JOINTS
-from biped.model.gait import breakpoints, build_step, parameter_names, piece_grid
+from biped.model.gait import breakpoints, build_step, parameter_names, piece_grid, pieces
 from biped.model.units import CONSTRAINT_UNITS, parameter_unit, unit_text
 from biped.optimization.comparison import GAINS, RADII
 from biped.optimization.problem import CHECK_SAMPLES, SOLVER_SAMPLES
@@ -121,7 +121,7 @@ class Tightest:
 
 @functools.lru_cache(maxsize=8)  # a page's table, captions and figures all read it
 def constraint_profile(gait: Gait, samples_per_half: int | None = None) -> tuple:
-    """On the optimiser's check grid (or ``samples_per_half`` samples per spline piece): the
+    """On the optimiser's check grid (or ``samples_per_half`` samples per piece): the
     step's normalised times t/T (N,), Ψ1..Ψ7 (N, 7) less the gait's safety margins (NaN
     where a constraint is not checked: the swing foot at the ends) and the solver's margins
     δ (N, 7); read-only, computed once per gait record and grid."""
@@ -195,7 +195,7 @@ def dip_sentence(gait: Gait, dips: list[Dip]) -> str:
     elif all(d.kept for d in dips):
         why = (
             f"each between the solver's samples: the solver holds Ψ ≥ δ at its "
-            f"{SOLVER_SAMPLES[gait.knots] + 1} samples per spline piece only (dots in the insets)"
+            f"{SOLVER_SAMPLES[gait.knots] + 1} samples per piece only (dots in the insets)"
         )
     else:
         kept = [CONSTRAINT_MEANING[d.name].split()[0] for d in dips if not d.kept]
@@ -207,7 +207,7 @@ def dip_sentence(gait: Gait, dips: list[Dip]) -> str:
     )
     return (
         f"Below the solver's margin δ on the check grid ({CHECK_SAMPLES[gait.knots] + 1} samples "
-        f"per spline piece): {each}; {why}. {verdict}."
+        f"per piece): {each}; {why}. {verdict}."
     )
 
 
@@ -218,8 +218,17 @@ def knot_times(gait: Gait) -> list[float]:
 
 def _knots_text(gait: Gait) -> str:
     """'the knot t/T = 0.5' or 'the knots t/T = 0.25, 0.5, 0.75'."""
-    times = ", ".join(f"{t:.3g}" for t in knot_times(gait))
-    return f"the knot{'s' if gait.knots > 1 else ''} t/T = {times}"
+    times = knot_times(gait)
+    shown = ", ".join(f"{t:.3g}" for t in times)
+    return f"the knot{'s' if len(times) > 1 else ''} t/T = {shown}"
+
+
+def _jumps_text(gait: Gait, why: str = "") -> str:
+    """Where a figure's curves jump: ", jumping at the knot t/T = 0.5{why}", or for a family
+    without a knot (a Bézier curve: its accelerations continuous) that they do not."""
+    if not knot_times(gait):
+        return f" ({gait.knots}: no knot, no jump)"
+    return f", jumping at {_knots_text(gait)}{why}"
 
 
 def _jump_place(gait: Gait) -> str:
@@ -375,10 +384,11 @@ def _inset_place(ax, avoid: list) -> tuple[float, float]:
     )
 
 
-def solver_spacing(knots: int) -> float:
-    """[t/T] Between two of the solver's samples in a family of ``knots`` interior knots:
-    ``SOLVER_SAMPLES[knots]`` intervals per piece, knots + 1 pieces."""
-    return 1.0 / ((knots + 1) * SOLVER_SAMPLES[knots])
+def solver_spacing(knots) -> float:
+    """[t/T] Between two of the solver's samples in a family (``knots`` interior knots, or a
+    ``Bezier``): ``SOLVER_SAMPLES[knots]`` intervals per piece, knots + 1 pieces (a Bézier
+    curve: one)."""
+    return 1.0 / (pieces(knots) * SOLVER_SAMPLES[knots])
 
 
 def _dip_inset(
@@ -464,13 +474,13 @@ def gait_figures(gait: Gait) -> dict[str, Figure]:
     return {
         "torques.png": time_figure(
             gaits,
-            f"joint torques, jumping at {_knots_text(gait)} where the spline is C¹",
+            f"joint torques{_jumps_text(gait, ' where the spline is C¹')}",
             _knot_panels(gait, TORQUE_PANELS),
         ),
         "angles.png": time_figure(gaits, "absolute angles", ANGLE_PANELS),
         "ground.png": time_figure(
             gaits,
-            f"ground reaction on the stance foot, jumping at {_knots_text(gait)}",
+            f"ground reaction on the stance foot{_jumps_text(gait)}",
             _knot_panels(gait, GROUND_PANELS),
         ),
         "constraints.png": time_figure(

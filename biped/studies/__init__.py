@@ -3,7 +3,8 @@
 (``paper_method``), each its science on the one mechanism that claims a folder, resumes, runs
 stages on a pool or Dask, shows progress and summarizes (``campaign``); and a machined knee
 profile over the speeds (``profile_speeds``: a table of optimizations, no folder of its own),
-and both knees over nested gait families until their comparison converges (``converge``).
+and both knees over nested gait families until their comparison converges (``converge``);
+two atlases in two gait families compared cell by cell (``atlas_families``).
 
 May import: ``biped.model``, ``biped.optimization``, ``biped.records``, ``biped.runtime``,
 ``biped.errors``, numpy (the design map's figures are ``biped.pages.design_map_figures``).

@@ -2,7 +2,8 @@
 stance-knee bend), each difference between the knees with its error bar.
 
 Each cell (speed, clearance, knee bend) holds, for each knee and criterion, a certified
-optimum of the paper's spline, in the campaign's stages (``biped.studies.campaign``):
+optimum of the atlas's gait family (``Settings.knots``: the paper's spline by default, K
+interior knots, or a ``Bezier``), in the campaign's stages (``biped.studies.campaign``):
 
 1. ``own``: the point's own starts (``biped.optimization.optimize.optimize``); the
    criteria of the joints' work start from the sthenic optimum of the same point;
@@ -10,8 +11,9 @@ optimum of the paper's spline, in the campaign's stages (``biped.studies.campaig
    and of the other knee; the best of both is the point's answer, written as a gait file;
 3. ``fine``, ``tight``, ``richer``: the final optimum re-solved with twice the samples per
    piece (the discretization), to ten times tighter tolerance (the solver's), and, at
-   the corner cells, in the family of 3 interior knots (``biped.model.gait``), which holds the
-   paper's spline: how much the difference moves when the gait is richer.
+   the corner cells of an atlas of the paper's spline, in the family of 3 interior knots
+   (``biped.model.gait``), which holds it: how much the difference moves when the gait is
+   richer (``biped.studies.atlas_families`` compares two whole atlases).
 
 The difference of a cell is (rolling − revolute) / revolute of the criterion on the check
 grid (``biped.optimization.comparison.relative_change``). Its uncertainty (``Difference``) adds

@@ -16,8 +16,8 @@ sthenic independent optima; the energy independent optima with the sthenic neigh
 solves; the energy neighbours' solves. Each result depends only on files of the stages
 before, which are written whole (``biped.runtime.files``), so a sweep stopped at any moment
 and run again ends with exactly the files of an uninterrupted sweep. The folder's
-``sweep.json`` records what shapes the numbers (robot, safety, speeds, seed, starts,
-method, versions); resuming with any of them changed is refused. Points whose solver did
+``sweep.json`` records what shapes the numbers (robot, safety, speeds, seed, starts, gait
+family, method, versions); resuming with any of them changed is refused. Points whose solver did
 not converge, or whose optimum is infeasible, are saved with their status and counted in
 the summary; they are not optimised again.
 """
