@@ -105,11 +105,25 @@ RICH = {
 }
 
 
+def _walk(folder, speed: float, knee: str, passed: bool) -> None:
+    """A made-up walk record of a knee's final sthenic optimum (the forward walk alone)."""
+    cell = atlas.Cell(speed, 0.0, 0.0)
+    path = folder / atlas.Point(atlas.WALKS, knee, "sthenic", cell).filename()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    check = {"passed": passed, "cause": "" if passed else "slipped", "notes": []}
+    content = {"format": atlas.WALK_FORMAT, "every_check": False, "figures": {}}
+    path.write_text(json.dumps({**content, "checks": {"forward": check}}))
+
+
 @pytest.fixture
 def pair(tmp_path):
+    """The two atlases; at 0.2 m/s the rich one's gaits walked, the rolling knee's not
+    walking; the base one's not walked."""
     base, rich = tmp_path / "paper", tmp_path / "rich"
     _atlas(base, 1, PAPER)
     _atlas(rich, Bezier(11), RICH)
+    _walk(rich, 0.2, "revolute", True)
+    _walk(rich, 0.2, "rolling", False)
     return base, rich
 
 
@@ -124,6 +138,8 @@ def test_two_atlases_compare_cell_by_cell(pair):
     (at_05,) = [s for s in comparison.shifts if s.cell.speed == 0.5]
     assert at_05.rich.uncertainty is None and "tighter tolerance" in at_05.rich.why
     counts = comparison.counts("sthenic")
+    (at_02,) = [s for s in comparison.shifts if s.cell.speed == 0.2]
+    assert at_02.rich.walks is False and at_02.base.walks is None
     assert counts == {
         "hides": 1, "invents": 1, "same": 1, "unknown": 1, "sign_changes": 1, "cells": 4
     }  # fmt: skip
@@ -143,6 +159,7 @@ def test_compare_atlas_writes_its_json_figure_and_page(pair, tmp_path, capsys):
     assert (out / "families.png").read_bytes()[:4] == b"\x89PNG"
     page = (out / "families.md").read_text()
     assert "Bézier curves of degree 11 (57 parameters)" in page and "| unknown (" in page
+    assert "| hides | not walked / no |" in page
 
 
 def test_the_figure_shows_both_families_with_their_error_bars(pair):

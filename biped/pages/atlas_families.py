@@ -112,6 +112,10 @@ def _percent(side: Side) -> str:
     return f"{side.value:+.2f} % ± {bar}"
 
 
+def _walks(side: Side) -> str:
+    return {True: "yes", False: "no", None: "not walked"}[side.walks]
+
+
 def _where(shift: CellShift) -> str:
     return f"{shift.cell.speed:g} m/s, {100 * shift.cell.clearance:g} cm"
 
@@ -174,8 +178,9 @@ def markdown(comparison: FamilyComparison) -> str:
     lines += [
         "",
         f"| criterion | speed [m/s] | clearance [cm] | {family_label(base)} [%] | "
-        f"{family_label(rich)} [%] | shift [points] | verdict |",
-        "|---|---|---|---|---|---|---|",
+        f"{family_label(rich)} [%] | shift [points] | verdict | both knees walk "
+        f"({family_label(base)} / {family_label(rich)}) |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for s in comparison.shifts:
         shift = "" if s.shift is None else f"{s.shift:+.2f}"
@@ -184,7 +189,8 @@ def markdown(comparison: FamilyComparison) -> str:
         lines.append(
             f"| {s.criterion} | {s.cell.speed:g} | {100 * s.cell.clearance:g} | "
             f"{_percent(s.base)} | {_percent(s.rich)} | {shift} | {s.verdict}{flip}"
-            f"{' (' + why + ')' if why and s.verdict == 'unknown' else ''} |"
+            f"{' (' + why + ')' if why and s.verdict == 'unknown' else ''} | "
+            f"{_walks(s.base)} / {_walks(s.rich)} |"
         )
     return "\n".join(lines) + "\n"
 

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from biped.errors import BipedError
 from biped.model.gait import family_json, family_label, family_words
+from biped.model.kinematics import KNEES
 from biped.model.units import PURE
 from biped.studies import atlas
 from biped.studies.atlas import Cell, Difference
@@ -50,18 +51,24 @@ class Side:
         uncertainty: its error bar [%] (``atlas.Difference.uncertainty``), None if a term
             was not measured.
         why: why there is no value, or which term is not measured ("" when both are known).
+        walks: both knees' optima walk in MuJoCo (every check run passes; ``atlas.Walk``),
+            None where a knee's was not walked or its walk not measured.
     """
 
     value: float | None
     uncertainty: float | None
     why: str = ""
+    walks: bool | None = None
 
     @classmethod
-    def of(cls, difference: Difference) -> Side:
-        """A cell's ``atlas.Difference``, the richer-family term aside."""
+    def of(cls, difference: Difference, walks: tuple = ()) -> Side:
+        """A cell's ``atlas.Difference``, the richer-family term aside, and its knees'
+        ``atlas.Walk`` records (None: not walked)."""
         measured = [f"{what}: {why}" for what, why in difference.unmeasured if what != RICHER]
         why = difference.why or "; ".join(f"not measured, {text}" for text in measured)
-        return cls(difference.value, difference.uncertainty, why)
+        verdicts = [None if w is None else w.walks for w in walks]
+        both = None if not verdicts or None in verdicts else all(verdicts)
+        return cls(difference.value, difference.uncertainty, why, both)
 
     @property
     def distinguishable(self) -> bool:
@@ -73,7 +80,7 @@ class Side:
         )
 
     def to_dict(self) -> dict:
-        return {"value": self.value, "uncertainty": self.uncertainty, "why": self.why}
+        return dataclasses.asdict(self)
 
 
 @dataclass(frozen=True)
@@ -185,6 +192,8 @@ UNITS = {
     "cells[].rich.value": "%",
     "cells[].rich.uncertainty": "%",
     "cells[].shift": "percentage points",
+    "cells[].base.walks": PURE,
+    "cells[].rich.walks": PURE,
     "counts": PURE,
 }
 
@@ -240,7 +249,13 @@ def compare_atlases(base_folder, rich_folder) -> FamilyComparison:
     for criterion in base.criteria:
         for cell in common_cells(base, rich):
             sides = [
-                Side.of(atlas.difference(folder, settings, criterion, cell)[0])
+                Side.of(
+                    atlas.difference(folder, settings, criterion, cell)[0],
+                    tuple(
+                        atlas.read_walk(folder, atlas.Point("final", knee, criterion, cell))
+                        for knee in KNEES
+                    ),
+                )
                 for folder, settings in ((base_folder, base), (rich_folder, rich))
             ]
             shifts.append(cell_shift(criterion, cell, *sides))
