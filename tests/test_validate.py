@@ -410,3 +410,22 @@ def test_the_report_reads_back_as_the_record_it_was_written_from(report):
     with pytest.raises(ValueError, match="failed are: forward"):
         ValidationReport.from_dict({**failed, "passed": True})
     assert ValidationReport.from_dict({**failed, "passed": False}).failed() == ("forward",)
+
+
+def test_a_bezier_gait_is_validated_as_a_splines(tmp_path, capsys):
+    """A Bézier gait file (--family bezier) is played in MuJoCo as a spline's: its inverse
+    dynamics, impact and feedforward replay agree with the model and it walks 3 steps."""
+    from biped.model.bezier import Bezier
+    from biped.model.dynamics import Biped
+    from biped.optimization.optimize import optimize
+    from biped.optimization.problem import GaitProblem
+
+    problem = GaitProblem(Biped(Robot.paper(), "rolling"), 0.3, knots=Bezier(5))
+    path = Gait.from_optimum(optimize(problem, starts=1), Robot.paper()).write(
+        tmp_path / "bezier.json"
+    )
+    rrd = tmp_path / "bezier.rrd"
+    _, out, _ = _run(["validate", str(path), "--steps", "3", "--rrd", str(rrd), "--json"], capsys)
+    content = json.loads(out)
+    for name in ("model", "inverse_dynamics", "impact", "feedforward", "forward"):
+        assert content[name]["passed"], (name, content[name])
