@@ -137,8 +137,8 @@ def add_parser(commands) -> None:
 
 
 def cmd_compare(args) -> int:
-    """Two atlases of the same problem (robot, margins, criteria, knee bends) in two gait
-    families, on their common cells: per cell and criterion the difference between the knees
+    """Two atlases of the same problem (robot, margins, knee bends) in two gait families,
+    on their common cells and criteria: per cell and criterion the difference between the knees
     in each family with its error bar, the shift (rich less base) and whether the base family
     hides or invents a pay-off of the rolling knee (a shift beyond both error bars), agrees
     within them, or is unknown (an error bar not measured). Writes families.json,

@@ -1,7 +1,7 @@
 """Two atlases in two gait families compared cell by cell: a shift beyond both error bars is
 a pay-off the base family hides (lower in the rich one) or invents (higher); within them the
 same; an error bar not measured leaves the cell unknown, never the same; atlases of two
-problems, of one family or without a common cell are refused (exit 2)."""
+problems, of one family, without a common cell or criterion are refused (exit 2)."""
 
 import json
 
@@ -198,5 +198,23 @@ def test_atlases_that_do_not_compare_are_refused(pair, tmp_path, capsys):
     (other / atlas.MANIFEST).write_text(json.dumps(record))
     assert settings.criteria == ("sthenic",)
     assert main(["compare-atlas", str(base), str(other), "--out", str(out)]) == 2
-    assert "criteria" in capsys.readouterr().err
+    assert "allowed two atlases sharing a criterion" in capsys.readouterr().err
+    record["criteria"] = ["sthenic"]
+    record["safety"] = {**record["safety"], "friction": 0.9}
+    (other / atlas.MANIFEST).write_text(json.dumps(record))
+    assert main(["compare-atlas", str(base), str(other), "--out", str(out)]) == 2
+    assert "safety" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_only_the_criteria_of_both_atlases_are_compared(tmp_path):
+    """A rich atlas of one criterion beside a base of two: that criterion alone."""
+    base, rich = tmp_path / "paper", tmp_path / "rich"
+    settings = _atlas(base, 1, PAPER)
+    record = json.loads((base / atlas.MANIFEST).read_text())
+    record["criteria"] = ["energy-per-metre", "sthenic"]
+    (base / atlas.MANIFEST).write_text(json.dumps(record))
+    _atlas(rich, Bezier(11), RICH)
+    comparison = compare_atlases(base, rich)
+    assert comparison.criteria == ("sthenic",) and settings.criteria == ("sthenic",)
+    assert len(comparison.shifts) == len(PAPER)

@@ -3,10 +3,11 @@ hides or invents of the rolling knee's pay-off beside a rich family (``biped com
 
 Each atlas (``biped.studies.atlas``) gives, per cell and criterion, the difference between the
 knees, (rolling − revolute) / revolute [%], with its uncertainty (``atlas.Difference``). Two
-atlases compare when they answer the same problem (robot, margins, criteria, knee bends) in
-two families; their common cells are compared. Per cell (``verdict``), the shift is the rich
-family's difference less the base family's [percentage points], and it is told apart from
-nothing when it is larger than the sum of both error bars (a difference beyond both):
+atlases compare when they answer the same problem (robot, margins, knee bends) in two
+families; their common cells are compared, for their common criteria. Per cell
+(``verdict``), the shift is the rich family's difference less the base family's [percentage
+points], and it is told apart from nothing when it is larger than the sum of both error bars
+(a difference beyond both):
 
 - ``hides``: the rich family's difference is lower: the base family hides (part of) a
   pay-off of the rolling knee (or shows a cost the rolling knee does not have);
@@ -36,7 +37,7 @@ from biped.studies.atlas import Cell, Difference
 FORMAT = "biped-atlas-families/1"
 VERDICTS = ("hides", "invents", "same", "unknown")
 # What must be the same in both atlases' records for their cells to compare: the problem.
-SAME_PROBLEM = ("robot", "criteria", "knee_bends", "actuator_limits", "safety")
+SAME_PROBLEM = ("robot", "knee_bends", "actuator_limits", "safety")
 # The corners' re-solve in 3 knots: not a term of a difference's error bar.
 RICHER = atlas.MEASURES["richer"]
 
@@ -214,11 +215,21 @@ def check_pair(base: atlas.Settings, rich: atlas.Settings, names: tuple[str, str
             f"{names[1]}: its atlas is of the family {family_label(rich.knots)}, as "
             f"{names[0]}'s: allowed two atlases in two gait families"
         )
+    if not common_criteria(base, rich):
+        raise BipedError(
+            f"{names[1]}: its atlas has the criteria {', '.join(rich.criteria)}, "
+            f"{names[0]}'s {', '.join(base.criteria)}: allowed two atlases sharing a criterion"
+        )
     if not common_cells(base, rich):
         raise BipedError(
             f"{names[1]}: no cell (speed, clearance, knee bend) in common with {names[0]}: "
             "allowed two atlases sharing a cell"
         )
+
+
+def common_criteria(base: atlas.Settings, rich: atlas.Settings) -> list[str]:
+    """The criteria of both atlases, in the base atlas's order."""
+    return [criterion for criterion in base.criteria if criterion in rich.criteria]
 
 
 def common_cells(base: atlas.Settings, rich: atlas.Settings) -> list[Cell]:
@@ -241,12 +252,12 @@ def _load(folder, name: str) -> atlas.Settings:
 
 
 def compare_atlases(base_folder, rich_folder) -> FamilyComparison:
-    """The common cells of the atlases in ``base_folder`` and ``rich_folder`` compared,
-    every criterion; a BipedError if they are not two families of one problem."""
+    """The common cells of the atlases in ``base_folder`` and ``rich_folder`` compared, for
+    each criterion of both; a BipedError if they are not two families of one problem."""
     base, rich = _load(base_folder, "BASE"), _load(rich_folder, "RICH")
     check_pair(base, rich, (str(base_folder), str(rich_folder)))
     shifts = []
-    for criterion in base.criteria:
+    for criterion in common_criteria(base, rich):
         for cell in common_cells(base, rich):
             sides = [
                 Side.of(
