@@ -56,7 +56,7 @@ def figure(comparison: FamilyComparison) -> Figure:
         "Above each cell: hides / invents (the base family hides or invents a pay-off of the "
         "rolling knee: a shift beyond both error bars; 'sign flips': the families disagree "
         "on which knee needs less), = (within both error bars), ? (an error bar not "
-        "measured: hollow marker, ±?)",
+        "measured: hollow marker, ±?; 'none': no certified optimum of both knees)",
     ]
     chars = int(TITLE_CHARS_PER_INCH * width)
     fig.suptitle("\n".join(textwrap.fill(t, chars) for t in title), fontsize=9)
@@ -69,7 +69,10 @@ def _panel(ax, shifts: list[CellShift], labels: dict) -> None:
         style = FAMILY_STYLE[side]
         for i, shift in enumerate(shifts):
             found: Side = getattr(shift, side)
-            if found.value is None:
+            if found.value is None:  # no certified optimum of both knees: said on the axis
+                ax.annotate("none", (x[i] + dx, 0.0), xytext=(0, 3), textcoords="offset points",
+                            rotation=90, ha="center", va="bottom", fontsize=7,
+                            color=style["color"])  # fmt: skip
                 continue
             known = found.uncertainty is not None
             ax.errorbar(
@@ -185,7 +188,10 @@ def markdown(comparison: FamilyComparison) -> str:
     for s in comparison.shifts:
         shift = "" if s.shift is None else f"{s.shift:+.2f}"
         flip = ", sign changes" if s.sign_change else ""
-        why = "; ".join(w for w in (s.base.why, s.rich.why) if w)
+        labels = (family_label(base), family_label(rich))
+        why = "; ".join(
+            f"{label}: {w}" for label, w in zip(labels, (s.base.why, s.rich.why), strict=True) if w
+        )
         lines.append(
             f"| {s.criterion} | {s.cell.speed:g} | {100 * s.cell.clearance:g} | "
             f"{_percent(s.base)} | {_percent(s.rich)} | {shift} | {s.verdict}{flip}"
