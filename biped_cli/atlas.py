@@ -11,6 +11,7 @@ import numpy as np
 
 from biped.model.criteria import MAX_CLEARANCE, MAX_KNEE_BEND
 from biped_cli import args as types
+from biped_cli import checks
 
 DEFAULT_ATLAS = "logs/atlas"
 MAX_VALUES = 100
@@ -71,7 +72,6 @@ def cmd_atlas(args) -> int:
             safety=PAPER_SAFETY if args.paper_constraints else WALKABLE,
         )
     )
-    types.claim_folder(args.out)
     atlas.check_folder(args.out, settings)
     if args.dask is not None:
         check_dask(args.dask)
@@ -117,7 +117,7 @@ def add_parser(commands) -> None:
     )  # fmt: skip
     types.add_criterion(parser, several=True, default=DEFAULT_CRITERIA)
     types.add_knots(parser)
-    types.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
+    checks.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
     parser.add_argument(
         "--no-walks", action="store_true", help="skip walking the certified optima in MuJoCo"
     )

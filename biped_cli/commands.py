@@ -17,14 +17,8 @@ from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.model.two_phase import LANDINGS
 from biped_cli import args as types
-from biped_cli.args import (
-    budget,
-    check_folder,
-    check_output,
-    claim_folder,
-    robot_of,
-    safety,
-)
+from biped_cli import checks
+from biped_cli.args import budget, robot_of, safety
 
 DEFAULT_SWEEP = "logs/sweep"
 DEFAULT_FIGURES = "logs/figures"
@@ -155,13 +149,10 @@ def cmd_optimize(args) -> int:
     model = Biped(robot, args.knee)
     family = types.gait_family(args)
     problem = GaitProblem(model, args.speed, args.criterion, safety(args), knots=family)
-    check_output(args.out)
-    given = budget(args)  # an option the method would not use: refused before any work
+    given = budget(args)
     if args.double_support is not None:  # what the two-phase problem does not build
         from biped.optimization.two_phase import TwoPhaseProblem
 
-        if args.method != "ipopt":
-            raise BipedError(f"--double-support with --method {args.method}: allowed ipopt")
         TwoPhaseProblem(problem, args.double_support)
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
     setup = prepare(problem) if args.method == "ipopt" else 0.0
@@ -212,7 +203,7 @@ def add_optimize(commands) -> None:
     types.add_knee(opt, required=True)
     types.add_criterion(opt)
     types.add_speed(opt)
-    types.add_gait_out(opt)
+    checks.add_gait_out(opt)
     types.add_budget(opt)
     types.add_knots(opt)
     types.add_bezier(opt)
@@ -234,6 +225,13 @@ def add_optimize(commands) -> None:
         "it, the paper's impact map with both feet held) or zero-speed (it arrives at rest, no "
         "impact) (default %(default)s)",
     )
+    checks.declare_rule(opt, ("--double-support", "--method"), _check_double_support)
+
+
+def _check_double_support(args) -> None:
+    """The two-phase optimum is IPOPT's."""
+    if args.double_support is not None and args.method != "ipopt":
+        raise BipedError(f"--double-support with --method {args.method}: allowed ipopt")
 
 
 def cmd_double_support(args, problem, optimum) -> int:
@@ -293,7 +291,6 @@ def cmd_sweep(args) -> int:
     )
 
     robot = robot_of(args)
-    claim_folder(args.out)
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
@@ -331,7 +328,7 @@ def add_sweep(commands) -> None:
     types.add_speeds(sweep, DEFAULT_SPEEDS, "0.15:0.45:13")
     types.add_knee(sweep, several=True)
     types.add_criterion(sweep, several=True)
-    types.add_folder(sweep, "--out", DEFAULT_SWEEP, "folder of the sweep")
+    checks.add_folder(sweep, "--out", DEFAULT_SWEEP, "folder of the sweep")
     types.add_jobs(sweep)
     types.add_budget(sweep, sweep=True)
     types.add_knots(sweep)
@@ -352,7 +349,6 @@ def cmd_figures(args) -> int:
     from biped.pages.figures import make_figures
     from biped.records import gait_file
 
-    claim_folder(args.out)
     takes = "--sweep a folder of the gait files that biped sweep writes"
     for gait in sorted(Path(args.sweep).glob("*-*.json")):  # each its parameters' gait
         gait_file.read_consistent(gait, takes)
@@ -369,7 +365,7 @@ def add_figures(commands) -> None:
         metavar="DIR",
         help="folder of a sweep's results, as biped sweep --out writes it (default %(default)s)",
     )
-    types.add_folder(fig, "--out", DEFAULT_FIGURES, "folder of the figures and comparison.md")
+    checks.add_folder(fig, "--out", DEFAULT_FIGURES, "folder of the figures and comparison.md")
 
 
 def cmd_table(args) -> int:
@@ -383,7 +379,6 @@ def cmd_table(args) -> int:
     from biped.records.gait_file import write_json
     from biped.studies.sweep import optima_table
 
-    check_output(args.out)
     content = optima_table(args.sweep)
     counts = ", ".join(
         f"{len(s['speeds'])} {s['knee']} {s['criterion']}" for s in content["series"]
@@ -411,13 +406,14 @@ def add_table(commands) -> None:
         help="folder of a sweep's results, as biped sweep --out writes it, whose certified "
         f"optima the table holds (default %(default)s); {types.CERTIFIED_HELP}",
     )
-    table.add_argument(
+    checks.add_out(
+        table,
         "--out",
-        default="logs/optima.json",
-        metavar="FILE",
-        help=f"the table written (JSON), {types.FOLDERS_CREATED} (default %(default)s); "
+        checks.FILE,
+        f"the table written (JSON), {types.FOLDERS_CREATED} (default %(default)s); "
         "optimizations read the package's table alone (printed), so this file starts them "
         "once copied there",
+        default="logs/optima.json",
     )
 
 
@@ -467,11 +463,9 @@ def cmd_validate(args) -> int:
     from validate.outputs.outputs import report_path
     from validate.workflows import validate_and_record
 
-    gif = _check_video(args)
+    gif = _gif(args)
     gaits = read_gaits(args.gait, args.model)
     recordings = _recordings(args)
-    for rrd in recordings:
-        check_output(str(report_path(rrd)), "--rrd")
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:
         for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
@@ -503,44 +497,60 @@ def cmd_validate(args) -> int:
     return 0 if passed == len(args.gait) else 1
 
 
-def _check_video(args) -> str | None:
-    """Refuse --rrd, --video and --gif where they cannot be (before any work); the GIF's
-    path beside the video, if asked."""
-    from pathlib import Path
-
+def _check_one_gait(args) -> None:
+    """--rrd and --video name the output of a single gait."""
     if args.rrd and len(args.gait) > 1:
         raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
     if args.video and len(args.gait) > 1:
         raise BipedError(f"--video names one video: allowed with one gait (got {len(args.gait)})")
+
+
+def _check_video(args) -> None:
+    """--gif writes beside the --video, an MP4."""
     if args.gif and not args.video:
         raise BipedError("--gif writes beside the --video: allowed with --video FILE.mp4")
     if args.video:
         from validate.outputs.video import check_suffix
 
         check_suffix(args.video, "--video", ".mp4", " (--gif writes a GIF beside it)")
-        check_output(args.video, "--video")
-    gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
-    if gif is not None:
-        check_output(gif, "--gif")
-    return gif
+
+
+def _gif(args) -> str | None:
+    """The GIF's path beside the video, if asked."""
+    from pathlib import Path
+
+    return str(Path(args.video).with_suffix(".gif")) if args.gif else None
+
+
+def _given_recording(args) -> list:
+    """The recording --rrd names and its report beside it (none: named from the gaits)."""
+    from validate.outputs.outputs import report_path
+
+    return [args.rrd, str(report_path(args.rrd))] if args.rrd else []
 
 
 def _recordings(args) -> list:
-    """The recording of each gait file (--rrd, or named from the file), each checked free or
-    that gait file's own before any work."""
+    """The recording of each gait file (--rrd, or named from the file) and its report, each
+    checked free and claimed, the recording that gait file's own, before any work."""
     from pathlib import Path
 
-    from validate.outputs.outputs import check_owner, output_name
+    from validate.outputs.outputs import check_owner, output_name, report_path
 
     recordings = [
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
         for path in args.gait
     ]
-    types.distinct_outputs(recordings, "recording")
+    checks.claim_derived(args, "--rrd", recordings, "recording")
     for rrd, path in zip(recordings, args.gait, strict=True):
-        check_output(str(rrd), "--rrd")
         check_owner(rrd, path)  # never another gait's recording
+    checks.claim_derived(args, "--rrd", [report_path(rrd) for rrd in recordings], "recording")
     return recordings
+
+
+def _gifs(args) -> list:
+    """The GIF written beside the video, if asked (the check of --gif's output)."""
+    gif = _gif(args) if args.video else None
+    return [] if gif is None else [gif]
 
 
 def _print_validation(path: str, gait, result, report) -> None:
@@ -559,28 +569,37 @@ def add_validate(commands) -> None:
     val = types.add_command(commands, "validate", help, cmd_validate)
     types.add_gaits(val)
     types.add_steps(val)
-    val.add_argument(
+    checks.declare_rule(val, ("--rrd", "--video"), _check_one_gait)
+    checks.add_out(
+        val,
         "--rrd",
-        metavar="PATH",
-        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
+        checks.FILE,
+        f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
         "named from the gait file's folder and name; another gait's recording is refused; "
         f"{types.FOLDERS_CREATED})",
+        claims=checks.DERIVED,
+        paths=_given_recording,
+        metavar="PATH",
     )
     val.add_argument(
         "--json",
         action="store_true",
         help="print the report as JSON (several gaits: an object keyed by file)",
     )
-    val.add_argument(
+    checks.add_out(
+        val,
         "--video",
-        metavar="FILE.mp4",
-        help="also render MuJoCo's walk of a single gait to an H.264 MP4 video, a path "
+        checks.FILE,
+        "also render MuJoCo's walk of a single gait to an H.264 MP4 video, a path "
         f"ending in .mp4 ({types.FOLDERS_CREATED}; MUJOCO_GL=egl without a display; default: "
         "no video)",
+        metavar="FILE.mp4",
     )
     val.add_argument(
         "--gif", action="store_true", help="with --video, also an animated GIF beside it"
     )
+    checks.declare_rule(val, ("--gif", "--video"), _check_video)
+    checks.declare_output(val, checks.Output("--gif", checks.FILE, checks.WHOLE, paths=_gifs))
     viewer = val.add_mutually_exclusive_group()
     viewer.add_argument(
         "--spawn",
@@ -626,8 +645,6 @@ def cmd_pipeline(args) -> int:
         check_speed(Biped(robot, knee), args.speed)
     for knee in args.knees:
         check_simulable(robot, knee, f"--robot {args.robot!r}" if args.robot else "robot")
-    claim_folder(args.out)  # its gait files, pages and recordings are named from it
-    check_folder(args.recordings, "--recordings")
     pipeline = Pipeline(
         robot,
         args.speed,
@@ -655,9 +672,10 @@ def add_pipeline(commands) -> None:
     types.add_knee(pipe, several=True)
     types.add_criterion(pipe)
     types.add_steps(pipe)
-    types.add_folder(pipe, "--out", DEFAULT_PIPELINE, "folder of the gait files and reports")
+    checks.add_folder(pipe, "--out", DEFAULT_PIPELINE, "folder of the gait files and reports")
     what = "folder of the rerun recordings and videos"
-    types.add_folder(pipe, "--recordings", DEFAULT_RECORDINGS, what)
+    # its recordings are named from --out, claimed: its gait files, pages and recordings
+    checks.add_folder(pipe, "--recordings", DEFAULT_RECORDINGS, what, claims=checks.WITH_ANOTHER)
     pipe.add_argument(
         "--no-video",
         action="store_true",
