@@ -20,7 +20,19 @@ import numpy as np
 from biped.model.criteria import CRITERION_UNITS
 from biped.model.kinematics import KNEES
 from biped.pages.atlas_line import COLUMNS, AtlasLine
-from biped.pages.style import ATLAS_DPI, save
+from biped.pages.style import (
+    ATLAS_CELL_FONT,
+    ATLAS_CELL_WIDTH,
+    ATLAS_CURVES_WIDTH,
+    ATLAS_DPI,
+    ATLAS_MAP_AREA,
+    ATLAS_MAP_MARGINS,
+    FONT_HEADING,
+    FONT_NOTE,
+    FONT_SMALL,
+    FONT_TITLE,
+    save,
+)
 from biped.runtime.files import atomic_write_text
 from biped.studies.atlas import (
     MEASURES,
@@ -48,18 +60,8 @@ FIGURE_NAMES = {
     "energy-per-metre": r"energy per metre walked $C_E\,/\,S$",
     "electrical": r"electrical energy per metre walked $E\,/\,S$ (the motors', no regeneration)",
 }
-# A map's cell: its width at least [in], and its label's font [pt] from the first size (the
-# least readable) up to the second, as the cell allows.
-CELL_WIDTH = 0.45
-CELL_FONT = (8.0, 14.0)
-# A map panel's plot area at least [in] (width, height) and what its labels, colour bar and
-# titles take beside it.
-MAP_AREA = (3.6, 3.2)
-MAP_MARGINS = (1.6, 1.4)
 # The maps' colours: blue where the rolling knee needs less.
 CMAP = "RdBu_r"
-# The curves' panel with its legend beside it [in].
-CURVES_WIDTH = 7.4
 # The curves' speed axis: a tick at each speed for at most this many speeds, else
 # matplotlib's; one speed in a span of this much either side of it [m/s].
 SPEED_TICKS = 12
@@ -193,7 +195,10 @@ def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = 
     bends = settings.knee_bends
     width, height = _map_area(settings)
     fig = Figure(
-        figsize=((width + MAP_MARGINS[0]) * len(bends) + CURVES_WIDTH, height + MAP_MARGINS[1]),
+        figsize=(
+            (width + ATLAS_MAP_MARGINS[0]) * len(bends) + ATLAS_CURVES_WIDTH,
+            height + ATLAS_MAP_MARGINS[1],
+        ),
         layout="constrained",
     )
     axes = fig.subplots(1, len(bends) + 1, squeeze=False)[0]
@@ -202,7 +207,9 @@ def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = 
     top = max([abs(v) for v in values], default=1.0) or 1.0
     for ax, bend in zip(axes[:-1], bends, strict=True):
         _map_panel(fig, ax, settings, [r for r in mine if r.cell.knee_bend == bend], top)
-        ax.set_title(f"{_bend_words(bend)}\ncells: difference ± uncertainty [%]", fontsize=9)
+        ax.set_title(
+            f"{_bend_words(bend)}\ncells: difference ± uncertainty [%]", fontsize=FONT_TITLE
+        )
         if walked:
             _walks_legend(ax, any(r.not_walking() for r in mine if r.cell.knee_bend == bend))
     _curves_panel(axes[-1], settings, [r for r in mine if r.cell.knee_bend == bends[0]])
@@ -217,7 +224,7 @@ def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = 
         f"under {settings.constraints_words()}\n"
         "blue: the rolling knee needs less; hatched: not distinguishable (±?: uncertainty not "
         f"measured); x: no certified optimum of both knees\n{walks}",
-        fontsize=10,
+        fontsize=FONT_HEADING,
     )
     return fig
 
@@ -229,7 +236,11 @@ def _walks_legend(ax, marked: bool) -> None:
     label = NOT_WALKING_LABEL + ("" if marked else ": none")
     handle = Patch(label=label, **NOT_WALKING)
     ax.legend(
-        handles=[handle], fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1
+        handles=[handle],
+        fontsize=FONT_NOTE,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.16),
+        ncols=1,
     )
 
 
@@ -280,17 +291,17 @@ def _not_walking_frame(ax, at: tuple[int, int]) -> None:
 
 
 def _map_area(settings: Settings) -> tuple[float, float]:
-    """[in] (width, height) of a map panel's plot area: ``MAP_AREA``, wider for many speeds
-    (``CELL_WIDTH`` each)."""
-    return max(MAP_AREA[0], CELL_WIDTH * len(settings.speeds)), MAP_AREA[1]
+    """[in] (width, height) of a map panel's plot area: ``ATLAS_MAP_AREA``, wider for many speeds
+    (``ATLAS_CELL_WIDTH`` each)."""
+    return max(ATLAS_MAP_AREA[0], ATLAS_CELL_WIDTH * len(settings.speeds)), ATLAS_MAP_AREA[1]
 
 
 def cell_font(settings: Settings) -> float:
     """[pt] The font of a map cell's two lines of label: as large as the cell holds (about
-    4 characters wide, 2.5 lines high), within ``CELL_FONT``."""
+    4 characters wide, 2.5 lines high), within ``ATLAS_CELL_FONT``."""
     width, height = _map_area(settings)
     cell = (72 * width / len(settings.speeds), 72 * height / len(settings.clearances))
-    return float(np.clip(min(cell[0] / 3.6, cell[1] / 3.0), *CELL_FONT))
+    return float(np.clip(min(cell[0] / 3.6, cell[1] / 3.0), *ATLAS_CELL_FONT))
 
 
 def _cell_label(ax, at: tuple[int, int], d: Difference, top: float, font: float) -> None:
@@ -356,8 +367,10 @@ def _curves_panel(ax, settings: Settings, rows_: list[Row]) -> None:
     _speed_axis(ax, settings.speeds)
     ax.set_xlabel("speed [m/s]")
     ax.set_ylabel("(rolling − revolute) / revolute [%]")
-    ax.set_title(f"{_bend_words(settings.knee_bends[0])}\nbars: uncertainty [%]", fontsize=9)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the curves
+    ax.set_title(
+        f"{_bend_words(settings.knee_bends[0])}\nbars: uncertainty [%]", fontsize=FONT_TITLE
+    )
+    ax.legend(fontsize=FONT_SMALL, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the curves
 
 
 def _speed_axis(ax, speeds) -> None:
