@@ -215,7 +215,7 @@ def add_optimize(commands) -> None:
          "started from the single-support optimum, its double support a share of the step "
          "from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share): sthenic "
          "criterion, IPOPT with --method ipopt only; --out then receives the two-phase "
-         "optimum's file (not a gait file, see docs/gaits.md); default: single support only"),
+         "gait file (both phases, see docs/gaits.md); default: single support only"),
     )  # fmt: skip
     opt.add_argument(
         "--landing",
@@ -266,7 +266,8 @@ def cmd_double_support(args, problem, optimum) -> int:
             "may find a better optimum",
             file=sys.stderr,
         )
-    print(f"wrote {two_phase_file.write(args.out, two, best, checked)}")
+    gait = two_phase_file.gait_of(two, result, args.seed)
+    print(f"wrote {gait.write(args.out)}")
     return 0
 
 
