@@ -466,6 +466,12 @@ def cmd_validate(args) -> int:
 
     gif = _gif(args)
     gaits = read_gaits(args.gait, args.model)
+    for path, gait in zip(args.gait, gaits, strict=True):
+        if gait.two_phase and (args.video or args.spawn or args.connect):
+            raise BipedError(
+                f"gait file {path!r} is of two phases: its walk is not built, allowed no "
+                "--video, --spawn or --connect"
+            )
     recordings = _recordings(args)
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:

@@ -169,6 +169,19 @@ FIGURE_UNITS = {
         **{f"feedback_share_{joint}": PURE for joint in JOINTS},
         **{f"feedback_rms_{joint}": "N·m" for joint in JOINTS},
         **{f"torque_rms_{joint}": "N·m" for joint in JOINTS},
+        # a two-phase gait's (``check_two_phase_feedforward``)
+        **{f"{phase}_max_feedback_ratio": PURE for phase in ("single", "double")},
+        **{
+            f"{phase}_feedback_ratio_{joint}": PURE
+            for phase in ("single", "double")
+            for joint in JOINTS
+        },
+        **{
+            f"{foot}_force_{kind}_error": "N"
+            for foot in ("rear", "front")
+            for kind in ("rms", "max")
+        },
+        **{f"{foot}_cop_rms_error": "m" for foot in ("rear", "front")},
     },
     "forward": {
         **declared_units(WalkFigures),
