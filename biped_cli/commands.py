@@ -418,16 +418,17 @@ def add_table(commands) -> None:
     )
 
 
-def read_gaits(paths: list, model: str | None = None) -> list:
+def read_gaits(paths: list, model: str | None = None, two_phase: bool = False) -> list:
     """The gait files at ``paths`` (``biped validate``, ``biped robustness``), checked before
     any work: each readable, its samples, costs and constraints its parameters', its knee
-    one MuJoCo can model, and ``model`` (an MJCF path, if given) one it can be played on.
+    one MuJoCo can model, and ``model`` (an MJCF path, if given) one it can be played on; a
+    two-phase gait refused unless ``two_phase`` (``Gait.read``).
 
     Raises BipedError naming the file (and ``--model``). Returns the ``Gait`` records.
     """
     from biped.records.gait_file import Gait
 
-    gaits = [Gait.read(path, consistent=True) for path in paths]
+    gaits = [Gait.read(path, consistent=True, two_phase=two_phase) for path in paths]
     for path, gait in zip(paths, gaits, strict=True):
         check_simulable(gait.robot, gait.knee, f"gait file {path!r}")
     if model is not None:
@@ -465,7 +466,7 @@ def cmd_validate(args) -> int:
     from validate.workflows import validate_and_record
 
     gif = _gif(args)
-    gaits = read_gaits(args.gait, args.model)
+    gaits = read_gaits(args.gait, args.model, two_phase=True)
     for path, gait in zip(args.gait, gaits, strict=True):
         if gait.two_phase and (args.video or args.spawn or args.connect):
             raise BipedError(

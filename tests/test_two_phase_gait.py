@@ -2,6 +2,7 @@
 parameters, leaves single-support files as they were, and reads without CasADi or MuJoCo."""
 
 import dataclasses
+import functools
 import json
 import subprocess
 import sys
@@ -27,7 +28,7 @@ def test_two_phase_gait_reads_back_to_the_same_motion(written):
     parameters, the same double support's cubics, duration, front foot's wrench and
     samples, the same single support samples; rewritten, the same bytes."""
     gait, path = written
-    read = gait_file.read_consistent(path)
+    read = gait_file.read_consistent(path, two_phase=True)
     assert read.two_phase and read.parameters == gait.parameters
     ours, theirs = gait.double_support, read.double_support
     assert theirs.duration == ours.duration and theirs.landing == "impact"
@@ -96,7 +97,8 @@ def test_an_edited_two_phase_gait_is_refused(written, tmp_path, change, named):
     S = V (T + T_ds); the front wrench changed: the samples' torques are not its)."""
     _, path = written
     content = json.loads(path.read_text())
-    message = refusal(gait_file.read_consistent, edited_gait_file(content, tmp_path, change))
+    read = functools.partial(gait_file.read_consistent, two_phase=True)
+    message = refusal(read, edited_gait_file(content, tmp_path, change))
     assert named in message
 
 
@@ -108,7 +110,7 @@ def test_single_support_gait_files_are_unchanged(tmp_path):
     content = json.loads(path.read_text())
     assert "double_support" not in content
     assert not [key for key in content["units"] if key.startswith("double_support")]
-    again = gait_file.read_consistent(path).write(tmp_path / "again.json")
+    again = gait_file.read_consistent(path, two_phase=True).write(tmp_path / "again.json")
     assert again.read_bytes() == path.read_bytes()
 
 
@@ -117,7 +119,7 @@ import sys
 sys.modules["casadi"] = None
 sys.modules["mujoco"] = None
 from biped.records import gait_file
-gait = gait_file.read_consistent(sys.argv[1])
+gait = gait_file.read_consistent(sys.argv[1], two_phase=True)
 print(gait.double_support.sthenic)
 """
 
@@ -131,3 +133,19 @@ def test_two_phase_gait_reads_without_casadi_or_mujoco(written):
     )
     assert done.returncode == 0, done.stderr
     assert float(done.stdout) == pytest.approx(gait.double_support.sthenic, rel=1e-12)
+
+
+def test_commands_not_built_for_two_phases_refuse_it(written, tmp_path, capsys):
+    """A two-phase gait file given where only single support is built (a reader's default,
+    ``biped robustness``, ``biped report``) is refused by name, before any work (exit 2, one
+    line), never read as the single support phase alone."""
+    from biped_cli import main
+
+    _, path = written
+    assert "is of two phases" in refusal(gait_file.read_consistent, path)
+    for command in (["robustness", str(path), "--out", str(tmp_path / "map")],
+                    ["report", str(path), "--out", str(tmp_path / "pages")]):  # fmt: skip
+        assert main(command) == 2
+        error = capsys.readouterr().err
+        assert error.count("\n") == 1 and "is of two phases" in error
+        assert not (tmp_path / "map").exists() and not (tmp_path / "pages").exists()

@@ -153,7 +153,7 @@ def test_optimize_double_support_writes_the_two_phase_gait_file(tmp_path, capsys
     assert "two phases (double support 0.1 to 0.2 of the step, impact landing)" in printed
     content = json.loads(out.read_text())
     assert content["format"] == gait_file.FORMAT
-    gait = gait_file.read_consistent(out)
+    gait = gait_file.read_consistent(out, two_phase=True)
     double = gait.double_support
     assert gait.feasible and double.feasible and double.landing == "impact"
     assert f"C = {double.sthenic:.6g} N²·m·s" in printed

@@ -596,10 +596,18 @@ class Gait:
         return self.double_support is not None
 
     @classmethod
-    def read(cls, path: str | Path, allowed: str = GAIT_FILE, consistent: bool = False) -> Gait:
+    def read(
+        cls,
+        path: str | Path,
+        allowed: str = GAIT_FILE,
+        consistent: bool = False,
+        two_phase: bool = False,
+    ) -> Gait:
         """Read a gait file. Raises BipedError if it is not one, saying what it is if it is
         another of this project's files and what is ``allowed`` (default a gait file: what
-        the command takes); with ``consistent``, if its figures are not its parameters'."""
+        the command takes); with ``consistent``, if its figures are not its parameters';
+        without ``two_phase``, if it is a two-phase gait (what reads one says so: only
+        ``biped validate`` so far)."""
         path = Path(path)
         try:
             content = json.loads(path.read_text())
@@ -620,6 +628,12 @@ class Gait:
                 f"allowed {allowed}"
             )
         gait = cls.from_content(content, f"gait file {str(path)!r}")
+        if gait.two_phase and not two_phase:
+            raise BipedError(
+                f"gait file {str(path)!r} is of two phases (single then double support), which "
+                f"this command does not take yet: allowed a gait of single support (biped "
+                f"validate takes both)"
+            )
         if consistent:
             gait.check_consistency(f"gait file {str(path)!r}")
         return gait
