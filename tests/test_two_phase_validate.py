@@ -12,7 +12,7 @@ from biped.model.kinematics import swap_legs
 from tests.conftest import two_phase_gait
 from validate.checks import checks as c
 from validate.checks.validation import two_phase_checks
-from validate.scene.model import model_spec
+from validate.scene.model import compile_spec, model_spec
 from validate.walk.samples import GaitSamples
 
 
@@ -52,25 +52,29 @@ def test_samples_cover_both_phases_continuously(gait, samples):
 
 def test_validation_of_a_two_phase_gait(gait):
     """On its own model: the model, MuJoCo's inverse dynamics along both phases (the front
-    foot's wrench given), the knee loads and the replay of both phases, with both feet's
-    ground forces within ``FOOT_FORCE_SHARE`` of the weight, pass; the impact, the walk, its
-    gains and its orbit are not run, and fail as such."""
+    foot's wrench given), the knee loads, the landing against MuJoCo's impact map holding
+    both feet and the replay of both phases, with both feet's ground forces within
+    ``FOOT_FORCE_SHARE`` of the weight, pass; the walk, its gains and its orbit are not run,
+    and fail as such."""
     checks = {check.name: check for check in two_phase_checks(gait, model_spec(gait.biped))}
-    for name in ("model", "inverse_dynamics", "knee_loads", "feedforward"):
+    for name in ("model", "inverse_dynamics", "knee_loads", "impact", "feedforward"):
         assert checks[name].passed, checks[name].line()
     figures = checks["feedforward"].figures
     for foot in ("rear", "front"):
         assert figures[f"{foot}_force_rms_error"] < c.FOOT_FORCE_SHARE * gait.robot.weight
-    for name in ("impact", "forward", "gains", "orbit"):
+    for name in ("forward", "gains", "orbit"):
         assert not checks[name].passed and checks[name].causes == ["not run"]
 
 
 def test_wrong_knee_model_fails_the_replay(gait, samples):
     """The rolling knee's two-phase gait replayed on the revolute knee's model: the servos
-    and both feet's forces are far off."""
+    and both feet's forces are far off, and so is its landing against MuJoCo's impact map."""
     wrong = Biped(gait.robot, "revolute")
     check = c.check_two_phase_feedforward(model_spec(wrong), wrong, samples)
     assert not check.passed and set(check.causes) == {"servo share", "foot forces"}
+    model = compile_spec(model_spec(wrong))
+    impact = c.check_two_phase_impact(model, wrong, samples, gait)
+    assert not impact.passed and impact.causes == ["model mismatch"]
 
 
 def test_double_support_stretched_fails_the_replay(gait, samples):
@@ -108,7 +112,8 @@ def test_biped_validate_of_a_two_phase_gait(gait, tmp_path, capsys):
     rrd = tmp_path / "rec" / "two.rrd"
     assert main(["validate", str(path), "--rrd", str(rrd)]) == 1
     printed = capsys.readouterr().out
-    assert "PASS  feedforward" in printed and "FAIL  forward           [not run]" in printed
+    assert "PASS  feedforward" in printed and "PASS  impact" in printed
+    assert "FAIL  forward           [not run]" in printed
     report = json.loads((tmp_path / "rec" / "two.report.json").read_text())
     assert report["passed"] is False and report["feedforward"]["passed"] is True
     assert report["units"]["feedforward.rear_force_rms_error"] == "N"

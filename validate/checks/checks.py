@@ -393,6 +393,45 @@ def check_impact(model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait
     return check
 
 
+def check_two_phase_impact(
+    model: mujoco.MjModel, biped: Biped, samples: GaitSamples, gait: Gait
+) -> Check:
+    """A two-phase gait's landing, which holds both feet: MuJoCo's impact map with both
+    ankles held (``mujoco_impact(both_feet=True)``) applied to the file's state before the
+    landing, against the file's velocities after it (the double support's first sample, in
+    the same labels: no leg swap) and its impulses on the rear then the front foot
+    (``EXACT``; zero for a zero-speed landing)."""
+    exact = rigid_copy(model)
+    q, qd_minus = samples.single_support().end()
+    mj_qd_plus, mj_impulse = mujoco_impact(exact, biped, q, qd_minus, both_feet=True)
+    double = samples.double_support()
+    start = mapping(exact, "left", biped.radii).qvel(double.q[0], double.qd[0])
+    velocity = np.abs(mj_qd_plus - start)
+    slide = exact.jnt_type[exact.dof_jntid] == mujoco.mjtJoint.mjJNT_SLIDE  # m/s, else rad/s
+    impulse = np.asarray(gait.double_support.landing_impulse, dtype=float)
+    error = np.abs(mj_impulse - impulse).reshape(2, 3)  # rear, front: Ix, Iz [N·s], Iy [N·m·s]
+    figures = {
+        "max_linear_velocity_error": float(velocity[slide].max()),
+        "max_angular_velocity_error": float(velocity[~slide].max()),
+        "normal_impulse": float(mj_impulse[4]),  # on the landing (front) foot
+        "rear_normal_impulse": float(mj_impulse[1]),
+        "landing_speed": float(np.linalg.norm(biped.point_jacobian(q, "swing_ankle") @ qd_minus)),
+        "max_force_impulse_error": float(error[:, :2].max()),
+        "max_moment_impulse_error": float(error[:, 2].max()),
+    }
+    start_rates = np.abs(start)
+    size = float(np.linalg.norm(mj_impulse.reshape(2, 3)[:, :2]))
+    scales = {
+        "max_linear_velocity_error": (_peak(start_rates[slide]), "the largest hip speed"),
+        "max_angular_velocity_error": (_peak(start_rates[~slide]), "the largest joint rate"),
+        "max_force_impulse_error": (size, "the impulses"),
+        "max_moment_impulse_error": (_peak(mj_impulse.reshape(2, 3)[:, 2]), "their moments"),
+    }
+    notes = ["the landing holds both feet: MuJoCo's impact map with both ankles held"]
+    what = "MuJoCo's impact map holding both feet is not the gait file's landing"
+    return _exact_verdict("impact", figures, what, scales, notes)
+
+
 def check_feedforward(spec: mujoco.MjSpec, biped: Biped, samples: GaitSamples) -> Check:
     """Both stance sides replayed (``validate.walk.replay``): each joint's servo torque, RMS over
     the step, against the robot's torque scale (the largest RMS torque of its joints over

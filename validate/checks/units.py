@@ -159,6 +159,7 @@ FIGURE_UNITS = {
         "max_force_impulse_error": "N·s",  # of Ix, Iz
         "max_moment_impulse_error": "N·m·s",  # of Iy
         "normal_impulse": "N·s",
+        "rear_normal_impulse": "N·s",  # a two-phase gait's landing (both feet held)
         "landing_speed": "m/s",
     },
     "feedforward": {

@@ -84,18 +84,15 @@ NO_TWO_PHASE_WALK = (
     "MuJoCo's walk of a two-phase gait (a controller holding both feet through the double "
     "support, then lifting the rear one) is not built"
 )
-NO_TWO_PHASE_IMPACT = (
-    "the landing that holds both feet (eqs. 21-24 with six contact rows) is not cross-checked "
-    "with MuJoCo's impact map yet"
-)
 
 
 def two_phase_checks(gait: Gait, spec: mujoco.MjSpec) -> list[Check]:
     """The checks of a two-phase gait: the model; the inverse dynamics along both phases;
     the knee loads along its single support (the file's are the single support's); the
+    landing holding both feet against MuJoCo's impact map (``check_two_phase_impact``); the
     feedforward replay of both phases with both feet's ground forces
-    (``check_two_phase_feedforward``); the impact, the walk, its gains and its orbit not
-    run, each saying why (failed: unknown, never passed)."""
+    (``check_two_phase_feedforward``); the walk, its gains and its orbit not run, each
+    saying why (failed: unknown, never passed)."""
     biped, samples = gait.biped, GaitSamples.from_gait(gait)
     robot_model = compile_spec(spec)
     knee_loads = c.check_knee_loads(robot_model, biped, samples.single_support(), gait.knee_loads)
@@ -104,7 +101,7 @@ def two_phase_checks(gait: Gait, spec: mujoco.MjSpec) -> list[Check]:
         c.check_model(robot_model, biped),
         c.check_inverse_dynamics(robot_model, biped, samples),
         knee_loads,
-        c.not_run("impact", NO_TWO_PHASE_IMPACT),
+        c.check_two_phase_impact(robot_model, biped, samples, gait),
         c.check_two_phase_feedforward(spec, biped, samples),
         c.not_run("forward", NO_TWO_PHASE_WALK),
         c.not_run("gains", NO_TWO_PHASE_WALK),
