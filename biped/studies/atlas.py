@@ -47,7 +47,6 @@ from biped.model.criteria import (
     CRITERION_UNITS,
     PAPER_SAFETY,
     WALKABLE,
-    WORK_CRITERIA,
     Safety,
 )
 from biped.model.dynamics import Biped
@@ -75,7 +74,7 @@ from biped.optimization.problem import (
 from biped.records import gait_file
 from biped.runtime.claims import claimed
 from biped.runtime.files import atomic_write_text, distinct_values
-from biped.studies import campaign
+from biped.studies import campaign, staging
 from biped.studies.campaign import Task
 
 MANIFEST = "atlas.json"
@@ -391,61 +390,67 @@ def _solve_refined(task: Task) -> str:
 
 
 def stages(folder: Path, settings: Settings) -> list[list[Task]]:
-    """The tasks still to run, in the order their inputs need."""
-    cells = settings.cells()
-    index = {cell: k for k, cell in enumerate(cells)}
-    sthenic = "sthenic" in settings.criteria
+    """The tasks still to run, in waves whose inputs the waves before write
+    (``staging.schedule``): each point's own starts (a work criterion's from the sthenic
+    optimum of its problem), its final solve from its neighbours' own optima
+    (``neighbourhood``), its re-solves from its final optimum (the richer family's also from
+    the other knee's)."""
+    folder = str(folder)
 
-    def done(point):
-        return read(folder, point) is not None
+    def points(stage: str, cells=None) -> tuple:
+        cells = settings.cells() if cells is None else cells
+        return tuple(
+            Point(stage, k, c, cell) for c in settings.criteria for cell in cells for k in KNEES
+        )
 
-    def task(solve, point, given=()):
-        return Task(solve, settings, point, str(folder), tuple(given))
+    def at(stage: str, relation=lambda p: (p,)) -> staging.Seed:
+        """The results of ``stage`` at the points ``relation`` relates to a point's."""
+        return staging.Seed(stage, lambda p: relation(p.at(stage)))
 
-    def points(stage, criteria, cells_=cells):
-        return [Point(stage, k, c, cell) for c in criteria for cell in cells_ for k in KNEES]
-
-    work = [c for c in settings.criteria if c in WORK_CRITERIA]
-    first = [c for c in settings.criteria if c not in work or not sthenic]
-    own = [
-        [task(_solve_own, p) for p in points("own", first) if not done(p)],
-        [
-            task(_solve_own, p, [Point("own", p.knee, "sthenic", p.cell)])
-            for p in points("own", [c for c in work if sthenic])
-            if not done(p)
-        ],
-    ]
-    final = [
-        task(_solve_final, p, _neighbours(p, settings, index))
-        for p in points("final", settings.criteria)
-        if not done(p)
-    ]
+    knees = staging.Neighbours(across=(staging.Axis("knee", KNEES),))
     refined = [
-        task(_solve_refined, p)
-        for stage in ("fine", "tight")
-        for p in points(stage, settings.criteria)
-        if not done(p)
+        staging.Stage(s, _solve_refined, folder, points(s), reads=at("final"))
+        for s in ("fine", "tight")
     ]
-    refined += [
-        task(_solve_refined, p, [p.at("final", other) for other in KNEES if other != p.knee])
-        for p in points("richer", settings.criteria, settings.corners())
-        if not done(p)
+    plan = [
+        staging.Stage(
+            "own",
+            _solve_own,
+            folder,
+            points("own"),
+            given=at("own", staging.sthenic_twin(settings.criteria)),
+        ),
+        staging.Stage(
+            "final",
+            _solve_final,
+            folder,
+            points("final"),
+            given=at("own", neighbourhood(settings).of),
+            reads=at("own"),
+        ),
+        *refined,
+        staging.Stage(
+            "richer",
+            _solve_refined,
+            folder,
+            points("richer", settings.corners()),
+            given=at("final", knees.of),
+            reads=at("final"),
+        ),
     ]
-    return [*own, final, refined]
+    return staging.schedule(plan, settings, lambda _, point: read(folder, point) is not None)
 
 
-def _neighbours(point: Point, settings: Settings, index: dict) -> list[Point]:
-    """The ``own`` optima that start a point's final solve: the neighbouring speeds and
-    clearances of its cell, and the other knee."""
-    cell = point.cell
-    found = []
-    for values, field in ((settings.speeds, "speed"), (settings.clearances, "clearance")):
-        at = list(values).index(getattr(cell, field))
-        for j in (at - 1, at + 1):
-            if 0 <= j < len(values):
-                found.append(dataclasses.replace(cell, **{field: values[j]}))
-    own = [Point("own", point.knee, point.criterion, c) for c in found]
-    return own + [Point("own", k, point.criterion, cell) for k in KNEES if k != point.knee]
+def neighbourhood(settings: Settings) -> staging.Neighbours:
+    """The neighbours whose ``own`` optima start a point's final solve: the neighbouring
+    speeds and clearances of its cell, and the other knee."""
+    return staging.Neighbours(
+        steps=(
+            staging.Axis("cell.speed", tuple(settings.speeds)),
+            staging.Axis("cell.clearance", tuple(settings.clearances)),
+        ),
+        across=(staging.Axis("knee", KNEES),),
+    )
 
 
 def run_atlas(folder, settings: Settings, **where) -> Settings:
