@@ -86,7 +86,7 @@ def cmd_atlas(args) -> int:
         print(f"wrote {path}")
     certified = all(
         (content := atlas.read(args.out, atlas.Point("final", k, c, cell))) is not None
-        and content["certified"]
+        and content.certified
         for c in settings.criteria
         for cell in settings.cells()
         for k in ("revolute", "rolling")

@@ -33,6 +33,7 @@ from biped.pages.style import (
     FONT_TITLE,
     save,
 )
+from biped.records.atlas_optimum import AtlasOptimum
 from biped.runtime.files import atomic_write_text
 from biped.studies.atlas import (
     MEASURES,
@@ -75,15 +76,15 @@ NOT_WALKING_LABEL = "red frame: a knee's gait does not walk in MuJoCo"
 
 @dataclass(frozen=True)
 class Row:
-    """One line of ``atlas.csv``: a cell and criterion, both knees and their difference;
-    ``walks``: each knee's walk in MuJoCo (``Walk``, None where not walked), None when the
-    atlas was not walked."""
+    """One line of ``atlas.csv``: a cell and criterion, both knees' final optima
+    (``AtlasOptimum``, None where missing) and their difference; ``walks``: each knee's walk
+    in MuJoCo (``Walk``, None where not walked), None when the atlas was not walked."""
 
     criterion: str
     cell: Cell
     difference: Difference
-    revolute: dict | None
-    rolling: dict | None
+    revolute: AtlasOptimum | None
+    rolling: AtlasOptimum | None
     walks: dict | None = None
 
     def walking(self) -> bool:
@@ -123,7 +124,7 @@ def line(row: Row, weight: float, knots: int = 1) -> AtlasLine:
     family. A knee's cost is there only with a difference."""
     d = row.difference
     revolute, rolling = (
-        None if r is None or d.value is None else r["costs"][row.criterion]
+        None if r is None or d.value is None else r.costs[row.criterion]
         for r in (row.revolute, row.rolling)
     )
 
@@ -156,9 +157,9 @@ def line(row: Row, weight: float, knots: int = 1) -> AtlasLine:
     )
 
 
-def _starts(final: dict | None) -> int | None:
+def _starts(final: AtlasOptimum | None) -> int | None:
     """The starts that reached a knee's final optimum (its record's), None without one."""
-    return None if final is None else int(final["starts_at_best"])
+    return None if final is None else int(final.starts_at_best)
 
 
 def csv_text(table: list[Row], weight: float, knots: int = 1) -> str:

@@ -43,7 +43,6 @@ import numpy as np
 
 from biped.errors import BipedError
 from biped.model.criteria import (
-    ALL_CRITERIA,
     CRITERION_UNITS,
     PAPER_SAFETY,
     WALKABLE,
@@ -56,14 +55,12 @@ from biped.model.robot import Robot
 from biped.optimization.comparison import relative_change
 from biped.optimization.optimize import (
     Optimum,
-    Report,
     apart_from_table,
     best_of,
     checked,
     confirm,
     optimize,
     refine,
-    single_start_note,
 )
 from biped.optimization.problem import (
     GaitProblem,
@@ -72,6 +69,7 @@ from biped.optimization.problem import (
     walkable_description,
 )
 from biped.records import gait_file
+from biped.records.atlas_optimum import AtlasOptimum
 from biped.runtime.claims import claimed
 from biped.runtime.files import atomic_write_text, distinct_values
 from biped.studies import campaign, staging
@@ -259,79 +257,35 @@ def check_settings(settings: Settings) -> Settings:
     return settings
 
 
-def read(folder, point: Point) -> dict | None:
+def read(folder, point: Point) -> AtlasOptimum | None:
     """The record of ``point`` in ``folder``, None if missing or unreadable."""
-    try:
-        content = json.loads((Path(folder) / point.filename()).read_text())
-    except (OSError, ValueError, UnicodeDecodeError):
-        return None
-    return content if isinstance(content, dict) and "status" in content else None
+    return AtlasOptimum.read(Path(folder) / point.filename())
 
 
-def _record(optimum: Optimum, seconds: float) -> dict:
-    """What a stage keeps of an optimum: its status, costs, starts and variables."""
-    report, ev = optimum.report, optimum.evaluation
-    single = report.converged and report.starts_at_best < 2
-    return {
-        "status": report.status,
-        "feasible": optimum.feasible,
-        "certified": optimum.certified,
-        "value": _finite(optimum.value),
-        "costs": {c: ev.value(c, optimum.step.step_length) for c in ALL_CRITERIA},
-        "starts": report.starts,
-        "starts_at_best": report.starts_at_best,
-        "single_start": single_start_note(report) if single else None,
-        "next_optimum": _next_optimum(report) if single else 0.0,
-        "violations": optimum.evaluation.violations_line(),
-        "period": optimum.step.period,
-        "step_length": optimum.step.step_length,
-        "seconds": seconds,
-        "report": report.to_dict(),
-        "variables": [_finite(v) for v in optimum.variables],
-    }
-
-
-def _finite(value):
-    return float(value) if math.isfinite(value) else None
-
-
-def _next_optimum(report: Report) -> float:
-    """The relative distance to the next optimum the starts reached above the best (0 when
-    none did)."""
-    best = report.value
-    above = [
-        s.value
-        for s in report.history
-        if s.status == "Solve_Succeeded" and np.isfinite(s.value) and s.value > best * (1 + 1e-6)
-    ]
-    return min(above) / best - 1.0 if above else 0.0
-
-
-def _optimum(settings: Settings, point: Point, content: dict) -> Optimum | None:
+def _optimum(settings: Settings, point: Point, record: AtlasOptimum | None) -> Optimum | None:
     """The optimum a record holds (its numbers again: JSON keeps every bit)."""
-    if content is None or any(v is None for v in content["variables"]):
+    if record is None or not record.solved:
         return None
-    problem = settings.problem(point)
-    return checked(problem, np.array(content["variables"]), Report.from_dict(content["report"]))
+    return checked(settings.problem(point), np.array(record.variables), record.report)
 
 
-def _write(task: Task, optimum: Optimum, began: float) -> dict:
-    content = _record(optimum, time.perf_counter() - began)
-    atomic_write_text(task.path, json.dumps(content, indent=1, allow_nan=False))
-    return content
+def _write(task: Task, optimum: Optimum, began: float) -> AtlasOptimum:
+    record = AtlasOptimum.from_optimum(optimum, time.perf_counter() - began)
+    atomic_write_text(task.path, record.to_json())
+    return record
 
 
-def _line(point: Point, content: dict) -> str:
-    status = campaign.failure(content["status"], content["feasible"])
+def _line(point: Point, record: AtlasOptimum) -> str:
+    status = campaign.failure(record.status, record.feasible)
     if status is None:
         status = "certified" if point.stage == "final" else "converged, feasible"
-    value = content["costs"][point.criterion]
+    value = record.costs[point.criterion]
     return (
         f"[{point.stage:6}] {point.knee:8} {point.criterion:16} {point.cell.speed:.3f} m/s "
         f"clearance {100 * point.cell.clearance:4.1f} cm bend {point.cell.knee_bend:.3f} rad  "
         f"C = {value:12.6f} {CRITERION_UNITS[point.criterion]:6} {status}; "
-        f"{content['starts_at_best']}/{content['starts']} starts at best  "
-        f"{content['seconds']:5.1f} s"
+        f"{record.starts_at_best}/{record.starts} starts at best  "
+        f"{record.seconds:5.1f} s"
     )
 
 
@@ -352,7 +306,7 @@ def _solve_final(task: Task) -> str:
     own = _optimum(settings, point.at("own"), read(task.folder, point.at("own")))
     problem = settings.problem(point)
     given = [read(task.folder, p) for p in task.given]
-    starts = [np.array(c["variables"]) for c in given if c and None not in c["variables"]]
+    starts = [np.array(r.variables) for r in given if r is not None and r.solved]
     starts = apart_from_table(problem, starts)  # the table's were among the point's own
     optimum = own
     if starts:
@@ -360,10 +314,10 @@ def _solve_final(task: Task) -> str:
         optimum = again if own is None else best_of(problem, [own, again])
     if optimum is not None:  # a best reached by one start tried again
         optimum = confirm(problem, optimum, starts, jobs=1)
-    content = _write(task, optimum, began)
+    record = _write(task, optimum, began)
     gait = gait_file.Gait.from_optimum(optimum, settings.robot)
     gait.write(Path(task.folder) / point.gait_filename())
-    return _line(point, content)
+    return _line(point, record)
 
 
 def _solve_refined(task: Task) -> str:
@@ -371,9 +325,9 @@ def _solve_refined(task: Task) -> str:
     or in the richer family from it and from the other knee's (``richer``)."""
     settings, point, began = task.settings, task.point, time.perf_counter()
     final = read(task.folder, point.at("final"))
-    if final is None or None in final["variables"]:
+    if final is None or not final.solved:
         raise BipedError(f"{point.at('final').filename()}: no final optimum to refine")
-    start = np.array(final["variables"])
+    start = np.array(final.variables)
     if point.stage == "fine":
         samples = FINER * settings.problem(point).samples_per_half
         optimum = refine(settings.problem(point, samples=samples), start)
@@ -382,9 +336,7 @@ def _solve_refined(task: Task) -> str:
     else:
         richer = settings.problem(point, knots=RICHER_KNOTS)
         others = [read(task.folder, p) for p in task.given]
-        starts = [start] + [
-            np.array(c["variables"]) for c in others if c and None not in c["variables"]
-        ]
+        starts = [start] + [np.array(r.variables) for r in others if r is not None and r.solved]
         optimum = optimize(richer, starts=0, given=[richer.embedded(z) for z in starts], jobs=1)
     return _line(point, _write(task, optimum, began))
 
@@ -485,18 +437,19 @@ def summarize(folder, settings: Settings) -> str:
     ]
 
     def why_not(point):
-        content = read(folder, point)
-        if content is None:
+        record = read(folder, point)
+        if record is None:
             return "missing"
-        why = campaign.failure(content["status"], content["feasible"])
-        return f"{why} ({content['violations']})" if why == "INFEASIBLE" else why
+        why = campaign.failure(record.status, record.feasible)
+        return f"{why} ({record.violations})" if why == "INFEASIBLE" else why
 
     counted = "points certified (final optima, solver converged, feasible on the check grid)"
-    seconds = [
-        json.loads(path.read_text())["seconds"]
+    records = [
+        AtlasOptimum.read(path)
         for stage in STAGES
         for path in sorted((Path(folder) / stage).glob("*.json"))
     ]
+    seconds = [record.seconds for record in records if record is not None]
     note = (
         f"; {len(seconds)} optimizations, median {np.median(seconds):.2f} s each" if seconds else ""
     )
@@ -570,22 +523,23 @@ class Difference:
         return self.value is not None and uncertainty is not None and abs(self.value) > uncertainty
 
 
-def _not_certified(contents: dict) -> str:
+def _not_certified(records: dict) -> str:
     """Why the knees' records of one stage give no difference ("" when both are certified)."""
     reasons = []
     for knee in KNEES:
-        content = contents[knee]
-        if content is None:
+        record = records[knee]
+        if record is None:
             reasons.append(f"{knee} missing")
-        elif not content["certified"]:
-            why = campaign.failure(content["status"], content["feasible"])
-            detail = f": {content['violations']}" if content["violations"] else ""
+        elif not record.certified:
+            why = campaign.failure(record.status, record.feasible)
+            detail = f": {record.violations}" if record.violations else ""
             reasons.append(f"{knee} {why}{detail}")
     return "; ".join(reasons)
 
 
 def difference(folder, settings: Settings, criterion: str, cell: Cell) -> tuple[Difference, dict]:
-    """The cell's ``Difference`` for ``criterion`` and each knee's final record."""
+    """The cell's ``Difference`` for ``criterion`` and each knee's final record
+    (``AtlasOptimum``, None where missing), by knee."""
     records = {
         stage: {k: read(folder, Point(stage, k, criterion, cell)) for k in KNEES}
         for stage in STAGES
@@ -596,16 +550,16 @@ def difference(folder, settings: Settings, criterion: str, cell: Cell) -> tuple[
         return Difference(None, None, None, None, None, why), finals
 
     def change(stage):
-        contents = records[stage]
+        knees = records[stage]
         return relative_change(
-            contents["rolling"]["costs"][criterion], contents["revolute"]["costs"][criterion]
+            knees["rolling"].costs[criterion], knees["revolute"].costs[criterion]
         )
 
     value = change("final")
     asked = ("fine", "tight") + (("richer",) if cell in settings.corners() else ())
     missing = {stage: _not_certified(records[stage]) for stage in asked}
     moved = {stage: None if missing[stage] else change(stage) for stage in asked}
-    spread = 100 * math.sqrt(sum(finals[k]["next_optimum"] ** 2 for k in KNEES))
+    spread = 100 * math.sqrt(sum(finals[k].next_optimum ** 2 for k in KNEES))
     return (
         Difference(
             value=value,
