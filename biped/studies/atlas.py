@@ -2,7 +2,7 @@
 stance-knee bend), each difference between the knees with its error bar.
 
 Each cell (speed, clearance, knee bend) holds, for each knee and criterion, a certified
-optimum of the paper's spline, in the campaign's stages (``biped.studies.campaign``):
+optimum of the paper's spline, in the campaign's stages (``biped.studies.staging``):
 
 1. ``own``: the point's own starts (``biped.optimization.optimize.optimize``); the
    criteria of the joints' work start from the sthenic optimum of the same point;

@@ -10,12 +10,13 @@ Every point (knee, criterion, speed) is solved twice:
    same series and of the other knee at the same speed; the best of both is the point's
    gait file.
 
-The solves run in three stages, each task of a stage independent of the others, so they run
-in parallel (``biped.runtime.runner``: on all cores, or on the workers of a Dask cluster): the
-sthenic independent optima; the energy independent optima with the sthenic neighbours'
-solves; the energy neighbours' solves. Each result depends only on files of the stages
-before, which are written whole (``biped.runtime.files``), so a sweep stopped at any moment
-and run again ends with exactly the files of an uninterrupted sweep. The folder's
+The solves run in three waves (``biped.studies.staging``), each task of a wave independent of
+the others, so they run in parallel (``biped.runtime.runner``: on all cores, or on the
+workers of a Dask cluster): the sthenic independent optima; the energy independent optima
+with the sthenic neighbours' solves; the energy neighbours' solves. Each result depends only
+on files of the waves before, which are written whole (``biped.runtime.files``), so a sweep
+stopped at any moment and run again ends with exactly the files of an uninterrupted sweep.
+The folder's
 ``sweep.json`` records what shapes the numbers (robot, safety, speeds, seed, starts,
 method, versions); resuming with any of them changed is refused. Points whose solver did
 not converge, or whose optimum is infeasible, are saved with their status and counted in
