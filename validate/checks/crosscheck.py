@@ -50,9 +50,11 @@ def load_model(biped: Biped, exact: bool = False) -> mujoco.MjModel:
 
 
 def rigid_copy(model: mujoco.MjModel) -> mujoco.MjModel:
-    """A copy without armature and with massless knee links: the analytical robot exactly."""
+    """A copy without armature (a profiled knee's stretch's too) and with massless knee links:
+    the analytical robot exactly."""
     exact = copy.deepcopy(model)
     exact.dof_armature[:] = 0.0
+    exact.tendon_armature[:] = 0.0
     for side, part in ((s, p) for s in SIDES for p in ("link", "slider")):
         name = f"{side}_knee_{part}"  # a profiled knee's slider too (validate.scene.profile_mjcf)
         if mujoco.mj_name2id(exact, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
