@@ -167,3 +167,29 @@ def test_the_stretchs_armature_never_enters_the_knees_motion(model, biped_model)
         assert np.abs(on_motion).max() < 1e-12 * np.abs(inertial(bare, k)).max()
         off_motion = inertial(heavy, k, 1.0) - inertial(bare, k, 1.0)
         assert off_motion[slide] == pytest.approx(STRETCH_ARMATURE, rel=1e-9)
+
+
+def test_the_walks_equality_figures_are_mujocos_residuals(model, biped_model):
+    """The walk's equality figures are MuJoCo's own residuals, each in its unit: zero on
+    mapped states, and a knee slide moved by 5 µm off the rolling motion shows as 5 µm of
+    the profiled knee's length equalities (MuJoCo's efc_pos says the same), not as radians."""
+    from types import SimpleNamespace
+
+    from validate.checks.checks import knee_equality_violations
+
+    q, _, _ = random_state(biped_model, seed=2, n=4, spread=0.4)
+    mapped = mapping(model, "left", biped_model.radii)
+    qpos = np.array([mapped.qpos(state) for state in q])
+    exact = knee_equality_violations(SimpleNamespace(model=model, qpos=qpos))
+    assert exact["max_knee_equality_violation"] < 1e-13
+    assert exact["max_knee_length_violation"] < 1e-13
+    moved = qpos.copy()
+    moved[:, model.jnt_qposadr[model.joint("left_knee_slide").id]] += 5e-6
+    figures = knee_equality_violations(SimpleNamespace(model=model, qpos=moved))
+    assert figures["max_knee_length_violation"] == pytest.approx(5e-6, rel=1e-6)
+    assert figures["max_knee_equality_violation"] < 1e-13
+    data = mujoco.MjData(model)
+    data.qpos[:] = moved[0]
+    mujoco.mj_forward(model, data)
+    equality = data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    assert np.abs(data.efc_pos[: data.nefc][equality]).max() == pytest.approx(5e-6, rel=1e-6)

@@ -653,7 +653,7 @@ def walk_figures(
     figures["analytic_energy_per_step"] = float(energy)
     figures["energy_ratio"] = _ratio(figures["energy_per_step"], float(energy))
     if biped.knee == "rolling":
-        figures["max_knee_equality_violation"] = _knee_equality_violation(sim)
+        figures.update(knee_equality_violations(sim))
     return WalkFigures(**figures).to_dict()  # the names, their order and units declared there
 
 
@@ -763,14 +763,57 @@ def _joint_figures(biped, samples, sim: Simulation, end: int, steady, reference)
     }
 
 
-def _knee_equality_violation(sim: Simulation) -> float:
-    """Largest violation [rad] of the rolling knees' equalities over the walk."""
-    model, worst = sim.model, 0.0
+def knee_equality_violations(sim: Simulation) -> dict:
+    """Largest violations of the rolling knees' equalities over the walk, by their unit: the
+    angle equalities between two hinges [rad] (the circles' knee) and the length equalities
+    [m] (a profiled knee's arc lengths, ``knee_arc`` a slide, and its pinned stretch tendon).
+    Each is MuJoCo's own residual: the first object's change from its reference position less
+    the equality's quartic of the second's."""
+    model, worst = sim.model, {"rad": 0.0, "m": 0.0}
     for k in range(model.neq):
-        a, b = model.jnt_qposadr[model.eq_obj1id[k]], model.jnt_qposadr[model.eq_obj2id[k]]
-        violation = np.abs(sim.qpos[:, a] - model.eq_data[k, 1] * sim.qpos[:, b]).max()
-        worst = max(worst, float(violation))
-    return worst
+        if model.eq_type[k] == mujoco.mjtEq.mjEQ_JOINT:
+            first, unit = _joint_position(model, sim.qpos, model.eq_obj1id[k])
+            second, _ = _joint_position(model, sim.qpos, model.eq_obj2id[k])
+        elif model.eq_type[k] == mujoco.mjtEq.mjEQ_TENDON:
+            first, unit = _tendon_length(model, sim.qpos, model.eq_obj1id[k]), "m"
+            second = _tendon_length(model, sim.qpos, model.eq_obj2id[k])
+        else:
+            continue
+        quartic = np.polynomial.polynomial.polyval(second, model.eq_data[k, :5])
+        worst[unit] = max(worst[unit], float(np.abs(first - quartic).max()))
+    return {
+        "max_knee_equality_violation": worst["rad"],
+        "max_knee_length_violation": worst["m"] if model.ntendon and _profiled(model) else None,
+    }
+
+
+def _joint_position(model, qpos: np.ndarray, joint: int) -> tuple[np.ndarray, str]:
+    """A hinge's or a slide's change from its reference position over the walk, and its unit;
+    no joint (-1): zero."""
+    if joint < 0:
+        return np.zeros(len(qpos)), "rad"
+    address = model.jnt_qposadr[joint]
+    slide = model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_SLIDE
+    return qpos[:, address] - model.qpos0[address], "m" if slide else "rad"
+
+
+def _tendon_length(model, qpos: np.ndarray, tendon: int) -> np.ndarray:
+    """A fixed tendon's change from its reference length over the walk [m]; none (-1): zero."""
+    if tendon < 0:
+        return np.zeros(len(qpos))
+    first = model.tendon_adr[tendon]
+    wraps = range(first, first + model.tendon_num[tendon])
+    length = sum(model.wrap_prm[w] * qpos[:, model.jnt_qposadr[model.wrap_objid[w]]] for w in wraps)
+    return length - model.tendon_length0[tendon]
+
+
+def _profiled(model) -> bool:
+    """Whether the model's knees are profiled (a slide among their joints)."""
+    return any(
+        model.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE
+        and "knee" in (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or "")
+        for j in range(model.njnt)
+    )
 
 
 def scuff_notes(sim: Simulation, period: float, figures: dict, steps: int) -> list:

@@ -72,6 +72,7 @@ class WalkFigures:
     distance: float = unit_field("m")  # the hip's travel
     seconds_simulated: float = unit_field("s")
     max_knee_equality_violation: float | None = unit_field("rad", default=None)
+    max_knee_length_violation: float | None = unit_field("m", default=None)  # profiled knee
 
     def to_dict(self) -> dict:
         """The figures by name (those not measured left out)."""
