@@ -73,7 +73,7 @@ settings = atlas.Settings.from_dict(json.loads((folder / atlas.MANIFEST).read_te
 point = atlas.Point("richer", "revolute", "sthenic", atlas.Cell(1.0, 0.05, 0.0))
 finals = [atlas.read(folder, point.at("final", knee)) for knee in ("revolute", "rolling")]
 richer = settings.problem(point, knots=atlas.RICHER_KNOTS)
-given = [richer.embedded(np.array(f["variables"])) for f in finals]
+given = [richer.embedded(np.array(f.variables)) for f in finals]
 best = optimize(richer, starts=0, given=given, jobs=1)
 print(best.report.status, f"{best.report.value:.9f}")
 """

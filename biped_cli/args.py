@@ -7,7 +7,6 @@ import argparse
 import contextlib
 import dataclasses
 import re
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -36,11 +35,15 @@ from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.optimization.comparison import CERTIFIED
 from biped.optimization.problem import MIN_SPEED, max_walking_speed
+from biped_cli.checks import (  # noqa: F401 (the outputs' words, for the commands)
+    FOLDER_CREATED,
+    FOLDERS_CREATED,
+    SAME_FOLDERS,
+    declare_rule,
+    distinct_outputs,
+)
 from validate import DEFAULT_STEPS
 
-# What an option naming an output says of its missing folders (the path written is printed).
-FOLDERS_CREATED = "missing folders are created"
-FOLDER_CREATED = "created if missing"
 ROBOT_HELP = (
     "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1); a "
     "table [actuator] sets every joint's motor and gear, [actuators.knee] (ankle, hip) one "
@@ -166,20 +169,6 @@ def value_text(text: str) -> str:
     return text.removeprefix(VALUE_MARK)
 
 
-# Gait files whose outputs share a name (named from their folder and file names).
-SAME_FOLDERS = "gait files in folders of the same name"
-
-
-def distinct_outputs(names: list, what: str, gaits: str = SAME_FOLDERS) -> None:
-    """Refuse ``gaits`` that would write the same output: ``what``, named ``names``."""
-    repeated = sorted({str(name) for name in names if names.count(name) > 1})
-    if repeated:
-        raise BipedError(
-            f"{gaits} would share the {what} {repeated[0]!r}: allowed gait files of distinct "
-            "folder or file names"
-        )
-
-
 @contextlib.contextmanager
 def naming(prefix: str):
     """Within the block, a BipedError's line begins with ``prefix`` (``gait file 'a.json'``)."""
@@ -259,6 +248,7 @@ def add_bezier(parser) -> None:
         "parameters, each degree holding the ones below (with --family bezier, which asks "
         "for it: no default)",
     )
+    declare_rule(parser, ("--degree", "--knots", "--family"), gait_family)
 
 
 def gait_family(args):
@@ -335,60 +325,6 @@ def speeds(text: str) -> np.ndarray:
     return np.round(values, 6)
 
 
-def check_output(path: str, option: str = "--out") -> None:
-    """Fail before any work if ``path`` cannot become a file or another run writes it; it is
-    this command's until it ends (``biped.runtime.claims``)."""
-    from biped.runtime.claims import hold
-    from biped.runtime.files import special_kind
-
-    target = Path(path)
-    kind = special_kind(target)  # /dev/null, /dev/stdout: a rename would destroy it
-    if kind is not None:
-        raise BipedError(f"{option} {path!r} is {kind}: allowed a file path")
-    if target.is_dir():
-        raise BipedError(f"{option} {path!r} is a folder: allowed a file path")
-    check_folder(str(target.parent), option, of=path)
-    hold(path, option)
-
-
-def claim_folder(path: str, option: str = "--out") -> None:
-    """Fail before any work if ``path`` cannot be (or become) a writable folder or another run
-    writes in it; it is this command's until it ends (``biped.runtime.claims``)."""
-    from biped.runtime.claims import hold
-
-    check_folder(path, option)
-    hold(path, option)
-
-
-def claim_outputs(folder: str, names: list, option: str = "--out") -> None:
-    """Claim the outputs named ``names`` in ``folder`` (each name standing for its files,
-    ``NAME.json``, ``NAME.png``) until the command ends: two runs may write other gaits'
-    outputs into one folder, not the same."""
-    from biped.runtime.claims import hold
-
-    for name in names:
-        hold(Path(folder) / str(name), option)
-
-
-def check_folder(path: str, option: str, of: str | None = None) -> None:
-    """Fail before any work if ``path`` cannot be (or become) a writable folder."""
-    folder = Path(path)
-    named = of if of is not None else path
-    existing = folder
-    while not existing.exists():
-        existing = existing.parent
-    if not existing.is_dir():
-        raise BipedError(f"{option} {named!r}: {str(existing)!r} is a file, allowed a folder")
-    try:  # what a writer will do there (permissions alone miss /proc, read-only mounts)
-        with tempfile.TemporaryFile(dir=existing):
-            pass
-    except OSError as error:
-        raise BipedError(
-            f"{option} {named!r}: folder {str(existing)!r} is not writable "
-            f"({error.strerror}): allowed a folder this user can write in"
-        ) from None
-
-
 class _Default(int):
     """An option's default, told apart from the same number given (``given``)."""
 
@@ -400,7 +336,20 @@ def given(args, name: str) -> bool:
 
 def budget(args) -> dict:
     """The keyword arguments of ``biped.optimization.optimize.optimize`` given on the command
-    line; an option given that the method would not use is refused (BipedError)."""
+    line; an option given that the method would not use is refused (``check_budget``)."""
+    check_budget(args)
+    return {
+        "seed": args.seed,
+        "method": args.method,
+        "starts": args.starts,
+        "nelder_mead_starts": args.nelder_mead_starts,
+        "max_restarts": args.restarts,
+        "evaluations_per_run": args.evaluations,
+    }
+
+
+def check_budget(args) -> None:
+    """Refuse (BipedError) an option of the budget given that the method would not use."""
     nelder_mead = args.method == "nelder-mead" or args.nelder_mead_starts > 0
     unused = [("--nelder-mead-starts", "nelder_mead_starts")]
     if not getattr(args, "design", False):  # the pipeline's design stage is IPOPT's
@@ -418,14 +367,6 @@ def budget(args) -> dict:
                 f"{option} {getattr(args, name)}: Nelder-Mead's, allowed with --method "
                 "nelder-mead or --nelder-mead-starts K"
             )
-    return {
-        "seed": args.seed,
-        "method": args.method,
-        "starts": args.starts,
-        "nelder_mead_starts": args.nelder_mead_starts,
-        "max_restarts": args.restarts,
-        "evaluations_per_run": args.evaluations,
-    }
 
 
 # The options of ``add_safety`` that set a field of ``Safety`` of the same name, each left at
@@ -500,6 +441,8 @@ def add_budget(parser, sweep: bool = False):
              f"criterion evaluations per Nelder-Mead run, 1 to {MAX_EVALUATIONS} (default "
              f"{EVALUATIONS_PER_RUN}); with --method nelder-mead or --nelder-mead-starts"),
         )  # fmt: skip
+        budget_options = ("--starts", "--nelder-mead-starts", "--restarts", "--evaluations")
+        declare_rule(parser, budget_options, check_budget)
     add_safety(parser)
 
 
@@ -592,13 +535,6 @@ def add_steps(parser) -> None:
     parser.add_argument("--steps", type=steps, default=DEFAULT_STEPS, metavar="N", help=STEPS_HELP)
 
 
-def add_folder(parser, option: str, default: str, what: str, files: str = "") -> None:
-    """An output folder, ``--out DIR`` or ``--recordings DIR``: ``what`` it holds, and the
-    ``files`` written there (``": <folder>-<gait>.json"``)."""
-    help = f"{what}, {FOLDER_CREATED} (default {default}){files}"
-    parser.add_argument(option, default=default, metavar="DIR", help=help)
-
-
 def add_speed(parser, default: float | None = None) -> None:
     """``--speed V`` [m/s], required without a ``default``."""
     help = SPEED_HELP + ("" if default is None else " (default %(default)s)")
@@ -611,12 +547,6 @@ def add_speeds(parser, default: np.ndarray, shown: str) -> None:
     """``--speeds S`` [m/s], a range or a list (``speeds``)."""
     help = f"START:STOP:COUNT or a list V1,V2,... [m/s] (default {shown})"
     parser.add_argument("--speeds", type=speeds, default=default, metavar="S", help=help)
-
-
-def add_gait_out(parser) -> None:
-    """``--out FILE``: the gait file a command writes."""
-    help = f"gait file to write (JSON; {FOLDERS_CREATED})"
-    parser.add_argument("--out", required=True, metavar="FILE", help=help)
 
 
 def add_gaits(parser) -> None:

@@ -12,9 +12,11 @@ import numpy as np
 
 from biped.model.criteria import MAX_CLEARANCE, MAX_KNEE_BEND
 from biped_cli import args as types
+from biped_cli import checks
 
 DEFAULT_ATLAS = "logs/atlas"
 DEFAULT_FAMILIES = "logs/atlas-families"
+FAMILIES = "families"  # the comparison's files' name (``biped.pages.atlas_families.NAME``)
 MAX_VALUES = 100
 
 
@@ -73,7 +75,6 @@ def cmd_atlas(args) -> int:
             safety=PAPER_SAFETY if args.paper_constraints else WALKABLE,
         )
     )
-    types.claim_folder(args.out)
     atlas.check_folder(args.out, settings)
     if args.dask is not None:
         check_dask(args.dask)
@@ -88,7 +89,7 @@ def cmd_atlas(args) -> int:
         print(f"wrote {path}")
     certified = all(
         (content := atlas.read(args.out, atlas.Point("final", k, c, cell))) is not None
-        and content["certified"]
+        and content.certified
         for c in settings.criteria
         for cell in settings.cells()
         for k in ("revolute", "rolling")
@@ -120,7 +121,7 @@ def add_parser(commands) -> None:
     types.add_criterion(parser, several=True, default=DEFAULT_CRITERIA)
     types.add_knots(parser)
     types.add_bezier(parser)
-    types.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
+    checks.add_folder(parser, "--out", DEFAULT_ATLAS, "folder of the atlas")
     parser.add_argument(
         "--no-walks", action="store_true", help="skip walking the certified optima in MuJoCo"
     )
@@ -147,8 +148,7 @@ def cmd_compare(args) -> int:
     from biped.pages import atlas_families as pages
     from biped.studies.atlas_families import compare_atlases
 
-    comparison = compare_atlases(args.base, args.rich)  # reads only: refused before a claim
-    types.claim_folder(args.out)
+    comparison = compare_atlases(args.base, args.rich)
     for path in pages.write(comparison, args.out):
         print(f"wrote {path}")
     for criterion in comparison.criteria:
@@ -173,4 +173,6 @@ def add_compare_parser(commands) -> None:
         help="folder of the atlas of the same problem in a richer family (biped atlas "
         "--family bezier --degree N --out)",
     )
-    types.add_folder(parser, "--out", DEFAULT_FAMILIES, "folder of the comparison")
+    checks.add_folder(
+        parser, "--out", DEFAULT_FAMILIES, "folder of the comparison", claims=(FAMILIES,)
+    )

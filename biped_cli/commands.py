@@ -17,14 +17,8 @@ from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
 from biped.model.two_phase import LANDINGS
 from biped_cli import args as types
-from biped_cli.args import (
-    budget,
-    check_folder,
-    check_output,
-    claim_folder,
-    robot_of,
-    safety,
-)
+from biped_cli import checks
+from biped_cli.args import budget, robot_of, safety
 
 DEFAULT_SWEEP = "logs/sweep"
 DEFAULT_FIGURES = "logs/figures"
@@ -155,13 +149,10 @@ def cmd_optimize(args) -> int:
     model = Biped(robot, args.knee)
     family = types.gait_family(args)
     problem = GaitProblem(model, args.speed, args.criterion, safety(args), knots=family)
-    check_output(args.out)
-    given = budget(args)  # an option the method would not use: refused before any work
+    given = budget(args)
     if args.double_support is not None:  # what the two-phase problem does not build
         from biped.optimization.two_phase import TwoPhaseProblem
 
-        if args.method != "ipopt":
-            raise BipedError(f"--double-support with --method {args.method}: allowed ipopt")
         TwoPhaseProblem(problem, args.double_support)
     print(f"optimizing {problem.describe()} ({args.method}, seed {args.seed})...", file=sys.stderr)
     setup = prepare(problem) if args.method == "ipopt" else 0.0
@@ -212,7 +203,7 @@ def add_optimize(commands) -> None:
     types.add_knee(opt, required=True)
     types.add_criterion(opt)
     types.add_speed(opt)
-    types.add_gait_out(opt)
+    checks.add_gait_out(opt)
     types.add_budget(opt)
     types.add_knots(opt)
     types.add_bezier(opt)
@@ -224,7 +215,7 @@ def add_optimize(commands) -> None:
          "started from the single-support optimum, its double support a share of the step "
          "from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share): sthenic "
          "criterion, IPOPT with --method ipopt only; --out then receives the two-phase "
-         "optimum's file (not a gait file, see docs/gaits.md); default: single support only"),
+         "gait file (both phases, see docs/gaits.md); default: single support only"),
     )  # fmt: skip
     opt.add_argument(
         "--landing",
@@ -234,6 +225,13 @@ def add_optimize(commands) -> None:
         "it, the paper's impact map with both feet held) or zero-speed (it arrives at rest, no "
         "impact) (default %(default)s)",
     )
+    checks.declare_rule(opt, ("--double-support", "--method"), _check_double_support)
+
+
+def _check_double_support(args) -> None:
+    """The two-phase optimum is IPOPT's."""
+    if args.double_support is not None and args.method != "ipopt":
+        raise BipedError(f"--double-support with --method {args.method}: allowed ipopt")
 
 
 def cmd_double_support(args, problem, optimum) -> int:
@@ -268,7 +266,8 @@ def cmd_double_support(args, problem, optimum) -> int:
             "may find a better optimum",
             file=sys.stderr,
         )
-    print(f"wrote {two_phase_file.write(args.out, two, best, checked)}")
+    gait = two_phase_file.gait_of(two, result, args.seed)
+    print(f"wrote {gait.write(args.out)}")
     return 0
 
 
@@ -294,7 +293,6 @@ def cmd_sweep(args) -> int:
 
     robot = robot_of(args)
     family = types.gait_family(args)
-    claim_folder(args.out)
     # at the sweep's speed nearest the paper's optima
     paper_speed = float(min(args.speeds, key=lambda v: abs(v - paper_method.SPEED)))
     # the sweep's own settings first: the paper's method's follow from them
@@ -332,7 +330,7 @@ def add_sweep(commands) -> None:
     types.add_speeds(sweep, DEFAULT_SPEEDS, "0.15:0.45:13")
     types.add_knee(sweep, several=True)
     types.add_criterion(sweep, several=True)
-    types.add_folder(sweep, "--out", DEFAULT_SWEEP, "folder of the sweep")
+    checks.add_folder(sweep, "--out", DEFAULT_SWEEP, "folder of the sweep")
     types.add_jobs(sweep)
     types.add_budget(sweep, sweep=True)
     types.add_knots(sweep)
@@ -354,7 +352,6 @@ def cmd_figures(args) -> int:
     from biped.pages.figures import make_figures
     from biped.records import gait_file
 
-    claim_folder(args.out)
     takes = "--sweep a folder of the gait files that biped sweep writes"
     for gait in sorted(Path(args.sweep).glob("*-*.json")):  # each its parameters' gait
         gait_file.read_consistent(gait, takes)
@@ -371,7 +368,7 @@ def add_figures(commands) -> None:
         metavar="DIR",
         help="folder of a sweep's results, as biped sweep --out writes it (default %(default)s)",
     )
-    types.add_folder(fig, "--out", DEFAULT_FIGURES, "folder of the figures and comparison.md")
+    checks.add_folder(fig, "--out", DEFAULT_FIGURES, "folder of the figures and comparison.md")
 
 
 def cmd_table(args) -> int:
@@ -385,7 +382,6 @@ def cmd_table(args) -> int:
     from biped.records.gait_file import write_json
     from biped.studies.sweep import optima_table
 
-    check_output(args.out)
     content = optima_table(args.sweep)
     counts = ", ".join(
         f"{len(s['speeds'])} {s['knee']} {s['criterion']}" for s in content["series"]
@@ -413,26 +409,28 @@ def add_table(commands) -> None:
         help="folder of a sweep's results, as biped sweep --out writes it, whose certified "
         f"optima the table holds (default %(default)s); {types.CERTIFIED_HELP}",
     )
-    table.add_argument(
+    checks.add_out(
+        table,
         "--out",
-        default="logs/optima.json",
-        metavar="FILE",
-        help=f"the table written (JSON), {types.FOLDERS_CREATED} (default %(default)s); "
+        checks.FILE,
+        f"the table written (JSON), {types.FOLDERS_CREATED} (default %(default)s); "
         "optimizations read the package's table alone (printed), so this file starts them "
         "once copied there",
+        default="logs/optima.json",
     )
 
 
-def read_gaits(paths: list, model: str | None = None) -> list:
+def read_gaits(paths: list, model: str | None = None, two_phase: bool = False) -> list:
     """The gait files at ``paths`` (``biped validate``, ``biped robustness``), checked before
     any work: each readable, its samples, costs and constraints its parameters', its knee
-    one MuJoCo can model, and ``model`` (an MJCF path, if given) one it can be played on.
+    one MuJoCo can model, and ``model`` (an MJCF path, if given) one it can be played on; a
+    two-phase gait refused unless ``two_phase`` (``Gait.read``).
 
     Raises BipedError naming the file (and ``--model``). Returns the ``Gait`` records.
     """
     from biped.records.gait_file import Gait
 
-    gaits = [Gait.read(path, consistent=True) for path in paths]
+    gaits = [Gait.read(path, consistent=True, two_phase=two_phase) for path in paths]
     for path, gait in zip(paths, gaits, strict=True):
         check_simulable(gait.robot, gait.knee, f"gait file {path!r}")
     if model is not None:
@@ -469,11 +467,15 @@ def cmd_validate(args) -> int:
     from validate.outputs.outputs import report_path
     from validate.workflows import validate_and_record
 
-    gif = _check_video(args)
-    gaits = read_gaits(args.gait, args.model)
+    gif = _gif(args)
+    gaits = read_gaits(args.gait, args.model, two_phase=True)
+    for path, gait in zip(args.gait, gaits, strict=True):
+        if gait.two_phase and (args.video or args.spawn or args.connect):
+            raise BipedError(
+                f"gait file {path!r} is of two phases: its walk is not built, allowed no "
+                "--video, --spawn or --connect"
+            )
     recordings = _recordings(args)
-    for rrd in recordings:
-        check_output(str(report_path(rrd)), "--rrd")
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:
         for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
@@ -505,44 +507,60 @@ def cmd_validate(args) -> int:
     return 0 if passed == len(args.gait) else 1
 
 
-def _check_video(args) -> str | None:
-    """Refuse --rrd, --video and --gif where they cannot be (before any work); the GIF's
-    path beside the video, if asked."""
-    from pathlib import Path
-
+def _check_one_gait(args) -> None:
+    """--rrd and --video name the output of a single gait."""
     if args.rrd and len(args.gait) > 1:
         raise BipedError(f"--rrd names one recording: allowed with one gait (got {len(args.gait)})")
     if args.video and len(args.gait) > 1:
         raise BipedError(f"--video names one video: allowed with one gait (got {len(args.gait)})")
+
+
+def _check_video(args) -> None:
+    """--gif writes beside the --video, an MP4."""
     if args.gif and not args.video:
         raise BipedError("--gif writes beside the --video: allowed with --video FILE.mp4")
     if args.video:
         from validate.outputs.video import check_suffix
 
         check_suffix(args.video, "--video", ".mp4", " (--gif writes a GIF beside it)")
-        check_output(args.video, "--video")
-    gif = str(Path(args.video).with_suffix(".gif")) if args.gif else None
-    if gif is not None:
-        check_output(gif, "--gif")
-    return gif
+
+
+def _gif(args) -> str | None:
+    """The GIF's path beside the video, if asked."""
+    from pathlib import Path
+
+    return str(Path(args.video).with_suffix(".gif")) if args.gif else None
+
+
+def _given_recording(args) -> list:
+    """The recording --rrd names and its report beside it (none: named from the gaits)."""
+    from validate.outputs.outputs import report_path
+
+    return [args.rrd, str(report_path(args.rrd))] if args.rrd else []
 
 
 def _recordings(args) -> list:
-    """The recording of each gait file (--rrd, or named from the file), each checked free or
-    that gait file's own before any work."""
+    """The recording of each gait file (--rrd, or named from the file) and its report, each
+    checked free and claimed, the recording that gait file's own, before any work."""
     from pathlib import Path
 
-    from validate.outputs.outputs import check_owner, output_name
+    from validate.outputs.outputs import check_owner, output_name, report_path
 
     recordings = [
         Path(args.rrd) if args.rrd else Path(DEFAULT_RECORDINGS) / f"{output_name(path)}.rrd"
         for path in args.gait
     ]
-    types.distinct_outputs(recordings, "recording")
+    checks.claim_derived(args, "--rrd", recordings, "recording")
     for rrd, path in zip(recordings, args.gait, strict=True):
-        check_output(str(rrd), "--rrd")
         check_owner(rrd, path)  # never another gait's recording
+    checks.claim_derived(args, "--rrd", [report_path(rrd) for rrd in recordings], "recording")
     return recordings
+
+
+def _gifs(args) -> list:
+    """The GIF written beside the video, if asked (the check of --gif's output)."""
+    gif = _gif(args) if args.video else None
+    return [] if gif is None else [gif]
 
 
 def _print_validation(path: str, gait, result, report) -> None:
@@ -561,28 +579,37 @@ def add_validate(commands) -> None:
     val = types.add_command(commands, "validate", help, cmd_validate)
     types.add_gaits(val)
     types.add_steps(val)
-    val.add_argument(
+    checks.declare_rule(val, ("--rrd", "--video"), _check_one_gait)
+    checks.add_out(
+        val,
         "--rrd",
-        metavar="PATH",
-        help=f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
+        checks.FILE,
+        f"recording of a single gait (default {DEFAULT_RECORDINGS}/<folder>-<gait>.rrd, "
         "named from the gait file's folder and name; another gait's recording is refused; "
         f"{types.FOLDERS_CREATED})",
+        claims=checks.DERIVED,
+        paths=_given_recording,
+        metavar="PATH",
     )
     val.add_argument(
         "--json",
         action="store_true",
         help="print the report as JSON (several gaits: an object keyed by file)",
     )
-    val.add_argument(
+    checks.add_out(
+        val,
         "--video",
-        metavar="FILE.mp4",
-        help="also render MuJoCo's walk of a single gait to an H.264 MP4 video, a path "
+        checks.FILE,
+        "also render MuJoCo's walk of a single gait to an H.264 MP4 video, a path "
         f"ending in .mp4 ({types.FOLDERS_CREATED}; MUJOCO_GL=egl without a display; default: "
         "no video)",
+        metavar="FILE.mp4",
     )
     val.add_argument(
         "--gif", action="store_true", help="with --video, also an animated GIF beside it"
     )
+    checks.declare_rule(val, ("--gif", "--video"), _check_video)
+    checks.declare_output(val, checks.Output("--gif", checks.FILE, checks.WHOLE, paths=_gifs))
     viewer = val.add_mutually_exclusive_group()
     viewer.add_argument(
         "--spawn",
@@ -618,7 +645,6 @@ def cmd_pipeline(args) -> int:
     from functools import partial
     from pathlib import Path
 
-    from biped.model.gait import family_label
     from biped.optimization.optimize import check_speed
     from biped_cli.design import design_problem
     from validate.outputs.outputs import check_owner
@@ -626,17 +652,10 @@ def cmd_pipeline(args) -> int:
 
     robot = robot_of(args)
     family = types.gait_family(args)
-    if args.design and family != 1:
-        raise BipedError(
-            f"--design with the family {family_label(family)}: allowed with the paper's spline "
-            "(--knots 1, --family spline), the knee design's"
-        )
     for knee in args.knees:
         check_speed(Biped(robot, knee), args.speed)
     for knee in args.knees:
         check_simulable(robot, knee, f"--robot {args.robot!r}" if args.robot else "robot")
-    claim_folder(args.out)  # its gait files, pages and recordings are named from it
-    check_folder(args.recordings, "--recordings")
     pipeline = Pipeline(
         robot,
         args.speed,
@@ -658,6 +677,18 @@ def cmd_pipeline(args) -> int:
     return 0 if run_pipeline(pipeline, say=partial(print, flush=True)) else 1
 
 
+def _check_design_family(args) -> None:
+    """--design with the paper's spline only: the knee design's family."""
+    from biped.model.gait import family_label
+
+    family = types.gait_family(args)
+    if args.design and family != 1:
+        raise BipedError(
+            f"--design with the family {family_label(family)}: allowed with the paper's spline "
+            "(--knots 1, --family spline), the knee design's"
+        )
+
+
 def add_pipeline(commands) -> None:
     help = "optimize, validate and record both knees at one speed"
     pipe = types.add_command(commands, "pipeline", help, cmd_pipeline)
@@ -665,9 +696,10 @@ def add_pipeline(commands) -> None:
     types.add_knee(pipe, several=True)
     types.add_criterion(pipe)
     types.add_steps(pipe)
-    types.add_folder(pipe, "--out", DEFAULT_PIPELINE, "folder of the gait files and reports")
+    checks.add_folder(pipe, "--out", DEFAULT_PIPELINE, "folder of the gait files and reports")
     what = "folder of the rerun recordings and videos"
-    types.add_folder(pipe, "--recordings", DEFAULT_RECORDINGS, what)
+    # its recordings are named from --out, claimed: its gait files, pages and recordings
+    checks.add_folder(pipe, "--recordings", DEFAULT_RECORDINGS, what, claims=checks.WITH_ANOTHER)
     pipe.add_argument(
         "--no-video",
         action="store_true",
@@ -676,6 +708,7 @@ def add_pipeline(commands) -> None:
     types.add_budget(pipe)
     types.add_knots(pipe)
     types.add_bezier(pipe)
+    checks.declare_rule(pipe, ("--design", "--family", "--knots"), _check_design_family)
     types.add_robot(pipe)
     pipe.add_argument(
         "--design",

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from biped_cli import args as types
+from biped_cli import checks
 
 DEFAULT_LADDER = (1, 3, 7, 15)
 # The Bézier family's (``--family bezier``): degrees, each holding the one below.
@@ -56,8 +57,8 @@ def add_parser(commands) -> None:
     types.add_safety(parser)
     types.add_robot(parser)
     types.add_family(parser, then="--ladder's degrees")
-    types.add_folder(parser, "--out", DEFAULT_OUT, "folder of the results",
-                     f": {NAME}.json and its figure {NAME}.png")  # fmt: skip
+    checks.add_folder(parser, "--out", DEFAULT_OUT, "folder of the results",
+                      f": {NAME}.json and its figure {NAME}.png", claims=(NAME,))  # fmt: skip
     types.add_options(
         parser,
         ("--ladder", ladder, None, "K1,K2,...", "interior knots of each rung, each "
@@ -68,6 +69,7 @@ def add_parser(commands) -> None:
         ("--seed", types.non_negative, 0, "N", "seed of the perturbed starts (default 0)"),
         ("--jobs", types.jobs, None, "N", types.JOBS_HELP),
     )  # fmt: skip
+    checks.declare_rule(parser, ("--ladder", "--family"), ladder_of)
 
 
 def cmd_converge(args) -> int:
@@ -92,8 +94,6 @@ def cmd_converge(args) -> int:
         knee: GaitProblem(Biped(robot, knee), args.speed, args.criterion, safety) for knee in KNEES
     }
     families = ladder_of(args)
-    types.check_folder(args.out, "--out")
-    types.claim_outputs(args.out, [NAME])
     shown = ", ".join(map(family_label, families))
     print(f"converging {problems['rolling'].describe()} over {shown}...", file=sys.stderr)
     rungs = {}

@@ -11,10 +11,18 @@ import numpy as np
 
 from biped.errors import BipedError
 from biped_cli import args as types
+from biped_cli import checks
 
 DEFAULT_MAP = "logs/design-map"
 # Most grid values per radius: a map is an optimization per (r1, r2) and speed.
 MAX_GRID = 100
+
+
+def circles_of(args) -> list:
+    """The designed circles' gait file of ``--profile``, beside --out's (none without it)."""
+    from biped_cli.profile import circles_path
+
+    return [] if args.profile is None else [str(circles_path(args.out))]
 
 
 def radii(text: str) -> np.ndarray:
@@ -61,7 +69,7 @@ def add_parsers(commands) -> None:
     help = "optimal rolling-knee radii with the gait at one speed"
     design = types.add_command(commands, "design", help, cmd_design)
     types.add_speed(design)
-    types.add_gait_out(design)
+    checks.add_gait_out(design)
     from biped.model.profile import FAMILIES
 
     design.add_argument(
@@ -75,6 +83,8 @@ def add_parsers(commands) -> None:
         "optimal circles and never worse than them; the gait file's robot holds r1, r2, "
         "k1, k2 (default: circles)",
     )
+    # the designed circles' gait file, beside the profile's
+    checks.declare_output(design, checks.Output("--out", checks.FILE, checks.WHOLE, circles_of))
     _add_common(design)
 
     help = "optimal gait over a grid of knee radii, and the optimal radii, per speed"
@@ -89,7 +99,7 @@ def add_parsers(commands) -> None:
             help=f"{name} values [m]: START:STOP:COUNT or a list (default 10 from 0 to its "
             "upper bound)",
         )
-    types.add_folder(grid, "--out", DEFAULT_MAP, "folder of the map")
+    checks.add_folder(grid, "--out", DEFAULT_MAP, "folder of the map")
     types.add_jobs(grid)
     types.add_dask(grid)
     _add_common(grid)
@@ -160,7 +170,6 @@ def cmd_design(args) -> int:
     robot = types.robot_of(args)
     check_profile_options(args)
     problem = design_problem(args, robot, args.speed)
-    types.check_output(args.out)
     if args.profile is not None:
         return run_profile(args, problem)
     print(f"designing the {problem.describe()} (seed {args.seed})...", file=sys.stderr)
@@ -222,7 +231,6 @@ def cmd_design_map(args) -> int:
 
     robot = types.robot_of(args)
     problem = design_problem(args, robot, float(args.speeds[0]))
-    types.claim_folder(args.out)
     for note in bound_notes(problem):
         print(note)
     if args.dask is not None:

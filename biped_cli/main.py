@@ -12,6 +12,7 @@ import sys
 from biped.records.provenance import command_line, version
 from biped_cli import atlas, commands, converge, design, orbit, profile, report, robustness, size
 from biped_cli.args import Commands, complete_later, numbers_as_values
+from biped_cli.checks import run_checks
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
 
 DEBUG_HELP = "on an error, print its traceback before the one-line message"
@@ -131,6 +132,7 @@ def main(argv: list[str] | None = None) -> int:
             return exit_.code if isinstance(exit_.code, int) else EXIT_BAD_INPUT
         name[0] = f"biped {args.command}"
         with command_line(["biped", *argv]):
+            run_checks(args)  # those declared with its options: rules, outputs, claims
             return args.run(args)
 
     return run_guarded(lambda: name[0], run, debug="--debug" in argv)

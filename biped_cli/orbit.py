@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from biped_cli import args as types
+from biped_cli import checks
 
 DEFAULT_ORBIT = "logs/orbit"
 MAX_PHASES = 256
@@ -105,7 +106,9 @@ def _add_arguments(parser) -> None:
     )  # fmt: skip
     types.add_model(parser)
     files = f": <folder>-<gait>.json and .png, and {KNEES_FIGURE} given gaits of both knees"
-    types.add_folder(parser, "--out", DEFAULT_ORBIT, "folder of the results", files)
+    checks.add_folder(
+        parser, "--out", DEFAULT_ORBIT, "folder of the results", files, claims=checks.DERIVED
+    )
 
 
 def _value(knob: str | None, value) -> str:
@@ -201,11 +204,9 @@ def cmd_orbit(args) -> int:
     from validate.outputs.outputs import output_name
     from validate.studies.orbit_files import run_orbits, title
 
-    types.check_folder(args.out, "--out")
     gaits = read_gaits(args.gait, args.model)
     names = [output_name(path) for path in args.gait]
-    types.distinct_outputs(names, "result")
-    types.claim_outputs(args.out, names)
+    checks.claim_derived(args, "--out", names, "result")
     knob, values = args.vary if args.vary is not None else (None, [None])
     steps = Steps(angle=args.step, rate=args.step * RATE_STEP / STEP, phases=args.phases)
     with Progress(len(gaits) * len(values), "orbit") as bar:

@@ -23,12 +23,10 @@ def run_profile(args, problem) -> int:
     from biped.optimization.design import bound_notes
     from biped.optimization.profile_design import ProfileProblem, compare_profile
     from biped.records.gait_file import Gait
-    from biped_cli import args as types
     from biped_cli.design import certified_exit
 
     out = Path(args.out)
-    circles_path = out.with_name(f"{out.stem}{CIRCLES_SUFFIX}")
-    types.check_output(str(circles_path))
+    circles = circles_path(out)  # checked and claimed with --out (biped_cli.design)
     profiled = ProfileProblem(problem, args.profile)
     print(f"designing the {profiled.describe()} (seed {args.seed})...", file=sys.stderr)
     comparison = compare_profile(profiled, seed=args.seed, starts=args.starts)
@@ -49,12 +47,18 @@ def run_profile(args, problem) -> int:
         print(f"biped design: {reason}; no file written", file=sys.stderr)
         return 1
     gait = Gait.from_profile_design(comparison)
-    design = {**gait.design, "circles_gait": circles_path.name}
+    design = {**gait.design, "circles_gait": circles.name}
     path = dataclasses.replace(gait, design=design).write(out)
     print(f"wrote {path}")
-    written = Gait.from_design(comparison.circles).write(circles_path)
+    written = Gait.from_design(comparison.circles).write(circles)
     print(f"wrote {written} (the designed circles' gait, which the page draws beside)")
     return certified_exit(comparison.circles.uncertified())
+
+
+def circles_path(out: str | Path) -> Path:
+    """The designed circles' gait file beside the profile's, ``out``."""
+    out = Path(out)
+    return out.with_name(f"{out.stem}{CIRCLES_SUFFIX}")
 
 
 def check_profile_options(args) -> None:
@@ -74,19 +78,25 @@ def check_profile_options(args) -> None:
 def add_parser(commands) -> None:
     from biped.studies.sweep import DEFAULT_SPEEDS
     from biped_cli import args as types
+    from biped_cli import checks
 
     help = "a designed knee profile over the speeds, against circles designed at each"
     parser = types.add_command(commands, "profile-speeds", help, cmd_profile_speeds)
     parser.add_argument("gait", metavar="GAIT.json", help="gait file of biped design --profile")
     types.add_speeds(parser, DEFAULT_SPEEDS, "the sweep's, 0.15:0.45:13")
-    parser.add_argument("--out", required=True, metavar="FILE", help="JSON of the rows to write "
-                        f"(its figure beside it, .png; {types.FOLDERS_CREATED})")  # fmt: skip
+    help = f"JSON of the rows to write (its figure beside it, .png; {types.FOLDERS_CREATED})"
+    checks.add_out(parser, "--out", checks.FILE, help, paths=with_figure, required=True)
     types.add_options(
         parser,
         ("--starts", types.starts, 3, "N", "IPOPT starts of each optimization (default 3); "
          + types.CERTIFIED_HELP),
         ("--seed", types.non_negative, 0, "N", "seed of the random starts (default 0)"),
     )  # fmt: skip
+
+
+def with_figure(args) -> list:
+    """The rows' JSON --out names and its figure beside it, .png."""
+    return [args.out, str(Path(args.out).with_suffix(".png"))]
 
 
 def cmd_profile_speeds(args) -> int:
@@ -100,7 +110,6 @@ def cmd_profile_speeds(args) -> int:
     from biped.pages.style import save
     from biped.records.gait_file import Gait, write_json
     from biped.studies.profile_speeds import content_of, machined_circles, row_at, table
-    from biped_cli import args as types
 
     gait = Gait.read(args.gait, consistent=True)
     if gait.knee != "rolling" or not gait.robot.profiled:
@@ -109,9 +118,7 @@ def cmd_profile_speeds(args) -> int:
             "of a knee profile (biped design --profile)"
         )
     out = Path(args.out)
-    types.check_output(str(out))
-    figure_path = out.with_suffix(".png")
-    types.check_output(str(figure_path))
+    figure_path = out.with_suffix(".png")  # checked and claimed with --out (with_figure)
     machined = machined_circles(gait, args.gait)
     rows = []
     for speed in args.speeds:

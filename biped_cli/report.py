@@ -15,14 +15,8 @@ import json
 from pathlib import Path
 
 from biped.errors import BipedError
-from biped_cli.args import (
-    add_command,
-    add_folder,
-    add_gaits,
-    check_folder,
-    claim_outputs,
-    distinct_outputs,
-)
+from biped_cli import checks
+from biped_cli.args import add_command, add_gaits
 from biped_cli.commands import DEFAULT_RECORDINGS
 
 DEFAULT_REPORTS = "logs/reports"
@@ -117,7 +111,6 @@ def cmd_report(args) -> int:
     from biped.records import gait_file
     from validate.outputs.outputs import output_name
 
-    check_folder(args.out, "--out")
     pages = []
     for path in args.gait:  # every input read and checked before any work
         gait = gait_file.read_consistent(path)  # its figures its parameters'
@@ -133,8 +126,8 @@ def cmd_report(args) -> int:
                 links=links(Path(path), validation),
             )
         )
-    distinct_outputs([page.name for page in pages], "page", gaits="gait files")
-    claim_outputs(args.out, [page.name for page in pages])
+    names = [page.name for page in pages]
+    checks.claim_derived(args, "--out", names, "page", gaits="gait files")
     for written in write_pages(pages, args.out):
         print(f"wrote {written}")
     return 0
@@ -143,4 +136,5 @@ def cmd_report(args) -> int:
 def add_parser(commands) -> None:
     parser = add_command(commands, "report", "one Markdown page per gait, with figures", cmd_report)
     add_gaits(parser)
-    add_folder(parser, "--out", DEFAULT_REPORTS, "folder of the pages and their figures")
+    what = "folder of the pages and their figures"
+    checks.add_folder(parser, "--out", DEFAULT_REPORTS, what, claims=checks.DERIVED)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from biped.errors import BipedError
 from biped_cli import args as types
+from biped_cli import checks
 
 DEFAULT_ROBUSTNESS = "logs/robustness"
 # Most bisections of one limit (each halves its uncertainty).
@@ -52,7 +53,11 @@ def _add_arguments(parser) -> None:
     )  # fmt: skip
     types.add_model(parser)
     files = ": <folder>-<gait>.json and .png"
-    types.add_folder(parser, "--out", DEFAULT_ROBUSTNESS, "folder of the maps", files)
+    # --out checked before the gait files' checks, which take time; its maps named from them
+    checks.add_folder(
+        parser, "--out", DEFAULT_ROBUSTNESS, "folder of the maps", files, claims=checks.DERIVED
+    )
+    checks.declare_rule(parser, ("--steps", "--push-step"), _settings)
 
 
 def _settings(args):
@@ -164,11 +169,9 @@ def cmd_robustness(args) -> int:
     from validate.studies.robustness_files import map_gaits
 
     settings = _settings(args)
-    types.check_folder(args.out, "--out")  # before the gait files' checks, which take time
     gaits = read_gaits(args.gait, args.model)
     names = [output_name(path) for path in args.gait]
-    types.distinct_outputs(names, "map")
-    types.claim_outputs(args.out, names)
+    checks.claim_derived(args, "--out", names, "map")
     out, failed, mapped = Path(args.out), [], {}
     with Progress(len(gaits) * (1 + len(LIMITS)), "robustness") as bar:
         maps = map_gaits(args.gait, gaits, names, args.out, args.model, settings, progress=bar)

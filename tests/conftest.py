@@ -74,6 +74,29 @@ def optimal_gait(knee: str):
     return _OPTIMA[knee]
 
 
+_TWO_PHASE: dict = {}
+
+
+def two_phase_gait(knee: str, landing: str = "impact"):
+    """The two-phase gait at 0.3 m/s, a tenth to a fifth of the step in double support, one
+    start from ``optimal_gait(knee)`` (what ``biped optimize --double-support 0.1:0.2
+    --starts 1`` writes), in memory; computed once per session."""
+    from biped.optimization import two_phase as tpo
+    from biped.optimization.problem import GaitProblem
+    from biped.records import two_phase_file
+
+    if (knee, landing) not in _TWO_PHASE:
+        single = optimal_gait(knee)
+        problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3)
+        two = tpo.TwoPhaseProblem(problem, (0.1, 0.2), landing=landing)
+        result = tpo.optimize_two_phase(
+            tpo.TwoPhaseSolver(two), single.variables, single.value, starts=1, seed=0
+        )
+        assert result.best is not None, "the two-phase problem found no optimum"
+        _TWO_PHASE[knee, landing] = two_phase_file.gait_of(two, result, seed=0)
+    return _TWO_PHASE[knee, landing]
+
+
 def gait_of(optimum, robot=None):
     """The gait of ``optimum`` (``Gait.from_optimum``), in memory."""
     from biped.records.gait_file import Gait

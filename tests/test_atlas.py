@@ -19,6 +19,7 @@ from biped.optimization.problem import GaitProblem
 from biped.optimization.solver import Solver
 from biped.pages import atlas as pages
 from biped.pages.atlas_line import AtlasLine
+from biped.records.atlas_optimum import AtlasOptimum
 from biped.records.gait_file import Gait
 from biped.studies import atlas
 from biped.studies.atlas import Cell, Difference
@@ -87,7 +88,7 @@ def test_the_csv_gives_the_cost_of_transport_of_the_energies_per_metre_only():
     criterion has none."""
     diff = Difference(-1.0, discretization=0.1, tolerance=0.0, starts=0.1, richer=None, why="")
     for criterion, expected in (("energy-per-metre", 300.0 / ROBOT.weight), ("sthenic", None)):
-        finals = [{"costs": {criterion: value}, "starts_at_best": 2} for value in (300.0, 297.0)]
+        finals = [_final(criterion, value, 2) for value in (300.0, 297.0)]
         row = pages.Row(criterion, Cell(0.3, 0.0, 0.0), diff, *finals)
         line = pages.csv_text([row], ROBOT.weight).splitlines()[1].split(",")
         value = line[pages.COLUMNS.index("cost of transport revolute")]
@@ -106,7 +107,7 @@ def test_a_csv_line_is_its_record_and_reads_back_to_the_same_line():
     from biped.pages.atlas_line import COLUMNS, AtlasLine
 
     diff = Difference(-1.25, 0.1, -2e-8, 0.0, -0.5, why="")
-    finals = [{"costs": {"electrical": v}, "starts_at_best": 3} for v in (310.0, 306.125)]
+    finals = [_final("electrical", v, 3) for v in (310.0, 306.125)]
     rows = [
         pages.Row("electrical", Cell(0.4, 0.01, 0.1), diff, *finals),
         pages.Row(
@@ -149,7 +150,7 @@ def test_a_small_atlas_writes_its_table_figures_and_sentences(small):
     assert len(lines) == 1 + 2
     table = pages.rows(folder, settings)
     for row in table:  # the difference is the knees' costs on the check grid
-        costs = [r["costs"]["sthenic"] for r in (row.rolling, row.revolute)]
+        costs = [r.costs["sthenic"] for r in (row.rolling, row.revolute)]
         assert row.difference.value == pytest.approx(100 * (costs[0] / costs[1] - 1), rel=1e-9)
         assert row.difference.richer is not None  # both cells are corners
     text = (folder / "atlas.md").read_text()
@@ -179,12 +180,10 @@ def test_the_default_atlas_answers_the_walkable_constraints(small):
         safety = dataclasses.replace(WALKABLE, clearance=cell.clearance)
         for knee in KNEES:
             point = atlas.Point("final", knee, "sthenic", cell)
-            content = atlas.read(folder, point)
+            record = atlas.read(folder, point)
             problem = GaitProblem(biped.Biped(ROBOT, knee), cell.speed, "sthenic", safety)
-            optimum = checked(
-                problem, np.array(content["variables"]), Report.from_dict(content["report"])
-            )
-            assert optimum.feasible and content["certified"]
+            optimum = checked(problem, np.array(record.variables), record.report)
+            assert optimum.feasible and record.certified
             assert set(optimum.evaluation.walkable) == set(WALKABLE.walkable)
             assert min(m.min() for m in optimum.evaluation.walkable.values()) >= 0.0
             assert Gait.read(folder / point.gait_filename()).safety == safety
@@ -248,30 +247,43 @@ def test_an_atlas_stopped_by_signals_while_its_workers_run_resumes_to_the_same(s
     assert optima and optima == numbers(folder)
 
 
-def _stage_record(value: float, status: str = "converged") -> dict:
-    """A stage's record of an optimum of ``value`` (sthenic), as ``atlas._record`` keeps it."""
+def _stage_record(value: float, status: str = "converged") -> AtlasOptimum:
+    """A stage's record of an optimum of ``value`` (sthenic), as ``AtlasOptimum`` keeps it."""
     converged = status == "converged"
-    return {
-        "status": status,
-        "feasible": True,
-        "certified": converged,
-        "costs": {"sthenic": value},
-        "starts": 1,
-        "starts_at_best": 1 if converged else 0,
-        "next_optimum": 0.0,
-        "violations": "",
-        "seconds": 1.0,
-    }
+    at_best = 1 if converged else 0
+    report = Report("ipopt", status, 1, at_best, 10, 0.0, 0.0, 1.0, 0, value)
+    return AtlasOptimum(
+        status=status,
+        feasible=True,
+        certified=converged,
+        value=value,
+        costs={"sthenic": value},
+        starts=1,
+        starts_at_best=at_best,
+        single_start=None,
+        next_optimum=0.0,
+        violations="",
+        period=1.0,
+        step_length=0.3,
+        seconds=1.0,
+        report=report,
+        variables=(0.0,) * 21,
+    )
+
+
+def _final(criterion: str, value: float, starts_at_best: int) -> AtlasOptimum:
+    """A knee's final record of ``value`` of ``criterion``, reached by ``starts_at_best``."""
+    record = _stage_record(value)
+    return dataclasses.replace(record, costs={criterion: value}, starts_at_best=starts_at_best)
 
 
 def _write_cell(folder, cell, values: dict) -> None:
     """Records of ``cell``: {(stage, knee): (value, status)}."""
-    import json
 
     for (stage, knee), (value, status) in values.items():
         path = folder / atlas.Point(stage, knee, "sthenic", cell).filename()
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(_stage_record(value, status)))
+        path.write_text(_stage_record(value, status).to_json())
 
 
 def test_a_re_solve_that_did_not_converge_measures_nothing(tmp_path):

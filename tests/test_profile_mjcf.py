@@ -135,3 +135,61 @@ def test_rotor_torques_are_the_armatures_power(model, biped_model):
     circle_layout = Layout(circles)
     expected = circle_layout.rotor_inertia * circle_layout.joint_angles(flat.qacc(q, qd, qdd))
     assert np.array_equal(rotor_torques(flat, circle_layout, q, qd, qdd), expected)
+
+
+def test_the_stretchs_armature_never_enters_the_knees_motion(model, biped_model):
+    """The stretch tendon's armature (``STRETCH_ARMATURE``) is an inertia of a length that
+    is zero, with its rate and acceleration, on the rolling motion: MuJoCo's inertial forces
+    M q̈ at mapped states are those without it to rounding (1e-13 N of 300 N measured); an
+    acceleration off the motion, a slide's 1 m/s² alone, meets it in full."""
+    from validate.scene.profile_mjcf import STRETCH_ARMATURE
+
+    bare = mujoco.MjModel.from_xml_string(robot_xml(PROFILED, "rolling"))
+    bare.tendon_armature[:] = 0.0
+    heavy = mujoco.MjModel.from_xml_string(robot_xml(PROFILED, "rolling"))
+    assert STRETCH_ARMATURE > 0.0 and heavy.tendon_armature.max() == STRETCH_ARMATURE
+    q, qd, qdd = random_state(biped_model, seed=5, n=6, spread=0.4)
+    mapped = mapping(heavy, "left", biped_model.radii)
+    slide = heavy.joint("left_knee_slide").dofadr[0]
+
+    def inertial(m, k, extra=0.0):  # M q̈ [N, N·m] at state k, the slide accelerated by extra
+        data = mujoco.MjData(m)
+        data.qpos[:] = mapped.qpos(q[k])
+        mujoco.mj_forward(m, data)
+        qacc = mapped.qacc(q[k], qd[k], qdd[k])
+        qacc[slide] += extra
+        out = np.zeros(m.nv)
+        mujoco.mj_mulM(m, data, out, qacc)
+        return out
+
+    for k in range(len(q)):
+        on_motion = inertial(heavy, k) - inertial(bare, k)
+        assert np.abs(on_motion).max() < 1e-12 * np.abs(inertial(bare, k)).max()
+        off_motion = inertial(heavy, k, 1.0) - inertial(bare, k, 1.0)
+        assert off_motion[slide] == pytest.approx(STRETCH_ARMATURE, rel=1e-9)
+
+
+def test_the_walks_equality_figures_are_mujocos_residuals(model, biped_model):
+    """The walk's equality figures are MuJoCo's own residuals, each in its unit: zero on
+    mapped states, and a knee slide moved by 5 µm off the rolling motion shows as 5 µm of
+    the profiled knee's length equalities (MuJoCo's efc_pos says the same), not as radians."""
+    from types import SimpleNamespace
+
+    from validate.checks.checks import knee_equality_violations
+
+    q, _, _ = random_state(biped_model, seed=2, n=4, spread=0.4)
+    mapped = mapping(model, "left", biped_model.radii)
+    qpos = np.array([mapped.qpos(state) for state in q])
+    exact = knee_equality_violations(SimpleNamespace(model=model, qpos=qpos))
+    assert exact["max_knee_equality_violation"] < 1e-13
+    assert exact["max_knee_length_violation"] < 1e-13
+    moved = qpos.copy()
+    moved[:, model.jnt_qposadr[model.joint("left_knee_slide").id]] += 5e-6
+    figures = knee_equality_violations(SimpleNamespace(model=model, qpos=moved))
+    assert figures["max_knee_length_violation"] == pytest.approx(5e-6, rel=1e-6)
+    assert figures["max_knee_equality_violation"] < 1e-13
+    data = mujoco.MjData(model)
+    data.qpos[:] = moved[0]
+    mujoco.mj_forward(model, data)
+    equality = data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    assert np.abs(data.efc_pos[: data.nefc][equality]).max() == pytest.approx(5e-6, rel=1e-6)

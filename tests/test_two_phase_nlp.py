@@ -136,12 +136,14 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
     np.testing.assert_allclose(result.wrench, rear, atol=1e-7)
 
 
-def test_optimize_double_support_writes_the_two_phase_optimum(tmp_path, capsys):
-    """``biped optimize --double-support`` prints both optima and writes the two-phase one:
-    every variable with its unit, converged, the share in its range; the single-support gait
-    file is not written in its place."""
+def test_optimize_double_support_writes_the_two_phase_gait_file(tmp_path, capsys):
+    """``biped optimize --double-support`` prints both optima and writes the two-phase gait
+    file: a gait file of both phases that reads back consistent with its parameters, its
+    criterion over both phases the one printed, converged, the share in its range, every
+    variable with its unit."""
     import json
 
+    from biped.records import gait_file
     from biped_cli import main
 
     out = tmp_path / "two.json"
@@ -150,16 +152,25 @@ def test_optimize_double_support_writes_the_two_phase_optimum(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "two phases (double support 0.1 to 0.2 of the step, impact landing)" in printed
     content = json.loads(out.read_text())
-    assert content["format"] == "biped two-phase optimum"
-    assert content["feasible"] is True
-    assert content["value"] == pytest.approx(content["solver_value"], rel=1e-3)
-    assert content["status"] == "Solve_Succeeded"
-    assert 0.1 - 1e-8 <= content["share"] <= 0.2 + 1e-8
-    assert set(content["units"]["variables"]) == set(content["variables"])
-    assert content["units"]["variables"]["front_fz_0"] == "N"
-    assert content["units"]["variables"]["double_support"] == "s"
-    assert content["units"]["variables"]["lift_rate_x_hip"] == "m/s"
-    assert content["units"]["variables"]["lift_rate_trunk"] == "rad/s"
+    assert content["format"] == gait_file.FORMAT
+    gait = gait_file.read_consistent(out, two_phase=True)
+    double = gait.double_support
+    assert gait.feasible and double.feasible and double.landing == "impact"
+    assert f"C = {double.sthenic:.6g} N²·m·s" in printed
+    assert double.sthenic == pytest.approx(gait.optimizer.value, rel=1e-3)
+    assert gait.optimizer.status == "converged"
+    assert 0.1 - 1e-8 <= double.share <= 0.2 + 1e-8
+    units = content["units"]
+    variables = {k for k in units if k.startswith("optimizer.variables.")}
+    assert variables == {
+        f"optimizer.variables.{name}" for name in content["optimizer"]["variables"]
+    }
+    assert units["optimizer.variables.front_fz_0"] == "N"
+    assert units["optimizer.variables.double_support"] == "s"
+    assert units["optimizer.variables.lift_rate_x_hip"] == "m/s"
+    assert units["optimizer.variables.lift_rate_trunk"] == "rad/s"
+    assert units["parameters.landing_x_hip"] == "m"
+    assert units["double_support.duration"] == "s"
 
 
 def test_several_starts_keep_the_best_feasible_optimum():

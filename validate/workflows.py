@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from biped.errors import BipedError
 from biped.model.criteria import Safety
 from biped.model.robot import Robot
 from biped.records.gait_file import Gait, write_json
@@ -49,6 +50,12 @@ def validate_and_record(
     from validate.outputs.record import record
 
     result = validation.validate(gait, steps=steps, model=model)
+    if result.simulation is None:  # no walk to record or film (a two-phase gait's)
+        if video is not None or gif is not None:
+            raise BipedError("--video of a two-phase gait: its walk is not built (no video)")
+        return result, validation.validation_report(result.checks).with_files(
+            provenance=provenance()
+        )
     written = record(rrd, result, spawn=spawn, connect=connect)
     if source is not None:
         claim(written, source)
@@ -72,7 +79,11 @@ def files_lines(
 
     return [
         *([f"gait {gait_path}, report {report_path}"] if gait_path is not None else []),
-        *recording_lines(report.recording),
+        *(
+            recording_lines(report.recording)
+            if report.recording is not None
+            else ["no recording (the walk of a two-phase gait is not built)"]
+        ),
         *(f"video {video}" for video in report.video or ()),
     ]
 

@@ -22,7 +22,20 @@ from biped.model.criteria import CRITERION_UNITS
 from biped.model.gait import family_words
 from biped.model.kinematics import KNEES
 from biped.pages.atlas_line import COLUMNS, AtlasLine
-from biped.pages.style import ATLAS_DPI, save
+from biped.pages.style import (
+    ATLAS_CELL_FONT,
+    ATLAS_CELL_WIDTH,
+    ATLAS_CURVES_WIDTH,
+    ATLAS_DPI,
+    ATLAS_MAP_AREA,
+    ATLAS_MAP_MARGINS,
+    FONT_HEADING,
+    FONT_NOTE,
+    FONT_SMALL,
+    FONT_TITLE,
+    save,
+)
+from biped.records.atlas_optimum import AtlasOptimum
 from biped.runtime.files import atomic_write_text
 from biped.studies.atlas import (
     MEASURES,
@@ -50,18 +63,8 @@ FIGURE_NAMES = {
     "energy-per-metre": r"energy per metre walked $C_E\,/\,S$",
     "electrical": r"electrical energy per metre walked $E\,/\,S$ (the motors', no regeneration)",
 }
-# A map's cell: its width at least [in], and its label's font [pt] from the first size (the
-# least readable) up to the second, as the cell allows.
-CELL_WIDTH = 0.45
-CELL_FONT = (8.0, 14.0)
-# A map panel's plot area at least [in] (width, height) and what its labels, colour bar and
-# titles take beside it.
-MAP_AREA = (3.6, 3.2)
-MAP_MARGINS = (1.6, 1.4)
 # The maps' colours: blue where the rolling knee needs less.
 CMAP = "RdBu_r"
-# The curves' panel with its legend beside it [in].
-CURVES_WIDTH = 7.4
 # The curves' speed axis: a tick at each speed for at most this many speeds, else
 # matplotlib's; one speed in a span of this much either side of it [m/s].
 SPEED_TICKS = 12
@@ -75,15 +78,15 @@ NOT_WALKING_LABEL = "red frame: a knee's gait does not walk in MuJoCo"
 
 @dataclass(frozen=True)
 class Row:
-    """One line of ``atlas.csv``: a cell and criterion, both knees and their difference;
-    ``walks``: each knee's walk in MuJoCo (``Walk``, None where not walked), None when the
-    atlas was not walked."""
+    """One line of ``atlas.csv``: a cell and criterion, both knees' final optima
+    (``AtlasOptimum``, None where missing) and their difference; ``walks``: each knee's walk
+    in MuJoCo (``Walk``, None where not walked), None when the atlas was not walked."""
 
     criterion: str
     cell: Cell
     difference: Difference
-    revolute: dict | None
-    rolling: dict | None
+    revolute: AtlasOptimum | None
+    rolling: AtlasOptimum | None
     walks: dict | None = None
 
     def walking(self) -> bool:
@@ -123,7 +126,7 @@ def line(row: Row, weight: float, knots: int | Bezier = 1) -> AtlasLine:
     interior knots, or a ``Bezier``). A knee's cost is there only with a difference."""
     d = row.difference
     revolute, rolling = (
-        None if r is None or d.value is None else r["costs"][row.criterion]
+        None if r is None or d.value is None else r.costs[row.criterion]
         for r in (row.revolute, row.rolling)
     )
 
@@ -156,9 +159,9 @@ def line(row: Row, weight: float, knots: int | Bezier = 1) -> AtlasLine:
     )
 
 
-def _starts(final: dict | None) -> int | None:
+def _starts(final: AtlasOptimum | None) -> int | None:
     """The starts that reached a knee's final optimum (its record's), None without one."""
-    return None if final is None else int(final["starts_at_best"])
+    return None if final is None else int(final.starts_at_best)
 
 
 def csv_text(table: list[Row], weight: float, knots: int | Bezier = 1) -> str:
@@ -195,7 +198,10 @@ def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = 
     bends = settings.knee_bends
     width, height = _map_area(settings)
     fig = Figure(
-        figsize=((width + MAP_MARGINS[0]) * len(bends) + CURVES_WIDTH, height + MAP_MARGINS[1]),
+        figsize=(
+            (width + ATLAS_MAP_MARGINS[0]) * len(bends) + ATLAS_CURVES_WIDTH,
+            height + ATLAS_MAP_MARGINS[1],
+        ),
         layout="constrained",
     )
     axes = fig.subplots(1, len(bends) + 1, squeeze=False)[0]
@@ -204,7 +210,9 @@ def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = 
     top = max([abs(v) for v in values], default=1.0) or 1.0
     for ax, bend in zip(axes[:-1], bends, strict=True):
         _map_panel(fig, ax, settings, [r for r in mine if r.cell.knee_bend == bend], top)
-        ax.set_title(f"{_bend_words(bend)}\ncells: difference ± uncertainty [%]", fontsize=9)
+        ax.set_title(
+            f"{_bend_words(bend)}\ncells: difference ± uncertainty [%]", fontsize=FONT_TITLE
+        )
         if walked:
             _walks_legend(ax, any(r.not_walking() for r in mine if r.cell.knee_bend == bend))
     _curves_panel(axes[-1], settings, [r for r in mine if r.cell.knee_bend == bends[0]])
@@ -219,7 +227,7 @@ def figure(settings: Settings, table: list[Row], criterion: str, walked: bool = 
         f"under {settings.constraints_words()}\n"
         "blue: the rolling knee needs less; hatched: not distinguishable (±?: uncertainty not "
         f"measured); x: no certified optimum of both knees\n{walks}",
-        fontsize=10,
+        fontsize=FONT_HEADING,
     )
     return fig
 
@@ -231,7 +239,11 @@ def _walks_legend(ax, marked: bool) -> None:
     label = NOT_WALKING_LABEL + ("" if marked else ": none")
     handle = Patch(label=label, **NOT_WALKING)
     ax.legend(
-        handles=[handle], fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1
+        handles=[handle],
+        fontsize=FONT_NOTE,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.16),
+        ncols=1,
     )
 
 
@@ -282,17 +294,17 @@ def _not_walking_frame(ax, at: tuple[int, int]) -> None:
 
 
 def _map_area(settings: Settings) -> tuple[float, float]:
-    """[in] (width, height) of a map panel's plot area: ``MAP_AREA``, wider for many speeds
-    (``CELL_WIDTH`` each)."""
-    return max(MAP_AREA[0], CELL_WIDTH * len(settings.speeds)), MAP_AREA[1]
+    """[in] (width, height) of a map panel's plot area: ``ATLAS_MAP_AREA``, wider for many speeds
+    (``ATLAS_CELL_WIDTH`` each)."""
+    return max(ATLAS_MAP_AREA[0], ATLAS_CELL_WIDTH * len(settings.speeds)), ATLAS_MAP_AREA[1]
 
 
 def cell_font(settings: Settings) -> float:
     """[pt] The font of a map cell's two lines of label: as large as the cell holds (about
-    4 characters wide, 2.5 lines high), within ``CELL_FONT``."""
+    4 characters wide, 2.5 lines high), within ``ATLAS_CELL_FONT``."""
     width, height = _map_area(settings)
     cell = (72 * width / len(settings.speeds), 72 * height / len(settings.clearances))
-    return float(np.clip(min(cell[0] / 3.6, cell[1] / 3.0), *CELL_FONT))
+    return float(np.clip(min(cell[0] / 3.6, cell[1] / 3.0), *ATLAS_CELL_FONT))
 
 
 def _cell_label(ax, at: tuple[int, int], d: Difference, top: float, font: float) -> None:
@@ -358,8 +370,10 @@ def _curves_panel(ax, settings: Settings, rows_: list[Row]) -> None:
     _speed_axis(ax, settings.speeds)
     ax.set_xlabel("speed [m/s]")
     ax.set_ylabel("(rolling − revolute) / revolute [%]")
-    ax.set_title(f"{_bend_words(settings.knee_bends[0])}\nbars: uncertainty [%]", fontsize=9)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the curves
+    ax.set_title(
+        f"{_bend_words(settings.knee_bends[0])}\nbars: uncertainty [%]", fontsize=FONT_TITLE
+    )
+    ax.legend(fontsize=FONT_SMALL, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the curves
 
 
 def _speed_axis(ax, speeds) -> None:

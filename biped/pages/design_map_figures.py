@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 
 from biped.model.criteria import CRITERION_UNITS
 from biped.optimization.design import RADII
-from biped.pages.style import save
+from biped.pages.style import DESIGN_MAP_SIZE, DESIGN_SPEEDS_SIZE, FONT_HEADING, FONT_NOTE, save
 from biped.runtime.files import atomic_write_text
 from biped.studies.design_map import (
     MapPoint,
@@ -97,7 +97,7 @@ def _point_values(ax, settings: MapSettings, summary: SpeedSummary, points: list
         side = -1 if a > middle else 1
         ax.annotate(
             f"{value:.4g} {unit}{versus}", (100 * a, 100 * b), xytext=(7 * side, -4),
-            textcoords="offset points", fontsize=8, va="top",
+            textcoords="offset points", fontsize=FONT_NOTE, va="top",
             ha="right" if side < 0 else "left",
         )  # fmt: skip
 
@@ -111,7 +111,7 @@ def map_figure(settings: MapSettings, summary: SpeedSummary, results: dict):
     r1, r2 = np.array(settings.r1), np.array(settings.r2)
     table1 = settings.problem(settings.speeds[0]).reference_radii
     points = measured_points(settings, summary, results)
-    fig = Figure(figsize=(6.4, 5.6), layout="constrained")
+    fig = Figure(figsize=DESIGN_MAP_SIZE, layout="constrained")
     ax = fig.subplots()
     why = _map_surface(fig, ax, settings, summary, points)
     if why:
@@ -131,7 +131,7 @@ def map_figure(settings: MapSettings, summary: SpeedSummary, results: dict):
     ax.set_title(
         f"{settings.criterion} at {summary.speed:.3f} m/s (revolute knee {revolute})"
         + (f"\n{why}" if why else ""),
-        fontsize=10,
+        fontsize=FONT_HEADING,
     )
     for axis, grid, bound in (
         (ax.set_xlim, r1, settings.upper[0]),
@@ -142,7 +142,7 @@ def map_figure(settings: MapSettings, summary: SpeedSummary, results: dict):
     ax.set_xlabel("r1, shank circle [cm]")
     ax.set_ylabel("r2, thigh circle [cm]")
     # below the plot, not over it: the grid's corners (the Table 1 radii) stay in sight
-    fig.legend(loc="outside lower center", ncol=3, fontsize=8)
+    fig.legend(loc="outside lower center", ncol=3, fontsize=FONT_NOTE)
     return fig
 
 
@@ -150,7 +150,7 @@ def speeds_figure(settings: MapSettings, summaries: list[SpeedSummary]) -> Figur
     """The optimal radii (left, their upper bounds dotted) and the gains of the optimal and
     the Table 1 radii against the revolute knee (right), over the map's speeds."""
     speeds = [s.speed for s in summaries]
-    fig = Figure(figsize=(10, 4))
+    fig = Figure(figsize=DESIGN_SPEEDS_SIZE)
     left, right = fig.subplots(1, 2)
     for index, name in enumerate(RADII):
         radii = [np.nan if s.radii is None else 100 * s.radii[index] for s in summaries]

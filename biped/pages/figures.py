@@ -50,7 +50,17 @@ from biped.optimization.comparison import (
     SOLVER_GRID,
     relative_change,
 )
-from biped.pages.style import KNEE_LABELS, KNEE_STYLE, save
+from biped.pages.style import (
+    FONT_CAPTION,
+    FONT_NOTE,
+    FONT_SMALL,
+    FONT_TITLE,
+    KNEE_LABELS,
+    KNEE_STYLE,
+    PAPER_CRITERION_SIZE,
+    TIME_PANEL_SIZE,
+    save,
+)
 from biped.records.gait_file import Gait
 from biped.runtime.files import atomic_set
 from biped.studies.paper_method import spread_lines
@@ -164,7 +174,9 @@ def bulk_limits(values) -> tuple[float, float]:
 
 def note(ax, text: str, xy, offset, **style) -> None:
     """``text`` ``offset`` points away from ``xy`` (data units), in 8 pt unless ``style`` says."""
-    ax.annotate(text, xy=xy, xytext=offset, textcoords="offset points", **{"fontsize": 8, **style})
+    ax.annotate(
+        text, xy=xy, xytext=offset, textcoords="offset points", **{"fontsize": FONT_NOTE, **style}
+    )
 
 
 def _mark_off_scale(ax, x, value, limits, color, text) -> None:
@@ -206,13 +218,15 @@ def _difference_panel(ax, series, criterion) -> None:
         if out:
             _mark_off_scale(ax, x, value, limits, DIFFERENCE_COLOR, f"{x:.3f} m/s: {value:+.1f} %")
         elif len(speeds) <= MAX_LABELLED:
-            note(ax, f"{value:+.1f} %", (x, value), (0, 7), ha="center", fontsize=7)
+            note(ax, f"{value:+.1f} %", (x, value), (0, 7), ha="center", fontsize=FONT_SMALL)
     if len(speeds) == 0:
         empty = "no speed where both knees\nhave a certified optimum"
-        ax.text(0.5, 0.5, empty, ha="center", va="center", transform=ax.transAxes, fontsize=9)
+        ax.text(
+            0.5, 0.5, empty, ha="center", va="center", transform=ax.transAxes, fontsize=FONT_TITLE
+        )
     ax.set_ylim(*limits)
     sign = "below 0: the rolling knee needs less"
-    ax.text(0.02, 0.02, sign, transform=ax.transAxes, fontsize=8, color="0.3")
+    ax.text(0.02, 0.02, sign, transform=ax.transAxes, fontsize=FONT_NOTE, color="0.3")
 
 
 def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
@@ -221,7 +235,7 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
     the revolute knee in the optimal criterion (right); ``flagged``: gaits not certified.
     The caption states the difference's sign, and why the ``other`` panel looks as it does
     where that needs a word (``OTHER_NOTES``)."""
-    fig = Figure(figsize=(16, 5.0), layout="constrained")
+    fig = Figure(figsize=PAPER_CRITERION_SIZE, layout="constrained")
     axes = fig.subplots(1, 3)
     crosses = [g for g in flagged if g.criterion == criterion]
     for ax, cost in zip(axes, (criterion, other), strict=False):
@@ -250,7 +264,7 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
                 _mark_off_scale(ax, x, value, limits, FLAGGED_COLOR, text)
         ax.set_ylim(*limits)
         ax.set_ylabel(CRITERION_AXES[cost])
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=FONT_NOTE)
     _difference_panel(axes[2], series, criterion)
     axes[2].set_ylabel(DIFFERENCE_AXIS)
     for ax in axes:
@@ -266,7 +280,7 @@ def criterion_figure(series, criterion, other, title, flagged=()) -> Figure:
     ]
     if criterion in OTHER_NOTES:
         caption.append(f"Middle: {OTHER_NOTES[criterion]}")
-    fig.supxlabel("\n".join(_wrap(line) for line in caption), fontsize=8.5, ha="center")
+    fig.supxlabel("\n".join(_wrap(line) for line in caption), fontsize=FONT_CAPTION, ha="center")
     return fig
 
 
@@ -342,7 +356,7 @@ def _friction_marks(ax, gaits) -> None:
         note(ax, text, (t, ratio[i]), (-8, 8 + 12 * row), ha="right", color=color)
         top = max(top, float(ratio[i]))
     ax.set_ylim(0.0, 1.15 * top)
-    ax.legend(fontsize=8, loc="center left")
+    ax.legend(fontsize=FONT_NOTE, loc="center left")
 
 
 def _sole_marks(ax, gaits) -> None:
@@ -374,7 +388,9 @@ def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
         gaits: {knee: gait file content}, drawn in the knee's colour.
     """
     rows = int(np.ceil(len(panels) / columns))
-    fig = Figure(figsize=(4.4 * columns, 3.2 * rows), layout="constrained")
+    fig = Figure(
+        figsize=(TIME_PANEL_SIZE[0] * columns, TIME_PANEL_SIZE[1] * rows), layout="constrained"
+    )
     axes = np.atleast_1d(fig.subplots(rows, columns)).ravel()
     for ax, panel in zip(axes, panels, strict=False):
         for knee, gait in gaits.items():
@@ -392,7 +408,7 @@ def time_figure(gaits: dict, title: str, panels, columns: int = 3) -> Figure:
         ax.set_ylabel(panel.ylabel)
         ax.grid(alpha=0.3)
     if panels and panels[0].decorate is None:
-        axes[0].legend(fontsize=8)
+        axes[0].legend(fontsize=FONT_NOTE)
     for ax in axes[len(panels) :]:
         ax.remove()
     speeds = ", ".join(f"{k} {g.speed:.3f} m/s" for k, g in gaits.items())

@@ -16,7 +16,15 @@ from matplotlib.figure import Figure
 
 from biped.optimization.comparison import relative_change
 from biped.pages.figures import DIFFERENCE_AXIS
-from biped.pages.style import KNEE_STYLE
+from biped.pages.style import (
+    FONT_NOTE,
+    FONT_SMALL,
+    FONT_TITLE,
+    KNEE_STYLE,
+    MULTIPLIERS_SIZE,
+    ORBIT_KNEES_PANEL_SIZE,
+    ORBIT_VARIED_SIZE,
+)
 
 # How many spreads of ρ the uncertainty bands span (the orbit check's margin).
 SPREADS = 2.0
@@ -38,7 +46,7 @@ def _circle(ax, radius: float, **style) -> None:
 
 def multipliers_figure(orbit: dict, title: str) -> Figure:
     """The multipliers of an orbit check's figures (``orbit``) in the complex plane."""
-    figure = Figure(figsize=(5.6, 5.6), layout="constrained")
+    figure = Figure(figsize=MULTIPLIERS_SIZE, layout="constrained")
     ax = figure.subplots()
     _circle(ax, 1.0, color="k", linewidth=1.2, label="unit circle |μ| = 1")
     ax.axhline(0.0, color="0.8", linewidth=0.8, zorder=0)
@@ -74,9 +82,11 @@ def multipliers_figure(orbit: dict, title: str) -> Figure:
     ax.set_aspect("equal")
     ax.set_xlabel("Re μ [1]")
     ax.set_ylabel("Im μ [1]")
-    ax.legend(loc="upper left", fontsize=7, framealpha=0.9)
+    ax.legend(loc="upper left", fontsize=FONT_SMALL, framealpha=0.9)
     verdict = orbit.get("verdict", "")
-    ax.set_title(f"{title}\nFloquet multipliers of the walk's return map: {verdict}", fontsize=9)
+    ax.set_title(
+        f"{title}\nFloquet multipliers of the walk's return map: {verdict}", fontsize=FONT_TITLE
+    )
     return figure
 
 
@@ -86,7 +96,7 @@ def knob_figure(content: dict, title: str) -> Figure:
     values without an orbit in a strip above, off ρ's scale (nothing measured there); a band
     between two values where the verdict changes, dotted where ρ crosses 1 in it; the legend
     below, off the data, naming only what is drawn."""
-    figure = Figure(figsize=(7.0, 5.2), layout="constrained")
+    figure = Figure(figsize=ORBIT_VARIED_SIZE, layout="constrained")
     strip, ax = figure.subplots(2, 1, sharex=True, height_ratios=(1.0, 6.0))
     values, orbits = np.array(content["values"], float), content["orbits"]
     found = [(v, o) for v, o in zip(values, orbits, strict=True) if "spectral_radius" in o]
@@ -106,15 +116,15 @@ def knob_figure(content: dict, title: str) -> Figure:
     ax.set_ylim(0.0, 1.08 * max([1.2, *tops]))
     strip.set_ylim(0.0, 1.0)
     strip.set_yticks([])
-    strip.set_ylabel("no\norbit", rotation=0, ha="right", va="center", fontsize=8)
+    strip.set_ylabel("no\norbit", rotation=0, ha="right", va="center", fontsize=FONT_NOTE)
     strip.tick_params(labelbottom=False)
     ax.set_xlabel(f"scale of {content['scales']} [1]")
     ax.set_ylabel("spectral radius ρ [1]")
-    figure.legend(loc="outside lower center", ncols=3, fontsize=7)
+    figure.legend(loc="outside lower center", ncols=3, fontsize=FONT_SMALL)
     figure.suptitle(
         f"{title}\nρ of the walk's return map, bars: ± {SPREADS:g} spreads (the landing's "
         "noise); above: the scales without an orbit (no ρ)",
-        fontsize=9,
+        fontsize=FONT_TITLE,
     )
     return figure
 
@@ -137,7 +147,10 @@ def speeds_figure(rows: list[dict], title: str) -> Figure:
     """ρ of each knee against speed, one panel per criterion, and rolling - revolute below;
     ``rows``: one per gait, its ``knee``, ``criterion``, ``speed`` and orbit figures."""
     criteria = sorted({row["criterion"] for row in rows}, key=lambda c: c != "sthenic")
-    figure = Figure(figsize=(5.2 * len(criteria), 6.4), layout="constrained")
+    figure = Figure(
+        figsize=(ORBIT_KNEES_PANEL_SIZE[0] * len(criteria), ORBIT_KNEES_PANEL_SIZE[1]),
+        layout="constrained",
+    )
     axes = figure.subplots(2, len(criteria), squeeze=False, height_ratios=(2.0, 1.0), sharex="col")
     for column, criterion in enumerate(criteria):
         top, bottom = axes[0, column], axes[1, column]
@@ -165,11 +178,12 @@ def speeds_figure(rows: list[dict], title: str) -> Figure:
         top.plot([], [], color="0.4", label="falls: no orbit", **FALLS)
         top.set_ylim(0.0, 1.6)
         top.set_ylabel("spectral radius ρ [1]")
-        top.set_title(f"{criterion}-optimal gaits", fontsize=9)
-        top.legend(fontsize=7, loc="lower right")
+        top.set_title(f"{criterion}-optimal gaits", fontsize=FONT_TITLE)
+        top.legend(fontsize=FONT_SMALL, loc="lower right")
         _difference(bottom, by_knee)
     figure.suptitle(
-        f"{title}\nbars ± {SPREADS:g} spreads of ρ over MuJoCo's physics-step grid", fontsize=9
+        f"{title}\nbars ± {SPREADS:g} spreads of ρ over MuJoCo's physics-step grid",
+        fontsize=FONT_TITLE,
     )
     return figure
 
@@ -203,4 +217,4 @@ def _difference(ax, by_knee: dict) -> None:
             capsize=3,
         )
     ax.set_xlabel("walking speed [m/s]")
-    ax.set_ylabel(f"ρ: {DIFFERENCE_AXIS}", fontsize=8)
+    ax.set_ylabel(f"ρ: {DIFFERENCE_AXIS}", fontsize=FONT_NOTE)

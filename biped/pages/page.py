@@ -52,7 +52,7 @@ from biped.pages.figures import (
 )
 from biped.pages.orbit_figures import multipliers_figure
 from biped.pages.profile_figures import PROFILE_FIGURE, profile_figure
-from biped.pages.style import KNEE_STYLE, save
+from biped.pages.style import FONT_NOTE, FONT_SMALL, FONT_TINY, KNEE_STYLE, save
 from biped.pages.walk_figures import TORQUES_FIGURE, has_profiles, torques_figure
 from biped.pages.walk_figures import walk_lines as mujoco_walk_lines
 from biped.records.gait_file import Gait
@@ -322,7 +322,7 @@ def _with_knot(panel: Panel, jump: float | None, knots: list[float], legend: boo
         if panel.decorate is not None:
             panel.decorate(ax, gaits)
         elif legend:
-            ax.legend(fontsize=8, loc="best")
+            ax.legend(fontsize=FONT_NOTE, loc="best")
         if jump is not None:
             side, edge = _free_side(ax, KNOT, 0.2)
             ax.annotate(
@@ -333,7 +333,7 @@ def _with_knot(panel: Panel, jump: float | None, knots: list[float], legend: boo
                 textcoords="offset points",
                 ha="left" if side == "right" else "right",
                 va=edge,
-                fontsize=8,
+                fontsize=FONT_NOTE,
                 color="0.3",
             )
 
@@ -412,9 +412,9 @@ def _dip_inset(
     inset.plot([dip.at], [dip.value], marker="v", markersize=5, color=color)
     scale, unit = (1e3, f"m{dip.unit}") if dip.unit in ("m", "rad") else (1.0, dip.unit)
     inset.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v * scale:.4g}"))
-    inset.tick_params(labelsize=6, length=2, pad=1)
-    inset.set_ylabel(unit, fontsize=6, labelpad=1)
-    inset.set_title(f"{_milli(dip.value, dip.unit)} < δ", fontsize=7, pad=2)
+    inset.tick_params(labelsize=FONT_TINY, length=2, pad=1)
+    inset.set_ylabel(unit, fontsize=FONT_TINY, labelpad=1)
+    inset.set_title(f"{_milli(dip.value, dip.unit)} < δ", fontsize=FONT_SMALL, pad=2)
     ax.indicate_inset_zoom(inset, edgecolor="0.3")
 
 

@@ -23,6 +23,7 @@ from matplotlib.figure import Figure
 from biped.model.dynamics import JOINTS
 from biped.model.kinematics import Q1, Q2, Q3, Q4
 from biped.model.profile import PROFILE_RANGE, KneeProfile, knee_vectors, rolling
+from biped.pages.style import FONT_NOTE, FONT_SMALL, FONT_TINY, PROFILE_SIZE, PROFILE_SPEEDS_SIZE
 
 PROFILE_FIGURE = "profile.png"
 COLORS = {"profile": "tab:red", "circles": "0.45"}
@@ -73,7 +74,7 @@ def _shape_panel(ax, profile: KneeProfile, circles: tuple | None) -> None:
     ax.set_xlabel("x [mm] (forward)")
     ax.set_ylabel("z [mm] (thigh up)")
     ax.set_title(f"surfaces over θ {PROFILE_RANGE[0]:g} to {PROFILE_RANGE[1]:g} rad, to scale")
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=FONT_SMALL, loc="lower left")
 
 
 def _flexions(gait) -> dict[str, np.ndarray]:
@@ -95,7 +96,7 @@ def _contact_panels(ax_arc, ax_flex, gait, profile: KneeProfile) -> None:
     for ax in (ax_arc, ax_flex):
         ax.set_xlabel("t / T")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=FONT_SMALL)
 
 
 def _torque_panel(ax, joint: str, columns, gait, circles_gait) -> None:
@@ -116,7 +117,7 @@ def _torque_panel(ax, joint: str, columns, gait, circles_gait) -> None:
     ax.set_xlabel("t / T")
     ax.set_ylabel("Γ [N·m]")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=6)
+    ax.legend(fontsize=FONT_TINY)
 
 
 def profile_figure(gait, circles_gait=None) -> Figure:
@@ -126,7 +127,7 @@ def profile_figure(gait, circles_gait=None) -> Figure:
     robot = gait.robot
     profile = KneeProfile.of(robot)
     circles = None if circles_gait is None else (circles_gait.robot.r1, circles_gait.robot.r2)
-    fig = Figure(figsize=(15, 8.4), layout="constrained")
+    fig = Figure(figsize=PROFILE_SIZE, layout="constrained")
     axes = fig.subplots(2, 3).ravel()
     _shape_panel(axes[0], profile, circles)
     _contact_panels(axes[1], axes[2], gait, profile)
@@ -153,7 +154,7 @@ def speeds_figure(rows, criterion: str, designed_at: float) -> Figure:
     for ``designed_at`` against the circles designed at each speed, the circles designed with
     it (machined too) and the revolute knee, the circles against the revolute knee [%]; a
     speed not certified is left out (a gap)."""
-    fig = Figure(figsize=(8, 4.6), layout="constrained")
+    fig = Figure(figsize=PROFILE_SPEEDS_SIZE, layout="constrained")
     ax = fig.subplots()
     speeds = np.array([row.speed for row in rows])
     for (first, second), style in (
@@ -172,12 +173,12 @@ def speeds_figure(rows, criterion: str, designed_at: float) -> Figure:
         0.02,
         f" profile designed at {designed_at:.3f} m/s",
         transform=ax.get_xaxis_transform(),
-        fontsize=8,
+        fontsize=FONT_NOTE,
     )
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("walking speed [m/s]")
     ax.set_ylabel(f"change of the {criterion} criterion [%]")
     ax.set_title("one machined knee profile over the speeds (negative: it needs less)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=FONT_NOTE)
     return fig

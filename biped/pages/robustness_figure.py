@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from matplotlib.figure import Figure
 
+from biped.pages.style import FONT_NOTE, FONT_TITLE, ROBUSTNESS_SIZE
+
 WALKS = "#2a9d8f"
 UNSURE_BAR = dict(color="#e9c46a", hatch="///", edgecolor="0.3")
 BRACKET = "0.6"
@@ -40,7 +42,7 @@ def _end(limit, factor: float) -> tuple:
 def robustness_figure(result, title: str) -> Figure:
     """The figure of a map (``RobustnessMap``) whose nominal walk walked."""
     limits = result.limits
-    figure = Figure(figsize=(8.0, 6.0), layout="constrained")
+    figure = Figure(figsize=ROBUSTNESS_SIZE, layout="constrained")
     axes = figure.subplots(len(ROWS), 1)
     for ax, (label, low, high, factor, scale) in zip(axes, ROWS, strict=True):
         nominal = factor * limits[low].bracket[0]
@@ -57,17 +59,19 @@ def robustness_figure(result, title: str) -> Figure:
                 start, stop = sorted((walks, fails))
                 ax.barh(0, stop - start, left=start, height=0.5, zorder=2, **UNSURE_BAR)
             text = f"{walks:.3g}" if fails is not None else f"≥ {walks:.3g} (bracket end walks)"
-            ax.annotate(text, (walks, 0.3), ha="center", va="bottom", fontsize=8)
+            ax.annotate(text, (walks, 0.3), ha="center", va="bottom", fontsize=FONT_NOTE)
         ax.axvline(nominal, color="k", linewidth=1.5, zorder=3)
-        ax.annotate(f"nominal {nominal:g}", (nominal, -0.3), ha="center", va="top", fontsize=8)
+        ax.annotate(
+            f"nominal {nominal:g}", (nominal, -0.3), ha="center", va="top", fontsize=FONT_NOTE
+        )
         ax.set_ylim(-0.8, 0.8)
         ax.set_yticks([])
-        ax.set_title(label, fontsize=9, loc="left")
+        ax.set_title(label, fontsize=FONT_TITLE, loc="left")
     settings = result.settings
     figure.suptitle(
         f"{title}\nwalks of {settings.steps} steps, pushes at mid-step {settings.push_step} "
         f"({result.push_time:.3f} s), {settings.iterations} bisections per limit\n"
         "green: walks; hatched: up to the first failing value; grey: bracket searched",
-        fontsize=9,
+        fontsize=FONT_TITLE,
     )
     return figure

@@ -21,6 +21,7 @@ from matplotlib.figure import Figure
 
 from biped.model.dynamics import JOINTS
 from biped.pages.figures import TIME_AXIS, bulk_limits, joint_label, note
+from biped.pages.style import FONT_TITLE, WALK_TORQUES_SIZE
 from biped.records.validation_report import ValidationReport
 
 # The page's figure of the torques over one step.
@@ -155,7 +156,7 @@ def torques_figure(forward: dict, title: str) -> Figure:
     landing = forward.get("landing_window")
     landing = float(landing) if isinstance(landing, (int, float)) else 0.0
     after = phase >= landing
-    figure = Figure(figsize=(13.2, 6.8), layout="constrained")
+    figure = Figure(figsize=WALK_TORQUES_SIZE, layout="constrained")
     axes = figure.subplots(2, 3).ravel()
     for j, (ax, joint) in enumerate(zip(axes, JOINTS, strict=True)):
         ax.axhline(0.0, color="0.8", linewidth=0.8, zorder=0)
@@ -193,7 +194,9 @@ def torques_figure(forward: dict, title: str) -> Figure:
         ax.set_ylabel("torque [N·m]")
         ax.grid(alpha=0.3)
     handles, labels = axes[0].get_legend_handles_labels()
-    figure.legend(handles, labels, loc="outside lower center", ncols=len(labels), fontsize=9)
+    figure.legend(
+        handles, labels, loc="outside lower center", ncols=len(labels), fontsize=FONT_TITLE
+    )
     steps = forward.get("steps")
     figure.suptitle(
         f"{title}: the model's joint torques beside MuJoCo's over one step (the mean over "

@@ -54,6 +54,8 @@ from biped.model.impact import trailing_foot_lift
 from biped.model.kinematics import COORDINATES, KNEES, XH
 from biped.model.knee_loads import KNEE_SIDES, knee_forces
 from biped.model.robot import Robot
+from biped.model.two_phase import LANDINGS
+from biped.model.two_phase import parameter_names as two_phase_parameter_names
 from biped.model.units import (
     CONSTRAINT_UNITS,
     PERCENT,
@@ -74,6 +76,12 @@ from biped.optimization.problem import (
 )
 from biped.optimization.report import Report
 from biped.records.provenance import provenance as make_provenance
+from biped.records.two_phase_gait import (
+    DoubleSupport,
+    double_support_of,
+    two_phase_step,
+    unit_of,
+)
 from biped.records.validation_report import is_report
 from biped.runtime.files import atomic_write_text
 
@@ -502,6 +510,9 @@ class Gait:
     # The gait family: interior knots of a spline (1: the paper's; written if not), or a
     # Bézier family, written {"bezier": degree} (``family_of``).
     knots: int | Bezier = 1
+    # A two-phase gait's double support phase (``biped.records.two_phase_gait``); None (not
+    # written): a gait of single support only.
+    double_support: DoubleSupport | None = unit_field(DoubleSupport, default=None)
 
     @classmethod
     def from_optimum(cls, optimum: Optimum, robot: Robot, provenance: dict | None = None) -> Gait:
@@ -541,10 +552,62 @@ class Gait:
         return dataclasses.replace(gait, design=comparison.to_dict())
 
     @classmethod
-    def read(cls, path: str | Path, allowed: str = GAIT_FILE, consistent: bool = False) -> Gait:
+    def from_two_phase(
+        cls,
+        robot: Robot,
+        knee: str,
+        speed: float,
+        parameters,
+        landing: str,
+        front_wrench,
+        share_range,
+        optimizer: Optimizer,
+        safety: Safety = PAPER_SAFETY,
+        provenance: dict | None = None,
+    ) -> Gait:
+        """The two-phase gait (sthenic criterion) of the two-phase step's ``parameters``
+        (``biped.model.two_phase.parameter_names(landing)`` order), the front foot's wrench
+        at the double support's solver samples ``front_wrench`` (n + 1, 3) [N, N, N·m], the
+        problem's ``share_range`` and the solver's record ``optimizer``."""
+        model = Biped(robot, knee)
+        names = two_phase_parameter_names(landing)
+        named = dict(zip(names, map(float, parameters), strict=True))
+        step = two_phase_step(model, speed, named, landing)
+        evaluation = evaluate_step(model, step.single, CHECK_SAMPLES[1], safety=safety)
+        double = double_support_of(model, step, evaluation, front_wrench, share_range)
+        derived = _derived(model, step.single, evaluation, two_phase=True)
+        return cls(
+            knee=knee,
+            criterion="sthenic",
+            speed=float(speed),
+            safety=safety,
+            feasible=bool(evaluation.feasible and double.feasible),
+            robot=robot,
+            parameters=named,
+            optimizer=optimizer,
+            provenance=dict(provenance) if provenance is not None else make_provenance(),
+            double_support=double,
+            **derived,
+        )
+
+    @property
+    def two_phase(self) -> bool:
+        """A gait of single then double support (``double_support`` holds the second)."""
+        return self.double_support is not None
+
+    @classmethod
+    def read(
+        cls,
+        path: str | Path,
+        allowed: str = GAIT_FILE,
+        consistent: bool = False,
+        two_phase: bool = False,
+    ) -> Gait:
         """Read a gait file. Raises BipedError if it is not one, saying what it is if it is
         another of this project's files and what is ``allowed`` (default a gait file: what
-        the command takes); with ``consistent``, if its figures are not its parameters'."""
+        the command takes); with ``consistent``, if its figures are not its parameters';
+        without ``two_phase``, if it is a two-phase gait (what reads one says so: only
+        ``biped validate`` so far)."""
         path = Path(path)
         try:
             content = json.loads(path.read_text())
@@ -565,6 +628,12 @@ class Gait:
                 f"allowed {allowed}"
             )
         gait = cls.from_content(content, f"gait file {str(path)!r}")
+        if gait.two_phase and not two_phase:
+            raise BipedError(
+                f"gait file {str(path)!r} is of two phases (single then double support), which "
+                f"this command does not take yet: allowed a gait of single support (biped "
+                f"validate takes both)"
+            )
         if consistent:
             gait.check_consistency(f"gait file {str(path)!r}")
         return gait
@@ -593,7 +662,14 @@ class Gait:
             raise bad(f"robot or parameters missing ({error})") from None
         except BipedError as error:
             raise bad(str(error)) from None
-        expected = parameter_names(knots)
+        double = content.get("double_support")
+        if double is not None:
+            landing = double.get("landing") if isinstance(double, dict) else None
+            if landing not in LANDINGS:
+                raise bad(f"double_support.landing = {landing!r}, allowed {', '.join(LANDINGS)}")
+            expected = two_phase_parameter_names(landing)
+        else:
+            expected = parameter_names(knots)
         if (
             not isinstance(content["parameters"], dict)
             or names != set(expected)
@@ -604,7 +680,8 @@ class Gait:
             check_speed(Biped(robot, content["knee"]), content["speed"])
         except BipedError as error:
             raise bad(str(error)) from None
-        _check_step(content, bad)
+        double = None if double is None else DoubleSupport.from_content(double, bad)
+        _check_step(content, bad, 0.0 if double is None else double.duration)
         optimizer = _optimizer(content.get("optimizer"), bad)
         fields = {f.name: content.get(f.name) for f in dataclasses.fields(cls)}
         records = {
@@ -619,6 +696,7 @@ class Gait:
             )
         }
         parsed = {"safety": safety, "robot": robot, "optimizer": optimizer, "knots": knots}
+        parsed["double_support"] = double
         return cls(**{**fields, **records, **parsed, "samples": _samples(content, bad)})
 
     @staticmethod
@@ -630,6 +708,7 @@ class Gait:
         design: bool = False,
         profile: bool = False,
         profile_design: bool = False,
+        two_phase: bool = False,
     ) -> dict:
         """The ``units`` map of a gait file optimised for ``criterion`` in the family of
         ``knots`` interior knots, under the margins ``safety`` (the paper's by default), with
@@ -637,8 +716,12 @@ class Gait:
         designed knee's block if ``design`` (``DESIGN_UNITS``), with the knee profile's rates
         k1, k2 if ``profile`` (a robot whose knee surfaces are not circles), with a profile
         design's block if ``profile_design`` (``PROFILE_DESIGN_UNITS`` beside
-        ``DESIGN_UNITS``), from the fields' declarations: ``{"costs.sthenic": "N²·m·s", ...}``."""
+        ``DESIGN_UNITS``), with the double support's block if ``two_phase`` (its parameters'
+        and variables' units are the file's, ``_units``), from the fields' declarations:
+        ``{"costs.sthenic": "N²·m·s", ...}``."""
         units = declared_units(Gait, "", criterion)
+        if not two_phase:
+            units = {k: v for k, v in units.items() if not k.startswith("double_support.")}
         if not profile:  # circles: k1 = k2 = 0 are not written (``Robot.to_dict``)
             units.pop("robot.k1")
             units.pop("robot.k2")
@@ -676,12 +759,24 @@ class Gait:
             self.design is not None,
             self.robot.profiled,
             isinstance(self.design, dict) and "profile" in self.design,
+            self.two_phase,
         )
         for group in ("impact", "walkability"):  # a figure not written has no unit
             record = getattr(self, group)
             for f in dataclasses.fields(record) if record is not None else ():
                 if getattr(record, f.name) is None:
                     units.pop(f"{group}.{f.name}", None)
+        if not self.two_phase:
+            return units
+        # Two phases: no impact or electrical block; the two-phase step's parameters and the
+        # two-phase solver's variables.
+        dropped = ("impact.", "electrical.", "parameters.", "optimizer.variables.")
+        units = {k: v for k, v in units.items() if not k.startswith(dropped)}
+        for prefix, names in (
+            ("parameters.", self.parameters),
+            ("optimizer.variables.", self.optimizer.variables),
+        ):
+            units.update({prefix + name: unit_of(name) for name in names})
         return units
 
     def to_dict(self) -> dict:
@@ -691,7 +786,10 @@ class Gait:
             if f.name == "samples":
                 content["units"] = self._units()
             value = getattr(self, f.name)
-            if (f.name, value) in (("design", None), ("knots", 1)):  # the paper's: unwritten
+            unwritten = (("design", None), ("knots", 1), ("double_support", None))
+            if self.two_phase:  # no impact of one foot, no drive's figures
+                unwritten += (("impact", None), ("electrical", None))
+            if (f.name, value) in unwritten:  # the paper's, a single support: unwritten
                 continue
             if hasattr(value, "to_dict"):  # the samples, records, robot, a Bézier family
                 value = value.to_dict()
@@ -717,8 +815,18 @@ class Gait:
     @property
     def parameter_vector(self) -> np.ndarray:
         """The parameters in ``biped.model.gait.parameter_names(knots)`` order (the paper's
-        21 for its spline)."""
-        return np.array([self.parameters[name] for name in parameter_names(self.knots)])
+        21 for its spline); of a two-phase gait, ``biped.model.two_phase.parameter_names``'."""
+        if self.two_phase:
+            names = two_phase_parameter_names(self.double_support.landing)
+        else:
+            names = parameter_names(self.knots)
+        return np.array([self.parameters[name] for name in names])
+
+    def two_phase_step(self):
+        """The two-phase step of a two-phase gait's parameters (``biped.model.two_phase``)."""
+        if not self.two_phase:
+            raise BipedError("a gait of single support has no two-phase step")
+        return two_phase_step(self.biped, self.speed, self.parameters, self.double_support.landing)
 
     def check_consistency(self, source: str = "gait") -> None:
         """Raise a ``BipedError`` naming the first field that does not belong to the gait's
@@ -730,12 +838,27 @@ class Gait:
             return BipedError(f"{source} is inconsistent: {what}")
 
         try:
-            step = build_step(self.biped, self.speed, self.parameter_vector, self.knots)
+            if self.two_phase:
+                both = self.two_phase_step()
+                step = both.single
+            else:
+                step = build_step(self.biped, self.speed, self.parameter_vector, self.knots)
         except BipedError as error:
             raise bad(f"its parameters build no step ({error})") from None
         samples = CHECK_SAMPLES[self.knots]
         evaluation = evaluate_step(self.biped, step, samples, safety=self.safety)
-        expected = _derived(self.biped, step, evaluation)
+        expected = _derived(self.biped, step, evaluation, two_phase=self.two_phase)
+        feasible = evaluation.feasible
+        if self.two_phase:
+            double = self.double_support
+            try:
+                wanted = double_support_of(
+                    self.biped, both, evaluation, double.front_wrench_array, double.share_range
+                )
+            except BipedError as error:
+                raise bad(str(error)) from None
+            _check_double_support(double, wanted, bad)
+            feasible = evaluation.feasible and wanted.feasible
         units = self._units()
         for key in ("period", "step_length"):
             if _mismatch(getattr(self, key), expected[key]):
@@ -746,12 +869,11 @@ class Gait:
         _check_samples(self.samples, expected["samples"], units, bad)
         for group in ("costs", "constraints"):
             _check_group(getattr(self, group), group, expected[group], units, bad)
-        if self.feasible != evaluation.feasible:
+        if self.feasible != feasible:
             violated = evaluation.violations_line()
             raise bad(
                 f"feasible = {str(self.feasible).lower()}, its parameters give "
-                f"{str(evaluation.feasible).lower()}"
-                + (f" (Ψ < 0: {violated})" if violated else "")
+                f"{str(feasible).lower()}" + (f" (Ψ < 0: {violated})" if violated else "")
             )
         if self.impact is not None:
             _check_impact(self.impact, expected["impact"], bad)
@@ -772,10 +894,11 @@ def _robot(content: dict) -> Robot:
     return robot
 
 
-def _derived(model: Biped, step, evaluation) -> dict:
+def _derived(model: Biped, step, evaluation, two_phase: bool = False) -> dict:
     """The fields of a gait that its parameters determine, from its step and its evaluation
-    on the check grid."""
-    return {
+    on the check grid; of a two-phase gait's single support (``two_phase``) no impact (its
+    landing is in ``double_support``) and no electrical figures (not built for both phases)."""
+    derived = {
         "period": step.period,
         "step_length": step.step_length,
         "costs": Costs.of(model, step, evaluation),
@@ -790,6 +913,9 @@ def _derived(model: Biped, step, evaluation) -> dict:
             **{f.name: getattr(evaluation, f.name) for f in dataclasses.fields(Samples)}
         ),
     }
+    if two_phase:
+        derived["impact"] = derived["electrical"] = None
+    return derived
 
 
 def write_json(path: str | Path, content: dict) -> Path:
@@ -888,15 +1014,19 @@ def _check_kinds(content: dict, bad) -> None:
         raise bad(f"costs = {costs!r}, allowed finite numbers for {', '.join(CRITERIA)}")
 
 
-def _check_step(content: dict, bad) -> None:
-    """A step length of a walk, the speed times the period."""
+def _check_step(content: dict, bad, dwell: float = 0.0) -> None:
+    """A step length of a walk, the speed times the period (and the double support's
+    duration ``dwell`` [s] of a two-phase gait)."""
     speed, period, length = content["speed"], content["period"], content["step_length"]
     if length < MIN_STEP_LENGTH:
         raise bad(f"step_length = {length!r} m, allowed {MIN_STEP_LENGTH} m or more")
-    if not math.isclose(length, speed * period, rel_tol=1e-6):
+    if not (_finite_number(dwell) and dwell >= 0.0):
+        raise bad(f"double_support.duration = {dwell!r} s, allowed a number > 0")
+    if not math.isclose(length, speed * (period + dwell), rel_tol=1e-6):
+        both = " + double_support.duration" if dwell else ""
         raise bad(
-            f"step_length = {length!r} m, allowed speed × period = {speed * period!r} m "
-            f"(speed {speed!r} m/s, period {period!r} s)"
+            f"step_length = {length!r} m, allowed speed × (period{both}) = "
+            f"{speed * (period + dwell)!r} m (speed {speed!r} m/s, period {period!r} s)"
         )
 
 
@@ -1059,3 +1189,33 @@ def _check_impact(impact: Impact, expected: Impact, bad) -> None:
             f"impact.consistent = {impact.consistent!r}, its parameters give "
             f"{str(expected.consistent).lower()}"
         )
+
+
+def _check_double_support(stored: DoubleSupport, expected: DoubleSupport, bad) -> None:
+    """A two-phase gait's ``double_support`` against the one its parameters and its front
+    foot's wrench give: every number, its samples, ``feasible``."""
+    for f in dataclasses.fields(DoubleSupport):
+        path, found, wanted = f"double_support.{f.name}", getattr(stored, f.name), None
+        wanted = getattr(expected, f.name)
+        if f.name in ("landing", "feasible"):
+            if found != wanted:
+                raise bad(f"{path} = {found!r}, its parameters give {wanted!r}")
+            continue
+        if f.name == "samples":
+            for g in dataclasses.fields(wanted):
+                a, b = getattr(found, g.name), getattr(wanted, g.name)
+                if a.shape != b.shape or _mismatch(a, b):
+                    raise bad(f"{path}.{g.name} do not belong to the parameters")
+            continue
+        if isinstance(wanted, dict):
+            pairs = [(f"{path}.{k}", found.get(k) if isinstance(found, dict) else None, v)
+                     for k, v in wanted.items()]  # fmt: skip
+        else:
+            pairs = [(path, found, wanted)]
+        for where, value, target in pairs:
+            try:
+                off = np.shape(value) != np.shape(target) or _mismatch(value, target)
+            except (TypeError, ValueError):
+                off = True
+            if off:
+                raise bad(f"{where} = {value!r}, its parameters give {target!r}")

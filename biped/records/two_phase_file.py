@@ -1,90 +1,62 @@
-"""The file of a two-phase optimum (``biped optimize --double-support``): its problem, the
-solver's answer, every parameter with its unit, and the single-support optimum it started
-from, for comparison.
+"""The gait file of a two-phase optimum (``biped optimize --double-support``): a ``Gait`` with
+its ``double_support`` block (``biped.records.two_phase_gait``), made from the solver's answer.
 
-It is not a gait file: the commands that read gaits (validate, replay, pages, sweep) read the
-single-support ``Gait`` only; nothing reads this file back yet.
+Kept apart from ``biped.records.gait_file`` because it reads the two-phase NLP's variables
+(``biped.optimization.two_phase``, CasADi): reading the file needs neither.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
+from biped.optimization.report import Report
 from biped.optimization.two_phase import (
-    TwoPhaseCheck,
-    TwoPhaseOptimum,
+    WRENCH,
     TwoPhaseProblem,
+    TwoPhaseResult,
+    to_parameters,
     variable_names,
 )
-from biped.records.gait_file import write_json
-from biped.records.provenance import provenance
+from biped.records.gait_file import Gait, Optimizer
+from biped.records.two_phase_gait import unit_of
 
-FORMAT = "biped two-phase optimum"
-# The unit of a variable, from its name.
-_UNITS = (
-    ("accel", "rad/s²"),
-    ("rate_x_hip", "m/s"),
-    ("rate_z_hip", "m/s"),
-    ("rate", "rad/s"),
-    ("bend", "rad"),
-    ("trunk", "rad"),
-    ("period", "s"),
-    ("double_support", "s"),
-    ("front_cy", "N·m"),
-    ("front_f", "N"),
-)
+__all__ = ["gait_of", "unit_of"]
 
 
-def unit_of(name: str) -> str:
-    """The unit of the two-phase variable ``name``."""
-    for part, unit in _UNITS:
-        if part in name:
-            return unit
-    raise KeyError(name)
-
-
-def record(problem: TwoPhaseProblem, optimum: TwoPhaseOptimum, checked: TwoPhaseCheck) -> dict:
-    """The file's content: the problem, the answer, its check on the numeric model, the
-    variables by name with their units."""
-    single = problem.single
+def optimizer_record(problem: TwoPhaseProblem, result: TwoPhaseResult, seed: int) -> Optimizer:
+    """The solver's record of ``result``'s best start: IPOPT's status ("converged" when it
+    converged), the starts, its iterations and violation, every variable by name (IPOPT's dual
+    infeasibility is not kept by the two-phase solver: not measured, null)."""
+    best = result.best
+    report = Report(
+        method="ipopt",
+        status="converged" if best.converged else best.status,
+        starts=result.starts,
+        starts_at_best=result.at_best,
+        iterations=best.iterations,
+        constraint_violation=best.constraint_violation,
+        dual_infeasibility=float("nan"),
+        seconds=result.seconds,
+        seed=seed,
+        value=best.value,
+    )
     names = variable_names(problem.samples, problem.landing)
-    return {
-        "format": FORMAT,
-        "knee": single.knee,
-        "speed": single.speed,
-        "criterion": single.criterion,
-        "share_range": list(problem.share),
-        "landing": problem.landing,
-        "double_support_samples": problem.samples,
-        "value": checked.value,
-        "solver_value": optimum.value,
-        "feasible": checked.feasible,
-        "share": optimum.share,
-        "single_support_value": optimum.single_value,
-        "status": optimum.status,
-        "iterations": optimum.iterations,
-        "constraint_violation": optimum.constraint_violation,
-        "seconds": optimum.seconds,
-        "setup_seconds": optimum.setup_seconds,
-        "variables": dict(zip(names, np.asarray(optimum.variables).tolist(), strict=True)),
-        "units": {
-            "speed": "m/s",
-            "value": "N²·m·s",
-            "solver_value": "N²·m·s",
-            "single_support_value": "N²·m·s",
-            "share": "1",
-            "seconds": "s",
-            "setup_seconds": "s",
-            "variables": {name: unit_of(name) for name in names},
-        },
-        "provenance": provenance(),
-    }
+    return Optimizer.of(report, best.variables, names)
 
 
-def write(
-    path: str | Path, problem: TwoPhaseProblem, optimum: TwoPhaseOptimum, checked: TwoPhaseCheck
-) -> Path:
-    """Write the file atomically; returns its path."""
-    return write_json(path, record(problem, optimum, checked))
+def gait_of(problem: TwoPhaseProblem, result: TwoPhaseResult, seed: int) -> Gait:
+    """The two-phase gait of ``result``'s best start (which must exist)."""
+    single, best = problem.single, result.best
+    z = np.asarray(best.variables, dtype=float)
+    front = z[-len(WRENCH) * (problem.samples + 1) :].reshape(-1, len(WRENCH))
+    return Gait.from_two_phase(
+        robot=single.model.robot,
+        knee=single.knee,
+        speed=single.speed,
+        parameters=to_parameters(problem, z),
+        landing=problem.landing,
+        front_wrench=front,
+        share_range=problem.share,
+        optimizer=optimizer_record(problem, result, seed),
+        safety=single.safety,
+    )

@@ -1,7 +1,8 @@
 """Campaigns of many optimizations written as files and resumable: the sweep over speed
 (``sweep``), the map of knee radii (``design_map``), the paper's own method over seeds
 (``paper_method``), each its science on the one mechanism that claims a folder, resumes, runs
-stages on a pool or Dask, shows progress and summarizes (``campaign``); and a machined knee
+stages on a pool or Dask, shows progress and summarizes (``campaign``), their stages and the
+neighbours that start a point declared and ordered once (``staging``); and a machined knee
 profile over the speeds (``profile_speeds``: a table of optimizations, no folder of its own),
 and both knees over nested gait families until their comparison converges (``converge``);
 two atlases in two gait families compared cell by cell (``atlas_families``).

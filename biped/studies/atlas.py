@@ -3,7 +3,7 @@ stance-knee bend), each difference between the knees with its error bar.
 
 Each cell (speed, clearance, knee bend) holds, for each knee and criterion, a certified
 optimum of the atlas's gait family (``Settings.knots``: the paper's spline by default, K
-interior knots, or a ``Bezier``), in the campaign's stages (``biped.studies.campaign``):
+interior knots, or a ``Bezier``), in the campaign's stages (``biped.studies.staging``):
 
 1. ``own``: the point's own starts (``biped.optimization.optimize.optimize``); the
    criteria of the joints' work start from the sthenic optimum of the same point;
@@ -46,11 +46,9 @@ import numpy as np
 from biped.errors import BipedError
 from biped.model.bezier import Bezier
 from biped.model.criteria import (
-    ALL_CRITERIA,
     CRITERION_UNITS,
     PAPER_SAFETY,
     WALKABLE,
-    WORK_CRITERIA,
     Safety,
 )
 from biped.model.dynamics import Biped
@@ -60,14 +58,12 @@ from biped.model.robot import Robot
 from biped.optimization.comparison import relative_change
 from biped.optimization.optimize import (
     Optimum,
-    Report,
     apart_from_table,
     best_of,
     checked,
     confirm,
     optimize,
     refine,
-    single_start_note,
 )
 from biped.optimization.problem import (
     GaitProblem,
@@ -76,9 +72,10 @@ from biped.optimization.problem import (
     walkable_description,
 )
 from biped.records import gait_file
+from biped.records.atlas_optimum import AtlasOptimum
 from biped.runtime.claims import claimed
 from biped.runtime.files import atomic_write_text, distinct_values
-from biped.studies import campaign
+from biped.studies import campaign, staging
 from biped.studies.campaign import Task
 
 MANIFEST = "atlas.json"
@@ -263,79 +260,35 @@ def check_settings(settings: Settings) -> Settings:
     return settings
 
 
-def read(folder, point: Point) -> dict | None:
+def read(folder, point: Point) -> AtlasOptimum | None:
     """The record of ``point`` in ``folder``, None if missing or unreadable."""
-    try:
-        content = json.loads((Path(folder) / point.filename()).read_text())
-    except (OSError, ValueError, UnicodeDecodeError):
-        return None
-    return content if isinstance(content, dict) and "status" in content else None
+    return AtlasOptimum.read(Path(folder) / point.filename())
 
 
-def _record(optimum: Optimum, seconds: float) -> dict:
-    """What a stage keeps of an optimum: its status, costs, starts and variables."""
-    report, ev = optimum.report, optimum.evaluation
-    single = report.converged and report.starts_at_best < 2
-    return {
-        "status": report.status,
-        "feasible": optimum.feasible,
-        "certified": optimum.certified,
-        "value": _finite(optimum.value),
-        "costs": {c: ev.value(c, optimum.step.step_length) for c in ALL_CRITERIA},
-        "starts": report.starts,
-        "starts_at_best": report.starts_at_best,
-        "single_start": single_start_note(report) if single else None,
-        "next_optimum": _next_optimum(report) if single else 0.0,
-        "violations": optimum.evaluation.violations_line(),
-        "period": optimum.step.period,
-        "step_length": optimum.step.step_length,
-        "seconds": seconds,
-        "report": report.to_dict(),
-        "variables": [_finite(v) for v in optimum.variables],
-    }
-
-
-def _finite(value):
-    return float(value) if math.isfinite(value) else None
-
-
-def _next_optimum(report: Report) -> float:
-    """The relative distance to the next optimum the starts reached above the best (0 when
-    none did)."""
-    best = report.value
-    above = [
-        s.value
-        for s in report.history
-        if s.status == "Solve_Succeeded" and np.isfinite(s.value) and s.value > best * (1 + 1e-6)
-    ]
-    return min(above) / best - 1.0 if above else 0.0
-
-
-def _optimum(settings: Settings, point: Point, content: dict) -> Optimum | None:
+def _optimum(settings: Settings, point: Point, record: AtlasOptimum | None) -> Optimum | None:
     """The optimum a record holds (its numbers again: JSON keeps every bit)."""
-    if content is None or any(v is None for v in content["variables"]):
+    if record is None or not record.solved:
         return None
-    problem = settings.problem(point)
-    return checked(problem, np.array(content["variables"]), Report.from_dict(content["report"]))
+    return checked(settings.problem(point), np.array(record.variables), record.report)
 
 
-def _write(task: Task, optimum: Optimum, began: float) -> dict:
-    content = _record(optimum, time.perf_counter() - began)
-    atomic_write_text(task.path, json.dumps(content, indent=1, allow_nan=False))
-    return content
+def _write(task: Task, optimum: Optimum, began: float) -> AtlasOptimum:
+    record = AtlasOptimum.from_optimum(optimum, time.perf_counter() - began)
+    atomic_write_text(task.path, record.to_json())
+    return record
 
 
-def _line(point: Point, content: dict) -> str:
-    status = campaign.failure(content["status"], content["feasible"])
+def _line(point: Point, record: AtlasOptimum) -> str:
+    status = campaign.failure(record.status, record.feasible)
     if status is None:
         status = "certified" if point.stage == "final" else "converged, feasible"
-    value = content["costs"][point.criterion]
+    value = record.costs[point.criterion]
     return (
         f"[{point.stage:6}] {point.knee:8} {point.criterion:16} {point.cell.speed:.3f} m/s "
         f"clearance {100 * point.cell.clearance:4.1f} cm bend {point.cell.knee_bend:.3f} rad  "
         f"C = {value:12.6f} {CRITERION_UNITS[point.criterion]:6} {status}; "
-        f"{content['starts_at_best']}/{content['starts']} starts at best  "
-        f"{content['seconds']:5.1f} s"
+        f"{record.starts_at_best}/{record.starts} starts at best  "
+        f"{record.seconds:5.1f} s"
     )
 
 
@@ -356,7 +309,7 @@ def _solve_final(task: Task) -> str:
     own = _optimum(settings, point.at("own"), read(task.folder, point.at("own")))
     problem = settings.problem(point)
     given = [read(task.folder, p) for p in task.given]
-    starts = [np.array(c["variables"]) for c in given if c and None not in c["variables"]]
+    starts = [np.array(r.variables) for r in given if r is not None and r.solved]
     starts = apart_from_table(problem, starts)  # the table's were among the point's own
     optimum = own
     if starts:
@@ -364,10 +317,10 @@ def _solve_final(task: Task) -> str:
         optimum = again if own is None else best_of(problem, [own, again])
     if optimum is not None:  # a best reached by one start tried again
         optimum = confirm(problem, optimum, starts, jobs=1)
-    content = _write(task, optimum, began)
+    record = _write(task, optimum, began)
     gait = gait_file.Gait.from_optimum(optimum, settings.robot)
     gait.write(Path(task.folder) / point.gait_filename())
-    return _line(point, content)
+    return _line(point, record)
 
 
 def _solve_refined(task: Task) -> str:
@@ -375,9 +328,9 @@ def _solve_refined(task: Task) -> str:
     or in the richer family from it and from the other knee's (``richer``)."""
     settings, point, began = task.settings, task.point, time.perf_counter()
     final = read(task.folder, point.at("final"))
-    if final is None or None in final["variables"]:
+    if final is None or not final.solved:
         raise BipedError(f"{point.at('final').filename()}: no final optimum to refine")
-    start = np.array(final["variables"])
+    start = np.array(final.variables)
     if point.stage == "fine":
         samples = FINER * settings.problem(point).samples_per_half
         optimum = refine(settings.problem(point, samples=samples), start)
@@ -386,69 +339,73 @@ def _solve_refined(task: Task) -> str:
     else:
         richer = settings.problem(point, knots=RICHER_KNOTS)
         others = [read(task.folder, p) for p in task.given]
-        starts = [start] + [
-            np.array(c["variables"]) for c in others if c and None not in c["variables"]
-        ]
+        starts = [start] + [np.array(r.variables) for r in others if r is not None and r.solved]
         optimum = optimize(richer, starts=0, given=[richer.embedded(z) for z in starts], jobs=1)
     return _line(point, _write(task, optimum, began))
 
 
 def stages(folder: Path, settings: Settings) -> list[list[Task]]:
-    """The tasks still to run, in the order their inputs need."""
-    cells = settings.cells()
-    index = {cell: k for k, cell in enumerate(cells)}
-    sthenic = "sthenic" in settings.criteria
+    """The tasks still to run, in waves whose inputs the waves before write
+    (``staging.schedule``): each point's own starts (a work criterion's from the sthenic
+    optimum of its problem), its final solve from its neighbours' own optima
+    (``neighbourhood``), its re-solves from its final optimum (the richer family's also from
+    the other knee's)."""
+    folder = str(folder)
 
-    def done(point):
-        return read(folder, point) is not None
+    def points(stage: str, cells=None) -> tuple:
+        cells = settings.cells() if cells is None else cells
+        return tuple(
+            Point(stage, k, c, cell) for c in settings.criteria for cell in cells for k in KNEES
+        )
 
-    def task(solve, point, given=()):
-        return Task(solve, settings, point, str(folder), tuple(given))
+    def at(stage: str, relation=lambda p: (p,)) -> staging.Seed:
+        """The results of ``stage`` at the points ``relation`` relates to a point's."""
+        return staging.Seed(stage, lambda p: relation(p.at(stage)))
 
-    def points(stage, criteria, cells_=cells):
-        return [Point(stage, k, c, cell) for c in criteria for cell in cells_ for k in KNEES]
-
-    work = [c for c in settings.criteria if c in WORK_CRITERIA]
-    first = [c for c in settings.criteria if c not in work or not sthenic]
-    own = [
-        [task(_solve_own, p) for p in points("own", first) if not done(p)],
-        [
-            task(_solve_own, p, [Point("own", p.knee, "sthenic", p.cell)])
-            for p in points("own", [c for c in work if sthenic])
-            if not done(p)
-        ],
-    ]
-    final = [
-        task(_solve_final, p, _neighbours(p, settings, index))
-        for p in points("final", settings.criteria)
-        if not done(p)
-    ]
+    knees = staging.Neighbours(across=(staging.Axis("knee", KNEES),))
     refined = [
-        task(_solve_refined, p)
-        for stage in ("fine", "tight")
-        for p in points(stage, settings.criteria)
-        if not done(p)
+        staging.Stage(s, _solve_refined, folder, points(s), reads=at("final"))
+        for s in ("fine", "tight")
     ]
-    refined += [
-        task(_solve_refined, p, [p.at("final", other) for other in KNEES if other != p.knee])
-        for p in points("richer", settings.criteria, settings.corners())
-        if not done(p)
+    plan = [
+        staging.Stage(
+            "own",
+            _solve_own,
+            folder,
+            points("own"),
+            given=at("own", staging.sthenic_twin(settings.criteria)),
+        ),
+        staging.Stage(
+            "final",
+            _solve_final,
+            folder,
+            points("final"),
+            given=at("own", neighbourhood(settings).of),
+            reads=at("own"),
+        ),
+        *refined,
+        staging.Stage(
+            "richer",
+            _solve_refined,
+            folder,
+            points("richer", settings.corners()),
+            given=at("final", knees.of),
+            reads=at("final"),
+        ),
     ]
-    return [*own, final, refined]
+    return staging.schedule(plan, settings, lambda _, point: read(folder, point) is not None)
 
 
-def _neighbours(point: Point, settings: Settings, index: dict) -> list[Point]:
-    """The ``own`` optima that start a point's final solve: the neighbouring speeds and
-    clearances of its cell, and the other knee."""
-    cell = point.cell
-    found = []
-    for values, field in ((settings.speeds, "speed"), (settings.clearances, "clearance")):
-        at = list(values).index(getattr(cell, field))
-        for j in (at - 1, at + 1):
-            if 0 <= j < len(values):
-                found.append(dataclasses.replace(cell, **{field: values[j]}))
-    own = [Point("own", point.knee, point.criterion, c) for c in found]
-    return own + [Point("own", k, point.criterion, cell) for k in KNEES if k != point.knee]
+def neighbourhood(settings: Settings) -> staging.Neighbours:
+    """The neighbours whose ``own`` optima start a point's final solve: the neighbouring
+    speeds and clearances of its cell, and the other knee."""
+    return staging.Neighbours(
+        steps=(
+            staging.Axis("cell.speed", tuple(settings.speeds)),
+            staging.Axis("cell.clearance", tuple(settings.clearances)),
+        ),
+        across=(staging.Axis("knee", KNEES),),
+    )
 
 
 def run_atlas(folder, settings: Settings, **where) -> Settings:
@@ -484,18 +441,19 @@ def summarize(folder, settings: Settings) -> str:
     ]
 
     def why_not(point):
-        content = read(folder, point)
-        if content is None:
+        record = read(folder, point)
+        if record is None:
             return "missing"
-        why = campaign.failure(content["status"], content["feasible"])
-        return f"{why} ({content['violations']})" if why == "INFEASIBLE" else why
+        why = campaign.failure(record.status, record.feasible)
+        return f"{why} ({record.violations})" if why == "INFEASIBLE" else why
 
     counted = "points certified (final optima, solver converged, feasible on the check grid)"
-    seconds = [
-        json.loads(path.read_text())["seconds"]
+    records = [
+        AtlasOptimum.read(path)
         for stage in STAGES
         for path in sorted((Path(folder) / stage).glob("*.json"))
     ]
+    seconds = [record.seconds for record in records if record is not None]
     note = (
         f"; {len(seconds)} optimizations, median {np.median(seconds):.2f} s each" if seconds else ""
     )
@@ -569,22 +527,23 @@ class Difference:
         return self.value is not None and uncertainty is not None and abs(self.value) > uncertainty
 
 
-def _not_certified(contents: dict) -> str:
+def _not_certified(records: dict) -> str:
     """Why the knees' records of one stage give no difference ("" when both are certified)."""
     reasons = []
     for knee in KNEES:
-        content = contents[knee]
-        if content is None:
+        record = records[knee]
+        if record is None:
             reasons.append(f"{knee} missing")
-        elif not content["certified"]:
-            why = campaign.failure(content["status"], content["feasible"])
-            detail = f": {content['violations']}" if content["violations"] else ""
+        elif not record.certified:
+            why = campaign.failure(record.status, record.feasible)
+            detail = f": {record.violations}" if record.violations else ""
             reasons.append(f"{knee} {why}{detail}")
     return "; ".join(reasons)
 
 
 def difference(folder, settings: Settings, criterion: str, cell: Cell) -> tuple[Difference, dict]:
-    """The cell's ``Difference`` for ``criterion`` and each knee's final record."""
+    """The cell's ``Difference`` for ``criterion`` and each knee's final record
+    (``AtlasOptimum``, None where missing), by knee."""
     records = {
         stage: {k: read(folder, Point(stage, k, criterion, cell)) for k in KNEES}
         for stage in STAGES
@@ -595,16 +554,16 @@ def difference(folder, settings: Settings, criterion: str, cell: Cell) -> tuple[
         return Difference(None, None, None, None, None, why), finals
 
     def change(stage):
-        contents = records[stage]
+        knees = records[stage]
         return relative_change(
-            contents["rolling"]["costs"][criterion], contents["revolute"]["costs"][criterion]
+            knees["rolling"].costs[criterion], knees["revolute"].costs[criterion]
         )
 
     value = change("final")
     asked = ("fine", "tight") + (("richer",) if cell in settings.corners() else ())
     missing = {stage: _not_certified(records[stage]) for stage in asked}
     moved = {stage: None if missing[stage] else change(stage) for stage in asked}
-    spread = 100 * math.sqrt(sum(finals[k]["next_optimum"] ** 2 for k in KNEES))
+    spread = 100 * math.sqrt(sum(finals[k].next_optimum ** 2 for k in KNEES))
     return (
         Difference(
             value=value,

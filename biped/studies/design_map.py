@@ -52,7 +52,7 @@ from biped.optimization.optimize import DEFAULT_STARTS, optimize
 from biped.optimization.problem import VARIABLES
 from biped.runtime.claims import claimed
 from biped.runtime.files import atomic_write_text, distinct_values
-from biped.studies import campaign
+from biped.studies import campaign, staging
 from biped.studies.campaign import Task
 
 MANIFEST = "design-map.json"
@@ -185,7 +185,7 @@ def solve_point(task: Task) -> str:
     began = time.perf_counter()
     if point.kind == "design":
         given = []
-        for content in _stage_one(folder, settings, point.speed):
+        for content in _stage_one(folder, task.given):
             variables = campaign.variables(content["variables"])
             if variables is not None:
                 given.append((variables, content["radii"] or problem.reference_radii))
@@ -203,33 +203,50 @@ def solve_point(task: Task) -> str:
     return _line(point, content, CRITERION_UNITS[problem.criterion])
 
 
-def _stage_one(folder: Path, settings: MapSettings, speed: float) -> list[dict]:
-    """The first-stage results at ``speed`` that start the design: the best certified grid
-    point, the Table 1 and revolute gaits."""
+def _stage_one(folder: Path, given) -> list[dict]:
+    """The first-stage results that start the design (``given``: the first stage's points at
+    its speed, ``first_stage``): the best certified grid point, the Table 1 and revolute
+    gaits."""
     found = []
-    grid = [
-        read_point(folder, MapPoint("grid", speed, (r1, r2)))
-        for r1 in settings.r1
-        for r2 in settings.r2
-    ]
+    grid = [read_point(folder, p) for p in given if p.kind == "grid"]
     certified = [c for c in grid if c is not None and c["certified"]]
     if certified:
         found.append(min(certified, key=lambda c: c["value"]))
+    references = {p.kind: p for p in given if p.kind != "grid"}
     for kind in ("table1", "revolute"):
-        content = read_point(folder, MapPoint(kind, speed))
+        content = read_point(folder, references[kind])
         if content is not None and content["certified"]:
             found.append(content)
     return found
 
 
+def first_stage(settings: MapSettings, speed: float) -> tuple[MapPoint, ...]:
+    """The first stage's points at ``speed``: the revolute and Table 1 references, the grid."""
+    grid = tuple(MapPoint("grid", speed, (r1, r2)) for r1 in settings.r1 for r2 in settings.r2)
+    return (MapPoint("revolute", speed), MapPoint("table1", speed), *grid)
+
+
 def map_points(settings: MapSettings) -> tuple[list[MapPoint], list[MapPoint]]:
     """(first stage, second stage) points of a map."""
-    first, second = [], []
-    for speed in settings.speeds:
-        first += [MapPoint("revolute", speed), MapPoint("table1", speed)]
-        first += [MapPoint("grid", speed, (r1, r2)) for r1 in settings.r1 for r2 in settings.r2]
-        second.append(MapPoint("design", speed))
-    return first, second
+    first = [p for speed in settings.speeds for p in first_stage(settings, speed)]
+    return first, [MapPoint("design", speed) for speed in settings.speeds]
+
+
+def map_stages(folder: Path, settings: MapSettings) -> list[list[Task]]:
+    """The tasks still to run, in waves (``staging.schedule``): the references and the grid,
+    then the design at each speed, started from the first stage's results at its speed."""
+    first, second = map_points(settings)
+    plan = [
+        staging.Stage("first", solve_point, str(folder), tuple(first)),
+        staging.Stage(
+            "design",
+            solve_point,
+            str(folder),
+            tuple(second),
+            given=staging.Seed("first", lambda p: first_stage(settings, p.speed)),
+        ),
+    ]
+    return staging.schedule(plan, settings, lambda _, p: read_point(folder, p) is not None)
 
 
 def run_design_map(
@@ -265,10 +282,8 @@ def run_design_map(
     settings = MapSettings(robot, criterion, safety, tuple(speeds), r1, r2, upper, seed, starts)
     with claimed(folder):  # one run at a time on the folder
         folder = MAP.claim(folder, settings)  # checked before the folder is made
-        points = map_points(settings)
-        todo = [[p for p in stage if read_point(folder, p) is None] for stage in points]
-        stages = [[Task(solve_point, settings, p, str(folder)) for p in stage] for stage in todo]
-        total, remaining = sum(map(len, points)), sum(map(len, stages))
+        stages = map_stages(folder, settings)
+        total, remaining = sum(map(len, map_points(settings))), sum(map(len, stages))
         plan = (
             f"design map: {total} optimizations in {folder}, {total - remaining} already done, "
             f"{remaining} to run"

@@ -10,16 +10,16 @@ Every point (knee, criterion, speed) is solved twice:
    same series and of the other knee at the same speed; the best of both is the point's
    gait file.
 
-The solves run in three stages, each task of a stage independent of the others, so they run
-in parallel (``biped.runtime.runner``: on all cores, or on the workers of a Dask cluster): the
-sthenic independent optima; the energy independent optima with the sthenic neighbours'
-solves; the energy neighbours' solves. Each result depends only on files of the stages
-before, which are written whole (``biped.runtime.files``), so a sweep stopped at any moment
-and run again ends with exactly the files of an uninterrupted sweep. The folder's
-``sweep.json`` records what shapes the numbers (robot, safety, speeds, seed, starts, gait
-family, method, versions); resuming with any of them changed is refused. Points whose solver did
-not converge, or whose optimum is infeasible, are saved with their status and counted in
-the summary; they are not optimised again.
+The solves run in three waves (``biped.studies.staging``), each task of a wave independent of
+the others, so they run in parallel (``biped.runtime.runner``: on all cores, or on the
+workers of a Dask cluster): the sthenic independent optima; the energy independent optima
+with the sthenic neighbours' solves; the energy neighbours' solves. Each result depends only
+on files of the waves before, which are written whole (``biped.runtime.files``), so a sweep
+stopped at any moment and run again ends with exactly the files of an uninterrupted sweep.
+The folder's ``sweep.json`` records what shapes the numbers (robot, safety, speeds, seed,
+starts, gait family, method, versions); resuming with any of them changed is refused. Points
+whose solver did not converge, or whose optimum is infeasible, are saved with their status
+and counted in the summary; they are not optimised again.
 """
 
 from __future__ import annotations
@@ -36,7 +36,6 @@ from biped.model.criteria import (
     CRITERIA,
     CRITERION_UNITS,
     PAPER_SAFETY,
-    WORK_CRITERIA,
     Safety,
 )
 from biped.model.dynamics import Biped
@@ -58,7 +57,7 @@ from biped.optimization.optimize import (
 from biped.optimization.problem import GaitProblem, check_speed
 from biped.records import gait_file
 from biped.runtime.claims import claimed
-from biped.studies import campaign
+from biped.studies import campaign, staging
 from biped.studies.campaign import Task
 
 DEFAULT_SPEEDS = np.round(np.linspace(0.15, 0.45, 13), 6)  # [m/s], every 0.025 m/s
@@ -244,52 +243,53 @@ def _plan(folder: Path, points, final, stages, saved: set) -> str:
 
 
 def sweep_stages(folder: Path, settings: Settings, points, final, knees, saved: set) -> list:
-    """The tasks still to run, in stages whose tasks are independent of each other and
-    depend only on the files of the stages before: the sthenic independent optima; the
-    energy ones (each started from the sthenic optimum of its problem, when the sweep has
-    that criterion) with the sthenic finals; the energy finals. ``saved``: the points whose
-    independent optimum is in the folder."""
-    speeds = settings.speeds
-    needed = {n for p in final for n in [p, *neighbours(p, speeds, knees)]}
-    twins = {p: Point(p.knee, "sthenic", p.speed) for p in points if p.criterion in WORK_CRITERIA}
-    if not any(p.criterion == "sthenic" for p in points):
-        twins = {}
-
-    needed |= {twins[p] for p in needed if p in twins and p not in saved}
-
-    independent = [p for p in points if p in needed and p not in saved]
-    first = [p for p in independent if p not in twins]
-    second = [p for p in independent if p in twins]
-
-    def independent_task(p):
-        given = (twins[p],) if p in twins else ()
-        return Task(solve_independent, settings, p, str(folder / INDEPENDENT), given)
-
-    def final_task(p):
-        given = tuple(neighbours(p, speeds, knees))
-        return Task(_solve_with_neighbours, settings, p, str(folder), given)
-
-    early = [p for p in final if p not in twins]  # their neighbours are all in ``first``
-    late = [p for p in final if p in twins]
-    if not second:  # no stage waits for the sthenic optima: two stages
-        early, late = [], early + late
-    return [
-        [independent_task(p) for p in first],
-        [independent_task(p) for p in second] + [final_task(p) for p in early],
-        [final_task(p) for p in late],
+    """The tasks still to run, in waves (``staging.schedule``) whose tasks are independent of
+    each other and depend only on the files of the waves before: the sthenic independent
+    optima; the energy ones (each started from the sthenic optimum of its problem, when the
+    sweep has that criterion) with the sthenic finals; the energy finals. ``final``: the
+    points without a final optimum; ``saved``: those whose independent optimum is in the
+    folder. An independent optimum is solved only where a final still to run reads it."""
+    criteria = sorted({p.criterion for p in points})
+    own = staging.Seed(INDEPENDENT, lambda p: (p,))
+    stages = [
+        staging.Stage(
+            INDEPENDENT,
+            solve_independent,
+            str(folder / INDEPENDENT),
+            tuple(points),
+            given=staging.Seed(INDEPENDENT, staging.sthenic_twin(criteria)),
+            needed_only=True,
+        ),
+        staging.Stage(
+            "final",
+            _solve_with_neighbours,
+            str(folder),
+            tuple(points),
+            given=staging.Seed(INDEPENDENT, neighbourhood(settings.speeds, knees).of),
+            reads=own,
+        ),
     ]
+    pending = set(final)
+
+    def done(stage: staging.Stage, point: Point) -> bool:
+        return point in saved if stage.name == INDEPENDENT else point not in pending
+
+    return staging.schedule(stages, settings, done)
+
+
+def neighbourhood(speeds, knees) -> staging.Neighbours:
+    """The neighbours of a point whose independent optima start its second solve: the
+    neighbouring speeds of its series, and the same speed with the other knees (the
+    variables mean the same for both knees)."""
+    return staging.Neighbours(
+        steps=(staging.Axis("speed", tuple(speeds)),), across=(staging.Axis("knee", tuple(knees)),)
+    )
 
 
 def neighbours(point: Point, speeds, knees) -> list[Point]:
-    """The points whose independent optima start ``point``'s second solve: the neighbouring speeds
-    of its series, and the same speed with the other knees (the variables mean the same for
-    both knees)."""
-    i = list(speeds).index(point.speed)
-    return [
-        Point(point.knee, point.criterion, speeds[j])
-        for j in (i - 1, i + 1)
-        if 0 <= j < len(speeds)
-    ] + [Point(k, point.criterion, point.speed) for k in knees if k != point.knee]
+    """The points whose independent optima start ``point``'s second solve
+    (``neighbourhood``)."""
+    return neighbourhood(speeds, knees).of(point)
 
 
 def optima_table(folder) -> dict:

@@ -50,9 +50,11 @@ def load_model(biped: Biped, exact: bool = False) -> mujoco.MjModel:
 
 
 def rigid_copy(model: mujoco.MjModel) -> mujoco.MjModel:
-    """A copy without armature and with massless knee links: the analytical robot exactly."""
+    """A copy without armature (a profiled knee's stretch's too) and with massless knee links:
+    the analytical robot exactly."""
     exact = copy.deepcopy(model)
     exact.dof_armature[:] = 0.0
+    exact.tendon_armature[:] = 0.0
     for side, part in ((s, p) for s in SIDES for p in ("link", "slider")):
         name = f"{side}_knee_{part}"  # a profiled knee's slider too (validate.scene.profile_mjcf)
         if mujoco.mj_name2id(exact, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
@@ -239,13 +241,23 @@ def knee_link_effect(biped: Biped, q, qd, qdd, stance="left") -> float:
     return float(np.abs(a - b).max())
 
 
-def mujoco_impact(model: mujoco.MjModel, biped: Biped, q, qd_minus, stance: str = "left"):
+def mujoco_impact(
+    model: mujoco.MjModel,
+    biped: Biped,
+    q,
+    qd_minus,
+    stance: str = "left",
+    both_feet: bool = False,
+):
     """Impact map (eqs. 21-22) with MuJoCo's mass matrix and the landing foot's Jacobian.
 
     The swing foot (the other side than ``stance``) lands flat: its ankle stops and its angle
     stays (rows x, z, rotation about -y); the knee equalities of the rolling knee hold through
     the impact as well. Solves [M  -Aᵀ; A  0] [q̇⁺; ι] = [M q̇⁻; 0] and returns MuJoCo's q̇⁺
-    (nv,) and the ground impulse (3,), in MuJoCo's coordinates for ``stance``.
+    (nv,) and the ground impulse (3,), in MuJoCo's coordinates for ``stance``. With
+    ``both_feet`` the stance foot is held too (the landing that starts a double support,
+    ``biped.model.impact.both_feet_impact``): its three rows first, the impulse (6,) on the
+    stance then the swing foot.
     """
     mapped = mapping(model, stance, biped.radii)
     data = mujoco.MjData(model)
@@ -253,13 +265,16 @@ def mujoco_impact(model: mujoco.MjModel, biped: Biped, q, qd_minus, stance: str 
     mujoco.mj_fwdPosition(model, data)
     mass = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, mass)
-    swing = "right" if stance == "left" else "left"
-    jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
-    mujoco.mj_jacSite(model, data, jacp, jacr, model.site(f"{swing}_ankle").id)
+    feet = (stance, other(stance)) if both_feet else (other(stance),)
+    ankles = []
+    for side in feet:
+        jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+        mujoco.mj_jacSite(model, data, jacp, jacr, model.site(f"{side}_ankle").id)
+        ankles.append(np.stack([jacp[0], jacp[2], -jacr[1]]))
     equalities = equality_jacobian(model, data)
-    rows = np.concatenate([np.stack([jacp[0], jacp[2], -jacr[1]]), equalities])
+    rows = np.concatenate([*ankles, equalities])
     k = len(rows)
     system = np.block([[mass, -rows.T], [rows, np.zeros((k, k))]])
     rhs = np.concatenate([mass @ mapped.qvel(q, qd_minus), np.zeros(k)])
     solution = np.linalg.solve(system, rhs)
-    return solution[: model.nv], solution[model.nv : model.nv + 3]
+    return solution[: model.nv], solution[model.nv : model.nv + 3 * len(feet)]

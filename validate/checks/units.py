@@ -72,6 +72,7 @@ class WalkFigures:
     distance: float = unit_field("m")  # the hip's travel
     seconds_simulated: float = unit_field("s")
     max_knee_equality_violation: float | None = unit_field("rad", default=None)
+    max_knee_length_violation: float | None = unit_field("m", default=None)  # profiled knee
 
     def to_dict(self) -> dict:
         """The figures by name (those not measured left out)."""
@@ -159,6 +160,7 @@ FIGURE_UNITS = {
         "max_force_impulse_error": "N·s",  # of Ix, Iz
         "max_moment_impulse_error": "N·m·s",  # of Iy
         "normal_impulse": "N·s",
+        "rear_normal_impulse": "N·s",  # a two-phase gait's landing (both feet held)
         "landing_speed": "m/s",
     },
     "feedforward": {
@@ -169,6 +171,19 @@ FIGURE_UNITS = {
         **{f"feedback_share_{joint}": PURE for joint in JOINTS},
         **{f"feedback_rms_{joint}": "N·m" for joint in JOINTS},
         **{f"torque_rms_{joint}": "N·m" for joint in JOINTS},
+        # a two-phase gait's (``check_two_phase_feedforward``)
+        **{f"{phase}_max_feedback_ratio": PURE for phase in ("single", "double")},
+        **{
+            f"{phase}_feedback_ratio_{joint}": PURE
+            for phase in ("single", "double")
+            for joint in JOINTS
+        },
+        **{
+            f"{foot}_force_{kind}_error": "N"
+            for foot in ("rear", "front")
+            for kind in ("rms", "max")
+        },
+        **{f"{foot}_cop_rms_error": "m" for foot in ("rear", "front")},
     },
     "forward": {
         **declared_units(WalkFigures),

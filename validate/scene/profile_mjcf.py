@@ -24,6 +24,20 @@ carry ``KNEE_LINK_MASS`` (the arc's ``ARC_MASS``), the hinges and the arc ``KNEE
 the cross-check removes both (but the arc's mass). The slide has none: the lower leg it
 carries is its inertia, and a rotor's there would weigh on the knee by its rate Σ', which a
 large k2 makes metres a radian (8 m/rad: 0.16 kg·m² where the hinges' are 0.01).
+
+The stretch. The slide carries the lower leg's load along the common normal, nearly the leg's
+axis, where the circles have a rigid link; only its tendon equality holds it, and MuJoCo's
+implicit step (``implicitfast``, which the walks use for the servos' damping) does not keep
+an equality's rate: its velocity update (M − h D)⁻¹ M q̈ of the constraint solver's q̈ (D:
+the servos' damping) adds a stretch rate wherever the landing leg's knee and ankle servos
+brake large accelerations. At each landing the slide stretched by 17 µm (the circles'
+optimal gait at the designed radii, 0.3 m/s, on this knee with k = 1e-9; 2.4 µm under the
+walkable margins' softer landings), the micrometres that decide which sphere of the sole lands
+first, and the orbit's ρ went from the circles' 0.73 to 0.94. The stretch tendon therefore
+carries ``STRETCH_ARMATURE``, an inertia of its length: the stretch is zero with its rate and
+acceleration on the rolling motion, so it never enters the knee's dynamics (the cross-check
+removes it all the same), and it makes the slide too heavy for the implicit step to move (the
+landing's stretch 0.5 µm; ρ back to the circles', ``tests/test_profile_orbit.py``).
 """
 
 from __future__ import annotations
@@ -41,6 +55,11 @@ DRAWN_RADIUS = 0.006
 # cross-check's rigid copy keeps it (zero, its joint would have no inertia at all, and
 # MuJoCo's factorisation would warn); 1e-12 kg moves the robot's torques by ~1e-11 N·m.
 ARC_MASS, ARC_INERTIA = 1e-12, 1e-14
+# Armature of the slide's stretch, the pinned tendon knee_slide + k1 knee_lower + k2 knee_upper
+# [kg]: the stretch is 0 with its rate and acceleration on the rolling motion, so this inertia
+# never enters the knee's dynamics; it holds the slide along the leg against MuJoCo's implicit
+# step (module docstring, "The stretch"): 23 times the lower leg's 4.3 kg.
+STRETCH_ARMATURE = 100.0
 
 
 def _f(value: float) -> str:
@@ -130,7 +149,7 @@ def couplings(profile: KneeProfile, sides, solref: str, solimp: str) -> list[str
             f'    <fixed name="{side}_knee">',
             *(f'      <joint joint="{side}_knee_{part}" coef="1"/>' for part in ("upper", "lower")),
             "    </fixed>",
-            f'    <fixed name="{side}_knee_stretch">',
+            f'    <fixed name="{side}_knee_stretch" armature="{_f(STRETCH_ARMATURE)}">',
             f'      <joint joint="{side}_knee_slide" coef="1"/>',
             f'      <joint joint="{side}_knee_lower" coef="{_f(k1)}"/>',
             f'      <joint joint="{side}_knee_upper" coef="{_f(k2)}"/>',

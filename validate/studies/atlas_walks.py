@@ -193,7 +193,7 @@ def certified(folder, settings: atlas.Settings) -> list[atlas.Point]:
             for knee in KNEES:
                 point = atlas.Point("final", knee, criterion, cell)
                 record = atlas.read(folder, point)
-                if record is not None and record["certified"]:
+                if record is not None and record.certified:
                     found.append(point)
     return found
 

@@ -144,12 +144,14 @@ def figure(rows: list[dict], knob: str):
     chosen setting marked."""
     from matplotlib.figure import Figure
 
+    from biped.pages.style import FONT_NOTE, MARGINS_SIZE
+
     values = KNOBS[knob]["values"]
     unit = KNOBS[knob]["unit"]
     # Unbounded drawn left of the others (a landing bound: the loosest is the largest).
     positions = {v: i for i, v in enumerate(values)}
     labels = ["none" if v is None else f"{v:g}" for v in values]
-    fig = Figure(figsize=(11, 5.0), layout="constrained")
+    fig = Figure(figsize=MARGINS_SIZE, layout="constrained")
     axes = fig.subplots(1, 2)
     panels = (
         ("feedback_share", "servos' share of the joint torque", 1.0),
@@ -199,7 +201,7 @@ def figure(rows: list[dict], knob: str):
         ax.set_title(title)
         ax.grid(alpha=0.3)
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, fontsize=8, loc="outside lower center", ncol=4)
+    fig.legend(handles, labels, fontsize=FONT_NOTE, loc="outside lower center", ncol=4)
     fig.suptitle(
         "MuJoCo's 20-step walk of each sthenic optimum (dashed: the targets; ×: a check failed "
         "or a figure off its target; green: the preset)"

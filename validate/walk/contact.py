@@ -1,6 +1,8 @@
 """What MuJoCo's walk did with its feet, read from a simulation after the fact.
 
     ground_reaction   the stance foot's ground force and centre of pressure (single support)
+    feet_forces       each foot's ground force and centre of pressure in one state (both
+                      feet on the ground: a double support replayed)
     foot_tilt         the stance foot's tilt and the lift of its heel and toe, each step
     scuffs            the swing foot's touches of the floor before its landing window
     clearance         how high the swing foot passes over the floor, in MuJoCo and in the gait
@@ -63,6 +65,28 @@ def ground_reaction(sim: Simulation) -> dict:
             force[k] = f_sum[[0, 2]]
             cop[k] = moment / f_sum[2]
     return {"force": force, "cop": cop}
+
+
+def feet_forces(model: mujoco.MjModel, data: mujoco.MjData, layout, sides) -> np.ndarray:
+    """(len(sides), 3) [Fx, Fz [N], x of the centre of pressure from that foot's ankle [m]]
+    of the floor on each foot of ``sides`` in ``data``'s state (after ``mj_forward``); NaN
+    for a foot without contact force (its centre of pressure unknown)."""
+    frame = np.zeros(6)
+    out = np.zeros((len(sides), 3))
+    for row, side in enumerate(sides):
+        geoms, ankle_x = layout.foot_geoms[side], data.site(f"{side}_ankle").xpos[0]
+        f_sum, moment = np.zeros(3), 0.0
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            if contact.efc_address < 0 or not (contact.geom1 in geoms or contact.geom2 in geoms):
+                continue
+            mujoco.mj_contactForce(model, data, i, frame)
+            world = contact.frame.reshape(3, 3).T @ frame[:3]
+            f_sum += world
+            moment += (contact.pos[0] - ankle_x) * world[2]
+        cop = moment / f_sum[2] if f_sum[2] > 0.0 else np.nan
+        out[row] = f_sum[0], f_sum[2], cop
+    return out
 
 
 def _settled(sim: Simulation, period: float) -> list[slice]:

@@ -24,6 +24,13 @@ the designed gaits with a 2 cm clearance (whose swing ankle carries 0.08 N·m RM
 0.1 or more for any one joint 20 % off. At 0.25 ms the same exact torques reached 0.077 at
 that swing ankle.
 
+A two-phase gait's double support (``GaitSamples.double_support``) replays the same way from
+its landing state, both feet on the floor: the six motors' torques are the file's, which
+with both feet held fix the ground's forces on each foot (nine equations, three
+accelerations and six forces: no choice left to the contact), so ``feet`` reads MuJoCo's
+force and centre of pressure on each foot (``validate.walk.contact.feet_forces``) every
+``FEET_EVERY`` physics steps of the window, beside the file's.
+
 The window leaves out the first ``WINDOW[0]`` of the step (the contact settles under the
 stance foot, which starts exactly on the floor) and the last ``1 - WINDOW[1]`` (the swing foot
 comes down to the floor, where the landing belongs to the walk).
@@ -39,8 +46,9 @@ from mujoco import rollout
 
 from biped.model.dynamics import JOINTS, Biped
 from validate.scene.layout import Layout
-from validate.scene.mapping import mapping, rotor_torques
+from validate.scene.mapping import mapping, other, rotor_torques
 from validate.scene.model import JOINT_ORDER, with_servos
+from validate.walk.contact import feet_forces
 from validate.walk.samples import GaitSamples
 from validate.walk.simulate import KP, KV
 
@@ -50,6 +58,8 @@ TIMESTEP = 0.0000625
 SOLREF = (2 * TIMESTEP, 1.0)
 # Part of the step compared, as fractions of the period.
 WINDOW = (0.05, 0.95)
+# Physics steps between two readings of the feet's forces (``Replay.feet``).
+FEET_EVERY = 1
 
 
 @dataclass
@@ -64,6 +74,9 @@ class Replay:
         feedback: (M, 6) torques of the servos [N·m].
         angle_error: (M, 6) joint angle less the file's [rad].
         compared: (M,) the rows inside ``WINDOW``.
+        feet: with ``feet=True``, the times read (K,) [s] and MuJoCo's [Fx, Fz, x_cop] (K, 2, 3)
+            on the stance (rear) then the swing (front) foot [N, N, m from its ankle]; None
+            otherwise.
     """
 
     stance: str
@@ -72,6 +85,7 @@ class Replay:
     feedback: np.ndarray
     angle_error: np.ndarray
     compared: np.ndarray
+    feet: tuple | None = None
 
     def shares(self) -> np.ndarray:
         """(6,) the share of each joint's torque its servo added (see the module)."""
@@ -101,10 +115,14 @@ def replay_model(spec: mujoco.MjSpec, knee: str) -> mujoco.MjModel:
 
 
 def replay_step(
-    model: mujoco.MjModel, samples: GaitSamples, biped: Biped, stance: str = "left"
+    model: mujoco.MjModel,
+    samples: GaitSamples,
+    biped: Biped,
+    stance: str = "left",
+    feet: bool = False,
 ) -> Replay:
     """Replay one step of ``samples`` on ``model`` (``replay_model``) with ``stance`` the
-    stance side."""
+    stance side; with ``feet``, both feet's ground forces read along the window."""
     layout = Layout(model)
     mapped = mapping(model, stance, biped.radii)
     h = model.opt.timestep
@@ -149,13 +167,26 @@ def replay_step(
     feedforward = -(motors - rotor)[:, to_joint]
     feedback = -servo[:, to_joint]
     error = (angles - controls[0][:, layout.positions])[:, to_joint]
+    compared = t >= WINDOW[0] * period
+    read = None
+    if feet:
+        rows = np.flatnonzero(compared)[::FEET_EVERY]
+        sides = (stance, other(stance))
+        forces = np.empty((len(rows), 2, 3))
+        for j, k in enumerate(rows):  # the state and controls of step k: its forces
+            mujoco.mj_setState(model, data, before[k], spec)
+            data.ctrl[:] = controls[0][k]
+            mujoco.mj_forward(model, data)
+            forces[j] = feet_forces(model, data, layout, sides)
+        read = (t[rows], forces)
     return Replay(
         stance=stance,
         time=t,
         feedforward=feedforward,
         feedback=feedback,
         angle_error=-error,
-        compared=t >= WINDOW[0] * period,
+        compared=compared,
+        feet=read,
     )
 
 

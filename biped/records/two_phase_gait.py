@@ -1,0 +1,236 @@
+"""The double support phase of a two-phase gait file (``biped optimize --double-support``):
+the ``DoubleSupport`` record a ``Gait`` holds in its ``double_support`` block, each field with
+its unit, and how it follows from the gait's parameters (``biped.model.two_phase``).
+
+A two-phase gait file is a gait file (``biped.records.gait_file``) whose ``parameters`` are the
+two-phase step's (``biped.model.two_phase.parameter_names(landing)``), whose ``samples``,
+``costs``, ``constraints``, ``walkability`` and ``knee_loads`` are its single support phase's
+on the check grid (each integral divided by the whole step's length S = V (T + T_ds)), with no
+``impact`` and no ``electrical`` block (the landing holds both feet: its impulses are here; the
+drive's figures of a double support are not built), and with this block:
+
+    landing         "impact" or "zero-speed" (``biped.model.two_phase``)
+    duration        T_ds [s]; share T_ds / (T + T_ds), share_range the problem's
+    sthenic         C_Γ over both phases [N²·m·s]: the single support on the check grid, the
+                    double support on the solver's samples (what the optimizer minimised)
+    front_wrench    the front foot's ground wrench [Fx, Fz, Cy] at the solver's n + 1 samples
+                    of the phase (the load split the optimizer chose: an input, like the
+                    parameters); between them it is linear in time (the rule this file states)
+    coefficients    the cubic c0 + c1 t + c2 t² + c3 t³ of x_H, z_H, q5 (t from the landing)
+    landing_impulse the ground's impulse at the landing on the rear then the front foot
+    foot_margins    each foot's worst Ψ at the solver's samples (``FOOT_CONSTRAINTS``)
+    samples         the phase on ``CHECK_PER_INTERVAL`` times the solver's grid: q, q̇, q̈, the
+                    torques and both feet's wrenches (the front one as stated above)
+
+Everything here but ``front_wrench``, ``landing`` and ``share_range`` follows from the
+parameters; ``Gait.check_consistency`` recomputes it. Numpy only: read without CasADi.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from biped.errors import BipedError
+from biped.model import double_support as ds
+from biped.model.criteria import StepEvaluation
+from biped.model.dynamics import JOINTS, Biped
+from biped.model.kinematics import COORDINATES
+from biped.model.two_phase import TwoPhaseStep, build_two_phase, parameter_names
+from biped.model.units import PURE, per_coordinate, unit_field
+
+# The unit of a two-phase parameter or solver variable, from its name (the first part found).
+_UNITS = (
+    ("accel", "rad/s²"),
+    ("rate_x_hip", "m/s"),
+    ("rate_z_hip", "m/s"),
+    ("rate", "rad/s"),
+    ("bend", "rad"),
+    ("trunk", "rad"),
+    ("x_hip", "m"),
+    ("z_hip", "m"),
+    ("period", "s"),
+    ("double_support", "s"),
+    ("front_cy", "N·m"),
+    ("front_f", "N"),
+)
+# Samples of the phase's check grid per interval of the solver's (``samples``).
+CHECK_PER_INTERVAL = 10
+WRENCH = ["N", "N", "N·m"]
+WRENCH_COLUMNS = ("Fx", "Fz", "Cy")
+FEET = ("rear", "front")
+CUBIC = {
+    "x_hip": ["m", "m/s", "m/s²", "m/s³"],
+    "z_hip": ["m", "m/s", "m/s²", "m/s³"],
+    "trunk": ["rad", "rad/s", "rad/s²", "rad/s³"],
+}
+FOOT_UNITS = ["N", "N", "N", "m", "m"]  # ``biped.model.double_support.FOOT_CONSTRAINTS``
+
+
+def unit_of(name: str) -> str:
+    """The unit of the two-phase parameter or solver variable ``name``."""
+    for part, unit in _UNITS:
+        if part in name:
+            return unit
+    raise KeyError(name)
+
+
+@dataclass(frozen=True, eq=False)
+class PhaseSamples:
+    """The double support phase on its check grid, from the landing (t = 0) to lift-off."""
+
+    t: np.ndarray = unit_field("s")
+    q: np.ndarray = unit_field(per_coordinate("rad", "m"), COORDINATES)
+    qd: np.ndarray = unit_field(per_coordinate("rad/s", "m/s"), COORDINATES)
+    qdd: np.ndarray = unit_field(per_coordinate("rad/s²", "m/s²"), COORDINATES)
+    torques: np.ndarray = unit_field("N·m", JOINTS)
+    rear_wrench: np.ndarray = unit_field(WRENCH, WRENCH_COLUMNS)
+    front_wrench: np.ndarray = unit_field(WRENCH, WRENCH_COLUMNS)
+
+    def to_dict(self) -> dict:
+        return {f.name: getattr(self, f.name).tolist() for f in dataclasses.fields(self)}
+
+    @classmethod
+    def from_content(cls, content, bad) -> PhaseSamples:
+        """The samples of a file's ``double_support.samples``, each of its declared width."""
+        if not isinstance(content, dict):
+            raise bad("double_support.samples missing")
+        arrays = {}
+        for f in dataclasses.fields(cls):
+            columns = f.metadata["columns"]
+            try:
+                array = np.asarray(content[f.name], dtype=float)
+            except (KeyError, TypeError, ValueError):
+                raise bad(f"double_support.samples.{f.name} is not an array of numbers") from None
+            width = () if columns is None else (len(columns),)
+            if array.shape[1:] != width or not np.all(np.isfinite(array)):
+                raise bad(
+                    f"double_support.samples.{f.name} is not (N, {len(columns or ())}) finite"
+                )
+            arrays[f.name] = array
+        if len({len(a) for a in arrays.values()}) != 1 or len(arrays["t"]) < 2:
+            raise bad("double_support.samples do not have one row count of 2 or more")
+        return cls(**arrays)
+
+
+@dataclass(frozen=True, eq=False)
+class DoubleSupport:
+    """A two-phase gait's double support phase (see the module)."""
+
+    landing: str
+    duration: float = unit_field("s")
+    share: float = unit_field(PURE)
+    share_range: list = unit_field(PURE)
+    sthenic: float = unit_field("N²·m·s")
+    front_wrench: list = unit_field(WRENCH, WRENCH_COLUMNS)
+    coefficients: dict = unit_field(CUBIC)
+    landing_impulse: list = unit_field(WRENCH + WRENCH)
+    foot_margins: dict = unit_field({foot: FOOT_UNITS for foot in FEET})
+    feasible: bool  # both feet's constraints at the solver's samples, the rear foot pushed
+    samples: PhaseSamples = unit_field(PhaseSamples)
+
+    def to_dict(self) -> dict:
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        values["samples"] = self.samples.to_dict()
+        return values
+
+    @classmethod
+    def from_content(cls, content, bad) -> DoubleSupport:
+        """The record of a file's ``double_support`` object, its numbers checked finite."""
+        if not isinstance(content, dict):
+            raise bad("double_support is not an object")
+        names = [f.name for f in dataclasses.fields(cls)]
+        missing = [name for name in names if name not in content]
+        if missing:
+            raise bad(f"double_support.{missing[0]} missing")
+        front = np.asarray(content["front_wrench"], dtype=float)
+        if front.ndim != 2 or front.shape[1] != 3 or len(front) < 3 or (len(front) - 1) % 2:
+            raise bad(
+                f"double_support.front_wrench has shape {front.shape}: allowed (n + 1, 3), n even"
+            )
+        if not np.all(np.isfinite(front)):
+            raise bad("double_support.front_wrench is not finite: allowed finite numbers")
+        fields = {name: content[name] for name in names}
+        fields["samples"] = PhaseSamples.from_content(content["samples"], bad)
+        return cls(**fields)
+
+    @property
+    def front_wrench_array(self) -> np.ndarray:
+        """(n + 1, 3) [N, N, N·m] at the solver's samples."""
+        return np.asarray(self.front_wrench, dtype=float)
+
+
+def two_phase_step(model: Biped, speed: float, parameters: dict, landing: str) -> TwoPhaseStep:
+    """The step of a two-phase gait file's ``parameters`` (by name)."""
+    names = parameter_names(landing)
+    return build_two_phase(model, speed, np.array([parameters[n] for n in names]), landing)
+
+
+def _simpson(n: int) -> np.ndarray:
+    """Simpson's weights on n + 1 equally spaced samples of [0, 1] (n even)."""
+    w = np.ones(n + 1)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    return w / (3.0 * n)
+
+
+def front_wrench_at(front, duration: float, t) -> np.ndarray:
+    """The front foot's wrench (M, 3) at times t [s] from the landing: linear between the
+    solver's samples ``front`` (n + 1, 3), equally spaced over ``duration``."""
+    front = np.asarray(front, dtype=float)
+    grid = np.linspace(0.0, duration, len(front))
+    return np.column_stack([np.interp(t, grid, front[:, k]) for k in range(3)])
+
+
+def phase_samples(model: Biped, step: TwoPhaseStep, front) -> PhaseSamples:
+    """The double support of ``step`` on its check grid, the front foot's wrench ``front``
+    (n + 1, 3) at the solver's samples, linear between them."""
+    n = (len(front) - 1) * CHECK_PER_INTERVAL
+    t = np.linspace(0.0, step.double.duration, n + 1)
+    q, qd, qdd = ds.chain_state(
+        model, step.double.step_length, *ds.phase_coordinates(step.double, t)
+    )
+    swing = front_wrench_at(front, step.double.duration, t)
+    torques, rear = ds.split_with_swing_wrench(model, q, qd, qdd, swing)
+    return PhaseSamples(t, q, qd, qdd, torques, rear, swing)
+
+
+def double_support_of(
+    model: Biped,
+    step: TwoPhaseStep,
+    evaluation: StepEvaluation,
+    front,
+    share_range,
+) -> DoubleSupport:
+    """The record of ``step``'s double support, the single support's ``evaluation`` on the
+    check grid (its part of C_Γ), the front foot's wrench ``front`` at the solver's samples."""
+    front = np.asarray(front, dtype=float)
+    if front.ndim != 2 or front.shape[1] != 3 or (len(front) - 1) % 2 or len(front) < 3:
+        raise BipedError(f"front wrench of shape {front.shape}: allowed (n + 1, 3), n even")
+    samples = phase_samples(model, step, front)
+    at_solver = slice(None, None, CHECK_PER_INTERVAL)
+    torques, rear = samples.torques[at_solver], samples.rear_wrench[at_solver]
+    double = step.double.duration * float(_simpson(len(front) - 1) @ (torques**2).sum(-1))
+    margins = {
+        foot: ds.foot_margins(model.robot, wrench).min(axis=0).tolist()
+        for foot, wrench in zip(FEET, (rear, front), strict=True)
+    }
+    rear_pushed = not step.landing == "impact" or step.impulse[1] >= 0.0
+    feasible = bool(rear_pushed and all(min(m) >= 0.0 for m in margins.values()))
+    dwell = step.double.duration
+    return DoubleSupport(
+        landing=step.landing,
+        duration=dwell,
+        share=dwell / step.duration,
+        share_range=[float(x) for x in share_range],
+        sthenic=evaluation.sthenic + double / step.step_length,
+        front_wrench=front.tolist(),
+        coefficients={
+            name: row.tolist() for name, row in zip(CUBIC, step.double.coefficients, strict=True)
+        },
+        landing_impulse=np.asarray(step.impulse, dtype=float).tolist(),
+        foot_margins=margins,
+        feasible=feasible,
+        samples=samples,
+    )

@@ -1,0 +1,124 @@
+"""A two-phase gait in MuJoCo: its samples cover both phases, MuJoCo's dynamics and a replay
+of both phases agree with it (both feet's ground forces in double support), and the checks
+not built for it say so."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from biped import Biped
+from biped.model.kinematics import swap_legs
+from tests.conftest import two_phase_gait
+from validate.checks import checks as c
+from validate.checks.validation import two_phase_checks
+from validate.scene.model import compile_spec, model_spec
+from validate.walk.samples import GaitSamples
+
+
+@pytest.fixture(scope="module")
+def gait():
+    return two_phase_gait("rolling")
+
+
+@pytest.fixture(scope="module")
+def samples(gait):
+    return GaitSamples.from_gait(gait)
+
+
+def test_samples_cover_both_phases_continuously(gait, samples):
+    """The samples run from lift-off through the landing (positions continuous, the
+    velocities jumping by the impact: the file's double support starts after it) to the
+    next lift-off, which is the first sample's state with the legs swapped; the front foot
+    carries no load in single support and the file's wrench in double support."""
+    t_land, eps = samples.landing, 1e-9
+    assert samples.period == pytest.approx(gait.period + gait.double_support.duration)
+    before, after = samples.at("q", [t_land - eps]), samples.at("q", [t_land + eps])
+    np.testing.assert_allclose(before, after, atol=1e-7)
+    np.testing.assert_allclose(samples.at("qd", [t_land - eps])[0], gait.samples.qd[-1], atol=1e-6)
+    np.testing.assert_allclose(
+        samples.at("qd", [t_land + eps])[0], gait.double_support.samples.qd[0], atol=1e-6
+    )
+    q_lift, qd_lift = swap_legs(gait.biped, samples.q[-1], samples.qd[-1])
+    np.testing.assert_allclose(q_lift, samples.q[0], atol=1e-12)
+    np.testing.assert_allclose(qd_lift, samples.qd[0], atol=1e-12)
+    single = samples.t < t_land
+    assert not np.any(samples.swing_wrench[single])
+    np.testing.assert_allclose(
+        samples.double_support().swing_wrench, gait.double_support.samples.front_wrench
+    )
+    assert samples.single_support().period == gait.period
+
+
+def test_validation_of_a_two_phase_gait(gait):
+    """On its own model: the model, MuJoCo's inverse dynamics along both phases (the front
+    foot's wrench given), the knee loads, the landing against MuJoCo's impact map holding
+    both feet and the replay of both phases, with both feet's ground forces within
+    ``FOOT_FORCE_SHARE`` of the weight, pass; the walk, its gains and its orbit are not run,
+    and fail as such."""
+    checks = {check.name: check for check in two_phase_checks(gait, model_spec(gait.biped))}
+    for name in ("model", "inverse_dynamics", "knee_loads", "impact", "feedforward"):
+        assert checks[name].passed, checks[name].line()
+    figures = checks["feedforward"].figures
+    for foot in ("rear", "front"):
+        assert figures[f"{foot}_force_rms_error"] < c.FOOT_FORCE_SHARE * gait.robot.weight
+    for name in ("forward", "gains", "orbit"):
+        assert not checks[name].passed and checks[name].causes == ["not run"]
+
+
+def test_wrong_knee_model_fails_the_replay(gait, samples):
+    """The rolling knee's two-phase gait replayed on the revolute knee's model: the servos
+    and both feet's forces are far off, and so is its landing against MuJoCo's impact map."""
+    wrong = Biped(gait.robot, "revolute")
+    check = c.check_two_phase_feedforward(model_spec(wrong), wrong, samples)
+    assert not check.passed and set(check.causes) == {"servo share", "foot forces"}
+    model = compile_spec(model_spec(wrong))
+    impact = c.check_two_phase_impact(model, wrong, samples, gait)
+    assert not impact.passed and impact.causes == ["model mismatch"]
+
+
+def test_double_support_stretched_fails_the_replay(gait, samples):
+    """The double support's duration 10 % longer in the samples (the same torques, a slower
+    motion): the feet's forces and the servos are off."""
+    t = samples.t.copy()
+    later = t > samples.landing
+    t[later] = samples.landing + 1.1 * (t[later] - samples.landing)
+    stretched = dataclasses.replace(samples, t=t, period=float(t[-1]))
+    check = c.check_two_phase_feedforward(model_spec(gait.biped), gait.biped, stretched)
+    assert not check.passed and "foot forces" in check.causes
+
+
+def test_another_split_fails_the_feet_forces(gait, samples):
+    """The same motion and torques with 100 N moved from the rear foot's Fz to the front
+    foot's in the file: MuJoCo's feet, pushed by the same torques, do not carry that split."""
+    rear, front = samples.wrench.copy(), samples.swing_wrench.copy()
+    double = samples.t >= samples.landing
+    rear[double, 1] -= 100.0
+    front[double, 1] += 100.0
+    moved = dataclasses.replace(samples, wrench=rear, swing_wrench=front)
+    check = c.check_two_phase_feedforward(model_spec(gait.biped), gait.biped, moved)
+    assert not check.passed and check.causes == ["foot forces"]
+
+
+def test_biped_validate_of_a_two_phase_gait(gait, tmp_path, capsys):
+    """``biped validate`` on a two-phase gait file runs its checks, prints the ones not run
+    as such, writes the report without a recording and exits 1 (not every check passed); a
+    video of its walk is refused before any work (exit 2, one line)."""
+    import json
+
+    from biped_cli import main
+
+    path = gait.write(tmp_path / "two.json")
+    rrd = tmp_path / "rec" / "two.rrd"
+    assert main(["validate", str(path), "--rrd", str(rrd)]) == 1
+    printed = capsys.readouterr().out
+    assert "PASS  feedforward" in printed and "PASS  impact" in printed
+    assert "FAIL  forward           [not run]" in printed
+    report = json.loads((tmp_path / "rec" / "two.report.json").read_text())
+    assert report["passed"] is False and report["feedforward"]["passed"] is True
+    assert report["units"]["feedforward.rear_force_rms_error"] == "N"
+    assert not rrd.exists()
+    video = tmp_path / "walk.mp4"
+    assert main(["validate", str(path), "--video", str(video)]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "two phases" in error and not video.exists()
