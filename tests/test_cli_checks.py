@@ -23,6 +23,7 @@ REQUIRED = {
     "figures": [],
     "table": [],
     "atlas": [],
+    "compare-atlas": ["missing-base", "missing-rich"],
     "converge": ["--speed", "0.3"],
     "design": ["--speed", "0.3"],
     "design-map": [],
