@@ -20,6 +20,7 @@ from biped.studies.criteria_matrix import (
     KneeMatrix,
     Values,
     cross_started,
+    drive_parts,
 )
 from biped_cli import main
 from biped_cli.criteria import _verdict
@@ -127,6 +128,28 @@ def test_an_optimum_beaten_in_its_own_criterion_is_started_again(run):
     assert again.restarted == {"sthenic": "energy-per-metre"}
     assert again.optima["sthenic"].certified
     assert again.optima["sthenic"].value == pytest.approx(sthenic.value, rel=1e-5)
+
+
+def test_the_frictionless_energy_is_the_electrical_one_of_drives_without_friction(run):
+    """The electrical optimum's gait on drives without friction (viscous and Coulomb 0): its
+    electrical energy is what ``drive_parts`` gives without friction on the real drives, and
+    there without friction itself; the real drives' friction costs energy here. Braking
+    work is (|work| − net work) / 2, never negative."""
+    optimum = run["optima"]["revolute"].optima["electrical"]
+    length = optimum.step.step_length
+    free_drives = {"actuator": {"viscous_friction": 0.0, "coulomb_friction": 0.0}}
+    robot = biped.Robot.from_mapping(free_drives)
+    problem = dataclasses.replace(optimum.problem, model=biped.Biped(robot, "revolute"))
+    free = checked(problem, optimum.variables, optimum.report)
+    electrical_free = free.evaluation.value("electrical", length)
+    frictionless, braking = drive_parts(optimum)
+    assert frictionless == pytest.approx(electrical_free, rel=1e-12)
+    assert drive_parts(free)[0] == pytest.approx(electrical_free, rel=1e-12)
+    assert frictionless < optimum.evaluation.value("electrical", length)
+    ev = optimum.evaluation
+    net = ev.weights @ (ev.torques * ev.joint_rates).sum(-1)
+    assert braking == pytest.approx((ev.energy - net) / (2 * length), rel=1e-9)
+    assert braking >= 0.0
 
 
 def test_an_optimum_not_certified_leaves_its_figures_unknown_and_exits_1(run, capsys):

@@ -14,6 +14,10 @@ COSTS_WORDS = (
     "What optimizing each criterion (rows) costs in each other (columns), relative to that "
     "other's own optimum:"
 )
+WHY_WORDS = (
+    "Where the electrical energy goes (the same gaits; the friction is the electrical "
+    "energy less its value without the drives' friction):"
+)
 # The margins' presets named.
 MARGINS = {PAPER_SAFETY: "the paper's constraints", WALKABLE: "the walkable constraints"}
 
@@ -51,19 +55,20 @@ def _column(criterion: str) -> str:
 
 def values_table(matrix: KneeMatrix) -> list[str]:
     """One knee's matrix: a row per criterion minimised, every criterion measured on its
-    optimum (the diagonal in bold), the step, and whether it is certified."""
-    head = "| optimum of | " + " | ".join(map(_column, STUDIED)) + " | period [s] | step [m] |"
-    lines = [head, "|---" * (len(STUDIED) + 3) + "|"]
+    optimum (the diagonal in bold), the step, whether it is certified, and how many starts
+    reached its value (one alone: another optimum may lie near, other in the other
+    criteria)."""
+    head = " | ".join(map(_column, STUDIED)) + " | period [s] | step [m] | starts at its value |"
+    lines = ["| optimum of | " + head, "|---" * (len(STUDIED) + 4) + "|"]
     for row in matrix.rows:
         cells = []
         for measured in STUDIED:
             shown = _value(row.values.of(measured))
             cells.append(f"**{shown}**" if measured == row.optimized else shown)
         flag = "" if row.certified else f" (NOT CERTIFIED: {row.status})"
-        lines.append(
-            f"| {row.optimized}{flag} | " + " | ".join(cells)
-            + f" | {row.period:.4f} | {row.step_length:.4f} |"
-        )  # fmt: skip
+        step = f"{row.period:.4f} | {row.step_length:.4f}"
+        starts = f"{row.starts_at_best} of {row.starts}"
+        lines.append(f"| {row.optimized}{flag} | " + " | ".join(cells) + f" | {step} | {starts} |")
     return lines
 
 
@@ -77,6 +82,21 @@ def costs_table(matrix: KneeMatrix) -> list[str]:
             for measured in STUDIED
         ]
         lines.append(f"| {optimized} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def why_table(matrix: KneeMatrix) -> list[str]:
+    """Where each optimum's electrical energy goes: the drives' friction in it, and the
+    joints' braking work, which the energy criteria pay as work and the electrical one
+    barely (``biped.studies.criteria_matrix.drive_parts``)."""
+    lines = [
+        "| optimum of | electrical [J/m] | of it, the drives' friction [J/m] | braking work "
+        "[J/m] |",
+        "|---|---|---|---|",
+    ]
+    for row in matrix.rows:
+        cells = (row.values.of("electrical"), matrix.friction(row.optimized), row.braking)
+        lines.append(f"| {row.optimized} | " + " | ".join(_value(c, 2) for c in cells) + " |")
     return lines
 
 
@@ -115,6 +135,7 @@ def sentence(study: CriteriaStudy) -> list[str]:
             f"{matrix.knee} knee: each optimum is the least of its own criterion; optimizing "
             f"{worst[0]} costs {_percent(matrix.cost(*worst))} in {worst[1]}, the most, "
             f"optimizing {least[0]} {_percent(matrix.cost(*least))} in {least[1]}, the least."
+            + _why(matrix)
         )
     own = ", ".join(f"{c} {_percent(study.difference(c, c))}" for c in STUDIED)
     lines.append(f"Rolling vs revolute, each at its own optimum of the criterion: {own}.")
@@ -127,9 +148,29 @@ def tables(study: CriteriaStudy) -> list[str]:
     for matrix in study.knees:
         lines += [f"## {matrix.knee} knee", "", *values_table(matrix), ""]
         lines += [COSTS_WORDS, "", *costs_table(matrix), ""]
+        lines += [WHY_WORDS, "", *why_table(matrix), ""]
     lines += ["## Rolling vs revolute", "", "(rolling − revolute) / revolute of each criterion "
               "(columns) at each knee's optimum of a criterion (rows):", ""]  # fmt: skip
     return [*lines, *differences_table(study)]
+
+
+def _why(matrix: KneeMatrix) -> str:
+    """Why the electrical optimum parts from the others, in a sentence ("" where unknown)."""
+    shares = {}
+    for optimized in ("sthenic", "electrical"):
+        friction, electrical = matrix.friction(optimized), matrix.known(optimized, "electrical")
+        if friction is None or not electrical:
+            return ""
+        shares[optimized] = 100 * friction / electrical
+    braking = [matrix.row(optimized).braking for optimized in ("sthenic", "electrical")]
+    if None in braking:
+        return ""
+    return (
+        f" The drives' friction is {shares['sthenic']:.0f} % of the sthenic optimum's "
+        f"electrical energy and {shares['electrical']:.0f} % of the electrical optimum's, "
+        f"which brakes the joints by {braking[1]:.2f} J/m (the sthenic optimum "
+        f"{braking[0]:.2f} J/m)."
+    )
 
 
 def markdown(study: CriteriaStudy, figure: str | None = None, seconds: float | None = None) -> str:
@@ -153,4 +194,12 @@ def markdown(study: CriteriaStudy, figure: str | None = None, seconds: float | N
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["costs_table", "differences_table", "markdown", "sentence", "tables", "values_table"]
+__all__ = [
+    "costs_table",
+    "differences_table",
+    "markdown",
+    "sentence",
+    "tables",
+    "values_table",
+    "why_table",
+]

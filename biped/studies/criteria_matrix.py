@@ -32,7 +32,10 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+import numpy as np
+
 from biped.errors import BipedError
+from biped.model.actuators import drive
 from biped.model.bezier import Bezier
 from biped.model.criteria import CRITERION_UNITS, Safety, safety_dict
 from biped.model.gait import check_knots, family_json, parameter_names
@@ -85,6 +88,27 @@ def _measured(value) -> float | None:
     return value if math.isfinite(value) else None
 
 
+# The drives' friction (``biped.model.actuators.Actuator``): viscous and Coulomb, in the
+# gear and the motor.
+FRICTION = ("viscous_friction", "coulomb_friction")
+
+
+def drive_parts(optimum: Optimum) -> tuple[float | None, float | None]:
+    """What the criteria weigh differently in ``optimum``'s gait, each per metre walked
+    [J/m]: the electrical energy without regeneration as the criterion measures it but with
+    the drives' friction removed (the same torques, rates and accelerations,
+    ``biped.model.actuators.drive``), and the joints' braking work −∫ Σ min(Γ_i θ̇_i, 0) dt,
+    which the energy criteria count as they count positive work and the electrical one barely
+    (the friction brakes through the gear, the power sent back is lost, not paid)."""
+    ev, length = optimum.evaluation, optimum.step.step_length
+    constants = ev.actuators.constants()
+    held = {name: np.zeros_like(v) if name in FRICTION else v for name, v in constants.items()}
+    power = drive(held, ev.torques, ev.joint_rates, ev.joint_accels).power
+    frictionless = ev.weights @ np.maximum(power, 0.0).sum(-1) / length
+    braking = -(ev.weights @ np.minimum(ev.torques * ev.joint_rates, 0.0).sum(-1)) / length
+    return _measured(frictionless), _measured(braking)
+
+
 @dataclass(frozen=True)
 class OptimumRow:
     """One knee's optimum of one criterion and every criterion measured on it."""
@@ -98,6 +122,10 @@ class OptimumRow:
     starts: int = unit_field(PURE)  # of its multistart, the cross starts included
     starts_at_best: int = unit_field(PURE)  # converged starts at its value (AGREEMENT)
     seconds: float = unit_field("s")  # wall time of its starts
+    # what the criteria weigh differently (``drive_parts``): the electrical energy per metre
+    # with the drives' friction removed, and the joints' braking (negative) work per metre
+    frictionless: float | None = unit_field("J/m")
+    braking: float | None = unit_field("J/m")
     # the criterion whose optimum started it again (``cross_started``); None: none, and
     # the JSON leaves it out
     restarted_from: str | None = unit_field(None, default=None)
@@ -105,6 +133,7 @@ class OptimumRow:
     @classmethod
     def of_optimum(cls, optimum: Optimum, restarted_from: str | None = None) -> OptimumRow:
         report = optimum.report
+        frictionless, braking = drive_parts(optimum)
         return cls(
             optimized=optimum.criterion,
             values=Values.of_optimum(optimum),
@@ -115,6 +144,8 @@ class OptimumRow:
             starts=int(report.starts),
             starts_at_best=int(report.starts_at_best),
             seconds=float(report.seconds),
+            frictionless=frictionless,
+            braking=braking,
             restarted_from=restarted_from,
         )
 
@@ -170,6 +201,15 @@ class KneeMatrix:
         if not self.certified:
             return None
         return not self.exceptions(tolerance)
+
+    def friction(self, optimized: str) -> float | None:
+        """[J/m] The share of the drives' friction in the electrical energy of the optimum of
+        ``optimized``: the electrical energy less its value without friction."""
+        row = self.row(optimized)
+        electrical = row.values.of("electrical")
+        if electrical is None or row.frictionless is None:
+            return None
+        return electrical - row.frictionless
 
     def costs(self) -> dict:
         """{optimized: {measured: cost [%]}} for each pair of different criteria."""
@@ -396,6 +436,7 @@ __all__ = [
     "OptimumRow",
     "Values",
     "cross_started",
+    "drive_parts",
     "optimize_criteria",
     "study_of",
 ]
