@@ -19,8 +19,9 @@ from biped.studies.criteria_matrix import (
     CriteriaStudy,
     KneeMatrix,
     Values,
+    braking_work,
     cross_started,
-    drive_parts,
+    electrical_without,
 )
 from biped_cli import main
 from biped_cli.criteria import _verdict
@@ -130,26 +131,31 @@ def test_an_optimum_beaten_in_its_own_criterion_is_started_again(run):
     assert again.optima["sthenic"].value == pytest.approx(sthenic.value, rel=1e-5)
 
 
-def test_the_frictionless_energy_is_the_electrical_one_of_drives_without_friction(run):
-    """The electrical optimum's gait on drives without friction (viscous and Coulomb 0): its
-    electrical energy is what ``drive_parts`` gives without friction on the real drives, and
-    there without friction itself; the real drives' friction costs energy here. Braking
-    work is (|work| − net work) / 2, never negative."""
-    optimum = run["optima"]["revolute"].optima["electrical"]
+@pytest.mark.parametrize(
+    "removed, kept",
+    [
+        (criteria_matrix.FRICTION, {"viscous_friction": 0.0, "coulomb_friction": 0.0}),
+        (criteria_matrix.ROTORS, {"rotor_inertia": 0.0}),
+    ],
+)
+def test_the_energy_without_a_part_is_that_of_drives_without_it(run, removed, kept):
+    """The sthenic optimum's gait on drives without friction (or without rotor inertia): its
+    electrical energy is what ``electrical_without`` gives on the real drives, and there
+    without the part itself; the part costs energy here. Braking work is (|work| − net
+    work) / 2 per metre, never negative."""
+    optimum = run["optima"]["revolute"].optima["sthenic"]
     length = optimum.step.step_length
-    free_drives = {"actuator": {"viscous_friction": 0.0, "coulomb_friction": 0.0}}
-    robot = biped.Robot.from_mapping(free_drives)
+    robot = biped.Robot.from_mapping({"actuator": kept})
     problem = dataclasses.replace(optimum.problem, model=biped.Biped(robot, "revolute"))
     free = checked(problem, optimum.variables, optimum.report)
-    electrical_free = free.evaluation.value("electrical", length)
-    frictionless, braking = drive_parts(optimum)
-    assert frictionless == pytest.approx(electrical_free, rel=1e-12)
-    assert drive_parts(free)[0] == pytest.approx(electrical_free, rel=1e-12)
-    assert frictionless < optimum.evaluation.value("electrical", length)
+    energy_free = free.evaluation.value("electrical", length)
+    assert electrical_without(optimum, removed) == pytest.approx(energy_free, rel=1e-12)
+    assert electrical_without(free, removed) == pytest.approx(energy_free, rel=1e-12)
+    assert energy_free < optimum.evaluation.value("electrical", length)
     ev = optimum.evaluation
     net = ev.weights @ (ev.torques * ev.joint_rates).sum(-1)
-    assert braking == pytest.approx((ev.energy - net) / (2 * length), rel=1e-9)
-    assert braking >= 0.0
+    assert braking_work(optimum) == pytest.approx((ev.energy - net) / (2 * length), rel=1e-9)
+    assert braking_work(optimum) >= 0.0
 
 
 def test_an_optimum_not_certified_leaves_its_figures_unknown_and_exits_1(run, capsys):

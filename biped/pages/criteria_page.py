@@ -15,8 +15,8 @@ COSTS_WORDS = (
     "other's own optimum:"
 )
 WHY_WORDS = (
-    "Where the electrical energy goes (the same gaits; the friction is the electrical "
-    "energy less its value without the drives' friction):"
+    "Where the electrical energy goes (the same gaits; each part is the electrical energy "
+    "less its value without the drives' friction, or without the rotors' inertia):"
 )
 # The margins' presets named.
 MARGINS = {PAPER_SAFETY: "the paper's constraints", WALKABLE: "the walkable constraints"}
@@ -86,17 +86,24 @@ def costs_table(matrix: KneeMatrix) -> list[str]:
 
 
 def why_table(matrix: KneeMatrix) -> list[str]:
-    """Where each optimum's electrical energy goes: the drives' friction in it, and the
-    joints' braking work, which the energy criteria pay as work and the electrical one
-    barely (``biped.studies.criteria_matrix.drive_parts``)."""
+    """Where each optimum's electrical energy goes: the parts of the drives' friction and
+    of the rotors' inertia in it (what the sthenic criterion does not see), and the joints'
+    braking work, which the energy criteria pay as work and the electrical one barely
+    (``biped.studies.criteria_matrix``: ``electrical_without``, ``braking_work``)."""
     lines = [
-        "| optimum of | electrical [J/m] | of it, the drives' friction [J/m] | braking work "
-        "[J/m] |",
-        "|---|---|---|---|",
+        "| optimum of | electrical [J/m] | of it, the drives' friction [J/m] | the rotors' "
+        "inertia [J/m] | braking work [J/m] |",
+        "|---|---|---|---|---|",
     ]
     for row in matrix.rows:
-        cells = (row.values.of("electrical"), matrix.friction(row.optimized), row.braking)
-        lines.append(f"| {row.optimized} | " + " | ".join(_value(c, 2) for c in cells) + " |")
+        optimized = row.optimized
+        cells = (
+            row.values.of("electrical"),
+            matrix.part(optimized, "frictionless"),
+            matrix.part(optimized, "rotorless"),
+            row.braking,
+        )
+        lines.append(f"| {optimized} | " + " | ".join(_value(c, 2) for c in cells) + " |")
     return lines
 
 
@@ -156,20 +163,17 @@ def tables(study: CriteriaStudy) -> list[str]:
 
 def _why(matrix: KneeMatrix) -> str:
     """Why the electrical optimum parts from the others, in a sentence ("" where unknown)."""
-    shares = {}
-    for optimized in ("sthenic", "electrical"):
-        friction, electrical = matrix.friction(optimized), matrix.known(optimized, "electrical")
-        if friction is None or not electrical:
-            return ""
-        shares[optimized] = 100 * friction / electrical
+    electrical = matrix.known("sthenic", "electrical")
+    friction = matrix.part("sthenic", "frictionless")
+    rotors = matrix.part("sthenic", "rotorless")
     braking = [matrix.row(optimized).braking for optimized in ("sthenic", "electrical")]
-    if None in braking:
+    if not electrical or None in (friction, rotors, *braking):
         return ""
     return (
-        f" The drives' friction is {shares['sthenic']:.0f} % of the sthenic optimum's "
-        f"electrical energy and {shares['electrical']:.0f} % of the electrical optimum's, "
-        f"which brakes the joints by {braking[1]:.2f} J/m (the sthenic optimum "
-        f"{braking[0]:.2f} J/m)."
+        f" Of the sthenic optimum's electrical energy, {electrical:.1f} J/m, the drives' "
+        f"friction makes {friction:.1f} and the rotors' inertia {rotors:.1f} J/m, which the "
+        f"sthenic criterion does not see; the electrical optimum brakes the joints by "
+        f"{braking[1]:.2f} J/m (the sthenic optimum {braking[0]:.2f})."
     )
 
 

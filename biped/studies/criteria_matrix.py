@@ -88,25 +88,31 @@ def _measured(value) -> float | None:
     return value if math.isfinite(value) else None
 
 
-# The drives' friction (``biped.model.actuators.Actuator``): viscous and Coulomb, in the
-# gear and the motor.
+# What the sthenic criterion does not see of the drives (``biped.model.actuators.Actuator``):
+# their friction, viscous and Coulomb, in the gear and the motor; the rotors' inertia, which
+# the gear multiplies by its ratio squared.
 FRICTION = ("viscous_friction", "coulomb_friction")
+ROTORS = ("rotor_inertia",)
 
 
-def drive_parts(optimum: Optimum) -> tuple[float | None, float | None]:
-    """What the criteria weigh differently in ``optimum``'s gait, each per metre walked
-    [J/m]: the electrical energy without regeneration as the criterion measures it but with
-    the drives' friction removed (the same torques, rates and accelerations,
-    ``biped.model.actuators.drive``), and the joints' braking work −∫ Σ min(Γ_i θ̇_i, 0) dt,
-    which the energy criteria count as they count positive work and the electrical one barely
-    (the friction brakes through the gear, the power sent back is lost, not paid)."""
-    ev, length = optimum.evaluation, optimum.step.step_length
+def electrical_without(optimum: Optimum, removed: tuple) -> float | None:
+    """[J/m] ``optimum``'s electrical energy per metre without regeneration, as the criterion
+    measures it, with the drives' constants ``removed`` set to 0 (the same torques, rates
+    and accelerations, ``biped.model.actuators.drive``)."""
+    ev = optimum.evaluation
     constants = ev.actuators.constants()
-    held = {name: np.zeros_like(v) if name in FRICTION else v for name, v in constants.items()}
+    held = {name: np.zeros_like(v) if name in removed else v for name, v in constants.items()}
     power = drive(held, ev.torques, ev.joint_rates, ev.joint_accels).power
-    frictionless = ev.weights @ np.maximum(power, 0.0).sum(-1) / length
-    braking = -(ev.weights @ np.minimum(ev.torques * ev.joint_rates, 0.0).sum(-1)) / length
-    return _measured(frictionless), _measured(braking)
+    return _measured(ev.weights @ np.maximum(power, 0.0).sum(-1) / optimum.step.step_length)
+
+
+def braking_work(optimum: Optimum) -> float | None:
+    """[J/m] The joints' braking work per metre, −∫ Σ min(Γ_i θ̇_i, 0) dt / S, which the
+    energy criteria count as they count positive work and the electrical one barely (the
+    friction brakes through the gear, and the power sent back is lost, not paid)."""
+    ev = optimum.evaluation
+    work = ev.weights @ np.minimum(ev.torques * ev.joint_rates, 0.0).sum(-1)
+    return _measured(-work / optimum.step.step_length)
 
 
 @dataclass(frozen=True)
@@ -122,9 +128,11 @@ class OptimumRow:
     starts: int = unit_field(PURE)  # of its multistart, the cross starts included
     starts_at_best: int = unit_field(PURE)  # converged starts at its value (AGREEMENT)
     seconds: float = unit_field("s")  # wall time of its starts
-    # what the criteria weigh differently (``drive_parts``): the electrical energy per metre
-    # with the drives' friction removed, and the joints' braking (negative) work per metre
+    # what the criteria weigh differently: the electrical energy per metre with the drives'
+    # friction removed, with the rotors' inertia removed (``electrical_without``), and the
+    # joints' braking (negative) work per metre (``braking_work``)
     frictionless: float | None = unit_field("J/m")
+    rotorless: float | None = unit_field("J/m")
     braking: float | None = unit_field("J/m")
     # the criterion whose optimum started it again (``cross_started``); None: none, and
     # the JSON leaves it out
@@ -133,7 +141,6 @@ class OptimumRow:
     @classmethod
     def of_optimum(cls, optimum: Optimum, restarted_from: str | None = None) -> OptimumRow:
         report = optimum.report
-        frictionless, braking = drive_parts(optimum)
         return cls(
             optimized=optimum.criterion,
             values=Values.of_optimum(optimum),
@@ -144,8 +151,9 @@ class OptimumRow:
             starts=int(report.starts),
             starts_at_best=int(report.starts_at_best),
             seconds=float(report.seconds),
-            frictionless=frictionless,
-            braking=braking,
+            frictionless=electrical_without(optimum, FRICTION),
+            rotorless=electrical_without(optimum, ROTORS),
+            braking=braking_work(optimum),
             restarted_from=restarted_from,
         )
 
@@ -202,14 +210,13 @@ class KneeMatrix:
             return None
         return not self.exceptions(tolerance)
 
-    def friction(self, optimized: str) -> float | None:
-        """[J/m] The share of the drives' friction in the electrical energy of the optimum of
-        ``optimized``: the electrical energy less its value without friction."""
+    def part(self, optimized: str, without: str) -> float | None:
+        """[J/m] The part of the drives' friction (``without`` "frictionless") or of the
+        rotors' inertia ("rotorless") in the electrical energy of the optimum of
+        ``optimized``: the electrical energy less its value without them."""
         row = self.row(optimized)
-        electrical = row.values.of("electrical")
-        if electrical is None or row.frictionless is None:
-            return None
-        return electrical - row.frictionless
+        electrical, less = row.values.of("electrical"), getattr(row, without)
+        return None if electrical is None or less is None else electrical - less
 
     def costs(self) -> dict:
         """{optimized: {measured: cost [%]}} for each pair of different criteria."""
@@ -436,7 +443,8 @@ __all__ = [
     "OptimumRow",
     "Values",
     "cross_started",
-    "drive_parts",
+    "braking_work",
+    "electrical_without",
     "optimize_criteria",
     "study_of",
 ]
