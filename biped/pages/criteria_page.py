@@ -45,8 +45,8 @@ def _value(value: float | None, digits: int = 4) -> str:
     return UNKNOWN if value is None else f"{value:.{digits}f}"
 
 
-def _percent(value: float | None) -> str:
-    return UNKNOWN if value is None else f"{value:+.1f} %"
+def _percent(value: float | None, digits: int = 1) -> str:
+    return UNKNOWN if value is None else f"{value:+.{digits}f} %"
 
 
 def _column(criterion: str) -> str:
@@ -112,7 +112,7 @@ def differences_table(study: CriteriaStudy) -> list[str]:
     of each criterion (row)."""
     lines = ["| optimum of | " + " | ".join(STUDIED) + " |", "|---" * (len(STUDIED) + 1) + "|"]
     for optimized in STUDIED:
-        cells = [_percent(study.difference(optimized, measured)) for measured in STUDIED]
+        cells = [_percent(study.difference(optimized, measured), 2) for measured in STUDIED]
         lines.append(f"| {optimized} | " + " | ".join(cells) + " |")
     return lines
 
@@ -144,7 +144,7 @@ def sentence(study: CriteriaStudy) -> list[str]:
             f"optimizing {least[0]} {_percent(matrix.cost(*least))} in {least[1]}, the least."
             + _why(matrix)
         )
-    own = ", ".join(f"{c} {_percent(study.difference(c, c))}" for c in STUDIED)
+    own = ", ".join(f"{c} {_percent(study.difference(c, c), 2)}" for c in STUDIED)
     lines.append(f"Rolling vs revolute, each at its own optimum of the criterion: {own}.")
     return lines
 
