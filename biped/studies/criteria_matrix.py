@@ -20,6 +20,11 @@ it). Where another criterion's optimum is lower in c, the optimization of c is s
 from it (``cross_started``, which ``OptimumRow.restarted_from`` records); a column whose
 diagonal is still not its least is said (``KneeMatrix.exceptions``) and the command exits 1.
 
+Why they part, in each row: the optimum's electrical energy without the drives' friction and
+without the rotors' inertia (``electrical_without``: what the sthenic criterion, the robot's
+torques alone, does not see), and the joints' braking work (``braking_work``: what the energy
+criteria pay as work and the electrical one barely).
+
 A figure of an optimum that is not certified (converged and feasible on the check grid) is
 not an answer: its costs and differences are unknown (None), never zero, and the command
 exits 1.
