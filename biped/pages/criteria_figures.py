@@ -18,6 +18,10 @@ from biped.studies.criteria_matrix import STUDIED, CriteriaStudy, KneeMatrix
 UNKNOWN_COLOUR = "0.85"
 # A criterion's name on an axis, broken over lines.
 SHORT = {"sthenic": "sthenic", "energy-per-metre": "energy per\nmetre", "electrical": "electrical"}
+# [%] The least half-range of the knees' difference's colours, which end at the largest
+# difference on the diagonal (each knee at its own optimum, measured in its criterion): the
+# cells off it, other minima's figures, may lie far beyond and are drawn saturated.
+LEAST_SCALE = 1.0
 # Cells darker than this share of their colour scale are labelled in white.
 DARK = 0.6
 # The ratio to the column's own optimum the colour scale ends at (darkest above).
@@ -62,17 +66,19 @@ def _knee_panel(ax, matrix: KneeMatrix, norm):
 
 
 def _difference_panel(fig, ax, study: CriteriaStudy) -> None:
-    """(rolling − revolute) / revolute [%] in each cell, a diverging scale about 0."""
+    """(rolling − revolute) / revolute [%] in each cell, a diverging scale about 0 up to the
+    diagonal's largest (``LEAST_SCALE``)."""
     known = [[study.difference(a, b) for b in STUDIED] for a in STUDIED]
     found = np.array([[np.nan if d is None else d for d in row] for row in known])
-    largest = np.nanmax(np.abs(found)) if np.isfinite(found).any() else 1.0
-    largest = max(largest, 1e-6)
+    diagonal = np.abs(np.diag(found))
+    largest = max(np.nanmax(diagonal) if np.isfinite(diagonal).any() else 0.0, LEAST_SCALE)
     norm = TwoSlopeNorm(vcenter=0.0, vmin=-largest, vmax=largest)
     for (i, j), difference in np.ndenumerate(found):
         shown = "unknown" if np.isnan(difference) else f"{difference:+.2f} %"
         _label(ax, (i, j), shown, 2.0 * abs(norm(difference) - 0.5))
     image = ax.imshow(_masked(found), cmap=_cmap("RdBu_r"), norm=norm)
-    fig.colorbar(image, ax=ax, shrink=0.8, label="(rolling − revolute) / revolute [%]")
+    label = "(rolling − revolute) / revolute [%],\nto the diagonal's largest"
+    fig.colorbar(image, ax=ax, shrink=0.8, extend="both", label=label)
     _axes(ax, None)
     ax.set_title("rolling vs revolute knee")
 
@@ -81,6 +87,7 @@ def _label(ax, at: tuple, text: str, shade) -> None:
     """``text`` in the cell ``at`` (row, column), bold on the diagonal, white on a dark
     ``shade`` (its share of the colour scale, NaN: unknown)."""
     row, column = at
+    shade = np.clip(shade, 0.0, 1.0)  # beyond the scale (saturated, or infinite): its end
     dark = bool(np.isfinite(shade) and shade > DARK)
     ax.text(column, row, text, ha="center", va="center", fontsize=9,
             fontweight="bold" if row == column else "normal",
