@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from biped_cli import args as types
+from biped_cli import checks
 
 DEFAULT_OUT = "logs/criteria"
 # The outputs' name in the folder: criteria.json, criteria.png and criteria.md.
@@ -22,8 +23,9 @@ def add_parser(commands) -> None:
     types.add_robot(parser)
     types.add_knots(parser)
     types.add_bezier(parser)
-    types.add_folder(parser, "--out", DEFAULT_OUT, "folder of the results",
-                     f": {NAME}.json, its figure {NAME}.png and page {NAME}.md")  # fmt: skip
+    checks.add_folder(parser, "--out", DEFAULT_OUT, "folder of the results",
+                      f": {NAME}.json, its figure {NAME}.png and page {NAME}.md",
+                      claims=(NAME,))  # fmt: skip
     types.add_options(
         parser,
         ("--starts", types.starts, 3, "N", "IPOPT's own starts of each optimization (default "
@@ -54,8 +56,6 @@ def cmd_criteria(args) -> int:
         knee: GaitProblem(Biped(robot, knee), args.speed, "sthenic", safety, knots=family)
         for knee in KNEES
     }
-    types.check_folder(args.out, "--out")
-    types.claim_outputs(args.out, [NAME])
     print(f"optimizing each criterion of {problems['rolling'].describe()}...", file=sys.stderr)
     began = time.perf_counter()
     solved = {

@@ -24,6 +24,7 @@ REQUIRED = {
     "table": [],
     "atlas": [],
     "converge": ["--speed", "0.3"],
+    "criteria": ["--speed", "0.3"],
     "design": ["--speed", "0.3"],
     "design-map": [],
     "profile-speeds": ["missing.json"],

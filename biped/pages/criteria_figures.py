@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 
 from biped.model.criteria import CRITERION_UNITS
 from biped.pages.criteria_page import problem_words
-from biped.pages.style import KNEE_LABELS, KNEE_STYLE
+from biped.pages.style import CRITERIA_SIZE, FONT_TITLE, KNEE_LABELS, KNEE_STYLE
 from biped.studies.criteria_matrix import STUDIED, CriteriaStudy, KneeMatrix
 
 UNKNOWN_COLOUR = "0.85"
@@ -32,7 +32,7 @@ def criteria_figure(study: CriteriaStudy) -> Figure:
     """Three panels: the revolute and the rolling knee's matrices (the colour: the value over
     the column's own optimum, log scale; the text: the value [unit] and what it costs [%]),
     and the knees' difference (rolling − revolute) / revolute [%] in each cell."""
-    fig = Figure(figsize=(16, 5.6), layout="constrained")
+    fig = Figure(figsize=CRITERIA_SIZE, layout="constrained")
     axes = fig.subplots(1, 3)
     ratios = LogNorm(vmin=1.0, vmax=MOST_RATIO)
     image = None
@@ -89,7 +89,7 @@ def _label(ax, at: tuple, text: str, shade) -> None:
     row, column = at
     shade = np.clip(shade, 0.0, 1.0)  # beyond the scale (saturated, or infinite): its end
     dark = bool(np.isfinite(shade) and shade > DARK)
-    ax.text(column, row, text, ha="center", va="center", fontsize=9,
+    ax.text(column, row, text, ha="center", va="center", fontsize=FONT_TITLE,
             fontweight="bold" if row == column else "normal",
             color="white" if dark else "black")  # fmt: skip
 
