@@ -840,8 +840,9 @@ def optimize_two_phase(
     ``starts`` − 1 of its perturbations (``biped.optimization.optimize.perturbed``, seeded),
     each made a two-phase start by ``start_from_single``; the best feasible converged one.
 
-    One start is not enough: at 0.3 m/s and a share of 0.01-0.45 the rolling knee's problem
-    has optima at 826.47 and 736.78 N²·m·s, each reached from half the perturbed starts.
+    One start is not enough: at 0.3 m/s and a share of 0.01-0.45 the rolling knee's problem,
+    its landing not yet held in the friction cone, had optima at 826.47 and 736.78 N²·m·s,
+    each reached from half the perturbed starts.
     """
     began = time.perf_counter()
     problem = solver.problem
