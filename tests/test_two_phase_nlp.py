@@ -184,7 +184,7 @@ def test_optimize_double_support_writes_the_two_phase_gait_file(tmp_path, capsys
 def test_several_starts_keep_the_best_feasible_optimum():
     """``optimize_two_phase``: the best of three seeded starts is feasible on the numeric
     model, no worse than the first start's (the single-support optimum's) alone, and the
-    counts hold together; the same seed gives the same optimum."""
+    counts and each start's outcome hold together; the same seed gives the same optimum."""
     solver = solver_of("rolling")
     single = optimal_gait("rolling")
     result = tpo.optimize_two_phase(solver, single.variables, single.value, starts=3, seed=0)
@@ -192,6 +192,8 @@ def test_several_starts_keep_the_best_feasible_optimum():
     assert result.best is not None and result.checked.feasible
     assert result.best.value <= first.value
     assert 1 <= result.at_best <= result.feasible <= result.converged <= result.starts == 3
+    assert len(result.outcomes) == 3  # each start's end, said
+    assert sum(o.startswith("Solve_Succeeded") for o in result.outcomes) == result.converged
     again = tpo.optimize_two_phase(solver, single.variables, single.value, starts=3, seed=0)
     np.testing.assert_array_equal(again.best.variables, result.best.variables)
 

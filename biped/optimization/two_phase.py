@@ -822,6 +822,8 @@ class TwoPhaseResult:
             the ones feasible on the numeric model; at_best: those within 1e-6 (relative)
             of the best value.
         seconds: [s] all the solves, the solver's building not counted.
+        outcomes: each start's end, one line: IPOPT's status, and for a converged start
+            infeasible on the numeric model its violated constraints.
     """
 
     best: TwoPhaseOptimum | None
@@ -831,6 +833,7 @@ class TwoPhaseResult:
     feasible: int
     at_best: int
     seconds: float
+    outcomes: tuple = ()
 
 
 def optimize_two_phase(
@@ -849,23 +852,36 @@ def optimize_two_phase(
     rng = np.random.default_rng(seed)
     z = np.asarray(single_variables, dtype=float)
     candidates = [z] + [perturbed(z, rng) for _ in range(starts - 1)]
-    answers, converged = [], 0
+    answers, converged, outcomes = [], 0, []
     for candidate in candidates:
         try:
             start = start_from_single(problem, candidate)
-        except BipedError:  # a perturbed posture out of the legs' reach
+        except BipedError as error:  # a perturbed posture out of the legs' reach
+            outcomes.append(f"no start ({error})")
             continue
         answer = solver.solve(start, single_value)
+        outcomes.append(f"{answer.status} at {answer.value:.6g} N²·m·s")
         if not answer.converged:
             continue
         converged += 1
         checked = check(problem, answer.variables)
         if checked.feasible:
             answers.append((answer, checked))
+        else:
+            outcomes[-1] += f", infeasible: {checked.violations_line()}"
+    outcomes = tuple(outcomes)
     if not answers:
-        return TwoPhaseResult(None, None, starts, converged, 0, 0, time.perf_counter() - began)
+        seconds = time.perf_counter() - began
+        return TwoPhaseResult(None, None, starts, converged, 0, 0, seconds, outcomes)
     best, checked = min(answers, key=lambda pair: pair[0].value)
     at_best = sum(abs(a.value - best.value) <= 1e-6 * abs(best.value) for a, _ in answers)
     return TwoPhaseResult(
-        best, checked, starts, converged, len(answers), at_best, time.perf_counter() - began
+        best,
+        checked,
+        starts,
+        converged,
+        len(answers),
+        at_best,
+        time.perf_counter() - began,
+        outcomes,
     )
