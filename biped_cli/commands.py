@@ -251,7 +251,11 @@ def cmd_double_support(args, problem, optimum) -> int:
     )
     print(f"time: two phases' setup {solver.setup_seconds:.2f} s, solves {result.seconds:.2f} s")
     if result.best is None:
-        print(f"biped optimize: no two-phase optimum ({counts}); no file written", file=sys.stderr)
+        print(
+            f"biped optimize: no two-phase optimum ({counts}: {'; '.join(result.outcomes)}); "
+            "no file written",
+            file=sys.stderr,
+        )
         return 1
     best, checked = result.best, result.checked
     print(

@@ -10,7 +10,18 @@ import argparse
 import sys
 
 from biped.records.provenance import command_line, version
-from biped_cli import atlas, commands, converge, design, orbit, profile, report, robustness, size
+from biped_cli import (
+    atlas,
+    commands,
+    converge,
+    criteria,
+    design,
+    orbit,
+    profile,
+    report,
+    robustness,
+    size,
+)
 from biped_cli.args import Commands, complete_later, numbers_as_values
 from biped_cli.checks import run_checks
 from biped_cli.guard import EXIT_BAD_INPUT, run_guarded
@@ -95,6 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
         atlas.add_parser,
         atlas.add_compare_parser,
         converge.add_parser,
+        criteria.add_parser,
         design.add_parsers,
         profile.add_parser,
         report.add_parser,

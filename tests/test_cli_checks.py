@@ -25,6 +25,7 @@ REQUIRED = {
     "atlas": [],
     "compare-atlas": ["missing-base", "missing-rich"],
     "converge": ["--speed", "0.3"],
+    "criteria": ["--speed", "0.3"],
     "design": ["--speed", "0.3"],
     "design-map": [],
     "profile-speeds": ["missing.json"],

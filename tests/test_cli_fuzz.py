@@ -64,6 +64,7 @@ WORK = [
     ("biped.optimization.profile_design", "optimize_profile"),
     ("biped.optimization.two_phase", "optimize_two_phase"),
     ("biped.optimization.ladder", "climb"),
+    ("biped.studies.criteria_matrix", "optimize_criteria"),
     ("biped.studies.sweep", "run_sweep"),
     ("biped.studies.design_map", "run_design_map"),
     ("biped.studies.atlas", "run_atlas"),
@@ -77,7 +78,7 @@ WORK = [
 @pytest.fixture
 def no_work(monkeypatch):
     """The optimisers (single and two-phase, knee design and profile, the ladder of gait
-    families), the sweep, the design map, the atlas, the figures, the MuJoCo validation, the
+    families, each criterion's optimum), the sweep, the design map, the atlas, the figures, the MuJoCo validation, the
     robustness map and the orbit study stop the command, wherever a module bound them."""
     import importlib
     import pkgutil

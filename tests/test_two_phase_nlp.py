@@ -11,6 +11,8 @@ from biped.model import double_support as ds
 from biped.model import two_phase as tp
 from biped.model.criteria import Safety, simpson_weights
 from biped.model.gait import sample
+from biped.model.kinematics import Q5, QP2
+from biped.model.robot import FOOT_FRICTION
 from biped.optimization import two_phase as tpo
 from biped.optimization.problem import GaitProblem
 from tests.conftest import optimal_gait
@@ -116,9 +118,15 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
         margins = ds.foot_margins(model.robot, wrench)
         assert np.min(margins[:, :3]) > 0.0  # pushed, inside the friction cone
         assert np.min(margins[:, 3:]) > -1e-6  # ZMP in the sole [m]
-    assert step.impulse[1] > -1e-6  # the rear foot is not pulled at the landing
     checked = tpo.check(problem, optimum.variables)
     assert checked.feasible, checked.violations_line()
+    landing_margins = np.array(tp.landing_margins(step.impulse))  # (rear, front) by kind
+    if landing == "impact":  # both feet pushed, inside the floor's cone (the solver keeps 1 %)
+        np.testing.assert_array_less(tpo.IMPULSE_MARGIN * (1 - 1e-6), landing_margins[:, 0])
+        friction = np.abs(step.impulse[[0, 3]]) / step.impulse[[1, 4]]
+        np.testing.assert_array_less(friction, FOOT_FRICTION)
+    else:  # no impulse, nothing to constrain
+        np.testing.assert_array_equal(landing_margins, 0.0)
     assert checked.value == pytest.approx(optimum.value, rel=1e-3)  # check grid vs solver's
     # A front foot pulled instead of pushed at one sample is named.
     wrong = optimum.variables.copy()
@@ -176,7 +184,7 @@ def test_optimize_double_support_writes_the_two_phase_gait_file(tmp_path, capsys
 def test_several_starts_keep_the_best_feasible_optimum():
     """``optimize_two_phase``: the best of three seeded starts is feasible on the numeric
     model, no worse than the first start's (the single-support optimum's) alone, and the
-    counts hold together; the same seed gives the same optimum."""
+    counts and each start's outcome hold together; the same seed gives the same optimum."""
     solver = solver_of("rolling")
     single = optimal_gait("rolling")
     result = tpo.optimize_two_phase(solver, single.variables, single.value, starts=3, seed=0)
@@ -184,5 +192,53 @@ def test_several_starts_keep_the_best_feasible_optimum():
     assert result.best is not None and result.checked.feasible
     assert result.best.value <= first.value
     assert 1 <= result.at_best <= result.feasible <= result.converged <= result.starts == 3
+    assert len(result.outcomes) == 3  # each start's end, said
+    assert sum(o.startswith("Solve_Succeeded") for o in result.outcomes) == result.converged
     again = tpo.optimize_two_phase(solver, single.variables, single.value, starts=3, seed=0)
     np.testing.assert_array_equal(again.best.variables, result.best.variables)
+
+
+def _sliding(problem, variables, forward: float) -> np.ndarray:
+    """``variables`` (impact landing) with the rates before the landing changed, least, so that
+    the swing sole touches down ``forward`` [m/s] faster along the floor."""
+    model = problem.single.model
+    z = np.array(variables, dtype=float)
+    step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, z), "impact")
+    q_end, qd_end = step.single.end
+    jacobian = model.point_jacobian(q_end, "swing_ankle")
+    angles, rates = q_end[QP2 : Q5 + 1], qd_end[QP2 : Q5 + 1]
+    columns = []
+    for e in np.eye(5):
+        _, qd, _ = model.stance_state(angles, np.concatenate([[0.0], e]))
+        columns.append(jacobian @ qd)
+    change = np.linalg.lstsq(np.column_stack(columns), [forward, 0.0], rcond=None)[0]
+    at = tpo.variable_names(problem.samples, "impact").index("end_rate_q1")
+    z[at : at + 5] = rates[1:] + change
+    return z
+
+
+def test_a_sliding_landing_is_rejected():
+    """The landing's impulse on each foot pushes it and lies within the floor's friction cone
+    (μ = ``FOOT_FRICTION``) in the solver and in the numeric check: the impact optimum's
+    landing foot arriving 1 m/s faster along the floor needs more friction than the floor
+    has (the check names it), and the single-support optimum's touchdown (the rolling
+    knee's slides forward at 1.8 m/s) pulls the rear foot."""
+    solver = solver_of("rolling")
+    problem = solver.problem
+    single = optimal_gait("rolling")
+    optimum = solver.solve(tpo.start_from_single(problem, single.variables), single.value)
+    assert optimum.converged, optimum.status
+    assert tpo.check(problem, optimum.variables).feasible
+    sliding = _sliding(problem, optimum.variables, 1.0)
+    step = tp.build_two_phase(
+        problem.single.model, SPEED, tpo.to_parameters(problem, sliding), "impact"
+    )
+    assert abs(step.impulse[3]) > FOOT_FRICTION * step.impulse[4]  # outside the cone
+    found = tpo.check(problem, sliding).violations()
+    assert any(name.startswith("front impact_friction") for name in found), found
+    assert min(tpo._landing_rows(step.impulse)) < 0.0  # the solver's rows of that landing
+    # The single-support optimum's own touchdown, as the previous problem's start.
+    z = tpo.start_from_single(problem, single.variables)
+    at = tpo.variable_names(problem.samples, "impact").index("end_rate_q1")
+    z[at : at + 5] = single.variables[at : at + 5]
+    assert "rear normal_impulse" in tpo.check(problem, z).violations()

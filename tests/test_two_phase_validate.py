@@ -18,6 +18,14 @@ from validate.walk.samples import GaitSamples
 
 @pytest.fixture(scope="module")
 def gait():
+    """The rolling knee's zero-speed landing: its replay follows the file (the impact
+    landing's optimum, inside the floor's friction cone, touches down at 3 m/s and does not:
+    docs/gaits.md)."""
+    return two_phase_gait("rolling", "zero-speed")
+
+
+@pytest.fixture(scope="module")
+def impact_gait():
     return two_phase_gait("rolling")
 
 
@@ -26,11 +34,12 @@ def samples(gait):
     return GaitSamples.from_gait(gait)
 
 
-def test_samples_cover_both_phases_continuously(gait, samples):
+def test_samples_cover_both_phases_continuously(impact_gait):
     """The samples run from lift-off through the landing (positions continuous, the
     velocities jumping by the impact: the file's double support starts after it) to the
     next lift-off, which is the first sample's state with the legs swapped; the front foot
     carries no load in single support and the file's wrench in double support."""
+    gait, samples = impact_gait, GaitSamples.from_gait(impact_gait)
     t_land, eps = samples.landing, 1e-9
     assert samples.period == pytest.approx(gait.period + gait.double_support.duration)
     before, after = samples.at("q", [t_land - eps]), samples.at("q", [t_land + eps])
@@ -50,12 +59,15 @@ def test_samples_cover_both_phases_continuously(gait, samples):
     assert samples.single_support().period == gait.period
 
 
-def test_validation_of_a_two_phase_gait(gait):
+def test_validation_of_a_two_phase_gait(gait, impact_gait):
     """On its own model: the model, MuJoCo's inverse dynamics along both phases (the front
     foot's wrench given), the knee loads, the landing against MuJoCo's impact map holding
-    both feet and the replay of both phases, with both feet's ground forces within
-    ``FOOT_FORCE_SHARE`` of the weight, pass; the walk, its gains and its orbit are not run,
-    and fail as such."""
+    both feet (the impact landing's impulses) and the replay of both phases (the zero-speed
+    landing's), with both feet's ground forces within ``FOOT_FORCE_SHARE`` of the weight,
+    pass; the walk, its gains and its orbit are not run, and fail as such."""
+    impact = {c.name: c for c in two_phase_checks(impact_gait, model_spec(impact_gait.biped))}
+    for name in ("model", "inverse_dynamics", "knee_loads", "impact"):
+        assert impact[name].passed, impact[name].line()
     checks = {check.name: check for check in two_phase_checks(gait, model_spec(gait.biped))}
     for name in ("model", "inverse_dynamics", "knee_loads", "impact", "feedforward"):
         assert checks[name].passed, checks[name].line()
@@ -66,14 +78,15 @@ def test_validation_of_a_two_phase_gait(gait):
         assert not checks[name].passed and checks[name].causes == ["not run"]
 
 
-def test_wrong_knee_model_fails_the_replay(gait, samples):
+def test_wrong_knee_model_fails_the_replay(gait, samples, impact_gait):
     """The rolling knee's two-phase gait replayed on the revolute knee's model: the servos
     and both feet's forces are far off, and so is its landing against MuJoCo's impact map."""
     wrong = Biped(gait.robot, "revolute")
     check = c.check_two_phase_feedforward(model_spec(wrong), wrong, samples)
     assert not check.passed and set(check.causes) == {"servo share", "foot forces"}
     model = compile_spec(model_spec(wrong))
-    impact = c.check_two_phase_impact(model, wrong, samples, gait)
+    landing = GaitSamples.from_gait(impact_gait)
+    impact = c.check_two_phase_impact(model, wrong, landing, impact_gait)
     assert not impact.passed and impact.causes == ["model mismatch"]
 
 

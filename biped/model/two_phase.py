@@ -8,8 +8,8 @@ double support's end state, legs swapped, no impact) and ends when its swing foo
 x = S. The landing is either
 
 - ``"impact"``: the flat-foot impact of eqs. (21)-(24) with both feet held after it
-  (``biped.model.impact.both_feet_impact``), the rear foot pushed by the ground
-  (I_z >= 0, the caller's constraint); or
+  (``biped.model.impact.both_feet_impact``), each foot's impulse pushing it and within the
+  floor's friction cone (``landing_margins``, the caller's constraint); or
 - ``"zero-speed"``: the swing foot arrives at rest, its velocity already that of the closed
   chain, so nothing jumps.
 
@@ -55,8 +55,14 @@ from biped.model.dynamics import Biped
 from biped.model.gait import Step, paper_pieces
 from biped.model.impact import both_feet_impact
 from biped.model.kinematics import swap_legs
+from biped.model.robot import FOOT_FRICTION
+from biped.model.walkable import impact_friction_margins
 
 LANDINGS = ("impact", "zero-speed")
+# The feet at the landing, in the order of ``TwoPhaseStep.impulse``, and each foot's landing
+# constraints (``landing_margins``): the impulse into the floor, the friction cone's two sides.
+FEET = ("rear", "front")
+LANDING_CONSTRAINTS = ("normal_impulse", "impact_friction_forward", "impact_friction_backward")
 _ANGLES = ("qp2", "q1", "q2", "q3", "q4", "q5")
 _POSTURE = ("x_hip", "z_hip", "trunk")
 
@@ -115,6 +121,21 @@ class TwoPhaseStep:
     def step_length(self) -> float:
         """S [m]."""
         return self.single.step_length
+
+
+def landing_margins(impulse, friction: float = FOOT_FRICTION, solver: bool = False) -> list:
+    """Each foot's landing constraints (``FEET`` by ``LANDING_CONSTRAINTS``, >= 0 when met)
+    [N·s] from the impulse (6,) of ``TwoPhaseStep.impulse``: I_z, μ I_z − I_x, μ I_z + I_x,
+    the floor pushing the foot within its friction cone (μ = ``FOOT_FRICTION``, the MuJoCo
+    floor's, as in double support). The cone is the single-support problem's impact
+    friction (``biped.model.walkable.impact_friction_margins``); ``solver``: with its margin
+    (``RELATIVE_MARGIN`` of μ). Sums and products only: numbers or CasADi's symbols. A
+    zero-speed landing has no impulse, every margin 0 (met): nothing to constrain."""
+    margins = []
+    for at in (0, 3):
+        foot = impulse[at : at + 3]
+        margins.append([foot[1], *impact_friction_margins(foot, friction, solver)])
+    return margins
 
 
 def build_two_phase(model: Biped, speed: float, p, landing: str = "impact") -> TwoPhaseStep:

@@ -30,8 +30,10 @@ problem's range by two linear constraints.
 Criterion: C_Γ = (∫ ΓᵀΓ dt over both phases) / S [N²·m·s], Simpson's rule on each phase.
 Constraints: the single support's as the single-support problem's (``StepGraph``); in double
 support at each sample each foot's normal force, friction cone (μ = ``FOOT_FRICTION``) and ZMP
-in its sole with the single support's margins, both knees' bends >= δ; the rear foot pushed at
-the landing's impact (I_z >= 0); the hip at landing at least ``MIN_HIP_HEIGHT`` above the
+in its sole with the single support's margins, both knees' bends >= δ; at the landing's impact
+both feet pushed (I_z >= δ) and within the friction cone |I_x| <= μ I_z (μ = ``FOOT_FRICTION``
+at the single-support problem's 1 % margin, ``biped.model.two_phase.landing_margins``; the
+zero-speed landing has no impulse); the hip at landing at least ``MIN_HIP_HEIGHT`` above the
 ankles.
 """
 
@@ -44,7 +46,7 @@ import casadi as ca
 import numpy as np
 
 from biped.errors import BipedError, UnreachableError
-from biped.model import double_support
+from biped.model import double_support, walkable
 from biped.model import two_phase as two_phase_model
 from biped.model.criteria import (
     CONSTRAINT_SCALES,
@@ -109,7 +111,7 @@ _TRUNK_BOUNDS = (-0.6, 0.6)
 _DWELL_BOUNDS = (0.0, 3.0)
 # Scales of the double support's constraints: the landing's impulse [N·s], the closure [m²].
 IMPULSE_SCALE = 10.0
-IMPULSE_MARGIN = 1e-3  # [N·s] δ of the rear foot's impulse at an impact landing
+IMPULSE_MARGIN = 1e-3  # [N·s] δ of each foot's normal impulse at an impact landing
 MOMENT_SCALE = 100.0  # [N·m] the ZMP's constraints times Fz
 # [N²·m·s] The criterion is divided by this in the solver: the two-phase optima lie near
 # 1000, where IPOPT's tolerance on the dual infeasibility, 1e-9, is below the rounding of
@@ -120,6 +122,9 @@ OBJECTIVE_SCALE = 1000.0
 # room between the two legs' reaches.
 START_BEND = 0.2
 CLOSURE_SCALE = 0.01
+# [m/s] The swing foot's speed straight down at an impact landing of the start
+# (``gentle_landing``).
+LANDING_DESCENT = 0.05
 # The free coordinates of the closed chain and the six others (``biped.model.double_support``).
 FREE = [XH, ZH, Q5]
 BOUND = [QP1, QP2, Q1, Q2, Q3, Q4]
@@ -332,14 +337,24 @@ class TwoPhaseGraph(StepGraph):
             self.ds_swing_wrench.append(swing)
             self.ds_q.append(q)
         self.ds_squared = dwell * squared
-        if self.landing_kind == "impact":  # the rear foot pushed by the impact
-            rear_pushed = self.landing_impulse[1] - IMPULSE_MARGIN
-            inequalities.append(rear_pushed / IMPULSE_SCALE)
+        if self.landing_kind == "impact":  # both feet pushed, within the friction cone
+            inequalities += _landing_rows(self.landing_impulse)
         inequalities.append(self.landing_height)
         self.ds_inequalities = ca.vertcat(*inequalities)
         self.ds_equalities = ca.vertcat(*equalities)
         for name in ("ds_torques", "ds_stance_wrench", "ds_swing_wrench", "ds_q"):
             setattr(self, name, ca.horzcat(*getattr(self, name)))
+
+
+def _landing_rows(impulse) -> list:
+    """The landing's constraints in the solver (``two_phase_model.landing_margins`` with the
+    solver's margins: I_z − ``IMPULSE_MARGIN``, the cone at 0.99 μ as the single-support
+    problem's impact friction), each foot's, scaled."""
+    rows = []
+    for normal, *cone in two_phase_model.landing_margins(impulse, FOOT_FRICTION, solver=True):
+        rows.append((normal - IMPULSE_MARGIN) / IMPULSE_SCALE)
+        rows += [margin / walkable.SCALES["impact_friction"] for margin in cone]
+    return rows
 
 
 def _hip_between(c, bend_rear, bend_front, length):
@@ -601,6 +616,8 @@ def start_from_single(problem: TwoPhaseProblem, variables) -> np.ndarray:
         z[index("end_rate_q1") : index("end_rate_q5") + 1] = 0.0
         extras += [speed, 0.0, 0.0]  # the hip at V through the landing
     guess = np.concatenate([z, extras, np.zeros(2 * (n - 1) + len(WRENCH) * (n + 1))])
+    if problem.landing == "impact":
+        guess = gentle_landing(problem, guess)
     try:  # the lift-off's rates those after the landing: no jump to bridge
         step = two_phase_model.build_two_phase(
             model, speed, to_parameters(problem, guess), problem.landing
@@ -613,6 +630,39 @@ def start_from_single(problem: TwoPhaseProblem, variables) -> np.ndarray:
         return shifted_weight(problem, guess)
     except UnreachableError:
         return guess
+
+
+def gentle_landing(problem: TwoPhaseProblem, variables) -> np.ndarray:
+    """``variables`` (impact landing) with the rates before the landing those of the closed
+    chain, its hip moving at (V, 0) and its trunk still: both feet at rest, no impulse. The
+    single-support optimum's touchdown slides forward (the rolling knee's at 1.82 m/s), far
+    outside the landing's friction cone, and IPOPT does not find its way in from there
+    (1000 iterations at 0.3 m/s, 0.1-0.2); from a landing at rest it need only grow one."""
+    z = np.array(variables, dtype=float)
+    model, speed = problem.single.model, problem.single.speed
+    names = two_phase_model.parameter_names(problem.landing)
+    value = dict(zip(names, to_parameters(problem, z), strict=True))
+    length = speed * (value["period"] + value["double_support"])
+    landing = [value["landing_x_hip"], value["landing_z_hip"], value["landing_trunk"]]
+    try:
+        _, qd, _ = double_support.chain_state(model, length, landing, [speed, 0.0, 0.0])
+    except UnreachableError:
+        return z
+    rates = qd[Q1 : Q5 + 1]
+    # The swing ankle's velocity (2,) is linear in the rates: add the least ones that bring it
+    # down at LANDING_DESCENT, a landing inside the cone rather than at its apex.
+    q = double_support.chain_posture(model, length, landing)
+    angles = q[QP2 : Q5 + 1]
+
+    def touchdown(end_rates):
+        q_end, qd_end, _ = model.stance_state(angles, np.concatenate([[0.0], end_rates]))
+        return model.point_jacobian(q_end, "swing_ankle") @ qd_end
+
+    jacobian = np.column_stack([touchdown(e) for e in np.eye(len(rates))])
+    wanted = np.array([0.0, -LANDING_DESCENT]) - touchdown(rates)
+    rates = rates + np.linalg.lstsq(jacobian, wanted, rcond=None)[0]
+    z[index("end_rate_q1") : index("end_rate_q5") + 1] = rates
+    return z
 
 
 def closed_bends(problem: TwoPhaseProblem, variables) -> np.ndarray:
@@ -694,15 +744,16 @@ class TwoPhaseCheck:
         double_margins: (n + 1, 2, 5) both feet's Ψ (stance, swing; ``FOOT_CONSTRAINTS``
             [N, N, N, m, m]) at the double support's samples, where the front foot's wrench
             is defined: not between them.
-        rear_impulse: I_z of the ground on the rear foot at the landing [N·s] (0 for the
-            zero-speed landing).
+        landing_margins: (2, 3) each foot's (rear, front) landing constraints
+            (``biped.model.two_phase.LANDING_CONSTRAINTS`` [N·s]: I_z, μ I_z ∓ I_x, μ =
+            ``FOOT_FRICTION``), all 0 for the zero-speed landing.
         value: C_Γ [N²·m·s], the single support's integral on the check grid, the double
             support's on its samples.
     """
 
     single: StepEvaluation
     double_margins: np.ndarray
-    rear_impulse: float
+    landing_margins: np.ndarray
     value: float
 
     @property
@@ -717,8 +768,11 @@ class TwoPhaseCheck:
                 worst = float(np.min(self.double_margins[:, side, k]))
                 if not worst >= 0.0:
                     found[f"{foot} {name}"] = worst
-        if not self.rear_impulse >= 0.0:
-            found["rear impulse"] = self.rear_impulse
+        for side, foot in enumerate(two_phase_model.FEET):
+            for k, name in enumerate(two_phase_model.LANDING_CONSTRAINTS):
+                value = float(self.landing_margins[side, k])
+                if not value >= 0.0:
+                    found[f"{foot} {name}"] = value
         return found
 
     def violations_line(self) -> str:
@@ -730,7 +784,8 @@ class TwoPhaseCheck:
 
 def check(problem: TwoPhaseProblem, variables) -> TwoPhaseCheck:
     """``variables`` on the numeric model: the single support on the check grid with the
-    single-support problem's safety, the double support at its samples."""
+    single-support problem's safety, the double support at its samples, the landing's
+    impulses (both feet pushed, within the friction cone, no margin)."""
     single, model = problem.single, problem.single.model
     z = np.asarray(variables, dtype=float)
     parameters = to_parameters(problem, z)
@@ -750,7 +805,7 @@ def check(problem: TwoPhaseProblem, variables) -> TwoPhaseCheck:
     return TwoPhaseCheck(
         single=evaluation,
         double_margins=margins,
-        rear_impulse=float(step.impulse[1]),
+        landing_margins=np.array(two_phase_model.landing_margins(step.impulse)),
         value=(single_part + double_part) / step.step_length,
     )
 
@@ -767,6 +822,8 @@ class TwoPhaseResult:
             the ones feasible on the numeric model; at_best: those within 1e-6 (relative)
             of the best value.
         seconds: [s] all the solves, the solver's building not counted.
+        outcomes: each start's end, one line: IPOPT's status, and for a converged start
+            infeasible on the numeric model its violated constraints.
     """
 
     best: TwoPhaseOptimum | None
@@ -776,6 +833,7 @@ class TwoPhaseResult:
     feasible: int
     at_best: int
     seconds: float
+    outcomes: tuple = ()
 
 
 def optimize_two_phase(
@@ -785,31 +843,45 @@ def optimize_two_phase(
     ``starts`` − 1 of its perturbations (``biped.optimization.optimize.perturbed``, seeded),
     each made a two-phase start by ``start_from_single``; the best feasible converged one.
 
-    One start is not enough: at 0.3 m/s and a share of 0.01-0.45 the rolling knee's problem
-    has optima at 826.47 and 736.78 N²·m·s, each reached from half the perturbed starts.
+    One start is not enough: at 0.3 m/s and a share of 0.01-0.45 the rolling knee's problem,
+    its landing not yet held in the friction cone, had optima at 826.47 and 736.78 N²·m·s,
+    each reached from half the perturbed starts.
     """
     began = time.perf_counter()
     problem = solver.problem
     rng = np.random.default_rng(seed)
     z = np.asarray(single_variables, dtype=float)
     candidates = [z] + [perturbed(z, rng) for _ in range(starts - 1)]
-    answers, converged = [], 0
+    answers, converged, outcomes = [], 0, []
     for candidate in candidates:
         try:
             start = start_from_single(problem, candidate)
-        except BipedError:  # a perturbed posture out of the legs' reach
+        except BipedError as error:  # a perturbed posture out of the legs' reach
+            outcomes.append(f"no start ({error})")
             continue
         answer = solver.solve(start, single_value)
+        outcomes.append(f"{answer.status} at {answer.value:.6g} N²·m·s")
         if not answer.converged:
             continue
         converged += 1
         checked = check(problem, answer.variables)
         if checked.feasible:
             answers.append((answer, checked))
+        else:
+            outcomes[-1] += f", infeasible: {checked.violations_line()}"
+    outcomes = tuple(outcomes)
     if not answers:
-        return TwoPhaseResult(None, None, starts, converged, 0, 0, time.perf_counter() - began)
+        seconds = time.perf_counter() - began
+        return TwoPhaseResult(None, None, starts, converged, 0, 0, seconds, outcomes)
     best, checked = min(answers, key=lambda pair: pair[0].value)
     at_best = sum(abs(a.value - best.value) <= 1e-6 * abs(best.value) for a, _ in answers)
     return TwoPhaseResult(
-        best, checked, starts, converged, len(answers), at_best, time.perf_counter() - began
+        best,
+        checked,
+        starts,
+        converged,
+        len(answers),
+        at_best,
+        time.perf_counter() - began,
+        outcomes,
     )

@@ -4,7 +4,8 @@ and of MuJoCo's walk beside the model's drawn from a validation report's JSON
 (``orbit_figures``, ``walk_figures``), the figures of a designed knee profile and of it over
 the speeds (``profile_figures``), the design map's figures (``design_map_figures``), a
 robustness map's (``robustness_figure``), the optima over nested gait families
-(``converge_figures``), two atlases in two families cell by cell (``atlas_families``);
+(``converge_figures``), every criterion on each criterion's optimum (``criteria_page``,
+``criteria_figures``), two atlases in two gait families cell by cell (``atlas_families``);
 every figure of the project drawn in one style and written by one function (``style``).
 
 May import: every other layer of ``biped``, numpy, matplotlib.

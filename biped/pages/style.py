@@ -41,6 +41,7 @@ FONT_HEADING = 10  # a figure's title over several panels
 PAPER_CRITERION_SIZE = (16, 5.0)  # a criterion against speed, both knees (figures)
 TIME_PANEL_SIZE = (4.4, 3.2)  # a panel of a quantity over the step (figures, pages)
 CONVERGE_SIZE = (8, 6.4)  # the ladder of gait families (converge_figures)
+CRITERIA_SIZE = (16, 5.6)  # each criterion measured on each optimum, both knees (criteria_figures)
 DESIGN_MAP_SIZE = (6.4, 5.6)  # the criterion over the radii at one speed (design_map_figures)
 DESIGN_SPEEDS_SIZE = (10, 4)  # the designed radii and gains over speed (design_map_figures)
 MULTIPLIERS_SIZE = (5.6, 5.6)  # Floquet multipliers in the complex plane (orbit_figures)

@@ -38,7 +38,12 @@ from biped.model import double_support as ds
 from biped.model.criteria import StepEvaluation
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import COORDINATES
-from biped.model.two_phase import TwoPhaseStep, build_two_phase, parameter_names
+from biped.model.two_phase import (
+    TwoPhaseStep,
+    build_two_phase,
+    landing_margins,
+    parameter_names,
+)
 from biped.model.units import PURE, per_coordinate, unit_field
 
 # The unit of a two-phase parameter or solver variable, from its name (the first part found).
@@ -128,7 +133,9 @@ class DoubleSupport:
     coefficients: dict = unit_field(CUBIC)
     landing_impulse: list = unit_field(WRENCH + WRENCH)
     foot_margins: dict = unit_field({foot: FOOT_UNITS for foot in FEET})
-    feasible: bool  # both feet's constraints at the solver's samples, the rear foot pushed
+    # both feet's constraints at the solver's samples; at the landing both feet pushed within
+    # the friction cone (``biped.model.two_phase.landing_margins``)
+    feasible: bool
     samples: PhaseSamples = unit_field(PhaseSamples)
 
     def to_dict(self) -> dict:
@@ -216,8 +223,8 @@ def double_support_of(
         foot: ds.foot_margins(model.robot, wrench).min(axis=0).tolist()
         for foot, wrench in zip(FEET, (rear, front), strict=True)
     }
-    rear_pushed = not step.landing == "impact" or step.impulse[1] >= 0.0
-    feasible = bool(rear_pushed and all(min(m) >= 0.0 for m in margins.values()))
+    landing = np.min(landing_margins(step.impulse))  # 0 for a zero-speed landing
+    feasible = bool(landing >= 0.0 and all(min(m) >= 0.0 for m in margins.values()))
     dwell = step.double.duration
     return DoubleSupport(
         landing=step.landing,

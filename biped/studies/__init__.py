@@ -4,8 +4,9 @@
 stages on a pool or Dask, shows progress and summarizes (``campaign``), their stages and the
 neighbours that start a point declared and ordered once (``staging``); and a machined knee
 profile over the speeds (``profile_speeds``: a table of optimizations, no folder of its own),
-and both knees over nested gait families until their comparison converges (``converge``);
-two atlases in two gait families compared cell by cell (``atlas_families``).
+both knees over nested gait families until their comparison converges (``converge``),
+each criterion's optimum with every criterion measured on it (``criteria_matrix``), and two
+atlases in two gait families compared cell by cell (``atlas_families``).
 
 May import: ``biped.model``, ``biped.optimization``, ``biped.records``, ``biped.runtime``,
 ``biped.errors``, numpy (the design map's figures are ``biped.pages.design_map_figures``).
