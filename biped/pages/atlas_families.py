@@ -13,7 +13,17 @@ from matplotlib.figure import Figure
 
 from biped.model.gait import family_label, family_words
 from biped.pages.atlas import CRITERION_NAMES, FIGURE_NAMES
-from biped.pages.style import FAMILY_STYLE, save_with_json
+from biped.pages.style import (
+    FAMILIES_CELL_SIZE,
+    FAMILIES_LEAST_WIDTH,
+    FAMILIES_MARGINS,
+    FAMILY_STYLE,
+    FONT_HEADING,
+    FONT_NOTE,
+    FONT_SMALL,
+    FONT_TITLE,
+    save_with_json,
+)
 from biped.runtime.files import atomic_write_text
 from biped.studies.atlas_families import CellShift, FamilyComparison, Side
 
@@ -27,7 +37,6 @@ VERDICT_MARKS = {
 }
 # The two families' points beside each cell's tick [cells].
 OFFSET = 0.16
-PANEL_SIZE = (0.62, 3.1)  # [in] per cell (width), per criterion (height)
 TITLE_CHARS_PER_INCH = 15  # characters of the 9 pt title per inch of the figure's width
 
 
@@ -37,8 +46,9 @@ def figure(comparison: FamilyComparison) -> Figure:
     where it is unknown), the cell's verdict above it."""
     criteria = comparison.criteria
     cells = max(comparison.counts(c)["cells"] for c in criteria)
-    width = max(7.0, PANEL_SIZE[0] * cells + 2.0)
-    fig = Figure(figsize=(width, PANEL_SIZE[1] * len(criteria) + 1.6), layout="constrained")
+    cell, margin = FAMILIES_CELL_SIZE, FAMILIES_MARGINS
+    width = max(FAMILIES_LEAST_WIDTH, cell[0] * cells + margin[0])
+    fig = Figure(figsize=(width, cell[1] * len(criteria) + margin[1]), layout="constrained")
     axes = np.atleast_1d(fig.subplots(len(criteria), 1))
     labels = {
         "base": f"{family_label(comparison.base_family)}: {family_words(comparison.base_family)}",
@@ -47,9 +57,9 @@ def figure(comparison: FamilyComparison) -> Figure:
     for ax, criterion in zip(axes, criteria, strict=True):
         mine = [s for s in comparison.shifts if s.criterion == criterion]
         _panel(ax, mine, labels)
-        ax.set_title(FIGURE_NAMES.get(criterion, criterion), fontsize=10)
+        ax.set_title(FIGURE_NAMES.get(criterion, criterion), fontsize=FONT_HEADING)
     legend = "gait family (error bars: finer grid, tighter tolerance, starts)"
-    axes[0].legend(fontsize=8, loc="best", title=legend, title_fontsize=8)
+    axes[0].legend(fontsize=FONT_NOTE, loc="best", title=legend, title_fontsize=FONT_NOTE)
     title = [
         "The knees' difference (rolling − revolute) / revolute [%] in two gait families, "
         f"under {comparison.constraints}",
@@ -59,7 +69,7 @@ def figure(comparison: FamilyComparison) -> Figure:
         "measured: hollow marker, ±?; 'none': no certified optimum of both knees)",
     ]
     chars = int(TITLE_CHARS_PER_INCH * width)
-    fig.suptitle("\n".join(textwrap.fill(t, chars) for t in title), fontsize=9)
+    fig.suptitle("\n".join(textwrap.fill(t, chars) for t in title), fontsize=FONT_TITLE)
     return fig
 
 
@@ -71,7 +81,7 @@ def _panel(ax, shifts: list[CellShift], labels: dict) -> None:
             found: Side = getattr(shift, side)
             if found.value is None:  # no certified optimum of both knees: said on the axis
                 ax.annotate("none", (x[i] + dx, 0.0), xytext=(0, 3), textcoords="offset points",
-                            rotation=90, ha="center", va="bottom", fontsize=7,
+                            rotation=90, ha="center", va="bottom", fontsize=FONT_SMALL,
                             color=style["color"])  # fmt: skip
                 continue
             known = found.uncertainty is not None
@@ -87,18 +97,20 @@ def _panel(ax, shifts: list[CellShift], labels: dict) -> None:
             )
             if not known:
                 ax.annotate("±?", (x[i] + dx, found.value), xytext=(4, 2),
-                            textcoords="offset points", fontsize=7)  # fmt: skip
+                            textcoords="offset points", fontsize=FONT_SMALL)  # fmt: skip
     for i, shift in enumerate(shifts):
         text, colour = VERDICT_MARKS[shift.verdict]
         text += "\nsign flips" if shift.sign_change else ""
         ax.annotate(text, (x[i], 1.0), xycoords=("data", "axes fraction"), xytext=(0, -10),
-                    textcoords="offset points", ha="center", va="top", fontsize=8,
+                    textcoords="offset points", ha="center", va="top", fontsize=FONT_NOTE,
                     color=colour)  # fmt: skip
     ax.axhline(0.0, color="0.5", lw=0.6)
-    ax.set_xticks(x, [_cell_label(s) for s in shifts], fontsize=8)
+    ax.set_xticks(x, [_cell_label(s) for s in shifts], fontsize=FONT_NOTE)
     ax.set_xlim(-0.6, len(shifts) - 0.4)
     ax.margins(y=0.25)
-    ax.set_ylabel("rolling vs revolute [%]\n(below 0: the rolling knee needs less)", fontsize=8)
+    ax.set_ylabel(
+        "rolling vs revolute [%]\n(below 0: the rolling knee needs less)", fontsize=FONT_NOTE
+    )
     ax.grid(alpha=0.3, axis="y")
 
 

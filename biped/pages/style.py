@@ -52,6 +52,11 @@ PROFILE_SPEEDS_SIZE = (8, 4.6)  # a profile's criterion over speed (profile_figu
 ROBUSTNESS_SIZE = (8.0, 6.0)  # a gait's robustness map (robustness_figure)
 WALK_TORQUES_SIZE = (13.2, 6.8)  # MuJoCo's torques beside the model's (walk_figures)
 MARGINS_SIZE = (11, 5.0)  # the walkable margins' study (validate.studies.margins_study)
+# Two atlases in two gait families (atlas_families): per cell (width) and per criterion
+# (height), the labels' and title's room beside them, and the least width [in].
+FAMILIES_CELL_SIZE = (0.62, 3.1)
+FAMILIES_MARGINS = (2.0, 1.6)
+FAMILIES_LEAST_WIDTH = 7.0
 KNEE_LABELS = {"revolute": "revolute knee", "rolling": "rolling knee"}
 KNEE_STYLE = {
     "revolute": dict(color="tab:blue", marker="o"),
