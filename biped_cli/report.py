@@ -105,15 +105,18 @@ def cmd_report(args) -> int:
     reaction and constraints over the step; the verdict and figures of its validation in
     MuJoCo when <gait>.report.json lies beside it (biped pipeline's) or beside its recording
     (biped validate's, if the recording is of the gait as it is now); links to its recording
-    and video. All pages are written, or none.
+    and video. A two-phase gait's page shows both phases over the whole step, the landing,
+    both feet, beside the single support gait of the same knee, robot and speed given with it.
+    All pages are written, or none.
     """
     from biped.pages.page import Page, write_pages
+    from biped.pages.two_phase_page import single_of
     from biped.records import gait_file
     from validate.outputs.outputs import output_name
 
     pages = []
     for path in args.gait:  # every input read and checked before any work
-        gait = gait_file.read_consistent(path)  # its figures its parameters'
+        gait = gait_file.read_consistent(path, two_phase=True)  # its figures its parameters'
         found = validation_file(path)
         validation = read_validation(found)
         pages.append(
@@ -126,6 +129,10 @@ def cmd_report(args) -> int:
                 links=links(Path(path), validation),
             )
         )
+    gaits = [page.gait for page in pages]
+    for page in pages:  # a two-phase gait beside the single support optimum given with it
+        if page.gait.two_phase:
+            page.single = single_of(page.gait, gaits)
     names = [page.name for page in pages]
     checks.claim_derived(args, "--out", names, "page", gaits="gait files")
     for written in write_pages(pages, args.out):

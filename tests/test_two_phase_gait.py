@@ -137,15 +137,13 @@ def test_two_phase_gait_reads_without_casadi_or_mujoco(written):
 
 def test_commands_not_built_for_two_phases_refuse_it(written, tmp_path, capsys):
     """A two-phase gait file given where only single support is built (a reader's default,
-    ``biped robustness``, ``biped report``) is refused by name, before any work (exit 2, one
-    line), never read as the single support phase alone."""
+    ``biped robustness``) is refused by name, before any work (exit 2, one line), never read
+    as the single support phase alone."""
     from biped_cli import main
 
     _, path = written
     assert "is of two phases" in refusal(gait_file.read_consistent, path)
-    for command in (["robustness", str(path), "--out", str(tmp_path / "map")],
-                    ["report", str(path), "--out", str(tmp_path / "pages")]):  # fmt: skip
-        assert main(command) == 2
-        error = capsys.readouterr().err
-        assert error.count("\n") == 1 and "is of two phases" in error
-        assert not (tmp_path / "map").exists() and not (tmp_path / "pages").exists()
+    assert main(["robustness", str(path), "--out", str(tmp_path / "map")]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "is of two phases" in error
+    assert not (tmp_path / "map").exists()

@@ -53,6 +53,7 @@ from biped.pages.figures import (
 from biped.pages.orbit_figures import multipliers_figure
 from biped.pages.profile_figures import PROFILE_FIGURE, profile_figure
 from biped.pages.style import FONT_NOTE, FONT_SMALL, FONT_TINY, KNEE_STYLE, save
+from biped.pages.two_phase_figures import two_phase_figures
 from biped.pages.walk_figures import TORQUES_FIGURE, has_profiles, torques_figure
 from biped.pages.walk_figures import walk_lines as mujoco_walk_lines
 from biped.records.gait_file import Gait
@@ -510,37 +511,47 @@ class Page:
     validation: ValidationReport | None = None
     validation_source: Path | None = None
     links: list[Link] = field(default_factory=list)
+    # A two-phase gait's single support optimum of the same knee, robot and speed, shown
+    # beside it (``biped.pages.two_phase_page``); None: not given.
+    single: Gait | None = None
 
 
-def _number(value) -> str:
+def figure_text(value) -> str:
+    """A figure of a page's table: 'n/a' for None, yes/no, a range 'low to high', 4 digits."""
     if value is None:
         return "n/a"
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, (list, tuple)):  # a range "low to high", or a list of figures
-        return (" to " if len(value) == 2 else ", ").join(_number(v) for v in value)
+        return (" to " if len(value) == 2 else ", ").join(figure_text(v) for v in value)
     if isinstance(value, float):
         return f"{value:.4g}"
     return str(value)
 
 
-def _relative(path: Path, folder: Path) -> str:
+def relative_link(path: Path, folder: Path) -> str:
+    """The link to ``path`` from a page written in ``folder``."""
     return Path(os.path.relpath(Path(path).resolve(), Path(folder).resolve())).as_posix()
 
 
 def markdown(page: Page, folder: Path) -> str:
-    """The page's Markdown, its links relative to ``folder`` (where the page is written)."""
+    """The page's Markdown, its links relative to ``folder`` (where the page is written);
+    a two-phase gait's ``biped.pages.two_phase_page``'s."""
     gait = page.gait
+    if gait.two_phase:
+        from biped.pages.two_phase_page import two_phase_markdown  # it builds on this module
+
+        return two_phase_markdown(page, folder)
     report = gait.optimizer
     title = f"{gait.knee} knee, {gait.criterion}-optimal gait at {gait.speed:.3f} m/s"
     optimum = (
         "certified optimum"
         if certified(gait)
         else f"not a certified optimum (solver: {report.status}, "
-        f"feasible: {_number(gait.feasible)})"
+        f"feasible: {figure_text(gait.feasible)})"
     )
     lines = [f"# {title}", ""]
-    lines += [f"Gait file [`{page.source}`]({_relative(page.source, folder)}): {optimum}."]
+    lines += [f"Gait file [`{page.source}`]({relative_link(page.source, folder)}): {optimum}."]
     if page.validation is not None:
         verdict = "PASS" if page.validation.passed else "FAIL"
         lines += [f"Validation in MuJoCo: **{verdict}** (below)."]
@@ -552,7 +563,7 @@ def markdown(page: Page, folder: Path) -> str:
     lines += [""]
     for link in page.links:
         note = f" ({link.note})" if link.note else ""
-        lines += [f"- {link.label}: [`{link.path}`]({_relative(link.path, folder)}){note}"]
+        lines += [f"- {link.label}: [`{link.path}`]({relative_link(link.path, folder)}){note}"]
     if page.links:
         lines += [""]
     safety = gait.safety
@@ -625,7 +636,7 @@ def design_lines(gait: Gait) -> list[str]:
     ]
     for name in RADII:
         values = [(design.get(key) or {}).get(name) for key in ("radii", "lower", "upper")]
-        lines += [f"| {name} | {' | '.join(map(_number, values))} | m |"]
+        lines += [f"| {name} | {' | '.join(map(figure_text, values))} | m |"]
     lines += [
         "",
         "| knee compared | r1 [m] | r2 [m] | sthenic [N²·m·s] | energy [J] | certified |",
@@ -637,8 +648,8 @@ def design_lines(gait: Gait) -> list[str]:
             knee.get("sthenic"),
             knee.get("energy"),
         ]
-        shown = " | ".join(v if isinstance(v, str) else _number(v) for v in values)
-        lines += [f"| {knee.get('knee')} | {shown} | {_number(knee.get('certified'))} |"]
+        shown = " | ".join(v if isinstance(v, str) else figure_text(v) for v in values)
+        lines += [f"| {knee.get('knee')} | {shown} | {figure_text(knee.get('certified'))} |"]
     gains = design.get("gains_percent") or {}
     lines += [
         "",
@@ -671,15 +682,15 @@ def profile_lines(gait: Gait, name: str) -> list[str]:
         "",
         f"The surfaces' radii of curvature r_i + k_i ψ ({profile.get('family')} family, "
         f"`biped design --profile`), started from the designed circles; {kept}"
-        f"k1 = {_number(rates.get('k1'))} m/rad, k2 = {_number(rates.get('k2'))} m/rad "
-        f"(|k| <= {_number(profile.get('rate_bound'))} m/rad), over the knee's flexion "
-        f"{_number(profile.get('range'))} rad.",
+        f"k1 = {figure_text(rates.get('k1'))} m/rad, k2 = {figure_text(rates.get('k2'))} m/rad "
+        f"(|k| <= {figure_text(profile.get('rate_bound'))} m/rad), over the knee's flexion "
+        f"{figure_text(profile.get('range'))} rad.",
         "",
         "| surfaces' bound | margin | unit |",
         "|---|---|---|",
     ]
     for bound, margin in (profile.get("surface_margins") or {}).items():
-        lines += [f"| {bound} | {_number(margin)} | {'m' if 'convex' in bound else 'm²'} |"]
+        lines += [f"| {bound} | {figure_text(margin)} | {'m' if 'convex' in bound else 'm²'} |"]
     lines += [""]
     for key, words in (
         ("profile_vs_circles", "profile vs designed circles"),
@@ -843,7 +854,7 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
     verdict = "PASS" if report.passed else "FAIL"
     lines = ["## Validation in MuJoCo", ""]
     if page.validation_source is not None:
-        where = _relative(page.validation_source, folder)
+        where = relative_link(page.validation_source, folder)
         lines += [f"Report [`{page.validation_source}`]({where}): **{verdict}**.", ""]
     figure = f"{page.name}/{TORQUES_FIGURE}" if has_profiles(report) else None
     lines += mujoco_walk_lines(report, figure)
@@ -854,7 +865,7 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
         for name, value in check.figures.items():
             if name not in NOT_TABLED:
                 unit = unit_text(check.units.get(name, ""))
-                lines += [f"| {name} | {_number(value)} | {unit} |"]
+                lines += [f"| {name} | {figure_text(value)} | {unit} |"]
         lines += [""]
         if check.notes:  # sentences, one a line (a list of two figures is a range: "low to high")
             lines += [f"- {note}" for note in check.notes] + [""]
@@ -866,7 +877,10 @@ def _validation_lines(page: Page, folder: Path) -> list[str]:
 def page_figures(page: Page) -> dict[str, Figure]:
     """The page's figures: the gait's (``gait_figures``) and, with a validation report that
     has an orbit check, its multipliers (``ORBIT_FIGURE``), and with one whose forward check
-    has the torques over one step, MuJoCo's beside the model's (``TORQUES_FIGURE``)."""
+    has the torques over one step, MuJoCo's beside the model's (``TORQUES_FIGURE``); a
+    two-phase gait's are its phases' (``biped.pages.two_phase_figures``)."""
+    if page.gait.two_phase:
+        return two_phase_figures(page.gait)
     figures = gait_figures(page.gait)
     title = f"{page.gait.knee} knee, {page.gait.criterion}, {page.gait.speed:.3f} m/s"
     orbit = None if page.validation is None else page.validation.check("orbit")
