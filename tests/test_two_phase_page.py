@@ -52,6 +52,8 @@ def test_page_names_both_phases_beside_the_single_support_optimum(written):
     assert "single support then double support" in text
     assert "## Landing" in text and "an impact that stops both feet" in text
     assert "| rear |" in text and "| front |" in text and "Ix [N·s]" in text
+    ix, iz = gait.double_support.landing_impulse[3:5]  # the front foot's
+    assert f"| {abs(ix) / iz:.3g} |" in text  # the friction its landing needs
     share = gait.double_support.share
     assert f"| double support's share T_ds / (T + T_ds) | {share:.4g} | 0 | 1 |" in text
     step = gait.period + gait.double_support.duration
@@ -144,3 +146,16 @@ def test_a_two_phase_page_does_not_take_a_single_support_gait_of_another_speed(w
     assert single_of(gait, [dataclasses.replace(single, speed=0.31)]) is None
     assert single_of(gait, [dataclasses.replace(single, knee="revolute")]) is None
     assert isinstance(single, Gait)
+
+
+def test_a_zero_speed_landing_is_said_without_impulses():
+    """A zero-speed landing's page says nothing jumps and draws its landing as such."""
+    from biped.pages.two_phase_page import two_phase_markdown
+
+    gait = two_phase_gait("rolling", landing="zero-speed")
+    page = Page(name="zero", source=Path("logs/zero.json"), gait=gait)
+    text = two_phase_markdown(page, Path("logs/reports"))
+    assert "at zero foot speed" in text and "Ix [N·s]" not in text
+    figure = tpf.two_phase_figures(gait)[tpf.TORQUES]
+    labels = {line.get_label() for ax in figure.axes for line in ax.lines}
+    assert "landing (zero-speed)" in labels

@@ -138,8 +138,15 @@ def _feet(quantity: Callable):
 
 
 def _friction_line(ax, gait: Gait) -> None:
-    ax.axhline(
-        FOOT_FRICTION, color="k", linestyle=":", linewidth=1.0, label=f"μ = {FOOT_FRICTION:g}"
+    """The model's friction μ, the ratio no foot may exceed."""
+    ax.axhline(FOOT_FRICTION, color="k", linestyle=":", linewidth=1.0)
+    ax.annotate(
+        f"μ = {FOOT_FRICTION:g}, the model's friction",
+        (0.0, FOOT_FRICTION),
+        xycoords=("axes fraction", "data"),
+        xytext=(4, -10),
+        textcoords="offset points",
+        fontsize=FONT_NOTE,
     )
     ax.set_ylim(0.0, 1.15 * max(FOOT_FRICTION, *(np.nanmax(c.values) for c in _ratio(gait))))
 
@@ -149,11 +156,13 @@ def _ratio(gait: Gait) -> list[Curve]:
 
 
 def _sole_lines(ax, gait: Gait) -> None:
+    """The sole's heel and toe from the ankle: where each foot's ZMP must stay."""
     for name, x in gait.robot.sole_edges().items():
         ax.axhline(x, color="0.4", linestyle=":", linewidth=1.0)
         ax.annotate(
-            name,
+            f"{name} of the sole",
             (0.0, x),
+            xycoords=("axes fraction", "data"),
             xytext=(2, 2),
             textcoords="offset points",
             fontsize=FONT_NOTE,

@@ -17,6 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from biped.model.double_support import FOOT_CONSTRAINTS
+from biped.model.robot import FOOT_FRICTION
 from biped.model.units import unit_text
 from biped.pages.page import NOT_TABLED, Page, figure_text, relative_link
 from biped.pages.two_phase_figures import FIGURE_NAMES, step_duration
@@ -42,6 +43,12 @@ FRONT_RULE = (
     "The front foot's wrench is the optimizer's at its samples of the double support, linear "
     "between them (the file's rule): the rear foot's wrench and the torques follow from it, "
     "with a kink at each sample."
+)
+# Why the single support's curves jump at mid-step (``biped.pages.page.KNOT_WHY``'s reason).
+KNOT_RULE = (
+    "The single support's torques and ground forces jump at its mid-step, t = T/2: the "
+    "paper's spline is C¹ there (eqs. 25-26), so the accelerations jump. At the landing the "
+    "torques and the rear foot's forces jump too: the front foot takes its share of the load."
 )
 NOT_RUN = "not run"
 
@@ -105,22 +112,50 @@ def phase_rows(gait: Gait, single: Gait | None) -> list[str]:
     return lines
 
 
+def landing_friction(impulse) -> float | None:
+    """|Ix| / Iz of one foot's landing impulse (Ix, Iz, Iy): the friction coefficient the
+    landing needs on it; None where the ground gives no push (Iz <= 0: no friction holds)."""
+    ix, iz = impulse[0], impulse[1]
+    return abs(ix) / iz if iz > 0.0 else None
+
+
 def landing_lines(gait: Gait) -> list[str]:
-    """The landing's kind and its impulse on each foot."""
+    """The landing's kind, its impulse on each foot and the friction each foot needs for it
+    against the model's."""
     double = gait.double_support
     lines = [
         "",
         "## Landing",
         "",
         f"The landing is {LANDING_WORDS[double.landing]}.",
+    ]
+    if double.landing != "impact":
+        return lines
+    lines += [
         "",
-        "| foot | " + " | ".join(f"{name} [{unit}]" for name, unit in IMPULSE) + " |",
-        "|---" * (len(IMPULSE) + 1) + "|",
+        "| foot | "
+        + " | ".join(f"{name} [{unit}]" for name, unit in IMPULSE)
+        + " | \\|Ix\\| / Iz: friction needed [1] |",
+        "|---" * (len(IMPULSE) + 2) + "|",
     ]
     impulse = double.landing_impulse
     for f, foot in enumerate(FEET):
         values = impulse[3 * f : 3 * f + 3]
-        lines += [f"| {foot} | " + " | ".join(f"{v:.4g}" for v in values) + " |"]
+        needed = landing_friction(values)
+        shown = "no push (Iz ≤ 0): none holds" if needed is None else f"{needed:.3g}"
+        lines += [f"| {foot} | " + " | ".join(f"{v:.4g}" for v in values) + f" | {shown} |"]
+    worst = [landing_friction(impulse[3 * f : 3 * f + 3]) for f in range(len(FEET))]
+    over = [foot for foot, w in zip(FEET, worst, strict=True) if w is None or w > FOOT_FRICTION]
+    lines += [
+        "",
+        f"The model's friction is μ = {FOOT_FRICTION:g}: "
+        + (
+            f"the landing needs more on the {' and '.join(over)} "
+            f"{'feet' if len(over) > 1 else 'foot'} (no constraint of the problem bounds it yet)."
+            if over
+            else "both feet hold through the landing."
+        ),
+    ]
     return lines
 
 
@@ -215,7 +250,8 @@ def two_phase_markdown(page: Page, folder: Path) -> str:
     lines += feet_lines(gait)
     lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---|---|"]
     lines += [f"| {n} | {v:.6g} | {unit_of(n)} |" for n, v in gait.parameters.items()]
-    lines += ["", "## Figures", "", "The double support is shaded. " + FRONT_RULE, ""]
+    lines += ["", "## Figures", "", f"The double support is shaded. {KNOT_RULE}", ""]
+    lines += [FRONT_RULE, ""]
     lines += [f"![{name[:-4]}]({page.name}/{name})" + "\n" for name in FIGURE_NAMES]
     if page.validation is not None:
         where = None
