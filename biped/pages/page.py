@@ -9,6 +9,9 @@
     <out>/<name>/walk_torques.png    MuJoCo's joint torques over one step beside the model's
                                      (with a report: ``biped.pages.walk_figures``)
 
+A two-phase gait's page (``biped optimize --double-support``) is ``biped.pages.two_phase_page``'s
+with the figures of ``biped.pages.two_phase_figures`` instead.
+
 The page gives the gait's parameters by name with their units, its criteria, the tightest
 margin of each constraint (which sample of the step, and how far above the solver's margin δ),
 where a constraint dips below δ between the solver's samples (an inset on its panel), the
