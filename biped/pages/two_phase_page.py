@@ -151,7 +151,7 @@ def landing_lines(gait: Gait) -> list[str]:
         f"The model's friction is μ = {FOOT_FRICTION:g}: "
         + (
             f"the landing needs more on the {' and '.join(over)} "
-            f"{'feet' if len(over) > 1 else 'foot'} (no constraint of the problem bounds it yet)."
+            f"{'feet' if len(over) > 1 else 'foot'}: in MuJoCo it would slide there."
             if over
             else "both feet hold through the landing."
         ),
