@@ -64,6 +64,7 @@ _UNITS = (
 # Samples of the phase's check grid per interval of the solver's (``samples``).
 CHECK_PER_INTERVAL = 10
 WRENCH = ["N", "N", "N·m"]
+IMPULSE = ["N·s", "N·s", "N·m·s"]  # a wrench integrated over the impact
 WRENCH_COLUMNS = ("Fx", "Fz", "Cy")
 FEET = ("rear", "front")
 CUBIC = {
@@ -131,7 +132,7 @@ class DoubleSupport:
     sthenic: float = unit_field("N²·m·s")
     front_wrench: list = unit_field(WRENCH, WRENCH_COLUMNS)
     coefficients: dict = unit_field(CUBIC)
-    landing_impulse: list = unit_field(WRENCH + WRENCH)
+    landing_impulse: list = unit_field(IMPULSE + IMPULSE)
     foot_margins: dict = unit_field({foot: FOOT_UNITS for foot in FEET})
     # both feet's constraints at the solver's samples; at the landing both feet pushed within
     # the friction cone (``biped.model.two_phase.landing_margins``)
