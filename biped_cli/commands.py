@@ -476,8 +476,8 @@ def cmd_validate(args) -> int:
     for path, gait in zip(args.gait, gaits, strict=True):
         if gait.two_phase and (args.video or args.spawn or args.connect):
             raise BipedError(
-                f"gait file {path!r} is of two phases: its walk is not built, allowed no "
-                "--video, --spawn or --connect"
+                f"gait file {path!r} is of two phases: the recording and video of its walk "
+                "are not built, allowed no --video, --spawn or --connect"
             )
     recordings = _recordings(args)
     reports, passed = {}, 0

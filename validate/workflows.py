@@ -50,9 +50,11 @@ def validate_and_record(
     from validate.outputs.record import record
 
     result = validation.validate(gait, steps=steps, model=model)
-    if result.simulation is None:  # no walk to record or film (a two-phase gait's)
+    if gait.two_phase:  # its walk is checked, not recorded or filmed
         if video is not None or gif is not None:
-            raise BipedError("--video of a two-phase gait: its walk is not built (no video)")
+            raise BipedError(
+                "--video of a two-phase gait: the recording and video of its walk are not built"
+            )
         return result, validation.validation_report(result.checks).with_files(
             provenance=provenance()
         )
@@ -82,7 +84,7 @@ def files_lines(
         *(
             recording_lines(report.recording)
             if report.recording is not None
-            else ["no recording (the walk of a two-phase gait is not built)"]
+            else ["no recording (the recording of a two-phase walk is not built)"]
         ),
         *(f"video {video}" for video in report.video or ()),
     ]

@@ -660,7 +660,7 @@ def walk_figures(
 def _foot_figures(biped, samples, sim: Simulation, tilt, counted: slice) -> dict:
     """``walk_figures`` of the feet: the stance foot's tilt, the swing foot's scuffs and its
     clearance over the steps ``counted``."""
-    scuffs = contact.scuffs(sim, samples.period)
+    scuffs = contact.scuffs(sim, samples.landing_time)
     clearance = contact.clearance(biped, samples, sim)
     return {
         "sole_length": float(biped.robot.foot_length),
@@ -686,7 +686,9 @@ def _tracking_figures(biped, samples, sim: Simulation, reaction, walked: int, re
         nan = np.full(len(sim.time), np.nan)
         reaction = {"force": np.stack([nan, nan], axis=1), "cop": nan}
     force, cop = reaction["force"][:end], reaction["cop"][:end]
-    steady = sim.phase[:end] >= LANDING * samples.period
+    # Since the landing: the step's start, or a two-phase gait's touchdown (τ = T).
+    since = sim.phase[:end] - (samples.landing if samples.two_phase else 0.0)
+    steady = ~((since >= 0.0) & (since < LANDING * samples.period))
     wrench_ref, zmp_ref = wrench_ref[:end], zmp_ref[:end]
     compared = ~np.isnan(cop) & steady  # single support, steady
     weight = biped.robot.weight
@@ -700,7 +702,9 @@ def _tracking_figures(biped, samples, sim: Simulation, reaction, walked: int, re
         "zmp_relative_error": _ratio(
             zmp_error, _rms(torques_ref[:end][compared, 0] / wrench_ref[compared, 1])
         ),
-        "touchdown_jump_error": _median(touchdown_jumps(biped, sim, max(walked, 1))),
+        "touchdown_jump_error": _median(
+            [] if sim.double_support else touchdown_jumps(biped, sim, max(walked, 1))
+        ),
         "ground_force_rms_error": _rms((force[compared] - wrench_ref[compared, :2]) / weight),
         "feedforward_rms": _rms(feedforward[steady]),
         "feedback_rms": _rms(feedback[steady]),
@@ -816,10 +820,11 @@ def _profiled(model) -> bool:
     )
 
 
-def scuff_notes(sim: Simulation, period: float, figures: dict, steps: int) -> list:
-    """What the swing foot's clearance says of a walk of ``walk_figures``: its scuffs, and
-    whether they alone fail it, or how near it came to scuffing (``SCUFF_MARGIN``)."""
-    scuffs = contact.scuffs(sim, period)
+def scuff_notes(sim: Simulation, swing: float, figures: dict, steps: int) -> list:
+    """What the swing foot's clearance says of a walk of ``walk_figures`` whose swing lasts
+    ``swing`` [s] (``GaitSamples.landing_time``): its scuffs, and whether they alone fail
+    it, or how near it came to scuffing (``SCUFF_MARGIN``)."""
+    scuffs = contact.scuffs(sim, swing)
     if scuffs.steps:
         j = scuffs.steps[0]
         decided = walks({**figures, "scuff_steps": 0}, steps)
@@ -931,7 +936,7 @@ def check_forward(walker: Walker, steps: int, energy: float):
     reaction = contact.ground_reaction(sim)
     figures = walk_figures(walker.biped, walker.samples, sim, energy, reaction)
     figures["real_time_factor"] = figures["seconds_simulated"] / wall
-    notes = scuff_notes(sim, walker.period, figures, steps)
+    notes = scuff_notes(sim, walker.samples.landing_time, figures, steps)
     failures = walk_failures(figures, steps)
     if failures:  # why, in words, beside the figures (the atlas's lines give only the notes)
         notes = [f"not a walk of {steps} steps: " + ", ".join(failures), *notes]
@@ -973,7 +978,8 @@ def check_gains(walker: Walker, steps: int, energy: float, forward: Check) -> Ch
         clearances[scale] = figures["swing_clearance"]
         found |= set(walk_causes(figures, steps))
         notes += [
-            f"kp × {scale:g}: {note}" for note in scuff_notes(sim, walker.period, figures, steps)
+            f"kp × {scale:g}: {note}"
+            for note in scuff_notes(sim, walker.samples.landing_time, figures, steps)
         ]
     scales = sorted(results)
     walked = [s for s in scales if results[s]]

@@ -41,7 +41,7 @@ class Validation:
     checks: list[Check]
     biped: Biped
     samples: GaitSamples
-    simulation: Simulation | None  # None: no walk (a two-phase gait's is not built)
+    simulation: Simulation  # the forward check's walk
     contact: dict  # the walk's ground reaction (``validate.walk.contact.ground_reaction``)
     orbit: Orbit | None = None  # the walk's orbit and its multipliers (``validate.checks.orbit``)
 
@@ -63,7 +63,8 @@ def validate(
     spec = model if isinstance(model, mujoco.MjSpec) else model_spec(biped, model)
     robot_model = compile_spec(spec)
     if gait.two_phase:
-        return Validation(gait, two_phase_checks(gait, spec), biped, samples, None, {})
+        checks, sim, reaction = two_phase_checks(gait, spec, steps)
+        return Validation(gait, checks, biped, samples, sim, reaction)
     energy = gait.costs.energy
     results = [
         c.check_model(robot_model, biped),
@@ -79,34 +80,44 @@ def validate(
     return Validation(gait, results + [orbit], biped, samples, sim, reaction, found)
 
 
-# Why the checks of a walk are not run on a two-phase gait.
-NO_TWO_PHASE_WALK = (
-    "MuJoCo's walk of a two-phase gait (a controller holding both feet through the double "
-    "support, then lifting the rear one) is not built"
+# Why the orbit check is not run on a two-phase gait.
+NO_TWO_PHASE_ORBIT = (
+    "the return map of a two-phase walk (its section, a state of single support) is not built"
+)
+# Why the forward check's energy ratio is not measured on a two-phase gait.
+NO_TWO_PHASE_ENERGY = (
+    "energy_ratio not measured: the file's energy is its single support's, MuJoCo's the "
+    "whole step's"
 )
 
 
-def two_phase_checks(gait: Gait, spec: mujoco.MjSpec) -> list[Check]:
+def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS):
     """The checks of a two-phase gait: the model; the inverse dynamics along both phases;
     the knee loads along its single support (the file's are the single support's); the
     landing holding both feet against MuJoCo's impact map (``check_two_phase_impact``); the
     feedforward replay of both phases with both feet's ground forces
-    (``check_two_phase_feedforward``); the walk, its gains and its orbit not run, each
-    saying why (failed: unknown, never passed)."""
+    (``check_two_phase_feedforward``); MuJoCo's walk of both phases (``check_forward``: the
+    double support with both feet on the floor, each step ending at the rear foot's
+    lift-off) and the same walk at other gains (``check_gains``); the orbit not run, saying
+    why (failed: unknown, never passed). Returns (checks, the walk, its ground reaction)."""
     biped, samples = gait.biped, GaitSamples.from_gait(gait)
     robot_model = compile_spec(spec)
     knee_loads = c.check_knee_loads(robot_model, biped, samples.single_support(), gait.knee_loads)
     knee_loads.notes.append("the single support phase only (the double support's not built)")
-    return [
+    walker = Walker(gait, spec)
+    forward, sim, reaction = c.check_forward(walker, steps, float("nan"))
+    forward.notes.append(NO_TWO_PHASE_ENERGY)
+    checks = [
         c.check_model(robot_model, biped),
         c.check_inverse_dynamics(robot_model, biped, samples),
         knee_loads,
         c.check_two_phase_impact(robot_model, biped, samples, gait),
         c.check_two_phase_feedforward(spec, biped, samples),
-        c.not_run("forward", NO_TWO_PHASE_WALK),
-        c.not_run("gains", NO_TWO_PHASE_WALK),
-        c.not_run("orbit", NO_TWO_PHASE_WALK),
+        forward,
+        c.check_gains(walker, steps, float("nan"), forward),
+        c.not_run("orbit", NO_TWO_PHASE_ORBIT),
     ]
+    return checks, sim, reaction
 
 
 def validation_report(checks) -> ValidationReport:

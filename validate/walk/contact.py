@@ -3,8 +3,10 @@
     ground_reaction   the stance foot's ground force and centre of pressure (single support)
     feet_forces       each foot's ground force and centre of pressure in one state (both
                       feet on the ground: a double support replayed)
-    foot_tilt         the stance foot's tilt and the lift of its heel and toe, each step
-    scuffs            the swing foot's touches of the floor before its landing window
+    foot_tilt         the supporting feet's tilt and the lift of their heels and toes, each
+                      step (a two-phase walk's front foot from its touchdown)
+    scuffs            the swing foot's touches of the floor before its landing window (a
+                      two-phase gait's double support after its landing is none)
     clearance         how high the swing foot passes over the floor, in MuJoCo and in the gait
     advances          how far the hip goes forward in each step
 
@@ -89,12 +91,6 @@ def feet_forces(model: mujoco.MjModel, data: mujoco.MjData, layout, sides) -> np
     return out
 
 
-def _settled(sim: Simulation, period: float) -> list[slice]:
-    """Rows of each step after its first ``SETTLE`` of the period."""
-    skip = int(SETTLE * period / sim.model.opt.timestep)
-    return [slice(min(rows.start + skip, rows.stop), rows.stop) for rows in sim.step_slices()]
-
-
 @dataclass
 class FootTilt:
     """The stance foot in each step, after it settles.
@@ -110,23 +106,33 @@ class FootTilt:
 
 
 def foot_tilt(sim: Simulation, period: float) -> FootTilt:
+    """Each step's supporting feet (``Simulation.supports``: the stance foot, and in a
+    two-phase walk the front foot from its touchdown), the first ``SETTLE`` of the
+    ``period`` after each landing left out."""
+    skip = int(SETTLE * period / sim.model.opt.timestep)
     tilt, heel_lift, toe_lift = [], [], []
-    for rows, stance in zip(_settled(sim, period), sim.stances, strict=True):
-        heel, toe = sim.heel(stance)[rows], sim.toe(stance)[rows]
-        if not len(heel):
-            tilt.append(0.0), heel_lift.append(0.0), toe_lift.append(0.0)
-            continue
-        angle = np.arctan2(toe[:, 2] - heel[:, 2], toe[:, 0] - heel[:, 0])
-        tilt.append(float(np.abs(angle).max()))
-        heel_lift.append(float(heel[:, 2].max()))
-        toe_lift.append(float(toe[:, 2].max()))
+    for spans in sim.supports(skip):
+        feet = [_sole_tilt(sim, side, rows) for side, rows in spans]
+        tilt.append(max(f[0] for f in feet))
+        heel_lift.append(max(f[1] for f in feet))
+        toe_lift.append(max(f[2] for f in feet))
     return FootTilt(np.array(tilt), np.array(heel_lift), np.array(toe_lift))
+
+
+def _sole_tilt(sim: Simulation, side: str, rows: slice) -> tuple[float, float, float]:
+    """A sole's largest |tilt| [rad], heel and toe heights [m] over ``rows`` (0: none)."""
+    heel, toe = sim.heel(side)[rows], sim.toe(side)[rows]
+    if not len(heel):
+        return 0.0, 0.0, 0.0
+    angle = np.arctan2(toe[:, 2] - heel[:, 2], toe[:, 0] - heel[:, 0])
+    return float(np.abs(angle).max()), float(heel[:, 2].max()), float(toe[:, 2].max())
 
 
 @dataclass
 class Scuffs:
     """Touches of the floor by the swing foot between its lift-off (``LIFT_WINDOW``) and its
-    landing window (``LANDING_WINDOW``).
+    landing window (``LANDING_WINDOW``), each a fraction of the swing's time T (the gait's
+    landing: a two-phase gait's double support after it is no scuff).
 
     Attributes:
         steps: indices of the steps with a scuff.
@@ -141,13 +147,14 @@ class Scuffs:
     first_phase: np.ndarray
 
 
-def scuffs(sim: Simulation, period: float) -> Scuffs:
+def scuffs(sim: Simulation, swing_time: float) -> Scuffs:
+    """The scuffs of a walk whose swing lasts ``swing_time`` [s] (``GaitSamples.landing_time``)."""
     dt = sim.model.opt.timestep
     duration, depth, first = [], [], []
     for rows, stance in zip(sim.step_slices(), sim.stances, strict=True):
         swing = other(stance)
         touching = sim.touch(swing)[rows] > TOUCH_THRESHOLD
-        phase = sim.phase[rows] / period
+        phase = sim.phase[rows] / swing_time
         scuff = touching & (phase >= LIFT_WINDOW) & (phase < LANDING_WINDOW)
         lowest = np.minimum(sim.heel(swing)[rows, 2], sim.toe(swing)[rows, 2])
         duration.append(float(scuff.sum() * dt))
@@ -165,7 +172,7 @@ def scuffs(sim: Simulation, period: float) -> Scuffs:
 @dataclass
 class Clearance:
     """How high the lowest point of the swing sole passes over the floor between its lift-off
-    and its landing window (phase ``LIFT_WINDOW`` to ``LANDING_WINDOW``) [m].
+    and its landing window (``LIFT_WINDOW`` to ``LANDING_WINDOW`` of the swing's time) [m].
 
     Attributes:
         walk: (steps,) in MuJoCo, each step.
@@ -177,14 +184,14 @@ class Clearance:
 
 
 def clearance(biped: Biped, samples: GaitSamples, sim: Simulation) -> Clearance:
-    walk = []
+    walk, swing_time = [], samples.landing_time
     for rows, stance in zip(sim.step_slices(), sim.stances, strict=True):
         swing = other(stance)
-        phase = sim.phase[rows] / samples.period
+        phase = sim.phase[rows] / swing_time
         window = (phase >= LIFT_WINDOW) & (phase < LANDING_WINDOW)
         lowest = np.minimum(sim.heel(swing)[rows, 2], sim.toe(swing)[rows, 2])
         walk.append(float(lowest[window].min()) if window.any() else float("nan"))
-    t = np.linspace(LIFT_WINDOW, LANDING_WINDOW, 400) * samples.period
+    t = np.linspace(LIFT_WINDOW, LANDING_WINDOW, 400) * swing_time
     feet = biped.points(samples.at("q", t), ["swing_heel", "swing_toe"])[..., 1]
     return Clearance(walk=np.array(walk), gait=float(feet.min()))
 

@@ -69,6 +69,12 @@ class GaitSamples:
     def two_phase(self) -> bool:
         return self.landing is not None
 
+    @property
+    def landing_time(self) -> float:
+        """[s] the swing foot's landing: T, a two-phase gait's single support (its
+        ``landing``), the ``period`` of a gait of single support."""
+        return self.period if self.landing is None else self.landing
+
     @classmethod
     def from_gait(cls, gait: Gait) -> GaitSamples:
         """The samples of a gait (of both phases, a two-phase gait's)."""

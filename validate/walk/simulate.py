@@ -41,6 +41,15 @@ the landing window is a scuff: the step goes on (``validate.walk.contact`` repor
 foot has not landed after ``STEP_TIMEOUT`` periods, or the hip has dropped below ``FALLEN``
 of its height, the walk ends.
 
+A two-phase gait (``GaitSamples.double_support``) is walked the same way through both
+phases: the phase table runs from lift-off through the single support and the double
+support to the next lift-off (the hip advances over the rear ankle throughout). The swing
+foot's touch in the landing window (the last ``1 - LANDING_WINDOW`` of the single support's
+advance) is its touchdown (``Simulation.touchdowns``); the controller goes on with both
+feet on the floor, the rear ankle free as the stance ankle, every other joint on its servo,
+and the step ends at the rear foot's lift-off: the phase at the end of the table with the
+front foot on the floor. The legs then swap and the next step lifts the former rear foot.
+
 ``Walker`` prepares a gait on a model once; ``Walker.walk`` runs it under ``WalkSettings``
 (gains, friction, a push): the robustness of a gait is many walks of one walker. A walk starts
 from the file's start state, or from another state of the left leg in stance (``start``), and
@@ -185,12 +194,15 @@ class PhaseTable:
         controls: stance side -> (N, ``CONTROLS``): the file's torques of the six motors (as
             their controls), joint references, reference rates, and what each motor adds per
             unit ṡ² to turn its rotor (``Layout.rotor_inertia`` θ̈_ref): ``TORQUES``, ...
+        double_support: the step ends with a double support (a two-phase gait's, from its
+            landing to the rear foot's lift-off at the table's end).
     """
 
     advance: np.ndarray
     tau: np.ndarray
     speed: np.ndarray
     controls: dict
+    double_support: bool = False
 
     @functools.cached_property
     def interpolants(self) -> dict:
@@ -230,7 +242,9 @@ def phase_table(
         table[:, RATES] = layout.joint_angles(mapped.qvel(q, qd))
         table[:, ROTORS] = rotor_torques(mapped, layout, q, qd, qdd)
         table[:, ROTORS] /= layout.gears
-    return PhaseTable(advance, tau, speed=qd[:, XH], controls=controls)
+    return PhaseTable(
+        advance, tau, speed=qd[:, XH], controls=controls, double_support=samples.two_phase
+    )
 
 
 @dataclass
@@ -250,7 +264,11 @@ class Simulation:
     speed_torque: np.ndarray = None  # (N,) the stance ankle's torque on the speed [N·m]
     step_starts: list = field(default_factory=list)  # index of each step's first state
     stances: list = field(default_factory=list)  # stance side of each step
-    landed: list = field(default_factory=list)  # whether each step ended on a touchdown
+    landed: list = field(default_factory=list)  # whether each step ended on its event
+    # A two-phase gait's walk: each step's touchdown row (None: none), the double support
+    # from it to the step's end (its lift-off); a single support's steps end at touchdown.
+    double_support: bool = False
+    touchdowns: list = field(default_factory=list)
     warnings: int = 0  # MuJoCo warnings raised during the simulation
     settings: WalkSettings = WalkSettings()
     pushed: float = 0.0  # impulse given by the push [N·s]
@@ -297,16 +315,53 @@ class Simulation:
         """Normal force [N] on a sole."""
         return self.layout.touch(self.sensors, side)
 
+    def supports(self, settle: int = 0) -> list[list[tuple[str, slice]]]:
+        """Per step, each foot's rows while it is a support, its landing settled (its first
+        ``settle`` states after touchdown left out): a single support's stance foot after
+        the step's first ``settle`` states; a two-phase walk's stance foot from its
+        touchdown in the step before (settled; the walk's start for the first step) to the
+        step's lift-off, and its front foot from its touchdown (settled) to the lift-off."""
+        steps = zip(self.step_slices(), self.stances, strict=True)
+        if not self.double_support:
+            return [[(stance, slice(min(r.start + settle, r.stop), r.stop))] for r, stance in steps]
+        spans, since = [], 0  # the walk starts with both feet at rest on the floor
+        for (rows, stance), down in zip(steps, self.touchdowns, strict=True):
+            step = [(stance, slice(since, rows.stop))]  # since: at or before its start
+            if down is not None:
+                since = min(down + settle, rows.stop)
+                step.append((other(stance), slice(since, rows.stop)))
+            spans.append(step)
+        return spans
+
+    def landings(self, settle: int = 0) -> list[tuple[str, slice]]:
+        """Per step, the landing foot and its first ``settle`` states on the floor: the
+        stance foot at a single support's step start, the front foot from a two-phase
+        step's touchdown (none: an empty slice)."""
+        steps = zip(self.step_slices(), self.stances, strict=True)
+        if not self.double_support:
+            return [(stance, slice(r.start, min(r.start + settle, r.stop))) for r, stance in steps]
+        return [
+            (
+                other(stance),
+                slice(r.stop, r.stop) if down is None else slice(down, min(down + settle, r.stop)),
+            )
+            for (r, stance), down in zip(steps, self.touchdowns, strict=True)
+        ]
+
     def stance_foot_slip(self, settle: int = 0, landing: bool = False) -> np.ndarray:
-        """Travel [m] of each step's stance sole on the ground (the spread of its middle's
-        x) after its first ``settle`` states (during them if ``landing``): a foot rolling on
-        its sole barely moves its middle, a foot sliding moves it by the slide."""
-        slips = []
-        for rows, stance in zip(self.step_slices(), self.stances, strict=True):
-            middle = 0.5 * (self.heel(stance)[rows, 0] + self.toe(stance)[rows, 0])
-            part = middle[:settle] if landing else middle[settle:]
-            slips.append(float(np.ptp(part)) if len(part) else 0.0)
-        return np.array(slips)
+        """Travel [m] of each step's supporting soles on the ground (the spread of a sole's
+        middle x, the largest of the feet's ``supports``), or during the landing foot's
+        first ``settle`` states (``landing``): a foot rolling on its sole barely moves its
+        middle, a foot sliding moves it by the slide."""
+        steps = [[span] for span in self.landings(settle)] if landing else self.supports(settle)
+        return np.array(
+            [max(self._sole_travel(side, rows) for side, rows in step) for step in steps]
+        )
+
+    def _sole_travel(self, side: str, rows: slice) -> float:
+        """[m] the spread of a sole's middle x over ``rows`` (0: none)."""
+        middle = 0.5 * (self.heel(side)[rows, 0] + self.toe(side)[rows, 0])
+        return float(np.ptp(middle)) if len(middle) else 0.0
 
     # -------------------------------------------------------------- torques (N, 6)
     def motors(self) -> np.ndarray:
@@ -455,6 +510,7 @@ class WalkLog:
         self.sensors = np.empty((capacity, model.nsensordata))
         self.where, self.speed_torque = np.empty(capacity), np.empty(capacity)
         self.rows, self.step_starts, self.stances, self.landed = 0, [], [], []
+        self.touchdowns = []  # a two-phase walk's, per step (``StepEvents.touchdown``)
         mujoco.mj_getState(model, data, self.state[0], self.SPEC)
         self.sensors[0] = data.sensordata
         self.models, self.datas, self.warmstart = [model], [data], data.qacc_warmstart[None]
@@ -496,6 +552,8 @@ class WalkLog:
             step_starts=self.step_starts,
             stances=self.stances,
             landed=self.landed,
+            double_support=table.double_support,
+            touchdowns=self.touchdowns,
             warnings=self.warnings,
             **results,
         )
@@ -589,18 +647,31 @@ class PhaseController:
 
 class StepEvents:
     """How a step ends (the module docstring): the swing foot, off the ground since some time
-    in the step, touches it in the landing window (``landed``), the hip drops below ``floor``
-    [m] (``fallen``), ``timeout`` [s] passes, or the log is full (``rows``)."""
+    in the step, touches it in the landing window (``landed``); a two-phase gait's step goes
+    on through its double support from that touchdown (``touchdown``, its row) and ends at
+    the rear foot's lift-off, the phase at the end of the step with the front foot on the
+    floor. Or the hip drops below ``floor`` [m] (``fallen``), ``timeout`` [s] passes, or the
+    log is full (``rows``)."""
 
-    def __init__(self, layout: Layout, last_row: int, floor: float, timeout: float, rows: int):
+    def __init__(
+        self, layout: Layout, table: PhaseTable, samples: GaitSamples, floor, timeout, rows
+    ):
         self.layout, self.floor, self.timeout, self.rows = layout, floor, timeout, rows
-        self.landing_row = LANDING_WINDOW * last_row
+        last_row = len(table.tau) - 1
+        # The landing's row: the end of the step, or a two-phase gait's touchdown (τ = T).
+        landing = last_row
+        self.lift_row = None  # a step of single support ends at its touchdown
+        if samples.two_phase:
+            landing = float(np.interp(samples.landing, table.tau, np.arange(len(table.tau))))
+            self.lift_row = last_row
+        self.landing_row = LANDING_WINDOW * landing
         self.hip_height_at = layout.state_index("hip_height")
 
     def start_step(self, stance: str, log: WalkLog) -> None:
         self.touch_at = self.layout.sensor_index(other(stance), "touch")
         self.began = log.state[log.rows, 0]
         self.lifted = self.landed = self.fallen = False
+        self.touchdown = None  # [row] of a two-phase step's touchdown
 
     def running(self, log: WalkLog, chunk: int) -> bool:
         k = log.rows
@@ -609,20 +680,29 @@ class StepEvents:
 
     def after_step(self, log: WalkLog, k: int, chunk: int) -> int:
         """The physics steps of the period from row k that belong to the step: up to its
-        landing or its fall, if either came in it."""
+        landing (a two-phase step's lift-off) or its fall, if either came in it."""
         n, aloft, where = chunk, True, log.where[k : k + chunk]  # clipped: in the window alike
         if not self.lifted or where.item(-1) >= self.landing_row:
             contact = log.sensors[k : k + chunk, self.touch_at] > TOUCH_THRESHOLD
             if not self.lifted:  # a foot that never lifts makes no steps
                 aloft = np.logical_or.accumulate(~contact)
                 self.lifted = bool(aloft[-1])
-            if where.item(-1) >= self.landing_row and contact.any():
+            if where.item(-1) >= self.landing_row and contact.any() and self.touchdown is None:
                 down = np.flatnonzero((where >= self.landing_row) & contact & aloft)
-                if len(down):
+                if len(down) and self.lift_row is None:
                     n, self.landed = int(down[0]) + 1, True
+                elif len(down):
+                    self.touchdown = k + int(down[0])
+            if self.touchdown is not None and where.item(-1) >= self.lift_row:
+                after = np.arange(k, k + chunk) >= self.touchdown
+                lift = np.flatnonzero((where >= self.lift_row) & contact & after)
+                if len(lift):
+                    n, self.landed = int(lift[0]) + 1, True
         heights = log.state[k + 1 : k + 1 + n, self.hip_height_at]
         if not np.minimum.reduce(heights) >= self.floor:  # below the floor, or not finite
             n, self.fallen, self.landed = int(np.argmax(~(heights >= self.floor))) + 1, True, False
+            if self.touchdown is not None and self.touchdown >= k + n:
+                self.touchdown = None
         return n
 
 
@@ -669,7 +749,8 @@ def _walk_on(walker, steps, settings, model, data, start=None, stop_advance=None
     log = WalkLog(model, data, int(np.ceil(steps * STEP_TIMEOUT * period / dt)) + chunk)
     controller = PhaseController(walker.table, layout, chunk, dt, settings.speed_gain)
     floor = FALLEN * min(samples.start()[0][ZH], samples.end()[0][ZH])
-    events = StepEvents(layout, controller.last, floor, STEP_TIMEOUT * period, len(log.where))
+    timeout = STEP_TIMEOUT * period
+    events = StepEvents(layout, walker.table, samples, floor, timeout, len(log.where))
     shove = Shove(settings.push, model, layout, chunk, dt)
     with rollout.Rollout(nthread=0) as runner:
         for j, stance in enumerate((SIDES * steps)[:steps]):
@@ -690,6 +771,8 @@ def _walk_on(walker, steps, settings, model, data, start=None, stop_advance=None
                     events.landed = False
                     break
             log.landed.append(events.landed)
+            if walker.table.double_support:
+                log.touchdowns.append(events.touchdown)
             if not events.landed:
                 break
     return log.simulation(layout, walker.table, settings=settings, pushed=shove.pushed)
