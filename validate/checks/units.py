@@ -27,13 +27,13 @@ class WalkFigures:
     fell: bool  # the hip too low or the trunk tilted (``validate.checks.checks.HIP_DROP``, ...)
     stalled: bool  # a step not landed, the robot up, or landed without advancing the hip
     step_length: float = unit_field("m")  # the gait's, the scale of the slip and the advance
-    max_slip: float = unit_field("m")  # stance foot's travel in its stance, landing settled
+    max_slip: float = unit_field("m")  # a supporting foot's travel on the floor, landing settled
     max_slip_share: float = unit_field("S")  # that over the step length
     step_duration_range: list = unit_field(PERIOD)  # of the steps walked
     step_advance_range: list = unit_field("S")  # the hip's advance in each of them
-    max_landing_slide: float = unit_field("m")  # the stance foot's in the landing windows
+    max_landing_slide: float = unit_field("m")  # the landing foot's in the landing windows
     sole_length: float = unit_field("m")  # the robot's, the scale of the tilt
-    max_foot_tilt: float = unit_field("rad")  # of the stance foot
+    max_foot_tilt: float = unit_field("rad")  # of a supporting foot
     max_heel_lift: float = unit_field("m")  # of the stance sole's heel
     max_toe_lift: float = unit_field("m")  # and toe
     scuff_steps: int = unit_field(PURE)  # the swing foot on the floor before its landing

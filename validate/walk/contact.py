@@ -93,11 +93,11 @@ def feet_forces(model: mujoco.MjModel, data: mujoco.MjData, layout, sides) -> np
 
 @dataclass
 class FootTilt:
-    """The stance foot in each step, after it settles.
+    """The supporting feet in each step (``Simulation.supports``), after they settle.
 
     Attributes:
-        tilt: (steps,) largest |angle| of the sole from the floor [rad].
-        heel_lift, toe_lift: (steps,) highest the heel, resp. toe, rises above the floor [m].
+        tilt: (steps,) largest |angle| of a sole from the floor [rad].
+        heel_lift, toe_lift: (steps,) highest a heel, resp. toe, rises above the floor [m].
     """
 
     tilt: np.ndarray
