@@ -11,14 +11,16 @@ import pytest
 
 import biped
 from biped.model.bezier import DEGREES, MAX_DEGREE, MIN_DEGREE, Bezier, bernstein, elevate
-from biped.model.criteria import Safety
+from biped.model.criteria import MARGINS, WALKABLE, Safety, evaluate_step
 from biped.model.gait import (
     FREE_SWAP,
     build_step,
     check_embedding,
     embedded,
     parameter_names,
+    piece_grid,
     sample,
+    spline_basis,
 )
 from biped.model.gait import evaluate as evaluate_at
 from biped.model.kinematics import swap_legs
@@ -32,6 +34,8 @@ from biped.optimization.problem import (
     scales,
     variable_names,
 )
+from biped.optimization.solver import forget_solvers
+from biped.optimization.symbolic import KNEE_BETWEEN_SAMPLES_MARGIN, KNEES, StepGraph
 from biped.records.gait_file import Gait
 from tests.conftest import assert_graph_is_the_model
 
@@ -293,3 +297,90 @@ def test_a_ladder_of_degrees_is_nested_or_refused():
     ):
         with pytest.raises(biped.BipedError, match=why):
             check_ladder(bad)
+
+
+def _knee_rows(graph, values) -> dict:
+    """The graph's constraint rows of each knee (``values``: the constraints' numbers), in
+    order: first at the solver's samples, then at the check grid's between them."""
+    names = np.array(graph.constraint_names)
+    return {name: values[names == name] for name in KNEES}
+
+
+def _between(family, samples_per_half) -> np.ndarray:
+    """Which of the check grid's samples lie strictly inside the step and between the
+    solver's."""
+    t_check, _ = spline_basis(CHECK_SAMPLES[family], family)
+    t_solver = np.concatenate(piece_grid(samples_per_half, family))
+    apart = np.min(np.abs(t_check[:, None] - t_solver[None, :]), axis=1) > 1e-12
+    return apart & (t_check > 0.0) & (t_check < 1.0)
+
+
+@pytest.mark.parametrize("knee", biped.KNEES)
+def test_the_knees_are_held_between_the_solvers_samples(knee):
+    """A Bézier family's graph imposes the knees' Ψ4 (less the least stance bend) and Ψ5 at
+    every sample of the check grid between its 51 own, each row the numeric check's value
+    less ``KNEE_BETWEEN_SAMPLES_MARGIN`` (to 1e-12 at random variables); a spline family's
+    graph imposes them at its own samples alone (its constraints unchanged)."""
+    safety = Safety(knee_bend=0.01)
+    family = Bezier(8)
+    problem = GaitProblem(_model(knee), SPEED, safety=safety, knots=family)
+    graph = StepGraph(problem.model, problem.samples_per_half, safety, knots=family)
+    rng = np.random.default_rng(8)
+    z = problem.first_guess() + 0.3 * scales(family) * rng.standard_normal(len(scales(family)))
+    rows = _knee_rows(graph, graph.function()(z=z, speed=SPEED)["constraints"].full().ravel())
+    step = build_step(problem.model, SPEED, problem.to_parameters(z), family)
+    check = evaluate_step(problem.model, step, CHECK_SAMPLES[family], safety=safety)
+    between = _between(family, problem.samples_per_half)
+    assert between.sum() == 150
+    for column, name in enumerate(KNEES, start=3):
+        expected = check.constraints[between, column] - KNEE_BETWEEN_SAMPLES_MARGIN
+        assert len(rows[name]) == 51 + 150
+        np.testing.assert_allclose(rows[name][51:], expected, rtol=1e-12, atol=1e-12)
+    for knots in (1, 3, 15):
+        spline = StepGraph(problem.model, SOLVER_SAMPLES[knots], safety, knots=knots)
+        samples = (knots + 1) * (SOLVER_SAMPLES[knots] + 1)
+        counts = [spline.constraint_names.count(name) for name in KNEES]
+        assert counts == [samples, samples], knots
+
+
+# The atlas's cell of its best walking pay-off (walkable constraints, 0.2 m/s, 2 cm of
+# clearance) at degree 11, where the rolling knee's optimum on the solver's samples alone
+# dipped 1.05e-5 rad below the swing knee's stop between two of them.
+DIPPED = dict(speed=0.2, clearance=0.02, degree=11)
+# [rad] IPOPT's constraint tolerance on the knees (scale 1 rad).
+SOLVER_TOLERANCE = 1e-9
+
+
+def _dipped_optimum():
+    safety = dataclasses.replace(WALKABLE, clearance=DIPPED["clearance"])
+    family = Bezier(DIPPED["degree"])
+    problem = GaitProblem(_model("rolling"), DIPPED["speed"], safety=safety, knots=family)
+    return optimize(problem, starts=1)
+
+
+def test_a_bezier_optimum_holds_its_knees_on_the_check_grid(monkeypatch):
+    """The rolling knee's degree 11 optimum at 0.2 m/s with 2 cm (walkable) is certified: on
+    the check grid its knees' Ψ4, Ψ5 keep the between-samples margin to the solver's
+    tolerance, and the swing knee leans on it (its least value between the solver's
+    samples, 1e-3 rad at them). On the solver's samples alone (the rows between them taken
+    away) the same problem's optimum is infeasible there: Ψ5 < 0 between two samples."""
+    held = _dipped_optimum()
+    assert held.certified, held.evaluation.violations_line()
+    psi = held.evaluation.constraints
+    between = _between(held.problem.knots, held.problem.samples_per_half)
+    knees = psi[:, 3:5]
+    assert np.nanmin(knees) >= KNEE_BETWEEN_SAMPLES_MARGIN - SOLVER_TOLERANCE
+    swing = psi[:, 4]
+    assert np.nanmin(swing[between]) == pytest.approx(KNEE_BETWEEN_SAMPLES_MARGIN, abs=1e-8)
+    assert np.nanmin(swing[~between]) >= MARGINS[4] - SOLVER_TOLERANCE
+    monkeypatch.setattr(StepGraph, "_knees_between_samples", lambda self: [])
+    forget_solvers()
+    try:
+        coarse = _dipped_optimum()
+    finally:
+        monkeypatch.undo()
+        forget_solvers()
+    assert coarse.report.converged and not coarse.feasible
+    assert set(coarse.evaluation.violations()) == {"swing_knee"}
+    worst = int(np.nanargmin(coarse.evaluation.constraints[:, 4]))
+    assert between[worst]
