@@ -1,7 +1,7 @@
 """The Bézier gait family (``biped.model.bezier``): its curves meet the step's end
 conditions (flat feet, leg swap, impact map) exactly, a degree's curve is the same motion
-in every higher degree (a nested ladder), and its rates and accelerations are the
-derivatives of its angles."""
+in every higher degree (a nested ladder), its rates and accelerations are the
+derivatives of its angles, and its solver holds the knees on the check grid."""
 
 import dataclasses
 import json
