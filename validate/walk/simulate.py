@@ -49,6 +49,10 @@ advance) is its touchdown (``Simulation.touchdowns``); the controller goes on wi
 feet on the floor, the rear ankle free as the stance ankle, every other joint on its servo,
 and the step ends at the rear foot's lift-off: the phase at the end of the table with the
 front foot on the floor. The legs then swap and the next step lifts the former rear foot.
+Once the front foot has landed (the first reading at or past the file's landing τ = T after
+the touchdown) its leg's references are re-anchored on the foot where it landed, so that the
+servos' chain closes (``validate.walk.anchor``, ``LandedChain``; ``WalkSettings.close_chain``
+off: the file's references throughout).
 
 ``Walker`` prepares a gait on a model once; ``Walker.walk`` runs it under ``WalkSettings``
 (gains, friction, a push): the robustness of a gait is many walks of one walker. A walk starts
@@ -79,6 +83,7 @@ from validate.scene.layout import Layout
 from validate.scene.mapping import mapping, other, rotor_torques
 from validate.scene.mjcf import SIDES
 from validate.scene.model import JOINT_ORDER, model_spec, with_servos
+from validate.walk.anchor import ChainAnchor, landed_step_length
 from validate.walk.samples import GaitSamples
 
 __all__ = ["JOINT_ORDER", "Push", "Simulation", "WalkSettings", "Walker", "simulate"]
@@ -144,6 +149,9 @@ class WalkSettings:
         friction: sliding friction coefficient of the soles and the floor (None: the
             model's, ``biped.model.robot.FOOT_FRICTION``).
         push: a shove on the trunk (None: none).
+        close_chain: a two-phase gait's front leg re-anchored at its touchdown on the foot
+            where it landed (``validate.walk.anchor``; False: the file's references
+            throughout the double support). No effect on a gait of single support.
     """
 
     kp_scale: float = 1.0
@@ -151,6 +159,7 @@ class WalkSettings:
     speed_scale: float = 1.0
     friction: float | None = None
     push: Push | None = None
+    close_chain: bool = True
 
     @property
     def kp(self) -> float:
@@ -196,6 +205,9 @@ class PhaseTable:
             unit ṡ² to turn its rotor (``Layout.rotor_inertia`` θ̈_ref): ``TORQUES``, ...
         double_support: the step ends with a double support (a two-phase gait's, from its
             landing to the rear foot's lift-off at the table's end).
+        motion: a two-phase gait's (q, q̇) (N, 9) each at the table's points, the paper's
+            coordinates of the left leg in stance (``validate.walk.anchor``); None: a gait
+            of single support.
     """
 
     advance: np.ndarray
@@ -203,16 +215,19 @@ class PhaseTable:
     speed: np.ndarray
     controls: dict
     double_support: bool = False
+    motion: tuple[np.ndarray, np.ndarray] | None = None
 
     @functools.cached_property
     def interpolants(self) -> dict:
-        """Stance side -> (2 ``CONTROLS``, N - 1): ``controls`` as columns (the first
-        ``CONTROLS`` rows, less the last point) over each column's increments to the next
-        point: what the walk interpolates, laid out for one gather."""
-        return {
-            side: np.ascontiguousarray(np.hstack([rows[:-1], np.diff(rows, axis=0)]).T)
-            for side, rows in self.controls.items()
-        }
+        """Stance side -> ``interpolant`` of its ``controls``."""
+        return {side: interpolant(rows) for side, rows in self.controls.items()}
+
+
+def interpolant(controls: np.ndarray) -> np.ndarray:
+    """(2 ``CONTROLS``, N - 1): ``controls`` (N, ``CONTROLS``) as columns (less the last
+    point) over each column's increments to the next point: what the walk interpolates,
+    laid out for one gather."""
+    return np.ascontiguousarray(np.hstack([controls[:-1], np.diff(controls, axis=0)]).T)
 
 
 def phase_table(
@@ -243,7 +258,12 @@ def phase_table(
         table[:, ROTORS] = rotor_torques(mapped, layout, q, qd, qdd)
         table[:, ROTORS] /= layout.gears
     return PhaseTable(
-        advance, tau, speed=qd[:, XH], controls=controls, double_support=samples.two_phase
+        advance,
+        tau,
+        speed=qd[:, XH],
+        controls=controls,
+        double_support=samples.two_phase,
+        motion=(q, qd) if samples.two_phase else None,
     )
 
 
@@ -269,6 +289,9 @@ class Simulation:
     # from it to the step's end (its lift-off); a single support's steps end at touchdown.
     double_support: bool = False
     touchdowns: list = field(default_factory=list)
+    # Each step's front leg re-anchored at its touchdown (``validate.walk.anchor.Anchoring``;
+    # None: not re-anchored, ``WalkSettings.close_chain`` off or no touchdown).
+    anchorings: list = field(default_factory=list)
     warnings: int = 0  # MuJoCo warnings raised during the simulation
     settings: WalkSettings = WalkSettings()
     pushed: float = 0.0  # impulse given by the push [N·s]
@@ -511,6 +534,7 @@ class WalkLog:
         self.where, self.speed_torque = np.empty(capacity), np.empty(capacity)
         self.rows, self.step_starts, self.stances, self.landed = 0, [], [], []
         self.touchdowns = []  # a two-phase walk's, per step (``StepEvents.touchdown``)
+        self.anchorings = []  # a two-phase walk's, per step (``LandedChain.anchoring``)
         mujoco.mj_getState(model, data, self.state[0], self.SPEC)
         self.sensors[0] = data.sensordata
         self.models, self.datas, self.warmstart = [model], [data], data.qacc_warmstart[None]
@@ -554,6 +578,7 @@ class WalkLog:
             landed=self.landed,
             double_support=table.double_support,
             touchdowns=self.touchdowns,
+            anchorings=self.anchorings,
             warnings=self.warnings,
             **results,
         )
@@ -620,6 +645,10 @@ class PhaseController:
         block = log.ctrl[period]
         block[:, self.columns] = self.commands
         return block
+
+    def anchor(self, controls: np.ndarray) -> None:
+        """Follow ``controls`` (N, ``CONTROLS``) for the rest of the step."""
+        self.interpolant = interpolant(controls)
 
     def advance(self, log: WalkLog, k: int) -> float:
         """[m] the hip's advance over the stance ankle at row k (the phase's reading)."""
@@ -706,6 +735,42 @@ class StepEvents:
         return n
 
 
+class LandedChain:
+    """The double support closed on the landed feet (``validate.walk.anchor``): at a
+    step's touchdown, the front leg's references re-anchored on the foot where it landed,
+    from the table's point of the touchdown to the step's end; ``anchoring``: the step's
+    (None before its touchdown)."""
+
+    def __init__(
+        self, table: PhaseTable, samples: GaitSamples, layout: Layout, biped: Biped, log: WalkLog
+    ):
+        self.table, self.log, self.layout, self.biped = table, log, layout, biped
+        self.anchor = ChainAnchor(table, layout, biped)
+        # The table's (fractional) row of the file's landing, τ = T.
+        self.landing_row = float(np.interp(samples.landing, table.tau, np.arange(len(table.tau))))
+        self.landing_row = 0.0
+
+    def start_step(self, stance: str) -> None:
+        self.stance, self.anchoring = stance, None
+
+    def after_step(self, events: StepEvents, controller: PhaseController) -> None:
+        """Re-anchor once: at the end of the first reading period after the touchdown that
+        reaches the file's landing (τ = T), the foot then at rest where it landed."""
+        log = self.log
+        row = log.rows - 1  # the period's last state
+        if self.anchoring is not None or events.touchdown is None or events.fallen:
+            return
+        if log.where[row] < self.landing_row:
+            return
+        step_length = landed_step_length(self.layout, self.biped, log.sensors[row], self.stance)
+        self.anchoring = self.anchor.anchoring(int(log.where[row]), step_length)
+        references, rates = self.anchor.servo_commands(self.stance, self.anchoring)
+        controls = self.table.controls[self.stance].copy()
+        controls[self.anchoring.start :, REFERENCES] = references
+        controls[self.anchoring.start :, RATES] = rates
+        controller.anchor(controls)
+
+
 class Shove:
     """The push of ``WalkSettings.push``: the rest of its impulse as a constant force on the
     trunk (MuJoCo's applied force, beside the controls) over each reading period from its
@@ -750,8 +815,12 @@ def _walk_on(walker, steps, settings, model, data, start=None, stop_advance=None
     controller = PhaseController(walker.table, layout, chunk, dt, settings.speed_gain)
     floor = FALLEN * min(samples.start()[0][ZH], samples.end()[0][ZH])
     timeout = STEP_TIMEOUT * period
+    closes = walker.table.double_support and settings.close_chain
     events = StepEvents(layout, walker.table, samples, floor, timeout, len(log.where))
     shove = Shove(settings.push, model, layout, chunk, dt)
+    anchor = LandedChain(walker.table, samples, layout, walker.biped, log) if closes else None
+    if anchor is not None:
+        anchor.landing_row = float(np.searchsorted(walker.table.tau, samples.landing))
     with rollout.Rollout(nthread=0) as runner:
         for j, stance in enumerate((SIDES * steps)[:steps]):
             stop = None if stop_advance is None or j < steps - 1 else stop_advance
@@ -760,6 +829,8 @@ def _walk_on(walker, steps, settings, model, data, start=None, stop_advance=None
             log.stances.append(stance)
             controller.start_step(stance)
             events.start_step(stance, log)
+            if anchor is not None:
+                anchor.start_step(stance)
             while events.running(log, chunk):
                 k = log.rows
                 block = controller.before_step(log, k)
@@ -767,12 +838,15 @@ def _walk_on(walker, steps, settings, model, data, start=None, stop_advance=None
                 n = events.after_step(log, k, chunk)
                 shove.after_step(n)
                 log.rows += n
+                if anchor is not None:
+                    anchor.after_step(events, controller)
                 if stop is not None and controller.advance(log, log.rows - 1) > stop:
                     events.landed = False
                     break
             log.landed.append(events.landed)
             if walker.table.double_support:
                 log.touchdowns.append(events.touchdown)
+                log.anchorings.append(None if anchor is None else anchor.anchoring)
             if not events.landed:
                 break
     return log.simulation(layout, walker.table, settings=settings, pushed=shove.pushed)
