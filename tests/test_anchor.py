@@ -6,6 +6,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from biped.model.kinematics import Q3, Q4, XH, ZH
 from tests.conftest import two_phase_gait
 from validate.checks.checks import MAX_FOOT_TILT, MAX_SLIP, walk_causes, walk_figures
 from validate.scene.mapping import other
@@ -133,3 +134,22 @@ def test_the_closed_chain_against_the_files_references(knee):
         assert before["scuff_steps"] > 0 == after["scuff_steps"]
     else:
         assert after["max_slip"] == pytest.approx(before["max_slip"], abs=1e-4)
+
+
+def test_a_foot_beyond_the_legs_reach_straightens_the_leg_and_says_the_gap(walked):
+    """A front foot landed 5 cm beyond the file's step length, out of the straight leg's
+    reach at the lift-off: the hip is brought back to the reach, the leg straight (knee
+    flexion 0) pointing at it, and ``reach_gap`` says how far the chain stays open; at the
+    file's step length the gap is 0."""
+    walker, sim = walked
+    anchor = ChainAnchor(walker.table, walker.layout, walker.biped)
+    start = sim.anchorings[0].start
+    assert anchor.anchoring(start, walker.samples.step_length).reach_gap == 0.0
+    far = anchor.anchoring(start, walker.samples.step_length + 0.05)
+    q = walker.table.motion[0][start:]
+    ankle = np.array([walker.samples.step_length + 0.05, walker.biped.robot.ankle_height])
+    distance = np.linalg.norm(q[:, [XH, ZH]] - ankle, axis=1)
+    reach = walker.biped.leg_reach()[1]
+    assert far.reach_gap == pytest.approx(distance.max() - reach, abs=1e-12) and far.reach_gap > 0
+    straight = distance >= reach
+    np.testing.assert_allclose(far.q[straight, Q3] - far.q[straight, Q4], 0.0, atol=1e-6)
