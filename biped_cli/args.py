@@ -200,7 +200,7 @@ def add_criterion(parser, several: bool = False, default=CRITERIA) -> None:
 
 def _add_several(parser, option: str, choices: tuple, help: str, default=None) -> None:
     """``option``: distinct ``choices``, one or more (default: ``default``, else all)."""
-    default = list(choices if default is None else default)
+    default = _DefaultList(choices if default is None else default)
     help += f" (default: {' '.join(default)})"
     parser.add_argument(
         option, nargs="+", choices=choices, default=default, action=Distinct, help=help
@@ -329,9 +329,13 @@ class _Default(int):
     """An option's default, told apart from the same number given (``given``)."""
 
 
+class _DefaultList(list):
+    """A list option's default, told apart from the same list given (``given``)."""
+
+
 def given(args, name: str) -> bool:
     """Whether the option ``name`` (its ``args`` attribute) was given on the command line."""
-    return not isinstance(getattr(args, name), _Default)
+    return not isinstance(getattr(args, name), (_Default, _DefaultList))
 
 
 def budget(args) -> dict:

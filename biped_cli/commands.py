@@ -307,6 +307,13 @@ def cmd_sweep(args) -> int:
         paper_method.check_paper_method(args.out, paper)
     if args.dask is not None:
         check_dask(args.dask)
+    two = None
+    if args.double_support is not None:  # refused before the sweep runs, not after
+        from biped.studies import two_phase_sweep
+
+        two = two_phase_sweep.two_phase_settings(sweep, args.double_support, args.landing)
+        two_phase_sweep.check_two_phase(args.out, two)
+        args.criteria = [two_phase_sweep.CRITERION]  # the two-phase problem's only one
     which = (args.knees, args.criteria)
     points = run_sweep(args.out, sweep, *which, **types.campaign(args, "sweep"))
     runs = []
@@ -323,7 +330,60 @@ def cmd_sweep(args) -> int:
         f"<knee>-<criterion>-<speed>.json, {INDEPENDENT}/ (each point's first solve)"
         f"{folder if runs else ''}"
     )
-    return 1 if uncertified(args.out, points, sweep) else 0
+    status = 1 if uncertified(args.out, points, sweep) else 0
+    if two is not None:  # from the sweep's single-support optima, those certified
+        status = max(status, cmd_sweep_double_support(args, two))
+    return status
+
+
+def cmd_sweep_double_support(args, settings) -> int:
+    """The sweep's two-phase optima (``biped.studies.two_phase_sweep``), their summary and
+    figure printed and written; 1 when a point has no two-phase optimum."""
+    from pathlib import Path
+
+    from biped.pages.two_phase_sweep_figures import two_phase_sweep_figure
+    from biped.studies import two_phase_sweep as study
+
+    summary = study.run_two_phase(
+        args.out, settings, args.knees, **types.campaign(args, "double support")
+    )
+    folder = Path(args.out) / study.FOLDER
+    figure = two_phase_sweep_figure(summary, folder / study.FIGURE)
+    print(two_phase_sweep_table(summary))
+    print(
+        f"double support results in {folder}: {study.RECORD}, {study.SUMMARY}, {figure.name}, "
+        f"a two-phase gait file (or its failure record) <knee>-sthenic-<speed>.json per point"
+    )
+    return 1 if any(p.double is None for p in summary.points) else 0
+
+
+def two_phase_sweep_table(summary) -> str:
+    """The summary as a table: per speed and knee both optima's C_Γ [N²·m·s], share, step
+    length [m], cadence [steps/min]; per speed the knees' difference [%]."""
+
+    def shown(value, form: str) -> str:
+        return "unknown" if value is None else format(value, form)
+
+    lines = [
+        "speed [m/s]  knee      C_Γ single / two phases [N²·m·s]  share  "
+        "S single / two [m]  cadence single / two [steps/min]"
+    ]
+    for p in sorted(summary.points, key=lambda p: (p.speed, p.knee)):
+        one, two = p.single, p.double
+        lines.append(
+            f"{p.speed:11.3f}  {p.knee:8}  "
+            f"{shown(one and one.sthenic, '10.4f')} / {shown(two and two.sthenic, '10.4f')}"
+            f"         {shown(two and two.share, '.3f')}  "
+            f"{shown(one and one.step_length, '.4f')} / {shown(two and two.step_length, '.4f')}"
+            f"     {shown(one and one.cadence, '6.1f')} / {shown(two and two.cadence, '6.1f')}"
+            + ("" if two else f"  ({p.why})")
+        )
+    for d in summary.differences:
+        lines.append(
+            f"{d.speed:.3f} m/s: rolling vs revolute C_Γ, single support "
+            f"{shown(d.single, '+.2f')} %, with double support {shown(d.double, '+.2f')} %"
+        )
+    return "\n".join(lines)
 
 
 def add_sweep(commands) -> None:
@@ -346,7 +406,34 @@ def add_sweep(commands) -> None:
         ("--paper-seeds", types.bounded(0, 100), 5, "N", "also run the paper's Nelder-Mead "
          "from N seeds at the speed nearest 0.3 m/s, for every knee and criterion, for "
          "comparison.md (default 5; 0: none)"),
+        ("--double-support", types.double_support_share, None, "LOW:HIGH",
+         "also optimize at each speed and knee the gait of two phases, single then double "
+         "support, its double support a share of the step from LOW to HIGH (0 <= LOW <= HIGH "
+         "< 0.5; one number: that share), started from the sweep's single-support optimum of "
+         "the same point: sthenic criterion only (--criteria sthenic, the default with this "
+         "option), written with a summary and a figure in OUT/double-support/ "
+         "(docs/gaits.md); default: single support only"),
     )  # fmt: skip
+    sweep.add_argument(
+        "--landing",
+        choices=LANDINGS,
+        default="impact",
+        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
+        "it) or zero-speed (it arrives at rest, no impact) (default %(default)s)",
+    )
+    checks.declare_rule(sweep, ("--double-support", "--criteria"), _check_sweep_double_support)
+
+
+def _check_sweep_double_support(args) -> None:
+    """The two-phase problem has the sthenic criterion only."""
+    if args.double_support is None or not types.given(args, "criteria"):
+        return
+    others = [c for c in args.criteria if c != "sthenic"]
+    if others:
+        raise BipedError(
+            f"--criteria {' '.join(args.criteria)} with --double-support: allowed sthenic "
+            "(the two-phase problem's only criterion)"
+        )
 
 
 def cmd_figures(args) -> int:

@@ -66,6 +66,7 @@ WORK = [
     ("biped.optimization.ladder", "climb"),
     ("biped.studies.criteria_matrix", "optimize_criteria"),
     ("biped.studies.sweep", "run_sweep"),
+    ("biped.studies.two_phase_sweep", "run_two_phase"),
     ("biped.studies.design_map", "run_design_map"),
     ("biped.studies.atlas", "run_atlas"),
     ("biped.pages.figures", "make_figures"),

@@ -48,6 +48,10 @@ MULTIPLIERS_SIZE = (5.6, 5.6)  # Floquet multipliers in the complex plane (orbit
 ORBIT_VARIED_SIZE = (7.0, 5.2)  # the spectral radius as a gain varies (orbit_figures)
 ORBIT_KNEES_PANEL_SIZE = (5.2, 6.4)  # a criterion's panel of the knees' orbits (orbit_figures)
 PROFILE_SIZE = (15, 8.4)  # a knee profile's surfaces and their contact (profile_figures)
+TWO_PHASE_SWEEP_SIZE = (
+    14,
+    4.4,
+)  # the knees with and without double support (two_phase_sweep_figures)
 PROFILE_SPEEDS_SIZE = (8, 4.6)  # a profile's criterion over speed (profile_figures)
 ROBUSTNESS_SIZE = (8.0, 6.0)  # a gait's robustness map (robustness_figure)
 WALK_TORQUES_SIZE = (13.2, 6.8)  # MuJoCo's torques beside the model's (walk_figures)

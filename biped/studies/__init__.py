@@ -6,7 +6,8 @@ neighbours that start a point declared and ordered once (``staging``); and a mac
 profile over the speeds (``profile_speeds``: a table of optimizations, no folder of its own),
 both knees over nested gait families until their comparison converges (``converge``),
 each criterion's optimum with every criterion measured on it (``criteria_matrix``), and two
-atlases in two gait families compared cell by cell (``atlas_families``).
+atlases in two gait families compared cell by cell (``atlas_families``); a sweep's
+two-phase optima beside its single-support ones (``two_phase_sweep``).
 
 May import: ``biped.model``, ``biped.optimization``, ``biped.records``, ``biped.runtime``,
 ``biped.errors``, numpy (the design map's figures are ``biped.pages.design_map_figures``).

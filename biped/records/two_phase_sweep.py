@@ -1,0 +1,135 @@
+"""The summary of a sweep with double support (``biped sweep --double-support``): per speed
+and knee the two-phase optimum beside the single-support optimum of the same point, and per
+speed the knees' difference with and without the double support phase.
+
+Each field carries its unit (``unit_field``); the file (``summary.json`` in the sweep's
+``double-support/`` folder) holds the record, its ``units`` map and reads back to the same
+record (``to_dict``, ``from_dict``). A figure that could not be measured (a point whose
+solver did not converge, or infeasible) is null: unknown, never zero.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from biped.errors import BipedError
+from biped.model.units import PERCENT, PURE, declared_units, unit_field
+from biped.runtime.files import atomic_write_text
+
+FORMAT = "biped-two-phase-sweep/1"
+STEPS_PER_MINUTE = "steps/min"  # a cadence, as the two-phase page prints it
+
+
+@dataclass(frozen=True)
+class Phases:
+    """One optimum's step (single support alone, or single then double support).
+
+    Attributes:
+        sthenic: C_Γ = (∫ ΓᵀΓ dt over the step) / S [N²·m·s]; for a two-phase gait over both
+            phases on the solver's samples, for a single support on the check grid.
+        share: T_ds / (T + T_ds) [1]; 0 for a single support.
+        step_length: S [m].
+        cadence: 60 / (T + T_ds) [steps/min].
+    """
+
+    sthenic: float = unit_field("N²·m·s")
+    share: float = unit_field(PURE)
+    step_length: float = unit_field("m")
+    cadence: float = unit_field(STEPS_PER_MINUTE)
+
+
+@dataclass(frozen=True)
+class PointSummary:
+    """A speed and knee: the single-support optimum and the two-phase one (None: not
+    certified, ``why`` says why)."""
+
+    knee: str = unit_field(None)
+    speed: float = unit_field("m/s")
+    single: Phases | None = unit_field(Phases)
+    double: Phases | None = unit_field(Phases)
+    why: str = unit_field(None, default="")
+
+
+@dataclass(frozen=True)
+class KneeDifference:
+    """(rolling − revolute) / revolute of C_Γ at one speed [%], negative where the rolling
+    knee needs less; None where either knee's optimum is not certified."""
+
+    speed: float = unit_field("m/s")
+    single: float | None = unit_field(PERCENT)
+    double: float | None = unit_field(PERCENT)
+
+
+@dataclass(frozen=True)
+class TwoPhaseSweepSummary:
+    """A sweep with double support: its share range and landing, its points and the knees'
+    differences (``None`` fields: unknown)."""
+
+    share_range: tuple = unit_field(PURE)
+    landing: str = unit_field(None)
+    points: tuple = unit_field([PointSummary])
+    differences: tuple = unit_field([KneeDifference])
+
+    @classmethod
+    def units(cls) -> dict:
+        return declared_units(cls)
+
+    def to_dict(self) -> dict:
+        content = {"format": FORMAT, **dataclasses.asdict(self)}
+        content["share_range"] = list(self.share_range)
+        content["points"] = [_point_dict(p) for p in self.points]
+        content["differences"] = [dataclasses.asdict(d) for d in self.differences]
+        return {**content, "units": self.units()}
+
+    @classmethod
+    def from_dict(cls, content: dict, source: str = "summary") -> TwoPhaseSweepSummary:
+        """The record of ``content`` (``to_dict``'s); a BipedError naming what is wrong."""
+        if not isinstance(content, dict) or content.get("format") != FORMAT:
+            found = content.get("format") if isinstance(content, dict) else None
+            raise BipedError(f"{source}: format {found!r}: allowed {FORMAT!r}")
+        try:
+            points = tuple(
+                PointSummary(
+                    **{
+                        **p,
+                        "single": _phases(p["single"]),
+                        "double": _phases(p["double"]),
+                    }
+                )
+                for p in content["points"]
+            )
+            differences = tuple(KneeDifference(**d) for d in content["differences"])
+            return cls(tuple(content["share_range"]), content["landing"], points, differences)
+        except (KeyError, TypeError) as error:
+            raise BipedError(f"{source}: not a two-phase sweep summary ({error})") from None
+
+    def write(self, path: str | Path) -> Path:
+        return atomic_write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False))
+
+    @classmethod
+    def read(cls, path: str | Path) -> TwoPhaseSweepSummary:
+        path = Path(path)
+        try:
+            content = json.loads(path.read_text())
+        except (OSError, ValueError) as error:
+            raise BipedError(f"{path}: unreadable two-phase sweep summary ({error})") from None
+        return cls.from_dict(content, str(path))
+
+
+def _point_dict(point: PointSummary) -> dict:
+    """A point's object: an unknown optimum's figures each null (unknown, with its unit)."""
+    content = dataclasses.asdict(point)
+    for phase in ("single", "double"):
+        if content[phase] is None:
+            content[phase] = {f.name: None for f in dataclasses.fields(Phases)}
+    return content
+
+
+def _phases(content) -> Phases | None:
+    """The figures of an optimum, None where the file says them all unknown (null)."""
+    if all(value is None for value in content.values()):
+        return None
+    return Phases(**content)
