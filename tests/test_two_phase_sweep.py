@@ -163,3 +163,23 @@ def test_a_resume_with_other_settings_is_refused_writing_nothing(tiny, capsys, o
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and named in err[0], err
     assert {p: p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()} == before
+
+
+def test_a_point_without_its_single_support_optimum_is_unknown_not_zero(tmp_path):
+    """No certified single-support optimum: the point's file says why, no solve is run, and
+    the summary leaves both its figures and the knees' difference unknown (None)."""
+    import biped
+    from biped.model.criteria import PAPER_SAFETY
+    from biped.studies.campaign import Task
+
+    settings = study.Settings(biped.Robot.paper(), PAPER_SAFETY, (0.3,), 0, 1, (0.1, 0.2), "impact")
+    folder = tmp_path / study.FOLDER
+    folder.mkdir()
+    point = study.Point("rolling", 0.3)
+    line = study.solve_two_phase(Task(study.solve_two_phase, settings, point, str(folder)))
+    assert "NO OPTIMUM: single support missing" in line
+    summary = study.summarize(tmp_path, settings, [point, study.Point("revolute", 0.3)])
+    rolling = summary.points[0]
+    assert rolling.single is None and rolling.double is None
+    assert rolling.why == "single support missing"
+    assert summary.differences == (KneeDifference(0.3, None, None),)

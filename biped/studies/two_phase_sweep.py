@@ -150,8 +150,11 @@ def _two_phase(folder: Path, point: Point) -> tuple[Gait | None, str]:
     path = folder / point.filename()
     if not path.exists():
         return None, "missing"
-    content = json.loads(path.read_text())
-    if content.get("format") == FAILURE:
+    try:
+        content = json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        raise BipedError(f"{path}: unreadable ({error}): allowed a two-phase gait file") from None
+    if isinstance(content, dict) and content.get("format") == FAILURE:
         return None, str(content["why"])
     return Gait.read(path, two_phase=True), ""
 
