@@ -183,3 +183,39 @@ def test_a_point_without_its_single_support_optimum_is_unknown_not_zero(tmp_path
     assert rolling.single is None and rolling.double is None
     assert rolling.why == "single support missing"
     assert summary.differences == (KneeDifference(0.3, None, None),)
+
+
+SOLVE_ALONE = """
+import sys
+from pathlib import Path
+import biped
+from biped.model.criteria import PAPER_SAFETY
+from biped.studies import two_phase_sweep as study
+from biped.studies.campaign import Task
+settings = study.Settings(
+    biped.Robot.paper(), PAPER_SAFETY, (0.3,), 0, 1, (0.1, 0.2), "zero-speed"
+)
+point = study.Point("revolute", 0.3)
+study.solve_two_phase(Task(study.solve_two_phase, settings, point, sys.argv[1]))
+"""
+
+
+def test_a_point_solved_in_a_fresh_process_is_the_same_bits(tiny, tmp_path):
+    """A resumed run's process has solved no single support: its two-phase optimum is the
+    same bits as the one solved after the sweep's (MUMPS on one thread in both)."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+
+    folder, _ = tiny
+    name = "revolute-sthenic-0.300.json"
+    shutil.copy(folder / name, tmp_path / name)
+    (tmp_path / study.FOLDER).mkdir()
+    env = {**os.environ, "PYTHONPATH": os.getcwd()}
+    command = [sys.executable, "-c", SOLVE_ALONE, str(tmp_path / study.FOLDER)]
+    subprocess.run(command, check=True, env=env, timeout=300)
+    alone = json.loads((tmp_path / study.FOLDER / name).read_text())
+    after = json.loads((folder / study.FOLDER / name).read_text())
+    for key in ("parameters", "double_support", "costs", "samples"):
+        assert alone[key] == after[key], key

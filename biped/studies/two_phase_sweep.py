@@ -28,6 +28,7 @@ from biped.model.robot import Robot
 from biped.model.two_phase import check_landing
 from biped.optimization.comparison import relative_change
 from biped.optimization.problem import GaitProblem
+from biped.optimization.solver import one_blas_thread
 from biped.optimization.two_phase import TwoPhaseProblem, TwoPhaseSolver, optimize_two_phase
 from biped.records import gait_file, two_phase_file
 from biped.records.gait_file import Gait
@@ -121,6 +122,9 @@ def solve_two_phase(task: Task) -> str:
         why = campaign.failure(single.optimizer.status, single.feasible)
         why = None if why is None else f"single support {why}"
     if why is None:
+        # MUMPS on one thread, as every single-support solve runs it: a resumed run's
+        # process, which solved no single support, gives the same bits (else 4e-14 of C_Γ)
+        one_blas_thread()
         problem = _problem(settings, point)
         variables = campaign.variables(single.optimizer.variables)
         result = optimize_two_phase(
