@@ -87,8 +87,15 @@ from biped.errors import BipedError
 from biped.model.kinematics import QP1, XH, ZH
 from validate.checks.checks import LANDING, Check
 from validate.checks.units import OrbitFigures
-from validate.scene.mapping import mapping
-from validate.walk.simulate import Simulation, Walker, WalkSettings
+from validate.scene.mapping import mapping, other
+from validate.walk.simulate import (
+    LANDING_WINDOW,
+    LIFT_WINDOW,
+    TOUCH_THRESHOLD,
+    Simulation,
+    Walker,
+    WalkSettings,
+)
 
 # The 12 coordinates of a state on the section, in order: the free angles [rad], then their
 # rates [rad/s] (``biped.model.kinematics``: qp2 swing foot, q1 stance shank, q2 stance thigh,
@@ -155,12 +162,13 @@ class ReturnMap:
             velocity every lifted state keeps (``lift``).
         flow: (12,) d/dt of the coordinates there [rad/s, rad/s²]: the direction along which
             a start is moved back to place MuJoCo's grid (``phases``).
+        advance: [m] the section's (None: ``section_advance``).
     """
 
-    def __init__(self, walker: Walker, settings: WalkSettings, reference, flow):
+    def __init__(self, walker: Walker, settings: WalkSettings, reference, flow, advance=None):
         self.walker, self.settings = walker, settings
         self.biped = walker.biped
-        self.advance = section_advance(walker)
+        self.advance = section_advance(walker) if advance is None else float(advance)
         self.dt = float(walker.model.opt.timestep)
         self.flow = np.asarray(flow, float)
         q, qd = reference
@@ -202,10 +210,31 @@ class ReturnMap:
         return np.array([self(x, (j + 0.5) / phases) for j in range(phases)])
 
 
-def section_advance(walker: Walker) -> float:
-    """[m] the hip's advance over the stance ankle on the section: the gait's at ``LANDING``
-    of the period."""
-    return float(walker.samples.at("q", [LANDING * walker.period])[0, XH])
+def section_time(walker: Walker) -> float:
+    """[s] the gait's time τ on the section: ``LANDING`` of the swing's time T after the
+    step's start (``GaitSamples.landing_time``: the period of a gait of single support, its
+    step starting at the touchdown; a two-phase gait's single support, its step starting at
+    the rear foot's lift-off)."""
+    return LANDING * walker.samples.landing_time
+
+
+def section_advance(walker: Walker, tau: float | None = None) -> float:
+    """[m] the hip's advance over the stance ankle on the section: the gait's at τ =
+    ``tau`` [s] (None: ``section_time``). A section's state has the stance foot on the floor
+    and the swing foot in the air (its 12 coordinates): a τ outside the swing, from
+    ``LIFT_WINDOW`` to ``LANDING_WINDOW`` of T (a two-phase gait's double support, where
+    both feet are held, included) is refused (BipedError)."""
+    tau = section_time(walker) if tau is None else float(tau)
+    swing = walker.samples.landing_time
+    low, high = LIFT_WINDOW * swing, LANDING_WINDOW * swing
+    if not low <= tau <= high:
+        where = "in the double support" if tau > swing and walker.samples.two_phase else "not"
+        raise BipedError(
+            f"a section at τ = {tau:.4g} s is {where} in the swing: its state would hold "
+            f"both feet on the floor, not 12 coordinates (allowed τ in [{low:.4g}, "
+            f"{high:.4g}] s)"
+        )
+    return float(walker.samples.at("q", [tau])[0, XH])
 
 
 def paper_state(sim: Simulation, row: int, stance: str, radii) -> tuple[np.ndarray, np.ndarray]:
@@ -224,17 +253,37 @@ def section_state(sim: Simulation, advance: float, radii, step: int):
     if step >= len(sim.step_starts) or not all(sim.landed[:step]):
         fell = next((j for j, landed in enumerate(sim.landed) if not landed), len(sim.landed))
         raise OrbitFailure(f"the walk did not land step {fell + 1}: no orbit")
-    rows = sim.step_slices()[step]
-    stance = sim.stances[step]
-    section, advance = advance, sim.hip_x()[rows] - sim.ankle_x(stance)[rows]
-    after = np.flatnonzero(advance >= section)
-    if not len(after) or after[0] == 0:
-        raise OrbitFailure(f"the walk did not reach the section in step {step + 1}: no orbit")
-    row = rows.start + int(after[0]) - 1
+    stance, row = sim.stances[step], crossing(sim, advance, step) - 1
     (qa, qda), (qb, qdb) = (paper_state(sim, r, stance, radii) for r in (row, row + 1))
-    share = (section - qa[XH]) / (qb[XH] - qa[XH])
+    share = (advance - qa[XH]) / (qb[XH] - qa[XH])
     dt = sim.time[row + 1] - sim.time[row]
     return qa + share * (qb - qa), qda + share * (qdb - qda), (qdb - qda) / dt
+
+
+def crossing(sim: Simulation, advance: float, step: int) -> int:
+    """The row of ``sim`` at which ``step`` first reaches the section (``advance`` [m]), its
+    state's first at or past it; OrbitFailure if it does not."""
+    rows = sim.step_slices()[step]
+    after = np.flatnonzero(sim.hip_x()[rows] - sim.ankle_x(sim.stances[step])[rows] >= advance)
+    if not len(after) or after[0] == 0:
+        raise OrbitFailure(f"the walk did not reach the section in step {step + 1}: no orbit")
+    return rows.start + int(after[0])
+
+
+def swing_aloft(sim: Simulation, advance: float, step: int) -> None:
+    """OrbitFailure unless the swing foot is off the floor where ``step`` crosses the section
+    (both physics steps around it): a state with both feet on the floor (a section in a
+    double support, or a foot dragged along) has fewer coordinates than the section's 12,
+    and a perturbation of them would push a held foot into the floor or lift it."""
+    row = crossing(sim, advance, step)
+    swing = other(sim.stances[step])
+    force = float(sim.touch(swing)[row - 1 : row + 1].max())
+    if force > TOUCH_THRESHOLD:
+        raise OrbitFailure(
+            f"the {swing} (swing) foot is on the floor on the section in step {step + 1} "
+            f"({force:.3g} N, allowed {TOUCH_THRESHOLD:g} N at most): no section of 12 "
+            "coordinates there"
+        )
 
 
 def coordinates(q, qd) -> np.ndarray:
@@ -263,13 +312,17 @@ class Settled:
         return self.states.mean(axis=0)
 
 
-def settle(walker: Walker, settings: WalkSettings) -> Settled:
+def settle(walker: Walker, settings: WalkSettings, advance: float | None = None) -> Settled:
     """Walk ``SETTLE_STEPS + MEAN_STEPS`` steps from the file's start state and read the
-    section of the last ``MEAN_STEPS``; OrbitFailure if the walk falls first."""
-    advance, radii = section_advance(walker), walker.biped.radii
-    steps = SETTLE_STEPS + MEAN_STEPS
+    section (``advance`` [m], None: ``section_advance``) of the last ``MEAN_STEPS``;
+    OrbitFailure if the walk falls first or crosses a section with both feet on the floor
+    (``swing_aloft``)."""
+    advance = section_advance(walker) if advance is None else float(advance)
+    radii, steps = walker.biped.radii, SETTLE_STEPS + MEAN_STEPS
     sim = walker.walk(steps + 1, settings, stop_advance=advance)
     found = [section_state(sim, advance, radii, k) for k in range(SETTLE_STEPS, steps)]
+    for k in range(SETTLE_STEPS, steps):
+        swing_aloft(sim, advance, k)
     q, qd, qdd = (np.array([state[i] for state in found]) for i in range(3))
     states = np.hstack([q[:, FREE], qd[:, FREE]])
     flow = np.concatenate([qd[:, FREE].mean(axis=0), qdd[:, FREE].mean(axis=0)])
@@ -425,20 +478,23 @@ class Orbit:
 
 
 def file_state(walker: Walker) -> np.ndarray:
-    """(12,) the gait file's state on the section: its motion at ``LANDING`` of the period."""
-    tau = [LANDING * walker.period]
+    """(12,) the gait file's state on the section: its motion at ``section_time``."""
+    tau = [section_time(walker)]
     return coordinates(walker.samples.at("q", tau)[0], walker.samples.at("qd", tau)[0])
 
 
-def orbit(walker: Walker, settings: WalkSettings = NOMINAL, steps: Steps = Steps()):
+def orbit(
+    walker: Walker, settings: WalkSettings = NOMINAL, steps: Steps = Steps(), tau=None
+) -> Orbit:
     """The orbit of ``walker``'s walk under ``settings`` (see the module docstring): the walk
-    settled from the file's start state, the Jacobian at its mean state on the section,
-    chord-Newton steps to the fixed point, the multipliers. An ``Orbit`` whose ``failure``
-    says why when a walk falls or misses the section."""
-    advance = section_advance(walker)
+    settled from the file's start state, the Jacobian at its mean state on the section (at
+    the gait's time ``tau`` [s], None: ``section_time``; one outside the swing refused,
+    ``section_advance``), chord-Newton steps to the fixed point, the multipliers. An
+    ``Orbit`` whose ``failure`` says why when a walk falls or misses the section."""
+    advance = section_advance(walker, tau)
     try:
-        settled = settle(walker, settings)
-        returns = ReturnMap(walker, settings, settled.reference, settled.flow)
+        settled = settle(walker, settings, advance)
+        returns = ReturnMap(walker, settings, settled.reference, settled.flow, advance)
         basis = section_basis(settled.flow, steps)
         directions = basis * steps.vector()[:, None]
         x = settled.mean

@@ -63,8 +63,8 @@ def validate(
     spec = model if isinstance(model, mujoco.MjSpec) else model_spec(biped, model)
     robot_model = compile_spec(spec)
     if gait.two_phase:
-        checks, sim, reaction = two_phase_checks(gait, spec, steps)
-        return Validation(gait, checks, biped, samples, sim, reaction)
+        checks, sim, reaction, found = two_phase_checks(gait, spec, steps)
+        return Validation(gait, checks, biped, samples, sim, reaction, found)
     energy = gait.costs.energy
     results = [
         c.check_model(robot_model, biped),
@@ -80,10 +80,6 @@ def validate(
     return Validation(gait, results + [orbit], biped, samples, sim, reaction, found)
 
 
-# Why the orbit check is not run on a two-phase gait.
-NO_TWO_PHASE_ORBIT = (
-    "the return map of a two-phase walk (its section, a state of single support) is not built"
-)
 # Why the forward check's energy ratio is not measured on a two-phase gait.
 NO_TWO_PHASE_ENERGY = (
     "energy_ratio not measured: the file's energy is its single support's, MuJoCo's the "
@@ -98,8 +94,10 @@ def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS
     feedforward replay of both phases with both feet's ground forces
     (``check_two_phase_feedforward``); MuJoCo's walk of both phases (``check_forward``: the
     double support with both feet on the floor, each step ending at the rear foot's
-    lift-off) and the same walk at other gains (``check_gains``); the orbit not run, saying
-    why (failed: unknown, never passed). Returns (checks, the walk, its ground reaction)."""
+    lift-off) and the same walk at other gains (``check_gains``); the walk's orbit
+    (``check_orbit``: its section in the single support, ``LANDING`` of T after the rear
+    foot's lift-off, the swing foot in the air). Returns (checks, the walk, its ground
+    reaction, the ``Orbit``)."""
     biped, samples = gait.biped, GaitSamples.from_gait(gait)
     robot_model = compile_spec(spec)
     knee_loads = c.check_knee_loads(robot_model, biped, samples.single_support(), gait.knee_loads)
@@ -115,9 +113,9 @@ def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS
         c.check_two_phase_feedforward(spec, biped, samples),
         forward,
         c.check_gains(walker, steps, float("nan"), forward),
-        c.not_run("orbit", NO_TWO_PHASE_ORBIT),
     ]
-    return checks, sim, reaction
+    orbit, found = check_orbit(walker)
+    return checks + [orbit], sim, reaction, found
 
 
 def validation_report(checks) -> ValidationReport:
