@@ -125,7 +125,7 @@ def test_another_split_fails_the_feet_forces(gait, samples):
 
 def test_biped_validate_of_a_two_phase_gait(gait, tmp_path, capsys):
     """``biped validate`` on a two-phase gait file runs its checks (the orbit's too), writes
-    the report without a recording and exits 1 (not every check passed); a video of its
+    the report and the recording and exits 1 (not every check passed); a video of its
     walk is refused before any work (exit 2, one line)."""
     import json
 
@@ -142,7 +142,7 @@ def test_biped_validate_of_a_two_phase_gait(gait, tmp_path, capsys):
     report = json.loads((tmp_path / "rec" / "two.report.json").read_text())
     assert report["passed"] is False and report["feedforward"]["passed"] is True
     assert report["units"]["feedforward.rear_force_rms_error"] == "N"
-    assert not rrd.exists()
+    assert rrd.exists() and report["recording"] == str(rrd)
     video = tmp_path / "walk.mp4"
     assert main(["validate", str(path), "--video", str(video)]) == 2
     error = capsys.readouterr().err

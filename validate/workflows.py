@@ -50,14 +50,8 @@ def validate_and_record(
     from validate.outputs.record import record
 
     result = validation.validate(gait, steps=steps, model=model)
-    if gait.two_phase:  # its walk is checked, not recorded or filmed
-        if video is not None or gif is not None:
-            raise BipedError(
-                "--video of a two-phase gait: the recording and video of its walk are not built"
-            )
-        return result, validation.validation_report(result.checks).with_files(
-            provenance=provenance()
-        )
+    if gait.two_phase and (video is not None or gif is not None):  # recorded, not filmed
+        raise BipedError("--video of a two-phase gait: the video of its walk is not built")
     written = record(rrd, result, spawn=spawn, connect=connect)
     if source is not None:
         claim(written, source)

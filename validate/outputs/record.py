@@ -21,6 +21,13 @@ Entity paths, on the timeline ``time`` (seconds of simulation):
     zmp/{analytic,mujoco,heel,toe}        ZMP, centre of pressure and the foot's ends, from the
                                           stance ankle [m]
     phase                                 the gait's time the controller follows, over T
+    feet/{Fx,Fz}/{stance,swing}_{analytic,mujoco}
+                                          a two-phase walk's ground force on each foot of
+                                          the step [N]: the stance foot (the rear one in
+                                          double support) and the swing foot (the front
+                                          one once landed), the gait's beside MuJoCo's
+    support/{analytic,mujoco}             a two-phase walk's feet on the floor, 1 (single
+                                          support) or 2 (double support)
     summary                               the gait's parameters, criteria and every check
     orbit/{unit_circle,radius,band,axes}  the complex plane of the orbit check's multipliers:
     orbit/multipliers                     the unit circle, ρ and ρ ± 2 spreads, the
@@ -30,7 +37,8 @@ Entity paths, on the timeline ``time`` (seconds of simulation):
 ``blueprint()`` lays them out: the 3D view following the robot, one plot per joint with its
 y range fixed to the bulk of the gait's torques (the landings' spikes run off it rather than
 flatten it), Fx and Fz in plots of their own (ranged the same way), the ZMP, the phase and
-the summary, and the multipliers in the complex plane. The time plots open on the last
+the summary, and the multipliers in the complex plane; a two-phase walk adds each foot's Fx
+and Fz and the supports below them. The time plots open on the last
 ``SHOWN_STEPS`` steps (zoom out for the whole walk); every series of a plot has a colour of
 its own, and where two run together the gait's (widest) shows around MuJoCo's feedforward
 and MuJoCo's torque (narrowest) drawn over them.
@@ -82,6 +90,9 @@ MUJOCO_COLOR = (230, 120, 60)
 FEEDFORWARD_COLOR = (70, 170, 90)
 FEEDBACK_COLOR = (200, 60, 160)
 LANDING_COLOR = (150, 150, 150)
+# A two-phase walk's swing (front) foot: the gait's and MuJoCo's.
+SWING_ANALYTIC_COLOR = (150, 110, 220)
+SWING_MUJOCO_COLOR = (230, 200, 60)
 SOLE_COLORS = {"heel": (120, 120, 120), "toe": (215, 215, 215)}  # the ZMP plot's sole edges
 ANALYTIC_WIDTH = 7.0
 FEEDFORWARD_WIDTH = 3.0
@@ -140,10 +151,13 @@ def with_legend_room(low: float, high: float) -> tuple[float, float]:
     return low, high + LEGEND_ROOM * (high - low)
 
 
-def blueprint(ranges: dict | None = None, window: tuple | None = None) -> rrb.Blueprint:
-    """The 3D walk above the ground reaction (Fx, Fz), ZMP and phase; one plot per joint's
-    torque (no legend: too tall for a plot, it would cover the curves) above their key, in
-    words, and the summary.
+def blueprint(
+    ranges: dict | None = None, window: tuple | None = None, feet: bool = False
+) -> rrb.Blueprint:
+    """The 3D walk above the ground reaction (Fx, Fz), ZMP and phase (with ``feet``, a
+    two-phase walk's: each foot's Fx and Fz and the supports below them); one plot per
+    joint's torque (no legend: too tall for a plot, it would cover the curves) above their
+    key, in words, and the summary.
 
     Args:
         ranges: y range (low, high) of a plot, by its origin (a torque's path, ``ground/Fx``,
@@ -175,6 +189,22 @@ def blueprint(ranges: dict | None = None, window: tuple | None = None) -> rrb.Bl
         for i, joint in enumerate(JOINTS)
     ]
     key = rrb.TextDocumentView(origin="torque_key", name="torque plots [N·m]")
+    ground = [
+        rrb.Horizontal(
+            plot("ground/Fx", "ground Fx [N]"),
+            plot("ground/Fz", "ground Fz [N]"),
+            plot("zmp", "ZMP, CoP [m]"),
+            rrb.TimeSeriesView(origin="phase", name="phase [T]"),
+        )
+    ]
+    if feet:
+        ground.append(
+            rrb.Horizontal(
+                plot("feet/Fx", "each foot's Fx [N]"),
+                plot("feet/Fz", "each foot's Fz [N]"),
+                rrb.TimeSeriesView(origin="support", name="feet on the floor [1]"),
+            )
+        )
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Vertical(
@@ -188,13 +218,8 @@ def blueprint(ranges: dict | None = None, window: tuple | None = None) -> rrb.Bl
                         tracking_entity="world/mujoco/trunk",
                     ),
                 ),
-                rrb.Horizontal(
-                    plot("ground/Fx", "ground Fx [N]"),
-                    plot("ground/Fz", "ground Fz [N]"),
-                    plot("zmp", "ZMP, CoP [m]"),
-                    rrb.TimeSeriesView(origin="phase", name="phase [T]"),
-                ),
-                row_shares=[2, 1],
+                *ground,
+                row_shares=[2] + [1] * len(ground),
             ),
             rrb.Vertical(
                 rrb.Grid(*torque_views, grid_columns=2),
@@ -376,12 +401,15 @@ def record(path: str | Path, validation, spawn: bool = False, connect: str | Non
     end = float(sim.time[-1])
     window = (max(float(sim.time[0]), end - SHOWN_STEPS * step.period), end)
     recording_id = f"{biped.knee}-{path.stem}"
-    layout = blueprint(ranges, window)
+    feet = _feet(step, sim, wrench, steady, ranges) if step.two_phase else None
+    layout = blueprint(ranges, window, feet=feet is not None)
 
     def log_all(rec) -> None:
         _log_torques(rec, biped, sim, torques, ranges, steady)
         _log_series(rec, biped, step, sim, contact, wrench, zmp)
         _log_world(rec, biped, sim, contact, q_ref, zmp)
+        if feet is not None:
+            _log_feet(rec, sim, feet)
         text = summary(biped, step, sim, checks, gait)
         rec.log("summary", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
         key = rr.TextDocument(TORQUE_KEY, media_type=rr.MediaType.MARKDOWN)
@@ -567,6 +595,45 @@ def _log_series(rec, biped: Biped, step, sim: Simulation, contact, wrench, zmp) 
     _scalars(rec, "zmp/mujoco", sim.time[sampled], contact["cop"][sampled])
     for name, value in biped.robot.sole_edges().items():
         _scalars(rec, f"zmp/{name}", sim.time, np.full(len(sim.time), value))
+
+
+def _feet(step: GaitSamples, sim: Simulation, wrench, steady, ranges: dict) -> dict:
+    """A two-phase walk's feet (``validate.walk.contact.feet_reaction``): each foot's force,
+    the gait's and MuJoCo's, and the supports, by their series' paths; their plots' ranges
+    added to ``ranges``."""
+    from validate.walk.contact import feet_reaction
+
+    mujoco_feet = feet_reaction(sim)
+    gait = {"stance": wrench[:, :2], "swing": step.at("swing_wrench", sim.phase)[:, :2]}
+    series = {}
+    for i, name in enumerate(("Fx", "Fz")):
+        both = np.concatenate([gait["stance"][:, i], gait["swing"][:, i]])
+        ranges[f"feet/{name}"] = torque_range(both, np.concatenate([steady, steady]))
+        for role in ("stance", "swing"):
+            series[f"feet/{name}/{role}_analytic"] = gait[role][:, i]
+            series[f"feet/{name}/{role}_mujoco"] = mujoco_feet[role][:, i]
+    series["support/analytic"] = np.where(sim.phase >= step.landing, 2.0, 1.0)
+    series["support/mujoco"] = mujoco_feet["supports"]
+    return series
+
+
+# The style of each series of ``_feet``: its name, colour and width, by the path's end.
+FEET_STYLES = {
+    "stance_analytic": ("stance foot, gait", ANALYTIC_COLOR, ANALYTIC_WIDTH),
+    "stance_mujoco": ("stance foot, MuJoCo", MUJOCO_COLOR, MUJOCO_WIDTH),
+    "swing_analytic": ("swing foot, gait", SWING_ANALYTIC_COLOR, FEEDFORWARD_WIDTH),
+    "swing_mujoco": ("swing foot, MuJoCo", SWING_MUJOCO_COLOR, MUJOCO_WIDTH),
+    "analytic": ("gait", ANALYTIC_COLOR, ANALYTIC_WIDTH),
+    "mujoco": ("MuJoCo", MUJOCO_COLOR, MUJOCO_WIDTH),
+}
+
+
+def _log_feet(rec, sim: Simulation, feet: dict) -> None:
+    """Each foot's Fx and Fz, the gait's and MuJoCo's, and the supports (``_feet``)."""
+    for path, values in feet.items():
+        _line(rec, path, *FEET_STYLES[path.rsplit("/", 1)[1]])
+        sampled = ~np.isnan(values)
+        _scalars(rec, path, sim.time[sampled], values[sampled])
 
 
 def _log_world(rec, biped: Biped, sim: Simulation, contact, q_ref, zmp) -> None:

@@ -3,6 +3,8 @@
     ground_reaction   the stance foot's ground force and centre of pressure (single support)
     feet_forces       each foot's ground force and centre of pressure in one state (both
                       feet on the ground: a double support replayed)
+    feet_reaction     a two-phase walk's ground force on each foot, stance and swing, and
+                      its supports (one foot or two) along the walk
     foot_tilt         the supporting feet's tilt and the lift of their heels and toes, each
                       step (a two-phase walk's front foot from its touchdown)
     scuffs            the swing foot's touches of the floor before its landing window (a
@@ -89,6 +91,29 @@ def feet_forces(model: mujoco.MjModel, data: mujoco.MjData, layout, sides) -> np
         cop = moment / f_sum[2] if f_sum[2] > 0.0 else np.nan
         out[row] = f_sum[0], f_sum[2], cop
     return out
+
+
+def feet_reaction(sim: Simulation) -> dict:
+    """A walk's ground force on each foot of a step, by role: ``"stance"`` (the step's stance
+    foot, the rear one in a double support) and ``"swing"`` (its swing foot, the front one
+    once landed), each (N, 2) [Fx, Fz] [N] every ``SAMPLE_EVERY`` states (NaN elsewhere; 0
+    on a foot off the floor); ``"supports"`` (N,): the feet MuJoCo's walk is on, 1 or 2
+    (two from a two-phase step's touchdown to its end, ``Simulation.touchdowns``)."""
+    model, layout = sim.model, sim.layout
+    data = mujoco.MjData(model)
+    forces = {role: np.full((len(sim.time), 2), np.nan) for role in ("stance", "swing")}
+    stance_of = sim.stance_of()
+    for k in range(0, len(sim.time), SAMPLE_EVERY):
+        data.qpos[:], data.qvel[:], data.ctrl[:] = sim.qpos[k], sim.qvel[k], sim.ctrl[k]
+        mujoco.mj_forward(model, data)
+        feet = feet_forces(model, data, layout, (stance_of[k], other(stance_of[k])))
+        forces["stance"][k], forces["swing"][k] = feet[0, :2], feet[1, :2]
+    supports = np.ones(len(sim.time))
+    touchdowns = sim.touchdowns if sim.double_support else []
+    for rows, down in zip(sim.step_slices(), touchdowns, strict=False):
+        if down is not None:
+            supports[down : rows.stop] = 2.0
+    return {**forces, "supports": supports}
 
 
 @dataclass
