@@ -560,12 +560,6 @@ def cmd_validate(args) -> int:
 
     gif = _gif(args)
     gaits = read_gaits(args.gait, args.model, two_phase=True)
-    for path, gait in zip(args.gait, gaits, strict=True):
-        if gait.two_phase and args.video:
-            raise BipedError(
-                f"gait file {path!r} is of two phases: the video of its walk is not built, "
-                "allowed no --video"
-            )
     recordings = _recordings(args)
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 
-from biped.errors import BipedError
 from biped.model.criteria import Safety
 from biped.model.robot import Robot
 from biped.records.gait_file import Gait, write_json
@@ -50,8 +49,6 @@ def validate_and_record(
     from validate.outputs.record import record
 
     result = validation.validate(gait, steps=steps, model=model)
-    if gait.two_phase and (video is not None or gif is not None):  # recorded, not filmed
-        raise BipedError("--video of a two-phase gait: the video of its walk is not built")
     written = record(rrd, result, spawn=spawn, connect=connect)
     if source is not None:
         claim(written, source)

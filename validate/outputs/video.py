@@ -190,16 +190,37 @@ class Captioned:
         self.renderer, self.verdict, self.passed = renderer, verdict, passed
 
     def frame(self, k: int) -> np.ndarray:
+        """State k's image under its caption (a two-phase walk's: a second band, the
+        support and the verdict)."""
+        image, support = self.renderer.render(k), self.support(k)
+        width = image.shape[1]
+        if support is None:
+            bands = [caption_band(self.caption(k), self.verdict, self.passed, width)]
+        else:  # the verdict beside the support, clear of the longer caption
+            bands = [
+                caption_band(self.caption(k), "", None, width),
+                caption_band(support, self.verdict, self.passed, width),
+            ]
+        return np.concatenate([*bands, image], axis=0)
+
+    def caption(self, k: int) -> str:
+        """The left of state k's caption: knee, speed, step j of n, the time."""
         r = self.renderer
-        image = r.render(k)
         steps = len(r.sim.stances)
         speed = r.step.step_length / r.step.period
-        left = (
+        return (
             f"{r.biped.knee} knee, {speed:.2f} m/s   step {r.step_of(k) + 1} / {steps}   "
             f"t = {r.sim.time[k]:5.2f} s"
         )
-        band = caption_band(left, self.verdict, self.passed, image.shape[1])
-        return np.concatenate([band, image], axis=0)
+
+    def support(self, k: int) -> str | None:
+        """A two-phase walk's support at state k: double from the step's touchdown to its
+        end (``Simulation.touchdowns``), else single; None for a walk of single support."""
+        sim = self.renderer.sim
+        if not sim.double_support:
+            return None
+        down = sim.touchdowns[self.renderer.step_of(k)]
+        return "double support" if down is not None and k >= down else "single support"
 
 
 def verdict_of(checks) -> tuple[str, bool]:
@@ -361,7 +382,8 @@ def main(argv=None) -> int:
         ):
             if path is not None:
                 check_suffix(path, option, suffix)
-        result = validate(gait_file.read_consistent(args.gait), steps=args.steps)
+        gait = gait_file.read_consistent(args.gait, two_phase=True)
+        result = validate(gait, steps=args.steps)
         ghost = not args.no_ghost
         if args.frame:
             frame_index(result, args.at)  # before anything is written
