@@ -150,6 +150,7 @@ def _more_other_files() -> dict:
     them."""
     from importlib import resources
 
+    from biped.records.atlas_optimum import AtlasOptimum
     from biped.studies import atlas
     from validate.checks.units import OrbitFigures
     from validate.outputs.outputs import claim
@@ -168,7 +169,7 @@ def _more_other_files() -> dict:
         owner = json.loads(claim(Path(folder) / "g.rrd", source).read_text())
     return {
         "an atlas's record": settings,
-        "one optimization of an atlas": atlas._record(optimum, 1.0),
+        "one optimization of an atlas": AtlasOptimum.from_optimum(optimum, 1.0).to_dict(),
         "a table of optima": shipped("biped.optimization", "optima.json"),
         "a catalog of actuators": shipped("biped.model", "catalog.json"),
         "an orbit study": orbit_study.OrbitStudy.of(
