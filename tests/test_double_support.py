@@ -185,3 +185,23 @@ def test_a_given_swing_wrench_fixes_the_rest_of_the_split(model, phase):
     wrenches = np.concatenate([stance, other], -1)
     lhs = torques @ JOINT_MATRIX + (np.swapaxes(rows, -1, -2) @ wrenches[..., None])[..., 0]
     np.testing.assert_allclose(lhs, model.generalized_forces(q, qd, qdd), atol=1e-9)
+
+
+def test_the_fine_grid_holds_the_front_wrench_linear_between_the_samples(model, phase):
+    """``sample_split``: ``FINE_PER_INTERVAL`` samples per interval of the given front
+    wrenches, the front wrench equal to them at their samples and linear in time between
+    (its second differences vanish within an interval), the split eq. (19')'s there."""
+    front = np.array([[0.0, 100.0, 0.0], [10.0, 300.0, 5.0], [20.0, 500.0, -5.0]])
+    fine = ds.sample_split(model, phase, front)
+    f = ds.FINE_PER_INTERVAL
+    assert len(fine.time) == 2 * f + 1
+    np.testing.assert_array_equal(fine.swing_wrench[::f], front)
+    np.testing.assert_allclose(np.diff(fine.swing_wrench[: f + 1], 2, axis=0), 0.0, atol=1e-9)
+    torques, rear = ds.split_with_swing_wrench(model, fine.q, fine.qd, fine.qdd, fine.swing_wrench)
+    np.testing.assert_allclose(fine.torques, torques, atol=1e-12)
+    np.testing.assert_allclose(fine.stance_wrench, rear, atol=1e-12)
+    # The front foot's constraints are linear in its wrench: held at the samples, they hold
+    # between them (only the rear foot's, which follow the motion, can fail there).
+    front_margins = ds.foot_margins(model.robot, fine.swing_wrench)
+    assert np.min(ds.foot_margins(model.robot, front)) > 0.0
+    assert np.min(front_margins) > 0.0

@@ -1,6 +1,7 @@
 """The two-phase gait's NLP: its graph is the numeric model, its options are checked."""
 
 import functools
+import json
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from biped.model.kinematics import Q5, QP2
 from biped.model.robot import FOOT_FRICTION
 from biped.optimization import two_phase as tpo
 from biped.optimization.problem import GaitProblem
-from tests.conftest import optimal_gait
+from tests.conftest import edited_gait_file, optimal_gait, refusal
 
 SPEED = 0.3  # [m/s]
 
@@ -100,7 +101,7 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
     """IPOPT converges from the single-support optimum (rolling knee, 0.3 m/s, a tenth to a
     fifth of the step in double support), and on the numeric model the optimum's double
     support holds: both feet pushed, in their friction cones, their ZMPs in their soles (at
-    the solver's samples, to its tolerance), the rear foot pushed at the landing, the share
+    the solver's samples and on the fine grid between them, to its tolerance), the rear foot pushed at the landing, the share
     in its range; MuJoCo agrees with both feet's forces."""
     solver = solver_of("rolling", landing)
     problem = solver.problem
@@ -120,6 +121,10 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
         assert np.min(margins[:, 3:]) > -1e-6  # ZMP in the sole [m]
     checked = tpo.check(problem, optimum.variables)
     assert checked.feasible, checked.violations_line()
+    # ... and between them: both feet's constraints on the file's 101 samples, the front
+    # wrench linear in time between its 11 variables.
+    assert checked.double_margins.shape == (10 * problem.samples + 1, 2, 5)
+    assert np.min(checked.double_margins) > -1e-6
     landing_margins = np.array(tp.landing_margins(step.impulse))  # (rear, front) by kind
     if landing == "impact":  # both feet pushed, inside the floor's cone (the solver keeps 1 %)
         np.testing.assert_array_less(tpo.IMPULSE_MARGIN * (1 - 1e-6), landing_margins[:, 0])
@@ -242,3 +247,60 @@ def test_a_sliding_landing_is_rejected():
     at = tpo.variable_names(problem.samples, "impact").index("end_rate_q1")
     z[at : at + 5] = single.variables[at : at + 5]
     assert "rear normal_impulse" in tpo.check(problem, z).violations()
+
+
+def test_constraints_held_at_the_samples_only_leave_the_sole_between_them(tmp_path):
+    """The feet's constraints held at the 11 solver samples only (``per_interval`` 1, the
+    problem before the fine grid) let the rolling knee's impact optimum put the rear foot's
+    ZMP beyond its toe between the samples, under the file's own rule (the front wrench
+    linear in time): the numeric check names it, the gait file says it is not feasible
+    (its worst margin the fine grid's), a file that claims it feasible is refused; the
+    problem on the fine grid holds every foot's constraint on all 101 samples."""
+    from biped.records import gait_file
+    from biped.records.gait_file import Gait
+    from biped.records.two_phase_file import optimizer_record
+
+    fine = solver_of("rolling")
+    coarse = fine.coarse
+    problem = coarse.problem
+    single = optimal_gait("rolling")
+    optimum = coarse.solve(tpo.start_from_single(problem, single.variables), single.value)
+    assert optimum.converged, optimum.status
+    model, robot = problem.single.model, problem.single.model.robot
+    step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, optimum.variables), "impact")
+    front = optimum.variables[-3 * (problem.samples + 1) :].reshape(-1, 3)
+    between = ds.sample_split(model, step.double, front)
+    at_samples = between.margins(robot)[:: ds.FINE_PER_INTERVAL]
+    assert np.min(at_samples) > -1e-6  # every foot's constraint holds at the 11 samples
+    toe = robot.foot_length - robot.foot_heel
+    assert np.max(ds.zmp(between.stance_wrench, robot.ankle_height)) > toe + 0.1  # [m]
+    found = tpo.check(problem, optimum.variables).violations()
+    assert found.get("rear zmp_toe", 0.0) < -0.1, found
+    result = tpo.TwoPhaseResult(optimum, None, 1, 1, 0, 1, optimum.seconds)
+    gait = Gait.from_two_phase(
+        robot=robot,
+        knee="rolling",
+        speed=SPEED,
+        parameters=tpo.to_parameters(problem, optimum.variables),
+        landing="impact",
+        front_wrench=front,
+        share_range=problem.share,
+        optimizer=optimizer_record(problem, result, seed=0),
+    )
+    assert not gait.feasible and not gait.double_support.feasible
+    assert gait.double_support.foot_margins["rear"][4] < -0.1  # zmp_toe [m], fine grid
+    path = gait.write(tmp_path / "tips.json")
+    assert not gait_file.read_consistent(path, two_phase=True).double_support.feasible
+    claimed = edited_gait_file(
+        json.loads(path.read_text()),
+        tmp_path,
+        lambda c: c["double_support"].update(feasible=True),
+        name="claimed.json",
+    )
+    read = functools.partial(gait_file.read_consistent, two_phase=True)
+    assert "double_support.feasible" in refusal(read, claimed)
+    # The problem on the fine grid: its optimum holds on every one of the 101 samples.
+    held = fine.solve(tpo.start_from_single(fine.problem, single.variables), single.value)
+    assert held.converged, held.status
+    assert np.min(tpo.check(fine.problem, held.variables).double_margins) > -1e-6
+    assert held.value > optimum.value  # holding them between the samples costs torque

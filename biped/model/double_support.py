@@ -68,6 +68,10 @@ BOUND = [QP1, QP2, Q1, Q2, Q3, Q4]
 FEET = ("stance", "swing")
 # Each foot's constraints Ψ >= 0 in double support [N, N, N, m, m].
 FOOT_CONSTRAINTS = ("normal_force", "friction_forward", "friction_backward", "zmp_heel", "zmp_toe")
+# Samples of the phase's fine grid per interval of the solver's: the front foot's wrench, a
+# variable at the solver's samples, is linear in time between them (the gait file's rule), and
+# both feet's constraints are judged, by the solver and by the file, on this grid.
+FINE_PER_INTERVAL = 10
 # Distance [m] from the chain's feet at which ``DoubleSupportPhase`` refuses an end state, and
 # the residual foot speed [m/s, rad/s] it accepts there.
 END_TOLERANCE = 1e-9
@@ -307,7 +311,8 @@ class DoubleSupportSamples:
     Attributes:
         time: (N,) [s] from the landing.
         q, qd, qdd: (N, 9) [rad, m; /s; /s²].
-        torques: (N, 6) [N·m], Γ of eq. (32), the split of least squared torque.
+        torques: (N, 6) [N·m], Γ of eq. (32): the split of least squared torque
+            (``sample_phase``) or the one of a given front wrench (``sample_split``).
         stance_wrench, swing_wrench: (N, 3) [N, N, N·m] of the ground on the rear and the
             front foot, moment about each foot's ankle.
     """
@@ -333,4 +338,28 @@ def sample_phase(model: Biped, phase: DoubleSupportPhase, samples: int) -> Doubl
     time = np.linspace(0.0, phase.duration, samples + 1)
     q, qd, qdd = chain_state(model, phase.step_length, *phase_coordinates(phase, time))
     torques, stance, swing = split_load(model, q, qd, qdd)
+    return DoubleSupportSamples(time, q, qd, qdd, torques, stance, swing)
+
+
+def front_wrench_at(front, duration: float, t) -> np.ndarray:
+    """The front foot's wrench (M, 3) [N, N, N·m] at times t [s] from the landing: linear in
+    time between the solver's samples ``front`` (n + 1, 3), equally spaced over
+    ``duration`` [s]."""
+    front = np.asarray(front, dtype=float)
+    grid = np.linspace(0.0, duration, len(front))
+    return np.column_stack([np.interp(t, grid, front[:, k]) for k in range(3)])
+
+
+def sample_split(
+    model: Biped, phase: DoubleSupportPhase, front, per_interval: int = FINE_PER_INTERVAL
+) -> DoubleSupportSamples:
+    """The phase on the fine grid, ``per_interval`` samples per interval of the solver's
+    ``front`` (n + 1, 3) [N, N, N·m]: the front foot's wrench linear in time between those,
+    the torques and the rear foot's wrench from eq. (19') (``split_with_swing_wrench``).
+    Both feet's ``margins`` on it are what a gait's double support must hold everywhere."""
+    front = np.asarray(front, dtype=float)
+    time = np.linspace(0.0, phase.duration, (len(front) - 1) * per_interval + 1)
+    q, qd, qdd = chain_state(model, phase.step_length, *phase_coordinates(phase, time))
+    swing = front_wrench_at(front, phase.duration, time)
+    torques, stance = split_with_swing_wrench(model, q, qd, qdd, swing)
     return DoubleSupportSamples(time, q, qd, qdd, torques, stance, swing)

@@ -15,7 +15,6 @@ from biped.optimization.two_phase import (
     TwoPhaseProblem,
     TwoPhaseResult,
     to_parameters,
-    variable_names,
 )
 from biped.records.gait_file import Gait, Optimizer
 from biped.records.two_phase_gait import unit_of
@@ -40,7 +39,7 @@ def optimizer_record(problem: TwoPhaseProblem, result: TwoPhaseResult, seed: int
         seed=seed,
         value=best.value,
     )
-    names = variable_names(problem.samples, problem.landing)
+    names = problem.names
     return Optimizer.of(report, best.variables, names)
 
 

@@ -18,7 +18,10 @@ drive's figures of a double support are not built), and with this block:
                     parameters); between them it is linear in time (the rule this file states)
     coefficients    the cubic c0 + c1 t + c2 t² + c3 t³ of x_H, z_H, q5 (t from the landing)
     landing_impulse the ground's impulse at the landing on the rear then the front foot
-    foot_margins    each foot's worst Ψ at the solver's samples (``FOOT_CONSTRAINTS``)
+    foot_margins    each foot's worst Ψ (``FOOT_CONSTRAINTS``) on the check grid below, the
+                    front wrench linear between the solver's samples: the constraints must
+                    hold between the samples too (a foot's ZMP that leaves its sole there
+                    tips it), and ``feasible`` is false when one does not
     samples         the phase on ``CHECK_PER_INTERVAL`` times the solver's grid: q, q̇, q̈, the
                     torques and both feet's wrenches (the front one as stated above)
 
@@ -62,7 +65,7 @@ _UNITS = (
     ("front_f", "N"),
 )
 # Samples of the phase's check grid per interval of the solver's (``samples``).
-CHECK_PER_INTERVAL = 10
+CHECK_PER_INTERVAL = ds.FINE_PER_INTERVAL
 WRENCH = ["N", "N", "N·m"]
 IMPULSE = ["N·s", "N·s", "N·m·s"]  # a wrench integrated over the impact
 WRENCH_COLUMNS = ("Fx", "Fz", "Cy")
@@ -134,8 +137,9 @@ class DoubleSupport:
     coefficients: dict = unit_field(CUBIC)
     landing_impulse: list = unit_field(IMPULSE + IMPULSE)
     foot_margins: dict = unit_field({foot: FOOT_UNITS for foot in FEET})
-    # both feet's constraints at the solver's samples; at the landing both feet pushed within
-    # the friction cone (``biped.model.two_phase.landing_margins``)
+    # both feet's constraints on the check grid (``samples``: the front wrench linear between
+    # the solver's samples); at the landing both feet pushed within the friction cone
+    # (``biped.model.two_phase.landing_margins``)
     feasible: bool
     samples: PhaseSamples = unit_field(PhaseSamples)
 
@@ -183,25 +187,13 @@ def _simpson(n: int) -> np.ndarray:
     return w / (3.0 * n)
 
 
-def front_wrench_at(front, duration: float, t) -> np.ndarray:
-    """The front foot's wrench (M, 3) at times t [s] from the landing: linear between the
-    solver's samples ``front`` (n + 1, 3), equally spaced over ``duration``."""
-    front = np.asarray(front, dtype=float)
-    grid = np.linspace(0.0, duration, len(front))
-    return np.column_stack([np.interp(t, grid, front[:, k]) for k in range(3)])
-
-
 def phase_samples(model: Biped, step: TwoPhaseStep, front) -> PhaseSamples:
     """The double support of ``step`` on its check grid, the front foot's wrench ``front``
-    (n + 1, 3) at the solver's samples, linear between them."""
-    n = (len(front) - 1) * CHECK_PER_INTERVAL
-    t = np.linspace(0.0, step.double.duration, n + 1)
-    q, qd, qdd = ds.chain_state(
-        model, step.double.step_length, *ds.phase_coordinates(step.double, t)
+    (n + 1, 3) at the solver's samples, linear between them (``ds.sample_split``)."""
+    fine = ds.sample_split(model, step.double, front, CHECK_PER_INTERVAL)
+    return PhaseSamples(
+        fine.time, fine.q, fine.qd, fine.qdd, fine.torques, fine.stance_wrench, fine.swing_wrench
     )
-    swing = front_wrench_at(front, step.double.duration, t)
-    torques, rear = ds.split_with_swing_wrench(model, q, qd, qdd, swing)
-    return PhaseSamples(t, q, qd, qdd, torques, rear, swing)
 
 
 def double_support_of(
@@ -218,11 +210,12 @@ def double_support_of(
         raise BipedError(f"front wrench of shape {front.shape}: allowed (n + 1, 3), n even")
     samples = phase_samples(model, step, front)
     at_solver = slice(None, None, CHECK_PER_INTERVAL)
-    torques, rear = samples.torques[at_solver], samples.rear_wrench[at_solver]
+    torques = samples.torques[at_solver]
     double = step.double.duration * float(_simpson(len(front) - 1) @ (torques**2).sum(-1))
+    fine = (samples.rear_wrench, samples.front_wrench)  # the file's rule between samples
     margins = {
         foot: ds.foot_margins(model.robot, wrench).min(axis=0).tolist()
-        for foot, wrench in zip(FEET, (rear, front), strict=True)
+        for foot, wrench in zip(FEET, fine, strict=True)
     }
     landing = np.min(landing_margins(step.impulse))  # 0 for a zero-speed landing
     feasible = bool(landing >= 0.0 and all(min(m) >= 0.0 for m in margins.values()))
