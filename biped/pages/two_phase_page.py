@@ -160,14 +160,15 @@ def landing_lines(gait: Gait) -> list[str]:
 
 
 def feet_lines(gait: Gait) -> list[str]:
-    """Each foot's tightest margin Ψ in double support (at the solver's samples)."""
+    """Each foot's tightest margin Ψ in double support (on the file's fine grid)."""
     double = gait.double_support
     lines = [
         "",
         "## Both feet in double support",
         "",
-        "Each foot's constraints Ψ ≥ 0 at their smallest over the solver's samples of the "
-        f"double support (rear foot pushed at the landing too): "
+        "Each foot's constraints Ψ ≥ 0 at their smallest over the double support's "
+        f"{len(double.samples.t)} samples, the front wrench linear between the optimizer's "
+        f"{len(double.front_wrench)} (rear foot pushed at the landing too): "
         f"{'all hold' if double.feasible else 'NOT all hold: the gait is not feasible'}.",
         "",
         "| constraint | " + " | ".join(f"{foot} foot" for foot in FEET) + " | unit |",
