@@ -18,13 +18,18 @@ from validate.walk import contact
 from validate.walk.simulate import TOUCH_THRESHOLD, Walker, WalkSettings, phase_table
 
 STEPS = 6
-# A step's touchdown and its lift-off, each against the gait's (T, T + T_ds), as a share of
-# it: the controller follows the hip's advance, not the clock, and the walk's speed varies by
-# a few per cent from step to step (measured over the first six steps: touchdowns at
-# 0.988-0.996 T, lift-offs at 0.996-1.039 of the period).
+# A step's touchdown against the gait's T, as a share of it: the controller follows the
+# hip's advance, not the clock, and the walk's speed varies by a few per cent from step to
+# step (measured over the first six steps: touchdowns at 0.982-1.013 T).
 EVENT_TOLERANCE = 0.05
-# The median step against the period: 1.003 measured.
+# The median step against the period T + T_ds: the walk's timing (1.008 measured; the double
+# support halved or doubled in the samples walks 1.061 and 0.922 of it).
 PERIOD_TOLERANCE = 0.03
+# Each step against the period: the step durations alternate, long and short, a mode of the
+# walk's orbit that is not damped (docs/gaits.md, "The orbit of a two-phase walk"), so a
+# step strays further than the median (0.987-1.076 over the first six steps). A step beyond
+# it is a walk that has lost the gait's timing.
+STEP_TOLERANCE = 0.10
 
 
 @pytest.fixture(scope="module")
@@ -48,8 +53,9 @@ def durations(sim) -> np.ndarray:
 def test_two_phase_walk_runs_both_phases(gait, walked):
     """Every step lifts the rear foot, lands the front one at T ± 5 %, goes on through the
     double support with both feet carrying the robot (each more than a fifth of the weight
-    on average) and ends at the rear foot's lift-off at the period T + T_ds ± 5 %, the
-    front foot on the floor; the legs then swap."""
+    on average) and ends at the rear foot's lift-off, the front foot on the floor; the legs
+    then swap. The steps last the period T + T_ds: their median within 3 %, each within
+    10 % (the undamped alternation of long and short steps)."""
     walker, sim = walked
     samples, weight = walker.samples, gait.robot.weight
     assert sim.double_support and all(sim.landed) and len(sim.stances) == STEPS
@@ -66,7 +72,7 @@ def test_two_phase_walk_runs_both_phases(gait, walked):
         assert rear.mean() > 0.2 * weight and front.mean() > 0.2 * weight
         assert front[-1] > TOUCH_THRESHOLD  # the step ends with the front foot down
     period = durations(sim) / samples.period
-    np.testing.assert_allclose(period, 1.0, atol=EVENT_TOLERANCE)
+    np.testing.assert_allclose(period, 1.0, atol=STEP_TOLERANCE)
     assert np.median(period) == pytest.approx(1.0, abs=PERIOD_TOLERANCE)
 
 
@@ -117,9 +123,8 @@ def test_wrong_knee_model_is_refused(gait):
 def test_double_support_of_another_duration_misses_the_period(gait, stretch):
     """The double support's duration halved or doubled in the samples (the same torques),
     walked on the file's references: the robot's steps, driven by its own hip, do not last
-    the samples' period (median 1.06 and 0.915 of it measured, against 1.003). With the
-    chain closed on the landed feet the halved double support walks a median 0.989 of it
-    (steps 0.94-1.06): the re-anchored front leg takes up the timing error."""
+    the samples' period (median 1.061 and 0.922 of it measured, against 1.008): the median
+    step tells the wrong timing from the walk's alternation of long and short steps."""
     walker = Walker(gait)
     samples = walker.samples
     t = samples.t.copy()
