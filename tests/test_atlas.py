@@ -247,7 +247,7 @@ def test_an_atlas_stopped_by_signals_while_its_workers_run_resumes_to_the_same(s
     assert optima and optima == numbers(folder)
 
 
-def _stage_record(value: float, status: str = "converged") -> AtlasOptimum:
+def stage_record(value: float, status: str = "converged") -> AtlasOptimum:
     """A stage's record of an optimum of ``value`` (sthenic), as ``AtlasOptimum`` keeps it."""
     converged = status == "converged"
     at_best = 1 if converged else 0
@@ -273,7 +273,7 @@ def _stage_record(value: float, status: str = "converged") -> AtlasOptimum:
 
 def _final(criterion: str, value: float, starts_at_best: int) -> AtlasOptimum:
     """A knee's final record of ``value`` of ``criterion``, reached by ``starts_at_best``."""
-    record = _stage_record(value)
+    record = stage_record(value)
     return dataclasses.replace(record, costs={criterion: value}, starts_at_best=starts_at_best)
 
 
@@ -283,7 +283,7 @@ def _write_cell(folder, cell, values: dict) -> None:
     for (stage, knee), (value, status) in values.items():
         path = folder / atlas.Point(stage, knee, "sthenic", cell).filename()
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(_stage_record(value, status).to_json())
+        path.write_text(stage_record(value, status).to_json())
 
 
 def test_a_re_solve_that_did_not_converge_measures_nothing(tmp_path):

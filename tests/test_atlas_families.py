@@ -10,12 +10,11 @@ import pytest
 import biped
 from biped.model.bezier import Bezier
 from biped.model.kinematics import KNEES
-from biped.optimization.optimize import Report
 from biped.pages import atlas_families as pages
-from biped.records.atlas_optimum import AtlasOptimum
 from biped.studies import atlas
 from biped.studies.atlas_families import Side, compare_atlases, verdict
 from biped_cli import main
+from tests.test_atlas import stage_record
 
 ROBOT = biped.Robot.paper()
 
@@ -57,29 +56,6 @@ def test_signs_change_only_where_both_differences_are_told_apart():
     assert verdict(Side(-0.5, 0.05), Side(3.0, 0.1))[2]
 
 
-def _record(value: float, status: str = "converged") -> AtlasOptimum:
-    """A stage's record of a sthenic optimum of ``value``, as ``AtlasOptimum`` keeps it."""
-    converged = status == "converged"
-    report = Report("ipopt", status, 1, int(converged), 10, 0.0, 0.0, 1.0, 0, value)
-    return AtlasOptimum(
-        status=status,
-        feasible=True,
-        certified=converged,
-        value=value,
-        costs={"sthenic": value},
-        starts=1,
-        starts_at_best=int(converged),
-        single_start=None,
-        next_optimum=0.0,
-        violations="",
-        period=1.0,
-        step_length=0.3,
-        seconds=1.0,
-        report=report,
-        variables=(0.0,) * 21,
-    )
-
-
 def _atlas(folder, family, cells: dict) -> atlas.Settings:
     """A made-up atlas of one clearance: {speed: (final, fine, tight) (revolute, rolling)
     sthenic values}, a tight value None for a re-solve that stopped at IPOPT's acceptable
@@ -90,9 +66,9 @@ def _atlas(folder, family, cells: dict) -> atlas.Settings:
     for cell in settings.cells():
         for stage, values in zip(("final", "fine", "tight"), cells[cell.speed], strict=True):
             for knee, value in zip(KNEES, values, strict=True):
-                content = _record(100.0, "Solved_To_Acceptable_Level")
+                content = stage_record(100.0, "Solved_To_Acceptable_Level")
                 if value is not None:
-                    content = _record(value)
+                    content = stage_record(value)
                 path = folder / atlas.Point(stage, knee, "sthenic", cell).filename()
                 path.write_text(content.to_json())
     return settings
