@@ -238,40 +238,26 @@ def cmd_double_support(args, problem, optimum) -> int:
     """The two-phase optimum from the single-support ``optimum`` of ``problem`` (as many
     starts as ``--starts``, seeded by ``--seed``), printed beside it and written to
     ``args.out``; 1 when no start converged to an optimum feasible on the numeric model."""
-    from biped.optimization.two_phase import TwoPhaseProblem, TwoPhaseSolver, optimize_two_phase
+    from biped.optimization.two_phase import TwoPhaseProblem
     from biped.records import two_phase_file
 
     two = TwoPhaseProblem(problem, args.double_support, landing=args.landing)
-    solver = TwoPhaseSolver(two)
-    result = optimize_two_phase(solver, optimum.variables, optimum.value, args.starts, args.seed)
-    low, high = two.share
-    counts = (
-        f"{result.converged} of {result.starts} starts converged, {result.feasible} feasible, "
-        f"{result.at_best} at the best value"
-    )
-    print(f"time: two phases' setup {solver.setup_seconds:.2f} s, solves {result.seconds:.2f} s")
-    if result.best is None:
-        print(
-            f"biped optimize: no two-phase optimum ({counts}: {'; '.join(result.outcomes)}); "
-            "no file written",
-            file=sys.stderr,
-        )
-        return 1
-    best, checked = result.best, result.checked
+    solved = two_phase_file.solve(two, optimum.variables, optimum.value, args.starts, args.seed)
     print(
-        f"two phases (double support {low:g} to {high:g} of the step, {args.landing} landing): "
-        f"C = {checked.value:.6g} N²·m·s (single support on the check grid) at a share of "
-        f"{best.share:.4f}, single support alone {optimum.value:.6g} "
-        f"({checked.value / optimum.value:.3g} times); IPOPT: {counts}"
+        f"time: two phases' setup {solved.setup_seconds:.2f} s, solves "
+        f"{solved.result.seconds:.2f} s"
     )
-    if result.at_best < 2:
+    if solved.gait is None:
+        print(f"biped optimize: {solved.failure()}; no file written", file=sys.stderr)
+        return 1
+    print(solved.line(optimum.value))
+    if solved.result.at_best < 2:
         print(
             "warning: the best two-phase value was reached by a single start; more --starts "
             "may find a better optimum",
             file=sys.stderr,
         )
-    gait = two_phase_file.gait_of(two, result, args.seed)
-    print(f"wrote {gait.write(args.out)}")
+    print(f"wrote {solved.gait.write(args.out)}")
     return 0
 
 
@@ -349,41 +335,12 @@ def cmd_sweep_double_support(args, settings) -> int:
     )
     folder = Path(args.out) / study.FOLDER
     figure = two_phase_sweep_figure(summary, folder / study.FIGURE)
-    print(two_phase_sweep_table(summary))
+    print(summary.table())
     print(
         f"double support results in {folder}: {study.RECORD}, {study.SUMMARY}, {figure.name}, "
         f"a two-phase gait file (or its failure record) <knee>-sthenic-<speed>.json per point"
     )
     return 1 if any(p.double is None for p in summary.points) else 0
-
-
-def two_phase_sweep_table(summary) -> str:
-    """The summary as a table: per speed and knee both optima's C_Γ [N²·m·s], share, step
-    length [m], cadence [steps/min]; per speed the knees' difference [%]."""
-
-    def shown(value, form: str) -> str:
-        return "unknown" if value is None else format(value, form)
-
-    lines = [
-        "speed [m/s]  knee      C_Γ single / two phases [N²·m·s]  share  "
-        "S single / two [m]  cadence single / two [steps/min]"
-    ]
-    for p in sorted(summary.points, key=lambda p: (p.speed, p.knee)):
-        one, two = p.single, p.double
-        lines.append(
-            f"{p.speed:11.3f}  {p.knee:8}  "
-            f"{shown(one and one.sthenic, '10.4f')} / {shown(two and two.sthenic, '10.4f')}"
-            f"         {shown(two and two.share, '.3f')}  "
-            f"{shown(one and one.step_length, '.4f')} / {shown(two and two.step_length, '.4f')}"
-            f"     {shown(one and one.cadence, '6.1f')} / {shown(two and two.cadence, '6.1f')}"
-            + ("" if two else f"  ({p.why})")
-        )
-    for d in summary.differences:
-        lines.append(
-            f"{d.speed:.3f} m/s: rolling vs revolute C_Γ, single support "
-            f"{shown(d.single, '+.2f')} %, with double support {shown(d.double, '+.2f')} %"
-        )
-    return "\n".join(lines)
 
 
 def add_sweep(commands) -> None:

@@ -21,6 +21,16 @@ from biped.runtime.files import atomic_write_text
 
 FORMAT = "biped-two-phase-sweep/1"
 STEPS_PER_MINUTE = "steps/min"  # a cadence, as the two-phase page prints it
+# The columns of ``PointSummary.line``.
+HEADER = (
+    "speed [m/s]  knee      C_Γ single / two phases [N²·m·s]  share  "
+    "S single / two [m]  cadence single / two [steps/min]"
+)
+
+
+def _shown(value, form: str) -> str:
+    """``value`` in ``form``; "unknown" for None (not measured)."""
+    return "unknown" if value is None else format(value, form)
 
 
 @dataclass(frozen=True)
@@ -52,6 +62,20 @@ class PointSummary:
     double: Phases | None = unit_field(Phases)
     why: str = unit_field(None, default="")
 
+    def line(self) -> str:
+        """Both optima's C_Γ [N²·m·s], share, step length [m] and cadence [steps/min], in
+        the columns of ``HEADER``; why the two-phase one is missing."""
+        one, two = self.single, self.double
+        return (
+            f"{self.speed:11.3f}  {self.knee:8}  "
+            f"{_shown(one and one.sthenic, '10.4f')} / {_shown(two and two.sthenic, '10.4f')}"
+            f"         {_shown(two and two.share, '.3f')}  "
+            f"{_shown(one and one.step_length, '.4f')} / "
+            f"{_shown(two and two.step_length, '.4f')}"
+            f"     {_shown(one and one.cadence, '6.1f')} / {_shown(two and two.cadence, '6.1f')}"
+            + ("" if two else f"  ({self.why})")
+        )
+
 
 @dataclass(frozen=True)
 class KneeDifference:
@@ -61,6 +85,13 @@ class KneeDifference:
     speed: float = unit_field("m/s")
     single: float | None = unit_field(PERCENT)
     double: float | None = unit_field(PERCENT)
+
+    def line(self) -> str:
+        """The knees' difference without and with the double support phase."""
+        return (
+            f"{self.speed:.3f} m/s: rolling vs revolute C_Γ, single support "
+            f"{_shown(self.single, '+.2f')} %, with double support {_shown(self.double, '+.2f')} %"
+        )
 
 
 @dataclass(frozen=True)
@@ -108,6 +139,13 @@ class TwoPhaseSweepSummary:
 
     def write(self, path: str | Path) -> Path:
         return atomic_write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False))
+
+    def table(self) -> str:
+        """The summary as a table: per speed and knee both optima (``PointSummary.line``),
+        then per speed the knees' difference (``KneeDifference.line``)."""
+        points = sorted(self.points, key=lambda p: (p.speed, p.knee))
+        lines = [HEADER] + [p.line() for p in points] + [d.line() for d in self.differences]
+        return "\n".join(lines)
 
     @classmethod
     def read(cls, path: str | Path) -> TwoPhaseSweepSummary:

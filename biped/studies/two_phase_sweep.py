@@ -191,7 +191,9 @@ def run_two_phase(sweep_folder, settings: Settings, knees, **where) -> Summary:
     return summary
 
 
-def _phases_of(gait: Gait | None, two_phase: bool) -> Phases | None:
+def phases_of(gait: Gait | None, two_phase: bool) -> Phases | None:
+    """The step of a gait (``Phases``), single support alone or ``two_phase``; None for
+    None."""
     if gait is None:
         return None
     if not two_phase:
@@ -213,8 +215,8 @@ def summarize(sweep_folder: Path, settings: Settings, points) -> Summary:
             PointSummary(
                 point.knee,
                 point.speed,
-                _phases_of(single, False),
-                _phases_of(double, True),
+                phases_of(single, False),
+                phases_of(double, True),
                 why,
             )
         )
