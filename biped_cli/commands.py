@@ -680,9 +680,16 @@ def cmd_pipeline(args) -> int:
     impact, forward walk with contact), its rerun recording and the video of its walk; then
     the two knees compared.
 
+    With --double-support, also each knee's two-phase optimum (single then double support,
+    as ``biped optimize --double-support``) started from its single-support optimum, written
+    (<knee>-sthenic-<speed>-double-support.json), validated and recorded the same way, and
+    both optima printed side by side with the knees' difference (as ``biped sweep
+    --double-support``).
+
     Writes, per knee, the gait file and the validation report (JSON) in --out and the
     recording and the video (MP4, unless --no-video) in --recordings; prints where they are.
-    Exits 0 only when every gait is feasible and passes every check, 1 otherwise.
+    Exits 0 only when every gait is certified (converged, feasible) and passes every check,
+    1 otherwise, its last line naming each gait that is not and the checks that failed.
     """
     from functools import partial
     from pathlib import Path
@@ -698,6 +705,13 @@ def cmd_pipeline(args) -> int:
         check_speed(Biped(robot, knee), args.speed)
     for knee in args.knees:
         check_simulable(robot, knee, f"--robot {args.robot!r}" if args.robot else "robot")
+    if args.double_support is not None:  # what the two-phase problem does not build
+        from biped.optimization.problem import GaitProblem
+        from biped.optimization.two_phase import TwoPhaseProblem
+
+        for knee in args.knees:
+            problem = GaitProblem(Biped(robot, knee), args.speed, args.criterion, safety(args))
+            TwoPhaseProblem(problem, args.double_support, landing=args.landing)
     pipeline = Pipeline(
         robot,
         args.speed,
@@ -711,8 +725,10 @@ def cmd_pipeline(args) -> int:
         video=not args.no_video,
         design=design_problem(args, robot, args.speed) if args.design else None,
         family=family,
+        double_support=args.double_support,
+        landing=args.landing,
     )
-    for name in map(pipeline.name, args.knees):  # never another gait's recording
+    for name in pipeline.names():  # never another gait's recording
         check_owner(
             pipeline.recordings / f"{name}.rrd", pipeline.out / f"{name}.json", "--recordings"
         )
@@ -728,6 +744,29 @@ def _check_design_family(args) -> None:
         raise BipedError(
             f"--design with the family {family_label(family)}: allowed with the paper's spline "
             "(--knots 1, --family spline), the knee design's"
+        )
+
+
+def _check_pipeline_double_support(args) -> None:
+    """The two-phase problem's gait: IPOPT's, sthenic, the paper's spline, no knee design."""
+    if args.double_support is None:
+        return
+    _check_double_support(args)
+    if args.criterion != "sthenic":
+        raise BipedError(
+            f"--criterion {args.criterion} with --double-support: allowed sthenic (the "
+            "two-phase problem's only criterion)"
+        )
+    if args.family != "spline" or args.knots != 1:
+        given = f"--family {args.family}" if args.family != "spline" else f"--knots {args.knots}"
+        raise BipedError(
+            f"{given} with --double-support: allowed the paper's spline (--family spline, "
+            "--knots 1), the two-phase problem's"
+        )
+    if args.design:
+        raise BipedError(
+            "--design with --double-support: allowed one of them (the two-phase problem has "
+            "no knee design)"
         )
 
 
@@ -752,6 +791,28 @@ def add_pipeline(commands) -> None:
     types.add_bezier(pipe)
     checks.declare_rule(pipe, ("--design", "--family", "--knots"), _check_design_family)
     types.add_robot(pipe)
+    types.add_options(
+        pipe,
+        ("--double-support", types.double_support_share, None, "LOW:HIGH",
+         "also optimize each knee's gait of two phases, single then double support (both feet "
+         "flat), started from its single-support optimum, its double support a share of the "
+         "step from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share), and write, "
+         "validate and record it as <knee>-sthenic-<speed>-double-support: sthenic criterion, "
+         "IPOPT, the paper's spline (--knots 1), no --design (docs/gaits.md); default: single "
+         "support only"),
+    )  # fmt: skip
+    pipe.add_argument(
+        "--landing",
+        choices=LANDINGS,
+        default="impact",
+        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
+        "it) or zero-speed (it arrives at rest, no impact) (default %(default)s)",
+    )
+    checks.declare_rule(
+        pipe,
+        ("--double-support", "--method", "--criterion", "--knots", "--family", "--design"),
+        _check_pipeline_double_support,
+    )
     pipe.add_argument(
         "--design",
         action="store_true",

@@ -140,13 +140,27 @@ def test_figures_reject_a_corrupt_gait_file(tmp_path, capsys):
         (["pipeline", "--speed", "-0.3"], "-0.3"),
         (["pipeline", "--steps", "0"], "'0'"),
         (["pipeline", "--knees", "hinge"], "hinge"),
+        (["pipeline", "--double-support", "0.7"], "'0.7'"),
+        (["pipeline", "--double-support", "0.3:0.1"], "'0.3:0.1'"),
+        (["pipeline", "--double-support", "0.1", "--landing", "soft"], "'soft'"),
+        (["pipeline", "--double-support", "0.1", "--criterion", "energy"], "--criterion energy"),
+        (["pipeline", "--double-support", "0.1", "--knots", "3"], "--knots 3"),
+        (
+            ["pipeline", "--double-support", "0.1", "--family", "bezier", "--degree", "5"],
+            "--family bezier",
+        ),
+        (["pipeline", "--double-support", "0.1", "--design"], "--design"),
+        (["pipeline", "--double-support", "0.1", "--method", "nelder-mead"], "nelder-mead"),
     ],
 )
-def test_pipeline_rejects_bad_options(capsys, argv, needle):
-    """Bad pipeline options are one line on stderr and exit 2, before any work."""
-    assert main(argv) == 2
+def test_pipeline_rejects_bad_options(capsys, argv, needle, tmp_path):
+    """Bad pipeline options are one line on stderr and exit 2, before any work: with
+    --double-support, what the two-phase problem does not build (another criterion, gait
+    family or method, a knee design) too; nothing written."""
+    out = tmp_path / "out"
+    assert main(argv + ["--out", str(out), "--recordings", str(tmp_path / "r")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and needle in err[0]
+    assert len(err) == 1 and needle in err[0] and not out.exists()
 
 
 def test_pipeline_refuses_a_file_as_output_folder(capsys):

@@ -74,7 +74,7 @@ def test_the_pipeline_prints_the_knees_compared_with_their_verdict(optima, tmp_p
     from validate import workflows
 
     monkeypatch.setattr(workflows, "_optimum", lambda pipeline, knee, found, say: optima[knee])
-    monkeypatch.setattr(workflows.Pipeline, "validated", lambda *args: (True, []))
+    monkeypatch.setattr(workflows.Pipeline, "validated", lambda *args: ((), []))
     pipeline = workflows.Pipeline(
         Robot.paper(), 0.3, ("revolute", "rolling"), "sthenic", PAPER_SAFETY, 1, tmp_path,
         tmp_path, {}, video=False,

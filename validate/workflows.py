@@ -4,9 +4,11 @@
 recording (``validate.outputs.record``) claimed by its gait file (``validate.outputs.outputs``),
 its video and report.
 ``run_pipeline``: ``biped pipeline`` whole, each knee's optimal gait at one speed written,
-validated and recorded, the knee's radii optimised too with a design problem, the knees
-compared; it prints (``say``) as it goes. The command line checks the input before; nothing
-here parses options. May import ``biped`` and ``validate``, never ``biped_cli``.
+validated and recorded, with double support each knee's two-phase optimum too (started from
+it, ``biped.records.two_phase_file.solve``), the knee's radii optimised too with a design
+problem, the knees compared; it prints (``say``) as it goes. The command line checks the
+input before; nothing here parses options. May import ``biped`` and ``validate``, never
+``biped_cli``.
 """
 
 from __future__ import annotations
@@ -87,7 +89,10 @@ class Pipeline:
 
     Gait files and reports go to ``out``, recordings and videos to ``recordings``, each
     named ``<knee>-<criterion>-<speed>``; ``design``: also the knee's radii optimised
-    (``biped.optimization.design``), named ``design-<criterion>-<speed>``.
+    (``biped.optimization.design``), named ``design-<criterion>-<speed>``;
+    ``double_support``: also each knee's two-phase optimum (single then double support,
+    ``biped.optimization.two_phase``) with that share range and ``landing``, named
+    ``<knee>-<criterion>-<speed>-double-support`` (``two_phase_name``).
     """
 
     robot: Robot
@@ -103,15 +108,29 @@ class Pipeline:
     design: object = None  # a ``biped.optimization.design.DesignProblem``, or None
     # the gaits' family (``biped.model.gait``): a spline's interior knots, or a ``Bezier``
     family: object = 1
+    # (least, largest) T_ds / (T + T_ds) [1] of the two-phase optima; None: single support only
+    double_support: tuple | None = None
+    landing: str = "impact"  # of the two-phase optima (``biped.model.two_phase.LANDINGS``)
 
     def name(self, knee: str) -> str:
         """The name of a knee's files ('design' for the designed gait)."""
         return f"{knee}-{self.criterion}-{self.speed:.3f}"
 
+    def two_phase_name(self, knee: str) -> str:
+        """The name of a knee's two-phase gait's files."""
+        return f"{self.name(knee)}-double-support"
+
+    def names(self) -> list[str]:
+        """The names of the knees' files, two-phase gaits' included."""
+        two = self.double_support is not None
+        return [self.name(k) for k in self.knees] + [
+            self.two_phase_name(k) for k in self.knees if two
+        ]
+
     def validated(self, label: str, gait_path: Path, gait: Gait, say: Callable) -> tuple:
         """Validate the gait written at ``gait_path`` (``gait``: its record) as the
-        pipeline's ``label`` knee; write its report. Returns (passed, its lines of the files
-        written)."""
+        pipeline's ``label`` gait; write its report. Returns (the names of the checks it
+        failed, its lines of the files written)."""
         name = gait_path.stem
         say(f"[{label}] validating {self.steps} steps in MuJoCo...")
         video = self.recordings / f"{name}.mp4" if self.video else None
@@ -128,37 +147,101 @@ class Pipeline:
         report_path = write_json(
             self.out / f"{name}.report.json", report.with_files(gait=str(gait_path)).to_dict()
         )
-        return result.passed, files_lines(report, gait_path, report_path)
+        failed = tuple(check.name for check in result.checks if not check.passed)
+        return failed, files_lines(report, gait_path, report_path)
 
 
 def run_pipeline(pipeline: Pipeline, say: Callable[[str], None] = print) -> bool:
-    """Run the pipeline (``Pipeline``), printing with ``say``; whether every gait is feasible
-    and passes every check."""
+    """Run the pipeline (``Pipeline``), printing with ``say``; whether every gait is certified
+    and passes every check (the last line names each gait that is not, or its checks that
+    failed)."""
     from biped.optimization.knees import compare_knees, knee_lines
 
-    passed, optima, written = True, {}, {}
+    failures, optima, written, two_phase = [], {}, {}, {}
     for knee in pipeline.knees:
         optima[knee] = optimum = _optimum(pipeline, knee, optima, say)
         if not _certified(knee, optimum, say):
-            passed = False
+            failures.append(f"{knee}: not certified")
             continue
         gait = Gait.from_optimum(optimum, pipeline.robot)
         gait_path = gait.write(pipeline.out / f"{pipeline.name(knee)}.json")
         # validated in memory: the file written is this record
-        knee_passed, written[knee] = pipeline.validated(knee, gait_path, gait, say)
-        passed = passed and knee_passed
-    if pipeline.design is not None:
-        passed = _design_stage(pipeline, optima, say) and passed
+        failed, written[knee] = pipeline.validated(knee, gait_path, gait, say)
+        failures += [f"{knee}: {', '.join(failed)}"] if failed else []
+    if pipeline.double_support is not None:  # each knee's, from its optimum just found
+        for knee in pipeline.knees:
+            two_phase[knee] = _two_phase_stage(pipeline, knee, optima[knee], failures, say)
+    if pipeline.design is not None and not _design_stage(pipeline, optima, say):
+        failures.append("design")
     if len(written) == 2:  # both knees' optima certified: each cost, its uncertainty, verdict
         say("[knees] re-solving both optima on a finer grid and more tightly...")
         differences = compare_knees({knee: optima[knee] for knee in written})
         for line in knee_lines(differences, pipeline.speed, pipeline.criterion):
             say(line)
+    if two_phase:
+        for line in _two_phase_table(pipeline, optima, two_phase).splitlines():
+            say(f"[double support] {line}")
     for knee, lines in written.items():  # every file written, once
         for line in lines:
             say(f"{knee:9} {line}")
-    say("all checks passed" if passed else "some checks FAILED")
-    return passed
+    for knee, (_, lines) in two_phase.items():
+        for line in lines:
+            say(f"{knee:9} {line}")
+    say("some checks FAILED: " + "; ".join(failures) if failures else "all checks passed")
+    return not failures
+
+
+def _two_phase_stage(pipeline: Pipeline, knee: str, optimum, failures: list, say: Callable):
+    """The knee's two-phase optimum from its single-support ``optimum``, written and
+    validated as the single-support gaits are; a failure appended to ``failures``. Returns
+    (the two-phase gait, None: none; its lines of the files written)."""
+    from biped.optimization.two_phase import TwoPhaseProblem
+    from biped.records import two_phase_file
+
+    label = f"{knee} two phases"
+    if not optimum.certified:
+        say(f"[{label}] FAIL  not solved: its start, the single-support optimum, is not certified")
+        failures.append(f"{label}: not solved")
+        return None, []
+    low, high = pipeline.double_support
+    say(
+        f"[{label}] optimizing single then double support ({low:g} to {high:g} of the step, "
+        f"{pipeline.landing} landing)..."
+    )
+    two = TwoPhaseProblem(optimum.problem, pipeline.double_support, landing=pipeline.landing)
+    seed, starts = pipeline.budget["seed"], pipeline.budget["starts"]
+    solved = two_phase_file.solve(two, optimum.variables, optimum.value, starts, seed)
+    say(f"[{label}] setup {solved.setup_seconds:.1f} s, solves {solved.result.seconds:.1f} s")
+    if solved.gait is None:
+        say(f"[{label}] FAIL  {solved.failure()}")
+        failures.append(f"{label}: no optimum")
+        return None, []
+    say(f"[{label}] {solved.line(optimum.value)}")
+    gait_path = solved.gait.write(pipeline.out / f"{pipeline.two_phase_name(knee)}.json")
+    failed, lines = pipeline.validated(label, gait_path, solved.gait, say)  # in memory
+    failures += [f"{label}: {', '.join(failed)}"] if failed else []
+    return solved.gait, lines
+
+
+def _two_phase_table(pipeline: Pipeline, optima: dict, two_phase: dict) -> str:
+    """Each knee's single-support and two-phase optima side by side and, with both knees,
+    the knees' difference with and without double support (as ``biped sweep
+    --double-support`` prints them: ``TwoPhaseSweepSummary.table``)."""
+    from biped.records.two_phase_sweep import PointSummary, TwoPhaseSweepSummary
+    from biped.studies.two_phase_sweep import differences, phases_of
+
+    rows = []
+    for knee, (gait, _) in two_phase.items():
+        optimum = optima[knee]
+        single = Gait.from_optimum(optimum, pipeline.robot) if optimum.certified else None
+        why = "" if gait else "no two-phase optimum" if single else "single support not certified"
+        rows.append(
+            PointSummary(knee, pipeline.speed, phases_of(single, False), phases_of(gait, True), why)
+        )
+    summary = TwoPhaseSweepSummary(
+        pipeline.double_support, pipeline.landing, tuple(rows), differences(rows)
+    )
+    return summary.table()
 
 
 def _optimum(pipeline: Pipeline, knee: str, optima: dict, say: Callable):
@@ -223,7 +306,7 @@ def _design_stage(pipeline: Pipeline, optima: dict, say: Callable) -> bool:
         return False
     gait = Gait.from_design(comparison)
     gait.write(gait_path)
-    passed, lines = pipeline.validated("design", gait_path, gait, say)  # in memory, as the knees
+    failed, lines = pipeline.validated("design", gait_path, gait, say)  # in memory, as the knees
     for line in lines:  # every file written, once
         say(f"[design] {line}")
-    return passed and not comparison.uncertified()
+    return not failed and not comparison.uncertified()
