@@ -205,3 +205,35 @@ def test_the_fine_grid_holds_the_front_wrench_linear_between_the_samples(model, 
     front_margins = ds.foot_margins(model.robot, fine.swing_wrench)
     assert np.min(ds.foot_margins(model.robot, front)) > 0.0
     assert np.min(front_margins) > 0.0
+
+
+def test_a_foot_that_lifts_or_lands_carrying_load_is_not_a_handover():
+    """The handover (``HANDOVERS``) of a zero-speed landing: the rear foot's wrench at
+    lift-off and the front foot's at its landing are judged by their largest
+    component against ``HANDOVER_TOLERANCE``; there the foot's Ψ are not judged (+inf),
+    everywhere else they are. A foot lifting off with 300 N on it fails; one with none
+    passes."""
+    robot = biped.Robot.paper()
+    n = 5
+    loaded = np.tile([10.0, 300.0, 5.0], (n, 1))
+    zeros = np.zeros((n, 9))
+
+    def samples(stance, swing):
+        return ds.DoubleSupportSamples(
+            np.linspace(0.0, 0.1, n), zeros, zeros, zeros, np.zeros((n, 6)), stance, swing
+        )
+
+    carrying = samples(loaded, loaded)
+    loads = ds.handover_loads(carrying.handover(zero_speed=True), zero_speed=True)
+    assert loads == {"rear_at_lift_off": 300.0, "front_at_landing": 300.0}
+    # the impact landing jumps the loads as it jumps the velocities: nothing judged
+    assert ds.handover_loads(carrying.handover(False), False) == {}
+    rear, front = loaded.copy(), loaded.copy()
+    rear[-1], front[0] = 0.0, 0.0
+    handed = samples(rear, front)
+    loads = ds.handover_loads(handed.handover(zero_speed=True), zero_speed=True)
+    assert max(loads.values()) <= ds.HANDOVER_TOLERANCE
+    margins = handed.margins(robot, zero_speed=True)
+    assert np.all(np.isinf(margins[-1, 0])) and np.all(np.isinf(margins[0, 1]))
+    assert np.all(np.isfinite(margins[:-1, 0])) and np.all(np.isfinite(margins[1:, 1]))
+    np.testing.assert_allclose(margins[1, 0], ds.foot_margins(robot, loaded[1]))

@@ -36,8 +36,8 @@ def test_graph_is_the_numeric_model_over_both_phases(knee, landing):
     """At the start the solver takes from the single-support optimum, the graph's double
     support (postures, torques, both wrenches for the front foot's wrench of the variables,
     the landing's impulses) and its criterion over both phases equal the numeric model's
-    (``biped.model.two_phase``, ``split_with_swing_wrench``), and the closure's equalities
-    hold."""
+    (``biped.model.two_phase``, ``split_with_swing_wrench``), the closure's equalities
+    hold and the handover's are the rear foot's wrench at lift-off."""
     solver = solver_of(knee, landing)
     problem = solver.problem
     z = tpo.start_from_single(problem, optimal_gait(knee).variables)
@@ -54,7 +54,11 @@ def test_graph_is_the_numeric_model_over_both_phases(knee, landing):
     np.testing.assert_allclose(stance.T, rear, atol=1e-5)
     np.testing.assert_allclose(swing.T, front, atol=0.0)
     np.testing.assert_allclose(impulse.ravel(), step.impulse, atol=1e-9)
-    assert np.max(np.abs(g[solver.n_inequalities :])) < 1e-9
+    equalities = g[solver.n_inequalities :].ravel()
+    if landing == "zero-speed":  # the last three: the rear foot's wrench at lift-off, scaled
+        equalities, handover = equalities[:-3], equalities[-3:]
+        np.testing.assert_allclose(handover * tpo._WRENCH_SCALES, rear[-1], atol=1e-6)
+    assert np.max(np.abs(equalities)) < 1e-9
     n = problem.single.samples_per_half
     *_, single_torques, _, _ = sample(model, step.single, n)
     single = step.single.period * simpson_weights(n) @ (single_torques**2).sum(1)
@@ -115,8 +119,16 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
     samples = ds.sample_phase(model, step.double, problem.samples)
     front = optimum.variables[-3 * (problem.samples + 1) :].reshape(-1, 3)
     _, rear = ds.split_with_swing_wrench(model, samples.q, samples.qd, samples.qdd, front)
-    for wrench in (rear, front):
-        margins = ds.foot_margins(model.robot, wrench)
+    # the load handed over after a zero-speed landing: the rear foot carries nothing at
+    # lift-off, nor the front foot at its landing; elsewhere each foot is pushed, in its cone, its ZMP in its sole
+    handed = ds.handover_rows(len(rear), landing == "zero-speed")
+    if landing == "zero-speed":
+        assert np.max(np.abs(rear[-1])) <= ds.HANDOVER_TOLERANCE
+        np.testing.assert_array_equal(front[0], 0.0)
+    for foot, wrench in zip(ds.FEET, (rear, front), strict=True):
+        loaded = np.ones(len(wrench), dtype=bool)
+        loaded[handed[foot]] = False
+        margins = ds.foot_margins(model.robot, wrench)[loaded]
         assert np.min(margins[:, :3]) > 0.0  # pushed, inside the friction cone
         assert np.min(margins[:, 3:]) > -1e-6  # ZMP in the sole [m]
     checked = tpo.check(problem, optimum.variables)

@@ -72,6 +72,17 @@ FOOT_CONSTRAINTS = ("normal_force", "friction_forward", "friction_backward", "zm
 # variable at the solver's samples, is linear in time between them (the gait file's rule), and
 # both feet's constraints are judged, by the solver and by the file, on this grid.
 FINE_PER_INTERVAL = 10
+# With the zero-speed landing, where a foot meets the air it hands its load over: the rear
+# foot at lift-off and the front foot at its landing (the impact landing jumps the loads as
+# it jumps the velocities, at both ends: the paper's idealisation). There its wrench is
+# zero: a flat foot leaves the floor when the floor stops pushing it, and a load that jumps
+# from one foot to the other is one that no servo on a closed chain and no compliant sole
+# can pass on (MuJoCo's walk of the gaits that
+# allowed it: the rear foot still carried 90 N of a 690 N weight 16 ms after its lift-off).
+# HANDOVER_TOLERANCE [N, N·m]: the largest component of such a wrench accepted (1 mN of a
+# 690 N weight); there the foot's constraints Ψ are not judged (no load, no ZMP).
+HANDOVERS = ("rear_at_lift_off", "front_at_landing")
+HANDOVER_TOLERANCE = 1e-3
 # Distance [m] from the chain's feet at which ``DoubleSupportPhase`` refuses an end state, and
 # the residual foot speed [m/s, rad/s] it accepts there.
 END_TOLERANCE = 1e-9
@@ -205,13 +216,18 @@ def zmp(wrench, ankle_height: float):
     return (wrench[..., 2] - ankle_height * wrench[..., 0]) / wrench[..., 1]
 
 
-def foot_margins(robot: Robot, wrench, friction: float = FOOT_FRICTION) -> np.ndarray:
+def foot_margins(robot: Robot, wrench, friction: float = FOOT_FRICTION, loaded=None) -> np.ndarray:
     """Ψ (..., 5) of one foot, ``FOOT_CONSTRAINTS`` [N, N, N, m, m]: Fz, μ Fz − Fx,
-    μ Fz + Fx, x_ZMP + l_p, L_p − l_p − x_ZMP; all >= 0 for a foot that holds."""
+    μ Fz + Fx, x_ZMP + l_p, L_p − l_p − x_ZMP; all >= 0 for a foot that holds. ``loaded``
+    (a mask of the wrenches, default all): where it is False the foot hands its load over,
+    its Ψ +inf (not judged)."""
     wrench = np.asarray(wrench, dtype=float)
+    if loaded is not None:
+        loaded = np.asarray(loaded, dtype=bool)
+        wrench = np.where(loaded[..., None], wrench, [0.0, 1.0, 0.0])  # a load for the ZMP
     fx, fz = wrench[..., 0], wrench[..., 1]
     x = zmp(wrench, robot.ankle_height)
-    return np.stack(
+    margins = np.stack(
         [
             fz,
             friction * fz - fx,
@@ -221,6 +237,7 @@ def foot_margins(robot: Robot, wrench, friction: float = FOOT_FRICTION) -> np.nd
         ],
         axis=-1,
     )
+    return margins if loaded is None else np.where(loaded[..., None], margins, np.inf)
 
 
 def held_feet_residual(model: Biped, step_length: float, q, qd=None) -> float:
@@ -325,12 +342,53 @@ class DoubleSupportSamples:
     stance_wrench: np.ndarray
     swing_wrench: np.ndarray
 
-    def margins(self, robot: Robot, friction: float = FOOT_FRICTION) -> np.ndarray:
-        """Ψ (N, 2, 5) of both feet (stance, swing), ``FOOT_CONSTRAINTS``."""
-        return np.stack(
-            [foot_margins(robot, w, friction) for w in (self.stance_wrench, self.swing_wrench)],
+    def margins(
+        self, robot: Robot, friction: float = FOOT_FRICTION, zero_speed: bool | None = None
+    ) -> np.ndarray:
+        """Ψ (N, 2, 5) of both feet (stance, swing), ``FOOT_CONSTRAINTS``; with
+        ``zero_speed`` True (a zero-speed landing) the feet's handover points
+        (``handover_rows``) +inf: not judged, the foot carries nothing there."""
+        margins = np.stack(
+            [foot_margins(robot, w, friction, loaded=rows) for w, rows in self._loaded(zero_speed)],
             axis=-2,
         )
+        return margins
+
+    def _loaded(self, zero_speed: bool | None) -> list:
+        """(wrench, rows judged) of each foot (stance, swing)."""
+        rows = np.ones(len(self.time), dtype=bool)
+        judged = []
+        for foot, wrench in zip(FEET, (self.stance_wrench, self.swing_wrench), strict=True):
+            kept = rows.copy()
+            if zero_speed is not None:
+                kept[handover_rows(len(self.time), zero_speed)[foot]] = False
+            judged.append((wrench, kept))
+        return judged
+
+    def handover(self, zero_speed: bool) -> dict:
+        """``HANDOVERS`` -> the wrench (3,) [N, N, N·m] of the rear foot at lift-off and of
+        the front foot at the landing (after an impact: not a handover, reported)."""
+        return {
+            "rear_at_lift_off": self.stance_wrench[-1].copy(),
+            "front_at_landing": self.swing_wrench[0].copy(),
+        }
+
+
+def handover_rows(count: int, zero_speed: bool) -> dict:
+    """Each foot's (``FEET``) rows of a phase sampled ``count`` times where it hands its load
+    over (``HANDOVERS``): with a zero-speed landing the stance (rear) foot's last and the
+    swing (front) foot's first; none after an impact (its loads jump, as its velocities)."""
+    if not zero_speed:
+        return {"stance": [], "swing": []}
+    return {"stance": [count - 1], "swing": [0]}
+
+
+def handover_loads(handover: dict, zero_speed: bool) -> dict:
+    """``HANDOVERS`` judged (those of a zero-speed landing; none after an impact) -> the
+    largest component of the foot's wrench there [N or N·m]: at most ``HANDOVER_TOLERANCE``
+    when met."""
+    judged = HANDOVERS if zero_speed else ()
+    return {name: float(np.max(np.abs(handover[name]))) for name in judged}
 
 
 def sample_phase(model: Biped, phase: DoubleSupportPhase, samples: int) -> DoubleSupportSamples:

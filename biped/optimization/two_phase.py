@@ -340,14 +340,26 @@ class TwoPhaseGraph(StepGraph):
         ]
         weights = _simpson(n)
         squared, inequalities, equalities = 0, [], []
+        # (foot, point) where a foot hands its load over (``double_support.HANDOVERS``):
+        # with the zero-speed landing, the front wrench's first sample fixed at 0 and the
+        # rear wrench at lift-off held at 0; the impact landing jumps the loads as it jumps
+        # the velocities, at both ends
+        smooth = self.landing_kind == "zero-speed"
+        handovers = {("stance", n * f), ("swing", 0)} if smooth else set()
         self.ds_torques, self.ds_stance_wrench, self.ds_swing_wrench, self.ds_q = [], [], [], []
         for i in range(n * f + 1):
             j, k = divmod(i, f)
             swing = wrenches[j] if k == 0 else wrenches[j] + (wrenches[j + 1] - wrenches[j]) * k / f
-            point = self._chain_point(c, cubic, dwell * i / (n * f), bends[i], swing)
+            point = self._chain_point(c, cubic, dwell * i / (n * f), bends[i], swing, smooth)
             if 0 < i < n * f:
                 equalities += point["closure"]
-            inequalities += point["margins"]
+            inequalities += point["knees"]
+            for foot, margins in zip(double_support.FEET, point["margins"], strict=True):
+                if (foot, i) in handovers:  # the foot carries nothing there: held below
+                    continue
+                inequalities += margins
+            if i == n * f and smooth:  # the rear foot hands its load over at lift-off
+                equalities += [point["stance"][k] / _WRENCH_SCALES[k] for k in range(3)]
             if k == 0:
                 squared = squared + weights[j] * ca.sumsqr(point["torques"])
                 self.ds_torques.append(point["torques"])
@@ -382,7 +394,7 @@ class TwoPhaseGraph(StepGraph):
                 bends.append(pair(f"{j}_{k}" if k else f"{j}"))
         return bends
 
-    def _chain_point(self, c, cubic, t, bends, swing) -> dict:
+    def _chain_point(self, c, cubic, t, bends, swing, relative=False) -> dict:
         """One point of the phase at time ``t`` [s]: the chain's q, q̇, q̈ from the cubics
         and the knee ``bends`` (rear, front), the split with the front wrench ``swing``; its
         closure equalities and both feet's and knees' constraints (scaled, >= 0)."""
@@ -408,12 +420,16 @@ class TwoPhaseGraph(StepGraph):
         for wrench in (stance, swing):
             values = _foot_margins(robot, wrench, FOOT_FRICTION, self.safety.zmp_margin)
             scale = [CONSTRAINT_SCALES[0]] * 3 + [MOMENT_SCALE] * 2
-            floor = [MARGINS[0]] * 3 + [MARGINS[1] * wrench[1]] * 2
-            margins += [(m - lo) / k for m, lo, k in zip(values, floor, scale, strict=True)]
+            # ``relative``: the cone's margin a share of the load; near a handover, where the
+            # load tends to 0, a floor in newtons met with the normal force's made the active
+            # set degenerate (IPOPT ended at its acceptable level)
+            cone = walkable.RELATIVE_MARGIN * FOOT_FRICTION * wrench[1] if relative else MARGINS[0]
+            floor = [MARGINS[0], cone, cone] + [MARGINS[1] * wrench[1]] * 2
+            margins.append([(m - lo) / k for m, lo, k in zip(values, floor, scale, strict=True)])
         knee = MARGINS[3]
-        margins += [rear - knee - self.safety.knee_bend, front - knee]
+        knees = [rear - knee - self.safety.knee_bend, front - knee]
         return {"q": q, "torques": torques, "stance": stance, "closure": closure,
-                "margins": margins}  # fmt: skip
+                "margins": margins, "knees": knees}  # fmt: skip
 
 
 def _knees_between(coefficients, safety: Safety):
@@ -716,7 +732,10 @@ def _bounds(problem: TwoPhaseProblem) -> tuple[np.ndarray, np.ndarray]:
         lower[unused] = upper[unused] = 0.0
         extra += [(-RATE_BOUND, RATE_BOUND)] * len(LANDING_RATES)
     extra += [_BEND_BOUNDS] * (2 * (samples - 1) + _between(problem))
-    extra += list(_WRENCH_BOUNDS) * (samples + 1)
+    wrenches = [list(_WRENCH_BOUNDS) for _ in range(samples + 1)]
+    if landing == "zero-speed":  # the front foot lands carrying nothing: its load grows
+        wrenches[0] = [(0.0, 0.0)] * len(WRENCH)
+    extra += [bound for sample in wrenches for bound in sample]
     low, high = np.array(extra).T
     return np.concatenate([lower, low]), np.concatenate([upper, high])
 
@@ -887,6 +906,10 @@ class TwoPhaseCheck:
             [N, N, N, m, m]) on the double support's fine grid (f = ``FINE_PER_INTERVAL``
             samples per interval of the solver's), the front foot's wrench linear in time
             between its variables: the gait file's rule and its ``feasible``.
+        handover: the feet's wrenches where they hand their load over (the rear foot's at
+            lift-off, the front foot's at a zero-speed landing): name -> largest component
+            [N or N·m] (``biped.model.double_support.handover_loads``); there the foot's Ψ
+            are not judged (+inf in ``double_margins``).
         landing_margins: (2, 3) each foot's (rear, front) landing constraints
             (``biped.model.two_phase.LANDING_CONSTRAINTS`` [N·s]: I_z, μ I_z ∓ I_x, μ =
             ``FOOT_FRICTION``), all 0 for the zero-speed landing.
@@ -898,6 +921,9 @@ class TwoPhaseCheck:
     double_margins: np.ndarray
     landing_margins: np.ndarray
     value: float
+    # the largest component of each judged handover's wrench [N or N·m]
+    # (``biped.model.double_support.handover_loads``), <= ``HANDOVER_TOLERANCE`` when met
+    handover: dict
 
     @property
     def feasible(self) -> bool:
@@ -916,6 +942,9 @@ class TwoPhaseCheck:
                 value = float(self.landing_margins[side, k])
                 if not value >= 0.0:
                     found[f"{foot} {name}"] = value
+        for name, load in self.handover.items():
+            if not load <= double_support.HANDOVER_TOLERANCE:
+                found[f"load {name.replace('_', ' ')}"] = load
         return found
 
     def violations_line(self) -> str:
@@ -937,7 +966,8 @@ def check(problem: TwoPhaseProblem, variables) -> TwoPhaseCheck:
     evaluation = evaluate_step(model, step.single, CHECK_SAMPLES_PER_HALF, safety=single.safety)
     front = z[-len(WRENCH) * (problem.samples + 1) :].reshape(-1, len(WRENCH))
     fine = double_support.sample_split(model, step.double, front)  # the file's rule
-    margins = fine.margins(model.robot)
+    zero_speed = problem.landing == "zero-speed"
+    margins = fine.margins(model.robot, zero_speed=True if zero_speed else None)
     torques = fine.torques[:: double_support.FINE_PER_INTERVAL]  # the solver's samples
     weights = step.single.period * simpson_weights(CHECK_SAMPLES_PER_HALF)
     single_part = float(weights @ (evaluation.torques**2).sum(-1))
@@ -947,6 +977,7 @@ def check(problem: TwoPhaseProblem, variables) -> TwoPhaseCheck:
         double_margins=margins,
         landing_margins=np.array(two_phase_model.landing_margins(step.impulse)),
         value=(single_part + double_part) / step.step_length,
+        handover=double_support.handover_loads(fine.handover(zero_speed), zero_speed),
     )
 
 

@@ -21,7 +21,13 @@ drive's figures of a double support are not built), and with this block:
     foot_margins    each foot's worst Ψ (``FOOT_CONSTRAINTS``) on the check grid below, the
                     front wrench linear between the solver's samples: the constraints must
                     hold between the samples too (a foot's ZMP that leaves its sole there
-                    tips it), and ``feasible`` is false when one does not
+                    tips it), and ``feasible`` is false when one does not; not where the
+                    foot hands its load over (the rear foot at lift-off, the front foot at
+                    a zero-speed landing): there it carries nothing and has no ZMP
+    handover        each foot's wrench where it hands its load over [N, N, N·m]: zero within
+                    ``HANDOVER_TOLERANCE`` (``biped.model.double_support``) after a
+                    zero-speed landing or the gait is not ``feasible``; after an impact
+                    reported, not judged (the impact landing jumps the loads)
     samples         the phase on ``CHECK_PER_INTERVAL`` times the solver's grid: q, q̇, q̈, the
                     torques and both feet's wrenches (the front one as stated above)
 
@@ -137,6 +143,10 @@ class DoubleSupport:
     coefficients: dict = unit_field(CUBIC)
     landing_impulse: list = unit_field(IMPULSE + IMPULSE)
     foot_margins: dict = unit_field({foot: FOOT_UNITS for foot in FEET})
+    # each foot's wrench where it hands its load over (``biped.model.double_support.HANDOVERS``:
+    # the rear foot's at lift-off, the front foot's at the landing), zero within
+    # ``HANDOVER_TOLERANCE`` after a zero-speed landing (after an impact: reported)
+    handover: dict = unit_field({name: WRENCH for name in ds.HANDOVERS})
     # both feet's constraints on the check grid (``samples``: the front wrench linear between
     # the solver's samples); at the landing both feet pushed within the friction cone
     # (``biped.model.two_phase.landing_margins``)
@@ -212,13 +222,21 @@ def double_support_of(
     at_solver = slice(None, None, CHECK_PER_INTERVAL)
     torques = samples.torques[at_solver]
     double = step.double.duration * float(_simpson(len(front) - 1) @ (torques**2).sum(-1))
-    fine = (samples.rear_wrench, samples.front_wrench)  # the file's rule between samples
-    margins = {
-        foot: ds.foot_margins(model.robot, wrench).min(axis=0).tolist()
-        for foot, wrench in zip(FEET, fine, strict=True)
-    }
+    zero_speed = step.landing == "zero-speed"
+    fine = ds.DoubleSupportSamples(  # the file's rule between samples
+        samples.t, samples.q, samples.qd, samples.qdd, samples.torques,
+        samples.rear_wrench, samples.front_wrench,
+    )  # fmt: skip
+    judged = fine.margins(model.robot, zero_speed=True if zero_speed else None).min(axis=0)
+    margins = {foot: judged[k].tolist() for k, foot in enumerate(FEET)}
+    handover = fine.handover(zero_speed)
+    loads = ds.handover_loads(handover, zero_speed)
     landing = np.min(landing_margins(step.impulse))  # 0 for a zero-speed landing
-    feasible = bool(landing >= 0.0 and all(min(m) >= 0.0 for m in margins.values()))
+    feasible = bool(
+        landing >= 0.0
+        and all(min(m) >= 0.0 for m in margins.values())
+        and all(load <= ds.HANDOVER_TOLERANCE for load in loads.values())
+    )
     dwell = step.double.duration
     return DoubleSupport(
         landing=step.landing,
@@ -232,6 +250,7 @@ def double_support_of(
         },
         landing_impulse=np.asarray(step.impulse, dtype=float).tolist(),
         foot_margins=margins,
+        handover={name: wrench.tolist() for name, wrench in handover.items()},
         feasible=feasible,
         samples=samples,
     )
