@@ -115,8 +115,9 @@ def test_the_planned_step_length_leaves_the_landing_gap(walked):
 @pytest.mark.parametrize("knee", ["rolling", "revolute"])
 def test_the_closed_chain_against_the_files_references(knee):
     """Twenty steps of each knee's zero-speed landing (one start), on the file's references
-    and with the chain closed on the landed feet: neither walk falls, and the closed chain's
-    walk, still beyond the 1 mm slip limit, fails by its slip, said as its cause. How much
+    and with the chain closed on the landed feet: neither walk falls, and each walk's slip
+    beyond the 1 mm limit, where it is (the optima with the load handed over slide 0.8-1.05
+    mm: docs/gaits.md), is said as its cause. How much
     the closed chain changes the slip, tilt and scuffs depends on the gait (docs/gaits.md,
     measured there for both knees): a figure, not a property of every gait."""
     walker = Walker(two_phase_gait(knee, "zero-speed"))
@@ -125,8 +126,9 @@ def test_the_closed_chain_against_the_files_references(knee):
         sim = walker.walk(20, WalkSettings(close_chain=close))
         figures[close] = walk_figures(walker.biped, walker.samples, sim, float("nan"))
         assert not figures[close]["fell"], f"close_chain={close}"
-    closed = figures[True]
-    assert closed["max_slip"] >= MAX_SLIP and "slipped" in walk_causes(closed, 20)
+    for walked in figures.values():
+        slipped = walked["max_slip"] >= MAX_SLIP
+        assert ("slipped" in walk_causes(walked, 20)) == slipped
 
 
 def test_a_foot_beyond_the_legs_reach_straightens_the_leg_and_says_the_gap(walked):

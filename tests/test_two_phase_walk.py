@@ -79,9 +79,9 @@ def test_two_phase_walk_runs_both_phases(gait, walked):
 def test_the_double_support_is_support_not_a_scuff(gait, walked):
     """The trailing foot on the floor in double support is no scuff, and the slip and tilt
     are each supporting foot's: the front foot's from its touchdown, the stance foot's from
-    its touchdown in the step before to its lift-off. The walk fails, by its slip alone (the
-    front foot sliding as it lands, the rear foot sliding back in double support, over
-    1 mm: docs/gaits.md)."""
+    its touchdown in the step before to its lift-off. Its verdict is its slip's: "slipped"
+    its only cause when a supporting foot slides 1 mm or more (the zero-speed optima slide
+    0.8-1.05 mm with the load handed over: docs/gaits.md), none otherwise."""
     walker, sim = walked
     figures = walk_figures(walker.biped, walker.samples, sim, float("nan"))
     assert figures["scuff_steps"] == 0 and not figures["fell"]
@@ -91,8 +91,8 @@ def test_the_double_support_is_support_not_a_scuff(gait, walked):
         assert front == other(stance) and landed.start == sim.touchdowns[j] + settle
         if j:
             assert rows.start == min(sim.touchdowns[j - 1] + settle, sim.step_starts[j])
-    assert figures["max_slip"] >= MAX_SLIP
-    assert walk_causes(figures, STEPS) == ["slipped"]
+    slipped = figures["max_slip"] >= MAX_SLIP
+    assert walk_causes(figures, STEPS) == ["slipped"] * slipped
 
 
 def test_a_walk_of_single_support_has_no_double_support():
