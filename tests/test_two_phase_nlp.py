@@ -100,6 +100,19 @@ def test_what_is_not_built_is_refused():
             tpo.TwoPhaseProblem(single, (0.1, 0.2))
 
 
+_OPTIMA: dict = {}
+
+
+def rolling_optimum(landing: str = "impact") -> tpo.TwoPhaseOptimum:
+    """IPOPT's answer for the rolling knee's problem of ``solver_of`` from its single-support
+    optimum (one start), solved once per session."""
+    if landing not in _OPTIMA:
+        problem, single = solver_of("rolling", landing).problem, optimal_gait("rolling")
+        start = tpo.start_from_single(problem, single.variables)
+        _OPTIMA[landing] = solver_of("rolling", landing).solve(start, single.value)
+    return _OPTIMA[landing]
+
+
 @pytest.mark.parametrize("landing", ["impact", "zero-speed"])
 def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
     """IPOPT converges from the single-support optimum (rolling knee, 0.3 m/s, a tenth to a
@@ -107,10 +120,8 @@ def test_two_phase_optimum_converges_and_holds_on_the_numeric_model(landing):
     support holds: both feet pushed, in their friction cones, their ZMPs in their soles (at
     the solver's samples and on the fine grid between them, to its tolerance), the rear foot pushed at the landing, the share
     in its range; MuJoCo agrees with both feet's forces."""
-    solver = solver_of("rolling", landing)
-    problem = solver.problem
-    single = optimal_gait("rolling")
-    optimum = solver.solve(tpo.start_from_single(problem, single.variables), single.value)
+    problem = solver_of("rolling", landing).problem
+    optimum = rolling_optimum(landing)
     assert optimum.converged, optimum.status
     assert 0.1 - 1e-8 <= optimum.share <= 0.2 + 1e-8
     model = problem.single.model
@@ -244,10 +255,9 @@ def test_a_sliding_landing_is_rejected():
     landing foot arriving 1 m/s faster along the floor needs more friction than the floor
     has (the check names it), and the single-support optimum's touchdown (the rolling
     knee's slides forward at 1.8 m/s) pulls the rear foot."""
-    solver = solver_of("rolling")
-    problem = solver.problem
+    problem = solver_of("rolling").problem
     single = optimal_gait("rolling")
-    optimum = solver.solve(tpo.start_from_single(problem, single.variables), single.value)
+    optimum = rolling_optimum("impact")
     assert optimum.converged, optimum.status
     assert tpo.check(problem, optimum.variables).feasible
     sliding = _sliding(problem, optimum.variables, 1.0)
