@@ -76,6 +76,12 @@ def cmd_atlas(args) -> int:
         )
     )
     atlas.check_folder(args.out, settings)
+    two = None
+    if args.double_support is not None:  # refused before the atlas runs, not after
+        from biped.studies import atlas_two_phase
+
+        two = atlas_two_phase.of_atlas(settings, args.double_support, args.landing)
+        atlas_two_phase.check_two_phase(args.out, two)
     if args.dask is not None:
         check_dask(args.dask)
     atlas.run_atlas(args.out, settings, **types.campaign(args, "atlas"))
@@ -94,7 +100,35 @@ def cmd_atlas(args) -> int:
         for cell in settings.cells()
         for k in ("revolute", "rolling")
     )
-    return 0 if certified and not atlas.unmeasured(args.out, settings) and not unwalked else 1
+    status = 0 if certified and not atlas.unmeasured(args.out, settings) and not unwalked else 1
+    if two is not None:  # from the atlas's single-support optima, those certified
+        status = max(status, cmd_atlas_double_support(args, settings, two))
+    return status
+
+
+def cmd_atlas_double_support(args, settings, two) -> int:
+    """The atlas's two-phase optima (``biped.studies.atlas_two_phase``), their summary and
+    figure printed and written; 1 when a knee at a built cell has no two-phase optimum."""
+    from pathlib import Path
+
+    from biped.pages.atlas_two_phase import atlas_two_phase_figure
+    from biped.studies import atlas_two_phase as study
+
+    where = types.campaign(args, "double support")
+    summary = study.run_two_phase(args.out, settings, two, **where)
+    folder = Path(args.out) / study.FOLDER
+    figure = atlas_two_phase_figure(summary, folder / study.FIGURE)
+    print(summary.table())
+    print(
+        f"double support results in {folder}: {study.RECORD}, {study.SUMMARY}, {figure.name}, "
+        "a two-phase gait file (or its failure record) <knee>-sthenic-<cell>.json per built "
+        f"cell and knee; {len(summary.not_built)} cell(s) and criteria not built"
+    )
+    missing = summary.missing()
+    if missing:
+        print(f"double support: {len(missing)} of {len(summary.points)} two-phase optima "
+              "NOT CERTIFIED (above: why)")  # fmt: skip
+    return 1 if missing else 0
 
 
 def add_parser(commands) -> None:
@@ -135,6 +169,63 @@ def add_parser(commands) -> None:
     types.add_robot(parser)
     types.add_jobs(parser)
     types.add_dask(parser)
+    add_double_support(parser)
+
+
+def add_double_support(parser) -> None:
+    """``--double-support LOW:HIGH`` and ``--landing``, and the rule of what they combine
+    with."""
+    from biped.model.two_phase import LANDINGS
+
+    parser.add_argument(
+        "--double-support",
+        type=types.double_support_share,
+        default=None,
+        metavar="LOW:HIGH",
+        help="after the atlas, at every cell where the gait of two phases is built (sthenic "
+        "criterion, the paper's spline and constraints: --paper-constraints), each knee's "
+        "optimum of single then double support, its double support a share of the step from "
+        "LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share), started from the "
+        "cell's single-support optimum; written with a summary and a figure in "
+        "OUT/double-support/ (docs/atlas.md); the other cells listed as not built, with why",
+    )
+    parser.add_argument(
+        "--landing",
+        choices=LANDINGS,
+        default="impact",
+        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
+        "it) or zero-speed (it arrives at rest, no impact) (default %(default)s)",
+    )
+    options = ("--double-support", "--criteria", "--paper-constraints", "--actuator-limits",
+               "--knots", "--family")  # fmt: skip
+    checks.declare_rule(parser, options, _check_double_support)
+
+
+def _check_double_support(args) -> None:
+    """--double-support where at least one cell builds the two-phase problem: sthenic among
+    the criteria, the paper's constraints and spline, no actuator limits."""
+    from biped.errors import BipedError
+
+    if args.double_support is None:
+        return
+    if "sthenic" not in args.criteria:
+        raise BipedError(
+            f"--criteria {' '.join(args.criteria)} with --double-support: allowed sthenic among "
+            "them (the two-phase problem's only criterion)"
+        )
+    if not args.paper_constraints:
+        raise BipedError(
+            "--double-support without --paper-constraints: allowed the paper's problem (the "
+            "two-phase problem is not built under the walkable constraints)"
+        )
+    if args.actuator_limits:
+        raise BipedError("--actuator-limits with --double-support: allowed neither (the "
+                         "two-phase problem has no actuator limits)")  # fmt: skip
+    if args.knots != 1 or args.family != "spline":
+        raise BipedError(
+            f"--knots {args.knots} --family {args.family} with --double-support: allowed the "
+            "paper's spline (--knots 1, --family spline)"
+        )
 
 
 def cmd_compare(args) -> int:

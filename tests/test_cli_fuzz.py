@@ -69,6 +69,7 @@ WORK = [
     ("biped.studies.two_phase_sweep", "run_two_phase"),
     ("biped.studies.design_map", "run_design_map"),
     ("biped.studies.atlas", "run_atlas"),
+    ("biped.studies.atlas_two_phase", "run_two_phase"),
     ("biped.pages.figures", "make_figures"),
     ("validate.checks.validation", "validate"),
     ("validate.studies.robustness", "robustness_map"),

@@ -111,7 +111,7 @@ class TwoPhaseSweepSummary:
     def to_dict(self) -> dict:
         content = {"format": FORMAT, **dataclasses.asdict(self)}
         content["share_range"] = list(self.share_range)
-        content["points"] = [_point_dict(p) for p in self.points]
+        content["points"] = [point_to_dict(p) for p in self.points]
         content["differences"] = [dataclasses.asdict(d) for d in self.differences]
         return {**content, "units": self.units()}
 
@@ -122,16 +122,7 @@ class TwoPhaseSweepSummary:
             found = content.get("format") if isinstance(content, dict) else None
             raise BipedError(f"{source}: format {found!r}: allowed {FORMAT!r}")
         try:
-            points = tuple(
-                PointSummary(
-                    **{
-                        **p,
-                        "single": _phases(p["single"]),
-                        "double": _phases(p["double"]),
-                    }
-                )
-                for p in content["points"]
-            )
+            points = tuple(point_from_dict(p) for p in content["points"])
             differences = tuple(KneeDifference(**d) for d in content["differences"])
             return cls(tuple(content["share_range"]), content["landing"], points, differences)
         except (KeyError, TypeError) as error:
@@ -157,13 +148,19 @@ class TwoPhaseSweepSummary:
         return cls.from_dict(content, str(path))
 
 
-def _point_dict(point: PointSummary) -> dict:
+def point_to_dict(point: PointSummary) -> dict:
     """A point's object: an unknown optimum's figures each null (unknown, with its unit)."""
     content = dataclasses.asdict(point)
     for phase in ("single", "double"):
         if content[phase] is None:
             content[phase] = {f.name: None for f in dataclasses.fields(Phases)}
     return content
+
+
+def point_from_dict(content: dict) -> PointSummary:
+    """The record of ``point_to_dict``'s object (a KeyError or TypeError where it is not)."""
+    single, double = _phases(content["single"]), _phases(content["double"])
+    return PointSummary(**{**content, "single": single, "double": double})
 
 
 def _phases(content) -> Phases | None:

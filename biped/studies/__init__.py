@@ -7,7 +7,8 @@ profile over the speeds (``profile_speeds``: a table of optimizations, no folder
 both knees over nested gait families until their comparison converges (``converge``),
 each criterion's optimum with every criterion measured on it (``criteria_matrix``), and two
 atlases in two gait families compared cell by cell (``atlas_families``); a sweep's
-two-phase optima beside its single-support ones (``two_phase_sweep``).
+two-phase optima beside its single-support ones (``two_phase_sweep``), and an atlas's
+(``atlas_two_phase``).
 
 May import: ``biped.model``, ``biped.optimization``, ``biped.records``, ``biped.runtime``,
 ``biped.errors``, numpy (the design map's figures are ``biped.pages.design_map_figures``).

@@ -114,9 +114,26 @@ def _single(folder: Path, point: Point) -> Gait | None:
 
 def solve_two_phase(task: Task) -> str:
     """A point's two-phase optimum from its certified single-support optimum, written as a
-    gait file; a failure record where there is none."""
+    gait file; a failure record where there is none (``solve_from_single``)."""
     settings, point = task.settings, task.point
     single = _single(Path(task.folder).parent, point)
+    return solve_from_single(
+        single,
+        lambda: _problem(settings, point),
+        settings,
+        task.path,
+        f"{point.knee:8} {point.speed:.3f} m/s",
+        {"knee": point.knee, "speed": point.speed},
+    )
+
+
+def solve_from_single(
+    single: Gait | None, problem, settings, path: Path, label: str, identity: dict
+) -> str:
+    """The two-phase optimum of ``problem()`` (built only when ``single`` is a certified
+    single-support optimum) from ``single``, ``settings.starts`` starts seeded by
+    ``settings.seed``, written as the gait file ``path``; else a failure record there
+    (``identity``, the point's fields, and why). Returns the point's line (``label``)."""
     why = "single support missing" if single is None else None
     if single is not None:
         why = campaign.failure(single.optimizer.status, single.feasible)
@@ -125,10 +142,10 @@ def solve_two_phase(task: Task) -> str:
         # MUMPS on one thread, as every single-support solve runs it: a resumed run's
         # process, which solved no single support, gives the same bits (else 4e-14 of C_Γ)
         one_blas_thread()
-        problem = _problem(settings, point)
+        built = problem()
         variables = campaign.variables(single.optimizer.variables)
         result = optimize_two_phase(
-            TwoPhaseSolver(problem), variables, single.costs.sthenic, settings.starts, settings.seed
+            TwoPhaseSolver(built), variables, single.costs.sthenic, settings.starts, settings.seed
         )
         if result.best is None:
             why = (
@@ -136,22 +153,22 @@ def solve_two_phase(task: Task) -> str:
                 f"converged, {result.feasible} feasible ({'; '.join(result.outcomes)})"
             )
         else:
-            gait = two_phase_file.gait_of(problem, result, settings.seed)
-            gait.write(task.path)
+            gait = two_phase_file.gait_of(built, result, settings.seed)
+            gait.write(path)
             double = gait.double_support
             return (
-                f"[two phases] {point.knee:8} {point.speed:.3f} m/s  C = {double.sthenic:12.6f} "
+                f"[two phases] {label}  C = {double.sthenic:12.6f} "
                 f"N²·m·s over the step, share {double.share:.4f} (single support alone "
                 f"{single.costs.sthenic:.6f}); {result.at_best}/{result.starts} starts at best"
             )
-    record = {"format": FAILURE, "knee": point.knee, "speed": point.speed, "why": why}
-    atomic_write_text(task.path, json.dumps(record, indent=1))
-    return f"[two phases] {point.knee:8} {point.speed:.3f} m/s  NO OPTIMUM: {why}"
+    record = {"format": FAILURE, **identity, "why": why}
+    atomic_write_text(path, json.dumps(record, indent=1))
+    return f"[two phases] {label}  NO OPTIMUM: {why}"
 
 
-def _two_phase(folder: Path, point: Point) -> tuple[Gait | None, str]:
-    """A point's two-phase gait (None: none) and why not ("" when there is one)."""
-    path = folder / point.filename()
+def read_two_phase(path: Path) -> tuple[Gait | None, str]:
+    """A point's two-phase gait file (None: none) and why not ("" when there is one;
+    "missing" when the file is)."""
     if not path.exists():
         return None, "missing"
     try:
@@ -161,6 +178,11 @@ def _two_phase(folder: Path, point: Point) -> tuple[Gait | None, str]:
     if isinstance(content, dict) and content.get("format") == FAILURE:
         return None, str(content["why"])
     return Gait.read(path, two_phase=True), ""
+
+
+def _two_phase(folder: Path, point: Point) -> tuple[Gait | None, str]:
+    """A point's two-phase gait (None: none) and why not ("" when there is one)."""
+    return read_two_phase(folder / point.filename())
 
 
 def run_two_phase(sweep_folder, settings: Settings, knees, **where) -> Summary:
