@@ -8,8 +8,8 @@ robustness map's (``robustness_figure``), the optima over nested gait families
 (``converge_figures``), every criterion on each criterion's optimum (``criteria_page``,
 ``criteria_figures``), two atlases in two gait families cell by cell (``atlas_families``),
 a sweep with double support (``two_phase_sweep_figures``), an atlas with double support
-(``atlas_two_phase``); every figure of the project
-drawn in one style and written by one function (``style``).
+(``atlas_two_phase``); every figure of the project drawn in one style and written by one
+function (``style``).
 
 May import: every other layer of ``biped``, numpy, matplotlib.
 """
