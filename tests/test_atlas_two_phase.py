@@ -192,3 +192,23 @@ def test_a_resume_with_another_landing_is_refused_writing_nothing(tiny, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "landing" in err[0], err
     assert {p: p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()} == before
+
+
+def test_a_run_stopped_before_a_point_redoes_that_point_alone_to_the_same_optimum(tiny, capsys):
+    """A point's file gone (a run stopped before it was written): the next run solves that
+    point alone, to the same optimum (its parameters, double support, costs and samples, bit
+    for bit; only the solver's wall time differs) and the same summary."""
+    folder, status = tiny
+    path = folder / study.FOLDER / study.Point("rolling", atlas.Cell(SPEED, 0.02, 0.0)).filename()
+    summary = folder / study.FOLDER / study.SUMMARY
+    before, summary_before = json.loads(path.read_text()), summary.read_bytes()
+    path.unlink()
+    capsys.readouterr()
+    assert main([*TINY, *DOUBLE, "--out", str(folder)]) == status
+    out, err = capsys.readouterr()
+    assert "3 already done, 1 to run" in err
+    assert (err + out).count("[two phases]") == 1
+    after = json.loads(path.read_text())
+    for key in ("parameters", "double_support", "costs", "samples"):
+        assert after[key] == before[key], key
+    assert summary.read_bytes() == summary_before
