@@ -55,7 +55,9 @@ def cmd_atlas(args) -> int:
     final optimum is certified, every re-solve measured what it is for and every walk was
     measured (a gait that does not walk is a finding, not a failure), 1 otherwise (a
     re-solve that did not converge leaves its term unknown: the run's last line and
-    atlas.md say which and why)."""
+    atlas.md say which and why). With --double-support, then each knee's two-phase optimum at
+    every cell where it is built, from the cell's single-support optimum, in
+    OUT/double-support/; exits 1 also when one is missing."""
     from biped.model.criteria import PAPER_SAFETY, WALKABLE
     from biped.pages import atlas as pages
     from biped.runtime.runner import check_dask

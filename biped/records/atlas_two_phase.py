@@ -73,9 +73,10 @@ class CellDifference:
             )
         size = "larger" if abs(two) > abs(one) else "smaller"
         side = "pay-off" if one < 0.0 else "extra cost"
+        times = f", {abs(two) / abs(one):.2f} times" if one else ""
         return (
             f"same sign; the rolling knee's {side} {size} with double support "
-            f"({two - one:+.2f} points, {abs(two) / abs(one) if one else float('inf'):.2f} times)"
+            f"({two - one:+.2f} points{times})"
         )
 
     def line(self) -> str:
