@@ -189,7 +189,8 @@ def add_double_support(parser) -> None:
         "optimum of single then double support, its double support a share of the step from "
         "LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share), started from the "
         "cell's single-support optimum; written with a summary and a figure in "
-        "OUT/double-support/ (docs/atlas.md); the other cells listed as not built, with why",
+        "OUT/double-support/ (docs/atlas.md); the other cells listed as not built, with why "
+        "(default: the atlas alone)",
     )
     parser.add_argument(
         "--landing",

@@ -10,7 +10,14 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from biped.pages.style import ATLAS_TWO_PHASE_CELL, FONT_NOTE, FONT_SMALL, FONT_TITLE, save
+from biped.pages.style import (
+    ATLAS_TWO_PHASE_CELL,
+    ATLAS_TWO_PHASE_WIDTHS,
+    FONT_NOTE,
+    FONT_SMALL,
+    FONT_TITLE,
+    save,
+)
 from biped.records.atlas_two_phase import AtlasTwoPhaseSummary
 
 WIDTH = 0.38  # of a bar, a cell 1 apart from the next
@@ -18,7 +25,6 @@ BARS = {
     "single": ("single support", "//", -WIDTH / 2),
     "double": ("with double support", "", WIDTH / 2),
 }
-LEAST_WIDTH = 5.0  # [in] of the figure, whatever its cells
 
 
 def _label(cell) -> str:
@@ -32,7 +38,8 @@ def atlas_two_phase_figure(summary: AtlasTwoPhaseSummary, path: str | Path) -> P
         summary.differences, key=lambda d: (d.knee_bend, d.clearance, d.difference.speed)
     )
     width, height = ATLAS_TWO_PHASE_CELL
-    fig = Figure(figsize=(max(LEAST_WIDTH, width * len(cells) + 1.5), height), layout="constrained")
+    least, labels = ATLAS_TWO_PHASE_WIDTHS
+    fig = Figure(figsize=(max(least, width * len(cells) + labels), height), layout="constrained")
     axis = fig.subplots()
     for phase, (label, hatch, shift) in BARS.items():
         labelled = False

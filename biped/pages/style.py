@@ -54,6 +54,7 @@ TWO_PHASE_SWEEP_SIZE = (
 )  # the knees with and without double support (two_phase_sweep_figures)
 # [in] an atlas with double support: the width of a cell's pair of bars, and the height
 ATLAS_TWO_PHASE_CELL = (1.3, 4.2)  # (atlas_two_phase)
+ATLAS_TWO_PHASE_WIDTHS = (5.0, 1.5)  # [in] the least figure, the axis's labels (atlas_two_phase)
 PROFILE_SPEEDS_SIZE = (8, 4.6)  # a profile's criterion over speed (profile_figures)
 ROBUSTNESS_SIZE = (8.0, 6.0)  # a gait's robustness map (robustness_figure)
 WALK_TORQUES_SIZE = (13.2, 6.8)  # MuJoCo's torques beside the model's (walk_figures)
