@@ -1,5 +1,6 @@
 """Shared fixtures: both robots and seeded random motions with the stance foot fixed."""
 
+import functools
 import json
 from pathlib import Path
 
@@ -77,23 +78,38 @@ def optimal_gait(knee: str):
 _TWO_PHASE: dict = {}
 
 
-def two_phase_gait(knee: str, landing: str = "impact"):
-    """The two-phase gait at 0.3 m/s, a tenth to a fifth of the step in double support, one
-    start from ``optimal_gait(knee)`` (what ``biped optimize --double-support 0.1:0.2
-    --starts 1`` writes), in memory; computed once per session."""
+@functools.cache
+def two_phase_solver(knee: str, landing: str = "impact"):
+    """The two-phase solver of ``knee`` at 0.3 m/s, a tenth to a fifth of the step in double
+    support, built once per session (the tests' processes share none)."""
     from biped.optimization import two_phase as tpo
     from biped.optimization.problem import GaitProblem
+
+    problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3)
+    return tpo.TwoPhaseSolver(tpo.TwoPhaseProblem(problem, (0.1, 0.2), landing=landing))
+
+
+@functools.cache
+def two_phase_result(knee: str, landing: str = "impact"):
+    """``two_phase_solver``'s best of one start from ``optimal_gait(knee)`` (what ``biped
+    optimize --double-support 0.1:0.2 --starts 1`` solves), once per session."""
+    from biped.optimization import two_phase as tpo
+
+    single = optimal_gait(knee)
+    solver = two_phase_solver(knee, landing)
+    return tpo.optimize_two_phase(solver, single.variables, single.value, starts=1, seed=0)
+
+
+def two_phase_gait(knee: str, landing: str = "impact"):
+    """The two-phase gait of ``two_phase_result`` (what ``biped optimize --double-support
+    0.1:0.2 --starts 1`` writes), in memory; computed once per session."""
     from biped.records import two_phase_file
 
     if (knee, landing) not in _TWO_PHASE:
-        single = optimal_gait(knee)
-        problem = GaitProblem(biped.Biped(biped.Robot.paper(), knee), 0.3)
-        two = tpo.TwoPhaseProblem(problem, (0.1, 0.2), landing=landing)
-        result = tpo.optimize_two_phase(
-            tpo.TwoPhaseSolver(two), single.variables, single.value, starts=1, seed=0
-        )
-        assert result.best is not None, "the two-phase problem found no optimum"
-        _TWO_PHASE[knee, landing] = two_phase_file.gait_of(two, result, seed=0)
+        result = two_phase_result(knee, landing)
+        assert result.best is not None, f"the two-phase problem found no optimum: {result}"
+        problem = two_phase_solver(knee, landing).problem
+        _TWO_PHASE[knee, landing] = two_phase_file.gait_of(problem, result, seed=0)
     return _TWO_PHASE[knee, landing]
 
 

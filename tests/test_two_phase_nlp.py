@@ -16,17 +16,21 @@ from biped.model.kinematics import Q5, QP2
 from biped.model.robot import FOOT_FRICTION
 from biped.optimization import two_phase as tpo
 from biped.optimization.problem import GaitProblem
-from tests.conftest import edited_gait_file, optimal_gait, refusal
+from tests.conftest import (
+    edited_gait_file,
+    optimal_gait,
+    refusal,
+    two_phase_result,
+    two_phase_solver,
+)
 
 SPEED = 0.3  # [m/s]
 
 
-@functools.cache
 def solver_of(knee: str, landing: str = "impact") -> tpo.TwoPhaseSolver:
     """The two-phase solver of ``knee`` at 0.3 m/s, a tenth to a fifth of the step in double
-    support (built once per session)."""
-    single = GaitProblem(biped.Biped(biped.Robot.paper(), knee), SPEED)
-    return tpo.TwoPhaseSolver(tpo.TwoPhaseProblem(single, (0.1, 0.2), landing=landing))
+    support (built once per session, shared with the two-phase gaits of ``tests.conftest``)."""
+    return two_phase_solver(knee, landing)
 
 
 @pytest.mark.parametrize(
@@ -100,17 +104,13 @@ def test_what_is_not_built_is_refused():
             tpo.TwoPhaseProblem(single, (0.1, 0.2))
 
 
-_OPTIMA: dict = {}
-
-
 def rolling_optimum(landing: str = "impact") -> tpo.TwoPhaseOptimum:
     """IPOPT's answer for the rolling knee's problem of ``solver_of`` from its single-support
-    optimum (one start), solved once per session."""
-    if landing not in _OPTIMA:
-        problem, single = solver_of("rolling", landing).problem, optimal_gait("rolling")
-        start = tpo.start_from_single(problem, single.variables)
-        _OPTIMA[landing] = solver_of("rolling", landing).solve(start, single.value)
-    return _OPTIMA[landing]
+    optimum (one start, converged and feasible on the numeric model), solved once per session
+    (the two-phase gait of ``tests.conftest`` is its file)."""
+    result = two_phase_result("rolling", landing)
+    assert result.best is not None, result.outcomes
+    return result.best
 
 
 @pytest.mark.parametrize("landing", ["impact", "zero-speed"])
@@ -287,10 +287,8 @@ def test_constraints_held_at_the_samples_only_leave_the_sole_between_them(tmp_pa
     from biped.records.two_phase_file import optimizer_record
 
     fine = solver_of("rolling")
-    coarse = fine.coarse
-    problem = coarse.problem
-    single = optimal_gait("rolling")
-    optimum = coarse.solve(tpo.start_from_single(problem, single.variables), single.value)
+    problem = fine.coarse.problem
+    optimum = rolling_optimum("impact").first_stage  # the two-stage solve's first
     assert optimum.converged, optimum.status
     model, robot = problem.single.model, problem.single.model.robot
     step = tp.build_two_phase(model, SPEED, tpo.to_parameters(problem, optimum.variables), "impact")
@@ -326,7 +324,7 @@ def test_constraints_held_at_the_samples_only_leave_the_sole_between_them(tmp_pa
     read = functools.partial(gait_file.read_consistent, two_phase=True)
     assert "double_support.feasible" in refusal(read, claimed)
     # The problem on the fine grid: its optimum holds on every one of the 101 samples.
-    held = fine.solve(tpo.start_from_single(fine.problem, single.variables), single.value)
+    held = rolling_optimum("impact")
     assert held.converged, held.status
     assert np.min(tpo.check(fine.problem, held.variables).double_margins) > -1e-6
     assert held.value > optimum.value  # holding them between the samples costs torque

@@ -573,6 +573,9 @@ class TwoPhaseOptimum:
     seconds: float
     setup_seconds: float
     single_value: float
+    # the first stage's answer (the feet's constraints at the solver's samples alone) of a
+    # two-stage solve (``TwoPhaseSolver.solve``); None for one stage
+    first_stage: TwoPhaseOptimum | None = None
 
     @property
     def converged(self) -> bool:
@@ -647,7 +650,8 @@ class TwoPhaseSolver:
         """IPOPT from the variables ``start``: first the ``coarse`` problem's (when there is
         one), then this problem's from the coarse answer (its bends between the samples
         those of the closed chain, ``closed_bends``), even unconverged (IPOPT's last point
-        is as near as the start); iterations and seconds are both stages'."""
+        is as near as the start); iterations and seconds are both stages', the first
+        stage's answer kept (``first_stage``)."""
         if self.coarse is None:
             return self.solve_once(start, single_value)
         first = self.coarse.solve(_renamed(start, self.problem, self.coarse.problem), single_value)
@@ -661,6 +665,7 @@ class TwoPhaseSolver:
             answer,
             iterations=first.iterations + answer.iterations,
             seconds=first.seconds + answer.seconds,
+            first_stage=first,
         )
 
     def solve_once(self, start, single_value: float) -> TwoPhaseOptimum:
