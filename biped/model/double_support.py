@@ -77,8 +77,8 @@ FINE_PER_INTERVAL = 10
 # it jumps the velocities, at both ends: the paper's idealisation). There its wrench is
 # zero: a flat foot leaves the floor when the floor stops pushing it, and a load that jumps
 # from one foot to the other is one that no servo on a closed chain and no compliant sole
-# can pass on (MuJoCo's walk of the gaits that
-# allowed it: the rear foot still carried 90 N of a 690 N weight 16 ms after its lift-off).
+# can pass on (MuJoCo's walk of the gaits that allowed it: the rear foot still carried 90 N
+# of a 690 N weight 16 ms after its lift-off).
 # HANDOVER_TOLERANCE [N, N·m]: the largest component of such a wrench accepted (1 mN of a
 # 690 N weight); there the foot's constraints Ψ are not judged (no load, no ZMP).
 HANDOVERS = ("rear_at_lift_off", "front_at_landing")
@@ -348,26 +348,18 @@ class DoubleSupportSamples:
         """Ψ (N, 2, 5) of both feet (stance, swing), ``FOOT_CONSTRAINTS``; with
         ``zero_speed`` True (a zero-speed landing) the feet's handover points
         (``handover_rows``) +inf: not judged, the foot carries nothing there."""
-        margins = np.stack(
-            [foot_margins(robot, w, friction, loaded=rows) for w, rows in self._loaded(zero_speed)],
-            axis=-2,
-        )
-        return margins
-
-    def _loaded(self, zero_speed: bool | None) -> list:
-        """(wrench, rows judged) of each foot (stance, swing)."""
-        rows = np.ones(len(self.time), dtype=bool)
-        judged = []
+        handed = handover_rows(len(self.time), bool(zero_speed))
+        feet = []
         for foot, wrench in zip(FEET, (self.stance_wrench, self.swing_wrench), strict=True):
-            kept = rows.copy()
-            if zero_speed is not None:
-                kept[handover_rows(len(self.time), zero_speed)[foot]] = False
-            judged.append((wrench, kept))
-        return judged
+            loaded = np.ones(len(self.time), dtype=bool)
+            loaded[handed[foot]] = False
+            feet.append(foot_margins(robot, wrench, friction, loaded=loaded))
+        return np.stack(feet, axis=-2)
 
     def handover(self, zero_speed: bool) -> dict:
         """``HANDOVERS`` -> the wrench (3,) [N, N, N·m] of the rear foot at lift-off and of
-        the front foot at the landing (after an impact: not a handover, reported)."""
+        the front foot at the landing (judged after a zero-speed landing only:
+        ``handover_loads``)."""
         return {
             "rear_at_lift_off": self.stance_wrench[-1].copy(),
             "front_at_landing": self.swing_wrench[0].copy(),
