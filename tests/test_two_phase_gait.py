@@ -89,6 +89,7 @@ def _edit_front_wrench(content):
         (_edit_front_wrench, "double_support"),
         (lambda c: c["double_support"].update(landing="soft"), "double_support.landing"),
         (lambda c: c["double_support"].pop("samples"), "double_support.samples"),
+        (lambda c: c["double_support"].update(energy=1.0), "double_support.energy"),
     ],
 )
 def test_an_edited_two_phase_gait_is_refused(written, tmp_path, change, named):
@@ -100,6 +101,36 @@ def test_an_edited_two_phase_gait_is_refused(written, tmp_path, change, named):
     read = functools.partial(gait_file.read_consistent, two_phase=True)
     message = refusal(read, edited_gait_file(content, tmp_path, change))
     assert named in message
+
+
+def test_the_work_over_both_phases_adds_the_double_supports(written, tmp_path):
+    """The file's C_E over both phases is the single support's and the double support's
+    joint work; over the double support the joints' signed work is the robot's change of
+    mechanical energy (the feet are held: the ground does none), which their work ∫ Σ |Γ θ̇|
+    bounds; torques 10 % off break that balance. A file written before these figures reads,
+    without them."""
+    gait, path = written
+    double, model, phase = gait.double_support, gait.biped, gait.double_support.samples
+    work = double.energy - gait.costs.energy
+    assert double.energy_per_metre == pytest.approx(double.energy / gait.step_length)
+
+    def mechanical(k):
+        return model.kinetic_energy(phase.q[k], phase.qd[k]) + model.potential_energy(phase.q[k])
+
+    def signed(torques):
+        return np.trapezoid((model.joint_angles(phase.qd) * torques).sum(-1), phase.t)
+
+    change = mechanical(-1) - mechanical(0)
+    assert signed(phase.torques) == pytest.approx(change, abs=1e-3 * work)
+    assert work >= abs(change) and work > 0.0
+    assert abs(signed(1.1 * phase.torques) - change) > 1e-2 * work
+    content = json.loads(path.read_text())
+    for name in ("energy", "energy_per_metre"):
+        content["double_support"].pop(name)
+    older = tmp_path / "older.json"
+    older.write_text(json.dumps(content))
+    read = gait_file.read_consistent(older, two_phase=True)
+    assert read.double_support.energy is None and read.double_support.energy_per_metre is None
 
 
 def test_single_support_gait_files_are_unchanged(tmp_path):

@@ -46,7 +46,8 @@ def written(tmp_path_factory):
 
 def test_page_names_both_phases_beside_the_single_support_optimum(written):
     """The page names both phases, the landing and its impulses per foot, each foot's
-    margins, and the share, step length and cadence beside the single support optimum's."""
+    margins, and the share, step length, cadence and joints' work per metre beside the single
+    support optimum's."""
     gait, _, text = written
     single = gait_of(optimal_gait("rolling"), Robot.paper())
     assert "single support then double support" in text
@@ -59,6 +60,8 @@ def test_page_names_both_phases_beside_the_single_support_optimum(written):
     step = gait.period + gait.double_support.duration
     assert f"| cadence | {60 / step:.4g} | {60 / single.period:.4g} | steps/min |" in text
     assert f"| step length S | {gait.step_length:.4g} | {single.step_length:.4g} | m |" in text
+    work = gait.double_support.energy_per_metre, single.costs.energy_per_metre
+    assert f"per metre C_E / S over the step | {work[0]:.4g} | {work[1]:.4g} | J/m |" in text
     for name in gait.parameters:
         assert f"| {name} | " in text
 

@@ -27,10 +27,16 @@ def _summary() -> TwoPhaseSweepSummary:
     """A summary with a point not certified (its two-phase optimum unknown)."""
     rows = (
         PointSummary(
-            "revolute", 0.3, Phases(30.36, 0.0, 0.178, 101.0), Phases(1078.5, 0.1, 0.165, 109.3)
+            "revolute",
+            0.3,
+            Phases(30.36, 0.0, 0.178, 101.0, 79.98),
+            Phases(1078.5, 0.1, 0.165, 109.3, 102.88),
         ),
         PointSummary(
-            "rolling", 0.3, Phases(30.18, 0.0, 0.178, 101.0), Phases(1038.0, 0.1, 0.168, 107.1)
+            "rolling",
+            0.3,
+            Phases(30.18, 0.0, 0.178, 101.0, 80.69),
+            Phases(1038.0, 0.1, 0.168, 107.1, 103.63),
         ),
         PointSummary("revolute", 0.4, Phases(59.5, 0.0, 0.2, 120.0), None, "NOT CONVERGED: x"),
         PointSummary("rolling", 0.4, Phases(59.0, 0.0, 0.2, 120.0), Phases(1.0, 0.2, 0.3, 80.0)),
@@ -52,14 +58,21 @@ def test_the_summarys_file_reads_back_to_the_same_record(tmp_path):
         "speed": 0.4,
         "single": pytest.approx(-0.8403, abs=1e-4),
         "double": None,
+        "energy_single": None,  # neither knee's energy per metre known there
+        "energy_double": None,
     }
 
 
 def test_the_knees_difference_has_the_comparisons_sign():
-    """(rolling − revolute) / revolute: negative where the rolling knee needs less."""
+    """(rolling − revolute) / revolute: negative where the rolling knee needs less, for C_Γ
+    and for the same optima's energy per metre."""
     (at_03, _) = differences(_summary().points)
     assert at_03 == KneeDifference(
-        0.3, pytest.approx(-0.5929, abs=1e-4), pytest.approx(-3.755, abs=1e-3)
+        0.3,
+        pytest.approx(-0.5929, abs=1e-4),
+        pytest.approx(-3.755, abs=1e-3),
+        pytest.approx(100 * (80.69 / 79.98 - 1), abs=1e-9),
+        pytest.approx(100 * (103.63 / 102.88 - 1), abs=1e-9),
     )
 
 

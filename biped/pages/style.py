@@ -48,10 +48,8 @@ MULTIPLIERS_SIZE = (5.6, 5.6)  # Floquet multipliers in the complex plane (orbit
 ORBIT_VARIED_SIZE = (7.0, 5.2)  # the spectral radius as a gain varies (orbit_figures)
 ORBIT_KNEES_PANEL_SIZE = (5.2, 6.4)  # a criterion's panel of the knees' orbits (orbit_figures)
 PROFILE_SIZE = (15, 8.4)  # a knee profile's surfaces and their contact (profile_figures)
-TWO_PHASE_SWEEP_SIZE = (
-    14,
-    4.4,
-)  # the knees with and without double support (two_phase_sweep_figures)
+# the knees with and without double support (two_phase_sweep_figures)
+TWO_PHASE_SWEEP_SIZE = (18, 4.4)
 # [in] an atlas with double support: the width of a cell's pair of bars, and the height
 ATLAS_TWO_PHASE_CELL = (1.3, 4.2)  # (atlas_two_phase)
 ATLAS_TWO_PHASE_WIDTHS = (5.0, 1.5)  # [in] the least figure, the axis's labels (atlas_two_phase)

@@ -95,6 +95,15 @@ def phase_rows(gait: Gait, single: Gait | None) -> list[str]:
             "N²·m·s",
         ),
     ]
+    if double.energy_per_metre is not None:  # a file written before has none
+        rows.append(
+            (
+                "joints' work per metre C_E / S over the step",
+                double.energy_per_metre,
+                None if single is None else single.costs.energy_per_metre,
+                "J/m",
+            )
+        )
     given = "single support optimum" if single else "single support optimum (not given)"
     lines = [f"| | two phases | {given} | unit |", "|---|---|---|---|"]
     for label, value, other, unit in rows:

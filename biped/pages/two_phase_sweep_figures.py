@@ -1,7 +1,9 @@
 """The figure of a sweep with double support (``biped.records.two_phase_sweep``): against
-speed, the knees' difference in C_Γ with and without the double support phase, then each
-knee's step length and cadence, single support alone (dashed) and with double support
-(solid). A point not certified is left out (unknown), never drawn as zero.
+speed, the knees' difference in C_Γ (what the optima minimise) and in the same optima's
+energy per metre C_E / S, with and without the double support phase, then each knee's step
+length and cadence, single support alone (dashed) and with double support (solid). A figure
+not known (a point not certified, a file without its double support's work) is left out,
+never drawn as zero.
 """
 
 from __future__ import annotations
@@ -33,18 +35,20 @@ def _known(pairs):
 def two_phase_sweep_figure(summary: TwoPhaseSweepSummary, path: str | Path) -> Path:
     """Write the figure of ``summary`` as the PNG ``path``; returns it."""
     fig = Figure(figsize=TWO_PHASE_SWEEP_SIZE, layout="constrained")
-    difference, length, cadence = fig.subplots(1, 3)
-    for phase, line in PHASE_LINES.items():
-        x, y = _known((d.speed, getattr(d, phase)) for d in summary.differences)
-        difference.plot(x, y, line, color="0.2", marker="o", label=PHASE_LABELS[phase])
-    difference.axhline(0.0, color="0.6", linewidth=0.8)
-    difference.set(
-        xlabel="speed [m/s]",
-        ylabel="C_Γ, (rolling − revolute) / revolute [%]",
-    )
+    difference, energy, length, cadence = fig.subplots(1, 4)
+    for axis, prefix, figure in (
+        (difference, "", "C_Γ"),
+        (energy, "energy_", "C_E / S of the same optima"),
+    ):
+        for phase, line in PHASE_LINES.items():
+            x, y = _known((d.speed, getattr(d, prefix + phase)) for d in summary.differences)
+            axis.plot(x, y, line, color="0.2", marker="o", label=PHASE_LABELS[phase])
+        axis.axhline(0.0, color="0.6", linewidth=0.8)
+        axis.set(xlabel="speed [m/s]", ylabel=f"{figure}, (rolling − revolute) / revolute [%]")
     difference.set_title(
         "the knees' difference (< 0: the rolling knee needs less)", fontsize=FONT_TITLE
     )
+    energy.set_title("the joints' work per metre, knees' difference", fontsize=FONT_TITLE)
     for knee in sorted({p.knee for p in summary.points}):
         rows = [p for p in summary.points if p.knee == knee]
         for phase, line in PHASE_LINES.items():
@@ -63,7 +67,7 @@ def two_phase_sweep_figure(summary: TwoPhaseSweepSummary, path: str | Path) -> P
         "sthenic optima",
         fontsize=FONT_TITLE,
     )
-    for axis in (difference, length, cadence):
+    for axis in (difference, energy, length, cadence):
         axis.legend(fontsize=FONT_NOTE)
         axis.grid(alpha=0.3)
     return save(fig, path)

@@ -13,6 +13,11 @@ drive's figures of a double support are not built), and with this block:
     duration        T_ds [s]; share T_ds / (T + T_ds), share_range the problem's
     sthenic         C_Γ over both phases [N²·m·s]: the single support on the check grid, the
                     double support on the solver's samples (what the optimizer minimised)
+    energy          C_E over both phases [J per step]: the joints' work ∫ Σ |Γ_i θ̇_i| dt, the
+                    single support's (``costs.energy``) and the double support's on ``samples``
+                    (trapezoids: the integrand has kinks where a joint's power changes sign);
+                    energy_per_metre the same over the step length [J/m]. Files written
+                    before these two have none (read, and left so)
     front_wrench    the front foot's ground wrench [Fx, Fz, Cy] at the solver's n + 1 samples
                     of the phase (the load split the optimizer chose: an input, like the
                     parameters); between them it is linear in time (the rule this file states)
@@ -152,6 +157,10 @@ class DoubleSupport:
     # (``biped.model.two_phase.landing_margins``)
     feasible: bool
     samples: PhaseSamples = unit_field(PhaseSamples)
+    # the joints' work over both phases, per step and per metre (see the module); None in a
+    # file written before them
+    energy: float | None = unit_field("J", default=None)
+    energy_per_metre: float | None = unit_field("J/m", default=None)
 
     def to_dict(self) -> dict:
         values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
@@ -164,7 +173,8 @@ class DoubleSupport:
         if not isinstance(content, dict):
             raise bad("double_support is not an object")
         names = [f.name for f in dataclasses.fields(cls)]
-        missing = [name for name in names if name not in content]
+        optional = {"energy", "energy_per_metre"}  # added later: absent from older files
+        missing = [name for name in names if name not in content and name not in optional]
         if missing:
             raise bad(f"double_support.{missing[0]} missing")
         front = np.asarray(content["front_wrench"], dtype=float)
@@ -174,7 +184,7 @@ class DoubleSupport:
             )
         if not np.all(np.isfinite(front)):
             raise bad("double_support.front_wrench is not finite: allowed finite numbers")
-        fields = {name: content[name] for name in names}
+        fields = {name: content.get(name) for name in names}
         fields["samples"] = PhaseSamples.from_content(content["samples"], bad)
         return cls(**fields)
 
@@ -238,6 +248,7 @@ def double_support_of(
         and all(load <= ds.HANDOVER_TOLERANCE for load in loads.values())
     )
     dwell = step.double.duration
+    energy = evaluation.energy + phase_work(model, samples)
     return DoubleSupport(
         landing=step.landing,
         duration=dwell,
@@ -253,4 +264,13 @@ def double_support_of(
         handover={name: wrench.tolist() for name, wrench in handover.items()},
         feasible=feasible,
         samples=samples,
+        energy=energy,
+        energy_per_metre=energy / step.step_length,
     )
+
+
+def phase_work(model: Biped, samples: PhaseSamples) -> float:
+    """[J] the joints' work over the double support, ∫ Σ |Γ_i θ̇_i| dt on its check grid
+    (trapezoids)."""
+    power = np.abs(model.joint_angles(samples.qd) * samples.torques).sum(-1)
+    return float(np.trapezoid(power, samples.t))

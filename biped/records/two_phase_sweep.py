@@ -24,7 +24,7 @@ STEPS_PER_MINUTE = "steps/min"  # a cadence, as the two-phase page prints it
 # The columns of ``PointSummary.line``.
 HEADER = (
     "speed [m/s]  knee      C_Γ single / two phases [N²·m·s]  share  "
-    "S single / two [m]  cadence single / two [steps/min]"
+    "S single / two [m]  cadence single / two [steps/min]  C_E / S single / two [J/m]"
 )
 
 
@@ -43,12 +43,16 @@ class Phases:
         share: T_ds / (T + T_ds) [1]; 0 for a single support.
         step_length: S [m].
         cadence: 60 / (T + T_ds) [steps/min].
+        energy_per_metre: C_E / S, the joints' work ∫ Σ |Γ_i θ̇_i| dt over the step (both
+            phases for a two-phase gait) per metre walked [J/m]; None for a two-phase file
+            written before its double support's work was recorded.
     """
 
     sthenic: float = unit_field("N²·m·s")
     share: float = unit_field(PURE)
     step_length: float = unit_field("m")
     cadence: float = unit_field(STEPS_PER_MINUTE)
+    energy_per_metre: float | None = unit_field("J/m", default=None)
 
 
 @dataclass(frozen=True)
@@ -73,24 +77,31 @@ class PointSummary:
             f"{_shown(one and one.step_length, '.4f')} / "
             f"{_shown(two and two.step_length, '.4f')}"
             f"     {_shown(one and one.cadence, '6.1f')} / {_shown(two and two.cadence, '6.1f')}"
-            + ("" if two else f"  ({self.why})")
+            f"                 {_shown(one and one.energy_per_metre, '7.2f')} / "
+            f"{_shown(two and two.energy_per_metre, '7.2f')}" + ("" if two else f"  ({self.why})")
         )
 
 
 @dataclass(frozen=True)
 class KneeDifference:
-    """(rolling − revolute) / revolute of C_Γ at one speed [%], negative where the rolling
-    knee needs less; None where either knee's optimum is not certified."""
+    """(rolling − revolute) / revolute at one speed [%], negative where the rolling knee
+    needs less: of C_Γ (``single``, ``double``, what the optima minimise) and of the same
+    sthenic optima's energy per metre C_E / S (``energy_single``, ``energy_double``); None
+    where either knee's figure is unknown."""
 
     speed: float = unit_field("m/s")
     single: float | None = unit_field(PERCENT)
     double: float | None = unit_field(PERCENT)
+    energy_single: float | None = unit_field(PERCENT, default=None)
+    energy_double: float | None = unit_field(PERCENT, default=None)
 
     def line(self) -> str:
         """The knees' difference without and with the double support phase."""
         return (
             f"{self.speed:.3f} m/s: rolling vs revolute C_Γ, single support "
             f"{_shown(self.single, '+.2f')} %, with double support {_shown(self.double, '+.2f')} %"
+            f"; their C_E / S, single support {_shown(self.energy_single, '+.2f')} %, with "
+            f"double support {_shown(self.energy_double, '+.2f')} %"
         )
 
 

@@ -219,10 +219,15 @@ def phases_of(gait: Gait | None, two_phase: bool) -> Phases | None:
     if gait is None:
         return None
     if not two_phase:
-        return Phases(gait.costs.sthenic, 0.0, gait.step_length, 60.0 / gait.period)
+        costs = gait.costs
+        return Phases(
+            costs.sthenic, 0.0, gait.step_length, 60.0 / gait.period, costs.energy_per_metre
+        )
     double = gait.double_support
     step = gait.period + double.duration
-    return Phases(double.sthenic, double.share, gait.step_length, 60.0 / step)
+    return Phases(
+        double.sthenic, double.share, gait.step_length, 60.0 / step, double.energy_per_metre
+    )
 
 
 def summarize(sweep_folder: Path, settings: Settings, points) -> Summary:
@@ -258,13 +263,19 @@ def differences(rows) -> tuple:
 
         found.append(
             KneeDifference(
-                speed, _change(rolling, revolute, "single"), _change(rolling, revolute, "double")
+                speed,
+                *(_change(rolling, revolute, phase) for phase in ("single", "double")),
+                *(_change(rolling, revolute, p, "energy_per_metre") for p in ("single", "double")),
             )
         )
     return tuple(found)
 
 
-def _change(rolling: PointSummary, revolute: PointSummary, phase: str) -> float | None:
-    """[%] (rolling − revolute) / revolute of C_Γ of one ``phase``; None if either is unknown."""
+def _change(
+    rolling: PointSummary, revolute: PointSummary, phase: str, figure: str = "sthenic"
+) -> float | None:
+    """[%] (rolling − revolute) / revolute of one ``phase``'s ``figure``; None if either is
+    unknown."""
     a, b = getattr(rolling, phase), getattr(revolute, phase)
-    return None if a is None or b is None else relative_change(a.sthenic, b.sthenic)
+    a, b = (None if x is None else getattr(x, figure) for x in (a, b))
+    return None if a is None or b is None else relative_change(a, b)
