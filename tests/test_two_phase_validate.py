@@ -65,7 +65,8 @@ def test_validation_of_a_two_phase_gait(gait, impact_gait):
     both feet (the impact landing's impulses) and the replay of both phases (the zero-speed
     landing's), with both feet's ground forces within ``FOOT_FORCE_SHARE`` of the weight,
     pass; MuJoCo's walk of both phases and its gains run, and fail by the feet's slip (the
-    zero-speed landing's walk: docs/gaits.md); the orbit is run on its section in the single
+    zero-speed landing's walk: docs/gaits.md), the joints' work per step within 10 % of the
+    file's over both phases; the orbit is run on its section in the single
     support, and is not shown stable (docs/gaits.md)."""
     impact_checks, *_ = two_phase_checks(impact_gait, model_spec(impact_gait.biped))
     impact = {c.name: c for c in impact_checks}
@@ -82,6 +83,12 @@ def test_validation_of_a_two_phase_gait(gait, impact_gait):
     for name in ("forward", "gains"):
         assert not checks[name].passed and "slipped" in checks[name].causes
         assert "not run" not in checks[name].causes
+    # MuJoCo's joints work per step within 10 % of the file's over both phases; against the
+    # single support's work alone (what the file's costs hold) they would not
+    walked = checks["forward"].figures["energy_per_step"]
+    assert walked == pytest.approx(gait.double_support.energy, rel=0.1)
+    assert walked > 1.1 * gait.costs.energy
+    assert not any("energy_ratio not measured" in n for n in checks["forward"].notes)
     orbit = checks["orbit"]
     assert not orbit.passed and orbit.causes == ["unstable orbit"]
     assert orbit.figures["verdict"] in ("undecided", "unstable")

@@ -80,10 +80,11 @@ def validate(
     return Validation(gait, results + [orbit], biped, samples, sim, reaction, found)
 
 
-# Why the forward check's energy ratio is not measured on a two-phase gait.
+# Why the forward check's energy ratio is not measured on a two-phase gait file written
+# before its double support's work was recorded.
 NO_TWO_PHASE_ENERGY = (
-    "energy_ratio not measured: the file's energy is its single support's, MuJoCo's the "
-    "whole step's"
+    "energy_ratio not measured: the file, written before its double support's work was "
+    "recorded, holds its single support's only, MuJoCo's is the whole step's"
 )
 
 
@@ -103,8 +104,11 @@ def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS
     knee_loads = c.check_knee_loads(robot_model, biped, samples.single_support(), gait.knee_loads)
     knee_loads.notes.append("the single support phase only (the double support's not built)")
     walker = Walker(gait, spec)
-    forward, sim, reaction = c.check_forward(walker, steps, float("nan"))
-    forward.notes.append(NO_TWO_PHASE_ENERGY)
+    energy = gait.double_support.energy  # the joints' work over both phases [J per step]
+    energy = float("nan") if energy is None else energy
+    forward, sim, reaction = c.check_forward(walker, steps, energy)
+    if np.isnan(energy):
+        forward.notes.append(NO_TWO_PHASE_ENERGY)
     checks = [
         c.check_model(robot_model, biped),
         c.check_inverse_dynamics(robot_model, biped, samples),
@@ -112,7 +116,7 @@ def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS
         c.check_two_phase_impact(robot_model, biped, samples, gait),
         c.check_two_phase_feedforward(spec, biped, samples),
         forward,
-        c.check_gains(walker, steps, float("nan"), forward),
+        c.check_gains(walker, steps, energy, forward),
     ]
     orbit, found = check_orbit(walker)
     return checks + [orbit], sim, reaction, found
