@@ -30,7 +30,6 @@ from biped.records import gait_file
 from biped.records.atlas_two_phase import AtlasTwoPhaseSummary as Summary
 from biped.records.atlas_two_phase import CellDifference, CellPoint, NotBuilt
 from biped.records.two_phase_sweep import PointSummary
-from biped.runtime.claims import claimed
 from biped.studies import atlas, campaign, two_phase_sweep
 from biped.studies.campaign import Task
 
@@ -191,31 +190,16 @@ def run_two_phase(atlas_folder, atlas_settings: atlas.Settings, settings: Settin
     """The two-phase optimum of both knees at every built cell of the atlas not yet in its
     ``FOLDER``, from the atlas's single-support optima (run first); ``where`` as
     ``campaign.Campaign.run`` says. Writes and returns the summary."""
-    folder = Path(atlas_folder) / FOLDER
-    with claimed(folder):
-        folder = TWO_PHASE.claim(folder, settings)
-        cells = built_cells(atlas_settings, settings)
-        points = [Point(k, c) for c in cells for k in KNEES]
-        todo = [p for p in points if not (folder / p.filename()).exists()]
-        tasks = [Task(solve_two_phase, settings, p, str(folder)) for p in todo]
-        plan = (
-            f"double support: {len(points)} two-phase optimizations in {folder}, "
-            f"{len(points) - len(todo)} already done, {len(todo)} to run"
-        )
-
-        def tally() -> str:
-            return campaign.tally(
-                points,
-                lambda p: two_phase_sweep.read_two_phase(folder / p.filename())[1] or None,
-                "points with a two-phase optimum (converged, feasible on the numeric model)",
-            )
-
-        TWO_PHASE.run(plan, [tasks] if tasks else [], tally, **where)
-        summary = summarize(
-            Path(atlas_folder), settings, cells, not_built(atlas_settings, settings)
-        )
-        summary.write(folder / SUMMARY)
-    return summary
+    cells = built_cells(atlas_settings, settings)
+    return two_phase_sweep.run_points(
+        Path(atlas_folder) / FOLDER,
+        TWO_PHASE,
+        settings,
+        [Point(k, c) for c in cells for k in KNEES],
+        solve_two_phase,
+        lambda: summarize(Path(atlas_folder), settings, cells, not_built(atlas_settings, settings)),
+        **where,
+    )
 
 
 def summarize(atlas_folder: Path, settings: Settings, cells, missing) -> Summary:

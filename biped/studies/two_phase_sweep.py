@@ -189,12 +189,28 @@ def run_two_phase(sweep_folder, settings: Settings, knees, **where) -> Summary:
     """The two-phase optimum of every knee and speed of ``settings`` not yet in the sweep's
     ``FOLDER``, from the sweep's single-support optima (run first); ``where`` as
     ``campaign.Campaign.run`` says. Writes and returns the summary."""
-    folder = Path(sweep_folder) / FOLDER
+    points = [Point(k, s) for k in knees for s in settings.speeds]
+    return run_points(
+        Path(sweep_folder) / FOLDER,
+        TWO_PHASE,
+        settings,
+        points,
+        solve_two_phase,
+        lambda: summarize(Path(sweep_folder), settings, points),
+        **where,
+    )
+
+
+def run_points(folder: Path, kind, settings, points, solve, summary, **where):
+    """The double support's campaign (``kind``, a ``campaign.Campaign``) in ``folder``: the
+    two-phase optimum of every point of ``points`` (each with ``filename()``) whose file is
+    not there yet, each a task of ``solve``; then ``summary()`` (a record with ``write``)
+    written as ``SUMMARY`` there and returned. One run of it at a time (``claimed``);
+    ``where`` as ``campaign.Campaign.run`` says."""
     with claimed(folder):
-        folder = TWO_PHASE.claim(folder, settings)
-        points = [Point(k, s) for k in knees for s in settings.speeds]
+        folder = kind.claim(folder, settings)
         todo = [p for p in points if not (folder / p.filename()).exists()]
-        tasks = [Task(solve_two_phase, settings, p, str(folder)) for p in todo]
+        tasks = [Task(solve, settings, p, str(folder)) for p in todo]
         plan = (
             f"double support: {len(points)} two-phase optimizations in {folder}, "
             f"{len(points) - len(todo)} already done, {len(todo)} to run"
@@ -203,14 +219,14 @@ def run_two_phase(sweep_folder, settings: Settings, knees, **where) -> Summary:
         def tally() -> str:
             return campaign.tally(
                 points,
-                lambda p: _two_phase(folder, p)[1] or None,
+                lambda p: read_two_phase(folder / p.filename())[1] or None,
                 "points with a two-phase optimum (converged, feasible on the numeric model)",
             )
 
-        TWO_PHASE.run(plan, [tasks] if tasks else [], tally, **where)
-        summary = summarize(Path(sweep_folder), settings, points)
-        summary.write(folder / SUMMARY)
-    return summary
+        kind.run(plan, [tasks] if tasks else [], tally, **where)
+        written = summary()
+        written.write(folder / SUMMARY)
+    return written
 
 
 def phases_of(gait: Gait | None, two_phase: bool) -> Phases | None:
