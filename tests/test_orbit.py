@@ -48,6 +48,7 @@ def test_the_optimal_gaits_walk_a_stable_orbit(knee):
     result = _orbit(knee)
     m = result.multipliers
     assert result.failure is None and result.verdict == "stable", o.notes(result)
+    assert result.phase == o.LANDING  # the stance foot at rest on the first section tried
     assert m.radius < 1.0 and m.upper < 1.0
     assert 0.0 < m.spread < 0.2  # the landing's noise, averaged over the grid
     # the flow is mapped to 0 within the grid's noise, which leaves 1 (a map that kept the

@@ -1,6 +1,8 @@
 """The orbit of a two-phase walk: its section in the single support after the rear foot's
-lift-off, crossed once per step with the swing foot in the air; the fixed point and its
-residual as stated; a section in the double support refused."""
+lift-off, crossed once per step with the swing foot in the air, where the stance foot is at
+rest (not at 0.1 T: there it still rocks from the double support, and the map of the 12
+coordinates is not the walk's); the fixed point and its residual as stated; a section in the
+double support refused."""
 
 import numpy as np
 import pytest
@@ -56,7 +58,7 @@ def test_the_fixed_point_is_the_maps_to_its_stated_residual(found):
     np.testing.assert_array_equal(images.mean(axis=0) - x, found.residual)
     figures = o.orbit_figures(found)
     assert figures.residual_rate == pytest.approx(np.abs(found.residual[6:]).max())
-    settled = o.settle(returns.walker, found.settings)
+    settled = o.settle(returns.walker, found.settings, returns.advance)
     start = returns.at_phases(settled.mean, found.steps.phases).mean(axis=0) - settled.mean
     scale = found.steps.vector()
     assert np.linalg.norm(found.residual / scale) <= np.linalg.norm(start / scale)
@@ -76,3 +78,33 @@ def test_a_section_in_the_double_support_is_refused(walker):
     advance = float(samples.at("q", [tau])[0, o.XH])
     with pytest.raises(o.OrbitFailure, match="on the floor on the section"):
         o.settle(walker, o.NOMINAL, advance)
+
+
+def test_the_section_is_where_the_stance_foot_is_at_rest(walker, found):
+    """At 0.1 T the stance foot still rocks from the double support (its tilt rate spreads
+    beyond ``HELD_RATE_SPREAD`` over the walk's steps) and the return map restarted from the
+    walk's own states there misses the walk's next state by more than 3 of the grid's spreads:
+    the 12 coordinates do not hold the walk's state (the root mean square of the misses over
+    the coordinates and three states, in spreads, beyond 2, against 1 for a map that is the
+    walk). The orbit's section is the first of ``SECTION_PHASES`` where the foot is at rest,
+    and there the restarted map is the walk.
+    Asked for 0.1 T, the orbit is not measured: undecided, said, and the check fails."""
+    landing = walker.samples.landing_time
+    early = o.settle(walker, o.NOMINAL, o.section_advance(walker, o.LANDING * landing))
+    assert early.held_rate_spread > o.HELD_RATE_SPREAD
+    assert found.phase in o.SECTION_PHASES and found.phase > o.LANDING
+    at_rest = o.settle(walker, o.NOMINAL, found.advance)
+    assert at_rest.held_rate_spread < o.HELD_RATE_SPREAD
+    for settled, advance, follows in ((early, None, False), (at_rest, found.advance, True)):
+        returns = o.ReturnMap(walker, o.NOMINAL, settled.reference, settled.flow, advance)
+        misses = []
+        for k in (3, 8, 12):
+            images = returns.at_phases(settled.states[k], o.PHASES)
+            misses.append((settled.states[k + 1] - images.mean(axis=0)) / images.std(axis=0))
+        rms = float(np.sqrt(np.mean(np.square(misses))))
+        assert (rms < 2.0) == follows, rms
+    asked = o.orbit(walker, tau=o.LANDING * landing)
+    assert asked.unsettled and asked.multipliers is None and asked.verdict == "undecided"
+    assert "not at rest on the section" in o.notes(asked)[0]
+    check = o.orbit_check(asked)
+    assert not check.passed and check.causes == ["unstable orbit"]

@@ -16,7 +16,11 @@ right after a rigid impact, exists in MuJoCo once the landing has settled. The s
 where the hip's advance over the stance ankle reaches the gait's at ``LANDING`` of the period
 (``section_advance``: x_H(0.1 T), 6 cm behind the ankle at 0.3 m/s), the state interpolated
 between the two physics steps around the crossing, so that the section does not move with
-MuJoCo's 2 ms grid.
+MuJoCo's 2 ms grid. The section must find the stance foot at rest (below): the first of
+``SECTION_PHASES`` where it is (``settled_section``). A gait of single support's is at
+``LANDING``; a two-phase gait's stance foot still rocks there from its double support (its
+normal force swinging between 0 and 2100 N, its tilt rate spreading by 0.06-0.21 rad/s from
+step to step), and its section is later in the swing (0.7 T for the optima at 0.3 m/s).
 
 The coordinates: with the stance foot flat on the floor the hip follows from the stance leg
 (``Chain.stance_state``), and a state on the section has 12 coordinates, the free angles
@@ -24,7 +28,12 @@ The coordinates: with the stance foot flat on the floor the hip follows from the
 pose and velocity (its tilt and its sink into the soft floor, a few micrometres, which the
 contact holds) and the rolling knee's equality are not coordinates: a perturbed state keeps
 the reference state's (``ReturnMap.lift``: the walk's mean state on the section), so a
-perturbation never lifts the stance foot or pushes it into the floor. The section fixes one
+perturbation never lifts the stance foot or pushes it into the floor. That holds the walk's
+state only where the foot is at rest: where its tilt rate spreads over the walk's steps by
+more than a tenth of the map's rate step (``HELD_RATE_SPREAD``), the map restarted from the
+walk's own states misses the walk's next ones (by 2-4 spreads, root mean square, at 0.1 T of
+a two-phase walk) and is not the walk's; the orbit is then not measured (``UnsettledSection``,
+verdict undecided). The section fixes one
 more direction, the flow along the orbit: a state moved along it reaches the same next state
 (J f = 0, a structural multiplier 0, measured as ``Multipliers.flow_gain``: within about
 its noise, ``Multipliers.flow_noise``, for the optimal gaits). The dynamic multipliers are
@@ -123,6 +132,18 @@ BOOTSTRAP = 200
 # the factor (ρ + 2 spreads = 0.95 for the rolling knee's optimal gait at 0.3 m/s: an
 # error halved within 12 steps, 7 s).
 MARGIN_SPREADS = 2.0
+# Where the section may lie, as fractions of the swing's time T after the step's start,
+# tried in turn: the orbit's is the first where the stance foot is at rest on the floor
+# (``HELD_RATE_SPREAD``). A gait of single support is at rest at the first, ``LANDING``; a
+# two-phase gait's stance foot still rocks there from the double support.
+SECTION_PHASES = (LANDING, 0.3, 0.5, 0.7)
+# [rad/s] The largest spread, over the walk's steps, of the stance foot's tilt rate on the
+# section: the return map holds the stance foot's pose and rates at the walk's mean
+# (``ReturnMap.lift``), so what they vary by must be small beside the map's rate step (a
+# tenth of it). The optimal gaits of single support: below 1e-3 rad/s at 0.1 T; the
+# two-phase gaits at 0.3 m/s: 0.06-0.21 rad/s at 0.1 and 0.3 T, their stance foot's
+# normal force swinging between 0 and 2100 N there.
+HELD_RATE_SPREAD = 0.1 * RATE_STEP
 # Largest relative difference of the orbit's step duration from the gait's period (30 ms of
 # the 0.59 s step at 0.3 m/s): the default walks' steps last 1.01-1.03 T; a walk that
 # settles at another period walks another orbit (the speed loop off: 1.3 T).
@@ -131,6 +152,11 @@ PERIOD_TOLERANCE = 0.05
 
 class OrbitFailure(BipedError):
     """A walk of the return map fell or did not reach the section: no orbit there."""
+
+
+class UnsettledSection(OrbitFailure):
+    """The stance foot is not at rest on the section: the 12 coordinates do not hold the
+    walk's state there, and no return map of them is the walk's (the orbit not decided)."""
 
 
 @dataclass(frozen=True)
@@ -300,12 +326,15 @@ class Settled:
         reference: (q, q̇) (9,) each, their mean in the paper's coordinates.
         flow: (12,) the mean d/dt of the coordinates there.
         period: [s] the mean duration of those steps.
+        held_rate_spread: [rad/s] the spread (standard deviation) of the stance foot's tilt
+            rate on the section over those steps, which the return map holds at its mean.
     """
 
     states: np.ndarray
     reference: tuple
     flow: np.ndarray
     period: float
+    held_rate_spread: float = 0.0
 
     @property
     def mean(self) -> np.ndarray:
@@ -328,7 +357,37 @@ def settle(walker: Walker, settings: WalkSettings, advance: float | None = None)
     flow = np.concatenate([qd[:, FREE].mean(axis=0), qdd[:, FREE].mean(axis=0)])
     starts = sim.time[sim.step_starts[SETTLE_STEPS : steps + 1]]
     period = float(np.diff(starts).mean())
-    return Settled(states, (q.mean(axis=0), qd.mean(axis=0)), flow, period)
+    biped = walker.biped
+    tilt = [
+        qd_k[QP1] - biped.stance_state(q_k[FREE], qd_k[FREE])[1][QP1]
+        for q_k, qd_k in zip(q, qd, strict=True)
+    ]
+    reference = (q.mean(axis=0), qd.mean(axis=0))
+    return Settled(states, reference, flow, period, float(np.std(tilt)))
+
+
+def settled_section(
+    walker: Walker, settings: WalkSettings, tau=None
+) -> tuple[float, Settled, float]:
+    """The section of the orbit: (its advance [m], the walk settled on it, its τ as a
+    fraction of T), the first of ``SECTION_PHASES`` (or the gait's time ``tau`` [s] alone)
+    where the stance foot is at rest (``HELD_RATE_SPREAD``); UnsettledSection if it is at
+    none, OrbitFailure if the walk falls first."""
+    landing = walker.samples.landing_time
+    phases = SECTION_PHASES if tau is None else (float(tau) / landing,)
+    spreads = []
+    for phase in phases:
+        advance = section_advance(walker, phase * landing)
+        settled = settle(walker, settings, advance)
+        if settled.held_rate_spread < HELD_RATE_SPREAD:
+            return advance, settled, phase
+        spreads.append(f"{settled.held_rate_spread:.2g} rad/s at {phase:g} T")
+    raise UnsettledSection(
+        "the stance foot is not at rest on the section: its tilt rate spreads "
+        f"{', '.join(spreads)} over the walk's steps (allowed < {HELD_RATE_SPREAD:g} rad/s, a "
+        "tenth of the map's rate step): the 12 coordinates do not hold the walk's state, no "
+        "return map"
+    )
 
 
 def section_basis(flow, steps: Steps = Steps()) -> np.ndarray:
@@ -430,6 +489,9 @@ class Orbit:
         steps: the central differences'.
         advance: [m] the hip's advance over the stance ankle on the section.
         failure: why there is no orbit (None: there is one; then every field below is set).
+        phase: the section's τ as a fraction of the swing's time T (``SECTION_PHASES``).
+        unsettled: no section tried has the stance foot at rest (``UnsettledSection``): the
+            orbit is not measured, its verdict undecided.
         fixed_point: (12,) x* on the section (``COORDINATES``).
         file_state: (12,) the gait file's state on the section.
         residual: (12,) F̄(x*) - x*.
@@ -444,6 +506,8 @@ class Orbit:
     steps: Steps
     advance: float
     failure: str | None = None
+    phase: float = LANDING
+    unsettled: bool = False
     fixed_point: np.ndarray | None = None
     file_state: np.ndarray | None = None
     residual: np.ndarray | None = None
@@ -462,9 +526,10 @@ class Orbit:
     def verdict(self) -> str:
         """'stable' (ρ + ``MARGIN_SPREADS`` spreads < 1, at the gait's period within
         ``PERIOD_TOLERANCE``), 'unstable' (ρ - as many spreads >= 1, or no orbit),
-        'another orbit' (stable at another period), else 'undecided'."""
+        'another orbit' (stable at another period), else 'undecided' (a section where the
+        stance foot is not at rest, too: not measured)."""
         if self.multipliers is None:
-            return "unstable"
+            return "undecided" if self.unsettled else "unstable"
         m = self.multipliers
         if m.radius - MARGIN_SPREADS * m.spread >= 1.0:
             return "unstable"
@@ -477,9 +542,10 @@ class Orbit:
         return self.verdict == "stable"
 
 
-def file_state(walker: Walker) -> np.ndarray:
-    """(12,) the gait file's state on the section: its motion at ``section_time``."""
-    tau = [section_time(walker)]
+def file_state(walker: Walker, phase: float = LANDING) -> np.ndarray:
+    """(12,) the gait file's state on the section: its motion at ``phase`` of the swing's
+    time T (``section_time`` by default)."""
+    tau = [phase * walker.samples.landing_time]
     return coordinates(walker.samples.at("q", tau)[0], walker.samples.at("qd", tau)[0])
 
 
@@ -489,11 +555,14 @@ def orbit(
     """The orbit of ``walker``'s walk under ``settings`` (see the module docstring): the walk
     settled from the file's start state, the Jacobian at its mean state on the section (at
     the gait's time ``tau`` [s], None: ``section_time``; one outside the swing refused,
-    ``section_advance``), chord-Newton steps to the fixed point, the multipliers. An
-    ``Orbit`` whose ``failure`` says why when a walk falls or misses the section."""
+    ``section_advance``; None: the first of ``SECTION_PHASES`` where the stance foot is at
+    rest, ``settled_section``), chord-Newton steps to the fixed point, the multipliers. An
+    ``Orbit`` whose ``failure`` says why when a walk falls or misses the section, or when the
+    stance foot is at rest on no section (``unsettled``)."""
     advance = section_advance(walker, tau)
+    phase = LANDING if tau is None else float(tau) / walker.samples.landing_time
     try:
-        settled = settle(walker, settings, advance)
+        advance, settled, phase = settled_section(walker, settings, tau)
         returns = ReturnMap(walker, settings, settled.reference, settled.flow, advance)
         basis = section_basis(settled.flow, steps)
         directions = basis * steps.vector()[:, None]
@@ -502,14 +571,17 @@ def orbit(
         found = multipliers(responses, basis, steps)
         jacobian = responses.mean(axis=0) @ np.linalg.inv(directions)
         x, images = _chord_steps(returns, x, jacobian, steps)
+    except UnsettledSection as error:
+        return Orbit(settings, steps, advance, failure=str(error), unsettled=True)
     except OrbitFailure as error:
-        return Orbit(settings, steps, advance, failure=str(error))
+        return Orbit(settings, steps, advance, failure=str(error), phase=phase)
     return Orbit(
         settings,
         steps,
         advance,
+        phase=phase,
         fixed_point=x,
-        file_state=file_state(walker),
+        file_state=file_state(walker, phase),
         residual=images.mean(axis=0) - x,
         noise=images.std(axis=0) / np.sqrt(steps.phases),
         period_ratio=settled.period / walker.period,
@@ -553,7 +625,7 @@ def orbit_figures(result: Orbit) -> OrbitFigures:
         "step_rate": steps.rate,
         "phases": steps.phases,
         "section_advance": result.advance,
-        "section_phase": LANDING,
+        "section_phase": result.phase,
         "walks": result.walks,
     }
     m = result.multipliers
@@ -588,6 +660,8 @@ def orbit_figures(result: Orbit) -> OrbitFigures:
 
 def notes(result: Orbit) -> list[str]:
     """What the orbit check says of ``result``: its slowest mode and the verdict's reason."""
+    if result.unsettled:
+        return [f"{result.failure} (the orbit is not decided)"]
     if result.failure is not None:
         return [f"{result.failure} (an orbit that cannot be found is unstable)"]
     m = result.multipliers
