@@ -12,20 +12,18 @@ record. A figure not measured (an optimum not certified) is null: unknown, never
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass
-from pathlib import Path
 
 from biped.errors import BipedError
-from biped.model.units import PURE, declared_units, unit_field
+from biped.model.units import PURE, unit_field
 from biped.records.two_phase_sweep import (
     HEADER,
     KneeDifference,
     PointSummary,
+    SummaryFile,
     point_from_dict,
     point_to_dict,
 )
-from biped.runtime.files import atomic_write_text
 
 FORMAT = "biped-atlas-two-phase/1"
 CELL_HEADER = "clearance [m]  bend [rad]  " + HEADER
@@ -102,19 +100,17 @@ class NotBuilt:
 
 
 @dataclass(frozen=True)
-class AtlasTwoPhaseSummary:
+class AtlasTwoPhaseSummary(SummaryFile):
     """An atlas with double support: its share range and landing, the knees at its cells, the
     cells' differences and the cells not built (``None`` figures: unknown)."""
+
+    KIND = "atlas two-phase summary"
 
     share_range: tuple = unit_field(PURE)
     landing: str = unit_field(None)
     points: tuple = unit_field([CellPoint])
     differences: tuple = unit_field([CellDifference])
     not_built: tuple = unit_field([NotBuilt])
-
-    @classmethod
-    def units(cls) -> dict:
-        return declared_units(cls)
 
     def to_dict(self) -> dict:
         return {
@@ -150,18 +146,6 @@ class AtlasTwoPhaseSummary:
             return cls(share, content["landing"], points, differences, not_built)
         except (KeyError, TypeError) as error:
             raise BipedError(f"{source}: not an atlas two-phase summary ({error})") from None
-
-    def write(self, path: str | Path) -> Path:
-        return atomic_write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False))
-
-    @classmethod
-    def read(cls, path: str | Path) -> AtlasTwoPhaseSummary:
-        path = Path(path)
-        try:
-            content = json.loads(path.read_text())
-        except (OSError, ValueError) as error:
-            raise BipedError(f"{path}: unreadable atlas two-phase summary ({error})") from None
-        return cls.from_dict(content, str(path))
 
     def missing(self) -> list[CellPoint]:
         """The knees at built cells without a two-phase optimum (a failure each)."""

@@ -105,19 +105,42 @@ class KneeDifference:
         )
 
 
+class SummaryFile:
+    """What the double support's summaries share (a sweep's here, an atlas's in
+    ``biped.records.atlas_two_phase``): their units, their file written atomically as the
+    JSON of ``to_dict`` and read back through ``from_dict``, an unreadable one named as a
+    ``KIND``."""
+
+    KIND = "summary"
+
+    @classmethod
+    def units(cls) -> dict:
+        return declared_units(cls)
+
+    def write(self, path: str | Path) -> Path:
+        return atomic_write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False))
+
+    @classmethod
+    def read(cls, path: str | Path):
+        path = Path(path)
+        try:
+            content = json.loads(path.read_text())
+        except (OSError, ValueError) as error:
+            raise BipedError(f"{path}: unreadable {cls.KIND} ({error})") from None
+        return cls.from_dict(content, str(path))
+
+
 @dataclass(frozen=True)
-class TwoPhaseSweepSummary:
+class TwoPhaseSweepSummary(SummaryFile):
     """A sweep with double support: its share range and landing, its points and the knees'
     differences (``None`` fields: unknown)."""
+
+    KIND = "two-phase sweep summary"
 
     share_range: tuple = unit_field(PURE)
     landing: str = unit_field(None)
     points: tuple = unit_field([PointSummary])
     differences: tuple = unit_field([KneeDifference])
-
-    @classmethod
-    def units(cls) -> dict:
-        return declared_units(cls)
 
     def to_dict(self) -> dict:
         content = {"format": FORMAT, **dataclasses.asdict(self)}
@@ -139,24 +162,12 @@ class TwoPhaseSweepSummary:
         except (KeyError, TypeError) as error:
             raise BipedError(f"{source}: not a two-phase sweep summary ({error})") from None
 
-    def write(self, path: str | Path) -> Path:
-        return atomic_write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False))
-
     def table(self) -> str:
         """The summary as a table: per speed and knee both optima (``PointSummary.line``),
         then per speed the knees' difference (``KneeDifference.line``)."""
         points = sorted(self.points, key=lambda p: (p.speed, p.knee))
         lines = [HEADER] + [p.line() for p in points] + [d.line() for d in self.differences]
         return "\n".join(lines)
-
-    @classmethod
-    def read(cls, path: str | Path) -> TwoPhaseSweepSummary:
-        path = Path(path)
-        try:
-            content = json.loads(path.read_text())
-        except (OSError, ValueError) as error:
-            raise BipedError(f"{path}: unreadable two-phase sweep summary ({error})") from None
-        return cls.from_dict(content, str(path))
 
 
 def point_to_dict(point: PointSummary) -> dict:
