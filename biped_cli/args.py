@@ -42,7 +42,7 @@ from biped_cli.checks import (  # noqa: F401 (the outputs' words, for the comman
     declare_rule,
     distinct_outputs,
 )
-from validate import DEFAULT_STEPS
+from validate import DEFAULT_STEPS, MODEL_TIMESTEP
 
 ROBOT_HELP = (
     "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1); a "
@@ -532,6 +532,36 @@ def not_a_robot_file(path: str) -> None:
             f"--robot {path!r} is {kind}, not a robot file: allowed a .json or .toml file of "
             "the robot's fields (r1 = 0.08 alone is one)"
         )
+
+
+# [s] The shortest physics step ``--timestep`` takes (a walk at it takes 20 times the
+# committed step's time).
+MIN_TIMESTEP = 1e-4
+TIMESTEP_HELP = (
+    f"MuJoCo's physics step of the walks (the forward, gains and orbit checks; the replay "
+    f"and the inverse dynamics keep their own) [s], from "
+    f"{MIN_TIMESTEP:g} to {MODEL_TIMESTEP:g}: the same model with its contacts, stops and "
+    "knee coupling at two steps' time constant, a finer model to hold the verdicts against "
+    f"(default: the model's own, {MODEL_TIMESTEP:g} s for the committed models)"
+)
+
+
+def timestep(text: str) -> float:
+    """``--timestep S`` [s], from ``MIN_TIMESTEP`` to the committed models' step."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"timestep = {text!r} is not a number") from None
+    if not (np.isfinite(value) and MIN_TIMESTEP <= value <= MODEL_TIMESTEP):
+        raise argparse.ArgumentTypeError(
+            f"timestep = {text!r} s: allowed {MIN_TIMESTEP:g} to {MODEL_TIMESTEP:g} s"
+        )
+    return value
+
+
+def add_timestep(parser) -> None:
+    """``--timestep S`` [s]: the walks' physics step (``validate.scene.model.at_timestep``)."""
+    parser.add_argument("--timestep", type=timestep, default=None, metavar="S", help=TIMESTEP_HELP)
 
 
 def add_steps(parser) -> None:

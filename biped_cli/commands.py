@@ -518,9 +518,16 @@ def cmd_validate(args) -> int:
     gif = _gif(args)
     gaits = read_gaits(args.gait, args.model, two_phase=True)
     recordings = _recordings(args)
+    models = [_walked_model(gait, args) for gait in gaits]
+    if args.timestep is not None and not args.json:
+        print(
+            f"MuJoCo's physics step {args.timestep:g} s (--timestep): contacts, stops and the "
+            "knee coupling at two steps' time constant",
+            flush=True,
+        )
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:
-        for path, gait, rrd in zip(args.gait, gaits, recordings, strict=True):
+        for path, gait, rrd, model in zip(args.gait, gaits, recordings, models, strict=True):
             bar.update(note=path)
             with types.naming(f"gait file {path!r}"):
                 result, reports[path] = validate_and_record(
@@ -532,7 +539,7 @@ def cmd_validate(args) -> int:
                     spawn=args.spawn,
                     connect=args.connect,
                     source=path,
-                    model=args.model,
+                    model=model,
                 )
             written = write_json(report_path(rrd), reports[path].with_files(gait=path).to_dict())
             passed += result.passed
@@ -547,6 +554,16 @@ def cmd_validate(args) -> int:
     elif len(args.gait) > 1:
         print(f"{passed} of {len(args.gait)} gaits pass every check")
     return 0 if passed == len(args.gait) else 1
+
+
+def _walked_model(gait, args):
+    """The model a gait is validated on: --model (a path; None: the default), at --timestep
+    when given (``validate.scene.model.at_timestep``)."""
+    if args.timestep is None:
+        return args.model
+    from validate.scene.model import at_timestep, model_spec
+
+    return at_timestep(model_spec(gait.biped, args.model), args.timestep)
 
 
 def _check_one_gait(args) -> None:
@@ -621,6 +638,7 @@ def add_validate(commands) -> None:
     val = types.add_command(commands, "validate", help, cmd_validate)
     types.add_gaits(val)
     types.add_steps(val)
+    types.add_timestep(val)
     checks.declare_rule(val, ("--rrd", "--video"), _check_one_gait)
     checks.add_out(
         val,

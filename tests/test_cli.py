@@ -117,6 +117,9 @@ def test_infeasible_optimum_writes_nothing(tmp_path, capsys):
         (["sweep", "--clearance", "-0.01"], "clearance = '-0.01'"),
         (["optimize", "--knee", "rolling", "--speed", "0.3", "--out", "."], "is a folder"),
         (["demo", "--knee", "rolling", "--hip-ahead", "nan"], "allowed a finite number"),
+        (["validate", "g.json", "--timestep", "0.004"], "timestep = '0.004' s: allowed"),
+        (["validate", "g.json", "--timestep", "1e-5"], "timestep = '1e-5' s: allowed"),
+        (["validate", "g.json", "--timestep", "fine"], "timestep = 'fine'"),
     ],
 )
 def test_bad_arguments_one_line_exit_2(capsys, argv, needle):

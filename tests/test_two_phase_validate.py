@@ -151,3 +151,27 @@ def test_biped_validate_of_a_two_phase_gait(gait, tmp_path, capsys):
     assert report["passed"] is False and report["feedforward"]["passed"] is True
     assert report["units"]["feedforward.rear_force_rms_error"] == "N"
     assert rrd.exists() and report["recording"] == str(rrd)
+
+
+def test_the_walks_slip_is_the_committed_steps(gait):
+    """The two-phase walk's stance foot creeps under the servos' damping at the committed
+    2 ms step (MuJoCo solves the contacts without the damping it then integrates
+    implicitly); the same model at 0.5 ms (``at_timestep``: contacts, stops and the knee's
+    coupling at two steps' time constant) walks the same steps without slipping, the
+    model's spec untouched."""
+    from validate.scene.model import at_timestep
+    from validate.walk import contact
+    from validate.walk.simulate import Walker
+
+    committed = model_spec(gait.biped)
+    fine = at_timestep(committed, 0.0005)
+    assert committed.option.timestep == 0.002 and fine.option.timestep == 0.0005
+    assert all(g.solref[0] == 0.001 for g in fine.geoms if g.contype or g.conaffinity)
+    slips = []
+    for spec in (committed, fine):
+        walker = Walker(gait, spec)
+        sim = walker.walk(8)
+        assert all(sim.landed)
+        settle = int(contact.SETTLE * walker.period / sim.model.opt.timestep)
+        slips.append(float(sim.stance_foot_slip(settle).max()))
+    assert slips[0] > 0.6e-3 and slips[1] < 0.3e-3, slips  # [m]

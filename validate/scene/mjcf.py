@@ -46,6 +46,7 @@ from biped.model.profile import KneeProfile
 from biped.model.robot import FOOT_FRICTION as SLIDING_FRICTION
 from biped.model.robot import JOINT_STOPS, SOLE_EDGES, Robot
 from biped.runtime.files import atomic_write_text
+from validate import MODEL_TIMESTEP
 from validate.scene import profile_mjcf
 
 SIDES = ("left", "right")
@@ -80,7 +81,7 @@ SOLE_CONTACT_RADIUS = 0.002
 # sink into it. The time constant is the shortest MuJoCo allows at the time step (2 steps).
 FOOT_SOLREF = "0.004 1"
 FOOT_SOLIMP = "0.99 0.999 0.0005 0.5 2"
-TIMESTEP = 0.002  # [s]
+TIMESTEP = MODEL_TIMESTEP  # [s]
 # Elliptic friction cones, friction as soft as the normal force (MuJoCo's default impedance
 # ratio). The stiff contact above already holds a loaded foot (the gaits need |Fx| / Fz of
 # about 0.1 at most). Against friction 50 times harder (``IMPRATIO_HARD``), the 20-step

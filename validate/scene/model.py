@@ -75,6 +75,25 @@ def committed_model(biped: Biped) -> Path | None:
     return FOLDER / f"scene_{biped.knee}.xml" if body == Robot.paper() else None
 
 
+def at_timestep(spec: mujoco.MjSpec, timestep: float) -> mujoco.MjSpec:
+    """``spec`` (copied) integrated at ``timestep`` [s]: the same model with its contacts, its
+    joints' stops and its equalities (the rolling knee's coupling) at two steps' time
+    constant, the shortest MuJoCo allows, as the committed model is at its own step
+    (``validate.scene.mjcf``). A shorter step is a finer model of the same robot, what the
+    committed step's verdicts can be held against (``biped validate --timestep``)."""
+    spec = spec.copy()
+    spec.option.timestep = timestep
+    solref = [2.0 * timestep, 1.0]
+    for geom in spec.geoms:
+        if geom.contype or geom.conaffinity:
+            geom.solref = solref
+    for joint in spec.joints:
+        joint.solref_limit = solref
+    for equality in spec.equalities:
+        equality.solref = solref
+    return spec
+
+
 def model_spec(biped: Biped, path: str | Path | None = None) -> mujoco.MjSpec:
     """The MJCF to play a gait of ``biped`` on (see the module docstring), as a spec to add to.
 
