@@ -564,6 +564,33 @@ def add_timestep(parser) -> None:
     parser.add_argument("--timestep", type=timestep, default=None, metavar="S", help=TIMESTEP_HELP)
 
 
+# The range of ``--kp-scale``: the robustness map's and the orbit study's scales of the servos.
+KP_SCALES = (0.25, 4.0)
+KP_SCALE_HELP = (
+    "the servos' stiffness in the walks (the forward, gains and orbit checks) as a multiple "
+    f"of the validation's kp = 1000 N·m/rad, from {KP_SCALES[0]:g} to {KP_SCALES[1]:g}; the "
+    "gains check scales it again by 0.5 and 2 (default 1)"
+)
+
+
+def kp_scale(text: str) -> float:
+    """``--kp-scale X``, within ``KP_SCALES``."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"kp scale = {text!r} is not a number") from None
+    if not (np.isfinite(value) and KP_SCALES[0] <= value <= KP_SCALES[1]):
+        raise argparse.ArgumentTypeError(
+            f"kp scale = {text!r}: allowed {KP_SCALES[0]:g} to {KP_SCALES[1]:g}"
+        )
+    return value
+
+
+def add_kp_scale(parser) -> None:
+    """``--kp-scale X``: the walks' servo stiffness (``WalkSettings.kp_scale``)."""
+    parser.add_argument("--kp-scale", type=kp_scale, default=1.0, metavar="X", help=KP_SCALE_HELP)
+
+
 def add_steps(parser) -> None:
     """``--steps N``: the steps of a forward walk in MuJoCo."""
     parser.add_argument("--steps", type=steps, default=DEFAULT_STEPS, metavar="N", help=STEPS_HELP)

@@ -525,6 +525,8 @@ def cmd_validate(args) -> int:
             "knee coupling at two steps' time constant",
             flush=True,
         )
+    if args.kp_scale != 1.0 and not args.json:
+        print(f"the walks' servo stiffness × {args.kp_scale:g} (--kp-scale)", flush=True)
     reports, passed = {}, 0
     with Progress(len(args.gait), "validate") as bar:
         for path, gait, rrd, model in zip(args.gait, gaits, recordings, models, strict=True):
@@ -540,6 +542,7 @@ def cmd_validate(args) -> int:
                     connect=args.connect,
                     source=path,
                     model=model,
+                    settings=_walk_settings(args),
                 )
             written = write_json(report_path(rrd), reports[path].with_files(gait=path).to_dict())
             passed += result.passed
@@ -554,6 +557,16 @@ def cmd_validate(args) -> int:
     elif len(args.gait) > 1:
         print(f"{passed} of {len(args.gait)} gaits pass every check")
     return 0 if passed == len(args.gait) else 1
+
+
+def _walk_settings(args):
+    """The walks' gains: the validation's, the servos' stiffness × --kp-scale (None: the
+    validation's own)."""
+    if args.kp_scale == 1.0:
+        return None
+    from validate.walk.simulate import WalkSettings
+
+    return WalkSettings(kp_scale=args.kp_scale)
 
 
 def _walked_model(gait, args):
@@ -639,6 +652,7 @@ def add_validate(commands) -> None:
     types.add_gaits(val)
     types.add_steps(val)
     types.add_timestep(val)
+    types.add_kp_scale(val)
     checks.declare_rule(val, ("--rrd", "--video"), _check_one_gait)
     checks.add_out(
         val,

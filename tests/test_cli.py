@@ -120,6 +120,8 @@ def test_infeasible_optimum_writes_nothing(tmp_path, capsys):
         (["validate", "g.json", "--timestep", "0.004"], "timestep = '0.004' s: allowed"),
         (["validate", "g.json", "--timestep", "1e-5"], "timestep = '1e-5' s: allowed"),
         (["validate", "g.json", "--timestep", "fine"], "timestep = 'fine'"),
+        (["validate", "g.json", "--kp-scale", "5"], "kp scale = '5': allowed 0.25 to 4"),
+        (["validate", "g.json", "--kp-scale", "stiff"], "kp scale = 'stiff'"),
     ],
 )
 def test_bad_arguments_one_line_exit_2(capsys, argv, needle):

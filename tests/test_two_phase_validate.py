@@ -175,3 +175,24 @@ def test_the_walks_slip_is_the_committed_steps(gait):
         settle = int(contact.SETTLE * walker.period / sim.model.opt.timestep)
         slips.append(float(sim.stance_foot_slip(settle).max()))
     assert slips[0] > 0.6e-3 and slips[1] < 0.3e-3, slips  # [m]
+
+
+def test_stiffer_servos_on_the_finer_model_walk_a_stable_orbit(gait):
+    """At 1 ms with the servos' stiffness doubled (``biped validate --timestep 0.001
+    --kp-scale 2``) the two-phase walk passes the forward and gains checks (the gains around
+    the doubled stiffness) and its orbit is stable; with the validation's stiffness on the
+    same model its orbit, a flip, is not."""
+    from validate.checks.orbit import check_orbit
+    from validate.scene.model import at_timestep
+    from validate.walk.simulate import Walker, WalkSettings
+
+    walker = Walker(gait, at_timestep(model_spec(gait.biped), 0.001))
+    stiff = WalkSettings(kp_scale=2.0)
+    energy = gait.double_support.energy
+    forward, *_ = c.check_forward(walker, 8, energy, stiff)
+    gains = c.check_gains(walker, 8, energy, forward, stiff)
+    assert forward.passed and gains.passed, (forward.line(), gains.line())
+    assert gains.figures["kp"] == 2 * c.WALK.kp
+    (stable, _), (default, found) = (check_orbit(walker, s) for s in (stiff, c.WALK))
+    assert stable.passed, stable.line()
+    assert not default.passed and found.multipliers.values[0].real < 0, default.line()

@@ -36,11 +36,14 @@ def validate_and_record(
     connect: str | None = None,
     source: str | Path | None = None,
     model=None,
+    settings=None,
 ):
     """Every check of a gait on ``model`` (an MJCF path; None: ``validate.scene.model.model_spec``'s
     default), its recording at ``rrd`` (also streamed to a viewer with ``spawn`` or
     ``connect``) and, if asked, the video of its walk at ``video`` (MP4) and ``gif``.
-    ``source``: the gait file, named as the recording's owner (``validate.outputs.outputs``).
+    ``source``: the gait file, named as the recording's owner (``validate.outputs.outputs``);
+    ``settings``: the walks' gains (``validate.walk.simulate.WalkSettings``; None: the
+    validation's).
 
     Returns the validation and its report (``biped.records.validation_report``: the checks
     with their units, the recording's and video's paths).
@@ -50,7 +53,8 @@ def validate_and_record(
     from validate.outputs.outputs import claim
     from validate.outputs.record import record
 
-    result = validation.validate(gait, steps=steps, model=model)
+    walk = {} if settings is None else {"settings": settings}  # None: the validation's gains
+    result = validation.validate(gait, steps=steps, model=model, **walk)
     written = record(rrd, result, spawn=spawn, connect=connect)
     if source is not None:
         claim(written, source)

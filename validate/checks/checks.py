@@ -42,7 +42,7 @@ knee without its equalities) fails the checks that need it, with the reason as a
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import mujoco
 import numpy as np
@@ -67,7 +67,10 @@ from validate.scene.model import ModelError, model_problems
 from validate.walk import contact
 from validate.walk.replay import DOUBLE_SUPPORT_TIMESTEP, replay_model, replay_step
 from validate.walk.samples import GaitSamples
-from validate.walk.simulate import KP, Simulation, Walker, WalkSettings, reference_along
+from validate.walk.simulate import Simulation, Walker, WalkSettings, reference_along
+
+# The validation's walk: the servos' and the speed loop's gains of ``validate.walk.simulate``.
+WALK = WalkSettings()
 
 # Agreement of two exact rigid-body models of one robot, in each figure's unit (N·m, N, m,
 # m/s, rad/s, N·s): a millionth of the torques (1-10 N·m), of the weight (687 N) and of the
@@ -939,10 +942,11 @@ def walk_verdict(walker: Walker, sim: Simulation, steps: int) -> list[str]:
     return walk_failures(figures, steps)
 
 
-def check_forward(walker: Walker, steps: int, energy: float):
-    """Walk at the default gains and check; returns (check, simulation, ground reaction)."""
+def check_forward(walker: Walker, steps: int, energy: float, settings: WalkSettings = WALK):
+    """Walk under ``settings`` (the validation's gains by default) and check; returns (check,
+    simulation, ground reaction)."""
     began = time.perf_counter()
-    sim = walker.walk(steps)
+    sim = walker.walk(steps, settings)
     wall = time.perf_counter() - began
     reaction = contact.ground_reaction(sim)
     figures = walk_figures(walker.biped, walker.samples, sim, energy, reaction)
@@ -976,14 +980,17 @@ def _key(scale: float) -> str:
     return f"{scale:g}".replace(".", "_")
 
 
-def check_gains(walker: Walker, steps: int, energy: float, forward: Check) -> Check:
-    """The walk at kp × ``GAIN_SCALES`` beside the default's."""
+def check_gains(
+    walker: Walker, steps: int, energy: float, forward: Check, settings: WalkSettings = WALK
+) -> Check:
+    """The walk at kp × ``GAIN_SCALES`` beside the forward check's (``settings``: its gains,
+    the validation's by default; the scales multiply its stiffness)."""
     results = {1.0: walks(forward.figures, steps)}
     clearances = {1.0: forward.figures["swing_clearance"]}
     found = set(walk_causes(forward.figures, steps))
     notes = []
     for scale in GAIN_SCALES:
-        sim = walker.walk(steps, WalkSettings(kp_scale=scale))
+        sim = walker.walk(steps, replace(settings, kp_scale=scale * settings.kp_scale))
         figures = walk_figures(walker.biped, walker.samples, sim, energy)
         results[scale] = walks(figures, steps)
         clearances[scale] = figures["swing_clearance"]
@@ -996,7 +1003,7 @@ def check_gains(walker: Walker, steps: int, energy: float, forward: Check) -> Ch
     walked = [s for s in scales if results[s]]
     figures = {f"walks_at_kp_x{_key(scale)}": results[scale] for scale in scales}
     figures |= {f"swing_clearance_at_kp_x{_key(scale)}": clearances[scale] for scale in scales}
-    figures["kp"] = KP
+    figures["kp"] = settings.kp
     if results[1.0]:  # the range around the default over which it walks
         low = high = scales.index(1.0)
         while low > 0 and results[scales[low - 1]]:

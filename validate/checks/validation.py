@@ -28,7 +28,7 @@ from validate.checks.orbit import Orbit, check_orbit
 from validate.checks.units import figure_units
 from validate.scene.model import compile_spec, model_spec
 from validate.walk.samples import GaitSamples
-from validate.walk.simulate import Simulation, Walker
+from validate.walk.simulate import Simulation, Walker, WalkSettings
 
 __all__ = ["EXACT", "Check", "Validation", "validate", "validation_report"]
 
@@ -51,11 +51,15 @@ class Validation:
 
 
 def validate(
-    gait: Gait, steps: int = DEFAULT_STEPS, model: str | Path | mujoco.MjSpec | None = None
+    gait: Gait,
+    steps: int = DEFAULT_STEPS,
+    model: str | Path | mujoco.MjSpec | None = None,
+    settings: WalkSettings = c.WALK,
 ):
     """All checks of a gait on ``model``
     (``validate.scene.model.model_spec``: by default the committed model of the gait's knee for
-    Table 1, the model generated from the gait's robot otherwise).
+    Table 1, the model generated from the gait's robot otherwise), its walks under
+    ``settings`` (the validation's gains by default).
 
     Raises BipedError if the model cannot be read or is of the other knee.
     """
@@ -63,7 +67,7 @@ def validate(
     spec = model if isinstance(model, mujoco.MjSpec) else model_spec(biped, model)
     robot_model = compile_spec(spec)
     if gait.two_phase:
-        checks, sim, reaction, found = two_phase_checks(gait, spec, steps)
+        checks, sim, reaction, found = two_phase_checks(gait, spec, steps, settings)
         return Validation(gait, checks, biped, samples, sim, reaction, found)
     energy = gait.costs.energy
     results = [
@@ -74,9 +78,9 @@ def validate(
         c.check_feedforward(spec, biped, samples),
     ]
     walker = Walker(gait, spec)
-    forward, sim, reaction = c.check_forward(walker, steps, energy)
-    results += [forward, c.check_gains(walker, steps, energy, forward)]
-    orbit, found = check_orbit(walker)
+    forward, sim, reaction = c.check_forward(walker, steps, energy, settings)
+    results += [forward, c.check_gains(walker, steps, energy, forward, settings)]
+    orbit, found = check_orbit(walker, settings)
     return Validation(gait, results + [orbit], biped, samples, sim, reaction, found)
 
 
@@ -88,7 +92,9 @@ NO_TWO_PHASE_ENERGY = (
 )
 
 
-def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS):
+def two_phase_checks(
+    gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS, settings: WalkSettings = c.WALK
+):
     """The checks of a two-phase gait: the model; the inverse dynamics along both phases;
     the knee loads along its single support (the file's are the single support's); the
     landing holding both feet against MuJoCo's impact map (``check_two_phase_impact``); the
@@ -106,7 +112,7 @@ def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS
     walker = Walker(gait, spec)
     energy = gait.double_support.energy  # the joints' work over both phases [J per step]
     energy = float("nan") if energy is None else energy
-    forward, sim, reaction = c.check_forward(walker, steps, energy)
+    forward, sim, reaction = c.check_forward(walker, steps, energy, settings)
     if np.isnan(energy):
         forward.notes.append(NO_TWO_PHASE_ENERGY)
     checks = [
@@ -116,9 +122,9 @@ def two_phase_checks(gait: Gait, spec: mujoco.MjSpec, steps: int = DEFAULT_STEPS
         c.check_two_phase_impact(robot_model, biped, samples, gait),
         c.check_two_phase_feedforward(spec, biped, samples),
         forward,
-        c.check_gains(walker, steps, energy, forward),
+        c.check_gains(walker, steps, energy, forward, settings),
     ]
-    orbit, found = check_orbit(walker)
+    orbit, found = check_orbit(walker, settings)
     return checks + [orbit], sim, reaction, found
 
 
