@@ -4,6 +4,7 @@ folder are two outputs; a claim ends with its process, however it ends."""
 
 import contextlib
 import io
+import os
 import signal
 import subprocess
 import sys
@@ -123,7 +124,13 @@ def test_two_sweeps_on_one_folder_at_once_the_second_is_refused(tmp_path):
         while not (out / "sweep.json").exists():
             assert first.poll() is None and time.monotonic() < deadline
             time.sleep(0.05)
-        second = _biped(*argv, "--clearance", "0.01")
+        # the first run held still while the second starts: it cannot finish first (a
+        # quick sweep on a loaded machine did), and it still holds its claim
+        os.kill(first.pid, signal.SIGSTOP)
+        try:
+            second = _biped(*argv, "--clearance", "0.01")
+        finally:
+            os.kill(first.pid, signal.SIGCONT)
         _, err = first.communicate(timeout=300)
     finally:
         if first.poll() is None:
