@@ -138,6 +138,16 @@ def edited_gait_file(content: dict, folder, change=None, name: str = "gait.json"
     return path
 
 
+def exit_status(argv) -> int:
+    """The exit status of ``biped argv``, argparse's own exit included."""
+    from biped_cli.main import main
+
+    try:
+        return main(argv)
+    except SystemExit as stop:
+        return stop.code
+
+
 def refusal(read, path) -> str:
     """The BipedError of ``read(path)``: one line, naming the file."""
     with pytest.raises(biped.BipedError) as error:

@@ -16,6 +16,7 @@ from biped.records.two_phase_sweep import KneeDifference, Phases, PointSummary
 from biped.studies import atlas
 from biped.studies import atlas_two_phase as study
 from biped_cli import main
+from tests.conftest import exit_status
 
 SPEED = 0.3  # [m/s]
 CLEARANCES = (0.0, 0.02)  # [m]
@@ -118,18 +119,10 @@ def test_what_does_not_combine_is_refused_with_exit_2_before_any_work(tmp_path, 
             argv[: argv.index(option)] + argv[argv.index(option) + 2 :] if option in argv else argv
         )
         argv += bad
-    assert _status(argv) == 2
+    assert exit_status(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and named in err[0], err
     assert not out.exists()
-
-
-def _status(argv) -> int:
-    """The exit status of ``biped argv``, argparse's own exit included."""
-    try:
-        return main(argv)
-    except SystemExit as stop:
-        return stop.code
 
 
 @pytest.fixture(scope="module")

@@ -17,6 +17,7 @@ from biped.records.two_phase_sweep import (
 from biped.studies import two_phase_sweep as study
 from biped.studies.two_phase_sweep import differences
 from biped_cli import main
+from tests.conftest import exit_status
 
 SPEED = 0.3  # [m/s]
 TINY = ["--speeds", str(SPEED), "--starts", "1", "--paper-seeds", "0", "--jobs", "1"]
@@ -98,18 +99,10 @@ def test_bad_input_is_refused_with_exit_2_before_any_work(tmp_path, capsys, bad,
     """A share out of [0, 0.5), a criterion other than sthenic, an unknown landing, another
     gait family: one line naming the value, exit 2, nothing written."""
     out = tmp_path / "out"
-    assert _status(["sweep", *TINY, *bad, "--out", str(out)]) == 2
+    assert exit_status(["sweep", *TINY, *bad, "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert named in err[-1], err
     assert not out.exists()
-
-
-def _status(argv) -> int:
-    """The exit status of ``biped argv``, argparse's own exit included."""
-    try:
-        return main(argv)
-    except SystemExit as stop:
-        return stop.code
 
 
 @pytest.fixture(scope="module")

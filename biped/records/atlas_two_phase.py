@@ -129,9 +129,7 @@ class AtlasTwoPhaseSummary(SummaryFile):
     @classmethod
     def from_dict(cls, content: dict, source: str = "summary") -> AtlasTwoPhaseSummary:
         """The record of ``content`` (``to_dict``'s); a BipedError naming what is wrong."""
-        if not isinstance(content, dict) or content.get("format") != FORMAT:
-            found = content.get("format") if isinstance(content, dict) else None
-            raise BipedError(f"{source}: format {found!r}: allowed {FORMAT!r}")
+        cls.check_format(content, source, FORMAT)
         try:
             points = tuple(
                 CellPoint(p["clearance"], p["knee_bend"], point_from_dict(p["point"]))

@@ -121,6 +121,14 @@ class SummaryFile:
         return atomic_write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False))
 
     @classmethod
+    def check_format(cls, content, source: str, allowed: str) -> None:
+        """A BipedError naming ``source`` unless ``content`` is an object of format
+        ``allowed``."""
+        if not isinstance(content, dict) or content.get("format") != allowed:
+            found = content.get("format") if isinstance(content, dict) else None
+            raise BipedError(f"{source}: format {found!r}: allowed {allowed!r}")
+
+    @classmethod
     def read(cls, path: str | Path):
         path = Path(path)
         try:
@@ -152,9 +160,7 @@ class TwoPhaseSweepSummary(SummaryFile):
     @classmethod
     def from_dict(cls, content: dict, source: str = "summary") -> TwoPhaseSweepSummary:
         """The record of ``content`` (``to_dict``'s); a BipedError naming what is wrong."""
-        if not isinstance(content, dict) or content.get("format") != FORMAT:
-            found = content.get("format") if isinstance(content, dict) else None
-            raise BipedError(f"{source}: format {found!r}: allowed {FORMAT!r}")
+        cls.check_format(content, source, FORMAT)
         try:
             points = tuple(point_from_dict(p) for p in content["points"])
             differences = tuple(KneeDifference(**d) for d in content["differences"])
