@@ -256,7 +256,7 @@ def test_rolling_knee_discs_are_drawn(knee):
             assert model.geom_group[disc.id] == 2  # shown by default
 
 
-def fine_spec(gait, factor: int = 4) -> mujoco.MjSpec:
+def fine_spec(gait, factor: int = 2) -> mujoco.MjSpec:
     """The committed scene of ``gait``'s knee at 1/``factor`` of its time step, each sole a box
     on the floor (four contact points) instead of its heel and toe points, the contacts and
     the knee equality as stiff as that step allows, friction harder than the normal force

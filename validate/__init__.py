@@ -25,7 +25,7 @@ import sys
 DEFAULT_STEPS = 20
 # MuJoCo's physics step of the committed models [s] (``validate.scene.mjcf.TIMESTEP``; here
 # so that the command line can say it without importing MuJoCo).
-MODEL_TIMESTEP = 0.002
+MODEL_TIMESTEP = 0.001
 
 if sys.platform.startswith("linux") and not (
     os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")

@@ -65,7 +65,7 @@ KNEE_ARMATURE = 0.02
 ANKLE_ARMATURE = 0.02
 # Equality constraint of the rolling knee: stiff and hard (solimp close to 1); its time
 # constant is the shortest MuJoCo allows at the time step (2 steps).
-KNEE_SOLREF = "0.004 1"
+KNEE_SOLREF = "0.002 1"
 KNEE_SOLIMP = "0.9999 0.99999 0.0001 0.5 2"
 # Foot box (drawn): width and sole thickness [m]; friction (sliding, torsional, rolling).
 FOOT_WIDTH = 0.10
@@ -79,7 +79,7 @@ SOLE_CONTACT_RADIUS = 0.002
 # Stiff contact, the same on the soles and the floor (MuJoCo averages the two geoms'
 # parameters): the gaits clear the ground by about a millimetre, so the stance foot must not
 # sink into it. The time constant is the shortest MuJoCo allows at the time step (2 steps).
-FOOT_SOLREF = "0.004 1"
+FOOT_SOLREF = "0.002 1"
 FOOT_SOLIMP = "0.99 0.999 0.0005 0.5 2"
 TIMESTEP = MODEL_TIMESTEP  # [s]
 # Elliptic friction cones, friction as soft as the normal force (MuJoCo's default impedance
@@ -110,7 +110,7 @@ KNEE_RANGE = JOINT_STOPS["knee"]  # flexion 138°, 3° past straight
 ANKLE_RANGE = JOINT_STOPS["ankle"]  # plantar flexion 46°, dorsiflexion 34°
 # The stops are as stiff as the contacts (a stop hit by a falling robot gives by a few
 # hundredths of a radian; at MuJoCo's default, 0.02 s, by 0.13 rad).
-LIMIT_SOLREF = "0.004 1"
+LIMIT_SOLREF = "0.002 1"
 LIMIT_SOLIMP = "0.99 0.999 0.001 0.5 2"
 # The links collide with the floor too (capsules as drawn, group 3), so that a robot that
 # falls lies on it; a walk never brings them near it (the knees stay 0.4 m up).

@@ -90,7 +90,7 @@ __all__ = ["JOINT_ORDER", "Push", "Simulation", "WalkSettings", "Walker", "simul
 
 # Joint-space feedback gains of the five tracked joints: stiffness [N·m/rad], damping
 # [N·m·s/rad]. The stance ankle has none (see the module docstring).
-KP = 1000.0
+KP = 2000.0
 KV = 40.0
 # A step waits for the swing foot at most this many periods.
 STEP_TIMEOUT = 2.0
