@@ -42,7 +42,7 @@ from biped_cli.checks import (  # noqa: F401 (the outputs' words, for the comman
     declare_rule,
     distinct_outputs,
 )
-from validate import DEFAULT_STEPS, MODEL_TIMESTEP
+from validate import DEFAULT_STEPS, MODEL_TIMESTEP, SERVO_KP
 
 ROBOT_HELP = (
     "robot parameters, .json or .toml; fields left out keep Table 1 (default: Table 1); a "
@@ -534,27 +534,30 @@ def not_a_robot_file(path: str) -> None:
         )
 
 
-# [s] The shortest physics step ``--timestep`` takes (a walk at it takes 20 times the
-# committed step's time).
+# [s] The shortest physics step ``--timestep`` takes (a walk at it takes 10 times the
+# committed step's time), and the longest: twice the committed step, the step of the models
+# before 1 ms, at which the two-phase walks' stance foot creeps (docs/gaits.md).
 MIN_TIMESTEP = 1e-4
+MAX_TIMESTEP = 2.0 * MODEL_TIMESTEP
 TIMESTEP_HELP = (
     f"MuJoCo's physics step of the walks (the forward, gains and orbit checks; the replay "
     f"and the inverse dynamics keep their own) [s], from "
-    f"{MIN_TIMESTEP:g} to {MODEL_TIMESTEP:g}: the same model with its contacts, stops and "
-    "knee coupling at two steps' time constant, a finer model to hold the verdicts against "
+    f"{MIN_TIMESTEP:g} to {MAX_TIMESTEP:g}: the same model with its contacts, stops and "
+    "knee coupling at two steps' time constant, a finer or coarser model to hold the "
+    "verdicts against "
     f"(default: the model's own, {MODEL_TIMESTEP:g} s for the committed models)"
 )
 
 
 def timestep(text: str) -> float:
-    """``--timestep S`` [s], from ``MIN_TIMESTEP`` to the committed models' step."""
+    """``--timestep S`` [s], from ``MIN_TIMESTEP`` to ``MAX_TIMESTEP``."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"timestep = {text!r} is not a number") from None
-    if not (np.isfinite(value) and MIN_TIMESTEP <= value <= MODEL_TIMESTEP):
+    if not (np.isfinite(value) and MIN_TIMESTEP <= value <= MAX_TIMESTEP):
         raise argparse.ArgumentTypeError(
-            f"timestep = {text!r} s: allowed {MIN_TIMESTEP:g} to {MODEL_TIMESTEP:g} s"
+            f"timestep = {text!r} s: allowed {MIN_TIMESTEP:g} to {MAX_TIMESTEP:g} s"
         )
     return value
 
@@ -568,8 +571,8 @@ def add_timestep(parser) -> None:
 KP_SCALES = (0.25, 4.0)
 KP_SCALE_HELP = (
     "the servos' stiffness in the walks (the forward, gains and orbit checks) as a multiple "
-    f"of the validation's kp = 1000 N·m/rad, from {KP_SCALES[0]:g} to {KP_SCALES[1]:g}; the "
-    "gains check scales it again by 0.5 and 2 (default 1)"
+    f"of the validation's kp = {SERVO_KP:g} N·m/rad, from {KP_SCALES[0]:g} to "
+    f"{KP_SCALES[1]:g}; the gains check scales it again by 0.5 and 2 (default 1)"
 )
 
 

@@ -65,36 +65,29 @@ def test_validation_of_a_two_phase_gait(gait, impact_gait):
     foot's wrench given), the knee loads, the landing against MuJoCo's impact map holding
     both feet (the impact landing's impulses) and the replay of both phases (the zero-speed
     landing's), with both feet's ground forces within ``FOOT_FORCE_SHARE`` of the weight,
-    pass; MuJoCo's walk of both phases and its gains run, and fail by the feet's slip (the
-    zero-speed landing's walk: docs/gaits.md), the joints' work per step within 10 % of the
-    file's over both phases; the orbit is measured on a section of its single support where
-    the stance foot is at rest, a flip within 0.15 of -1 (docs/gaits.md)."""
+    pass; MuJoCo's walk of both phases, its gains and its orbit pass too (the zero-speed
+    landing's walk: docs/gaits.md), the joints' work per step within 10 % of the file's over
+    both phases; the orbit is measured on a section of its single support where the stance
+    foot is at rest."""
     impact_checks, *_ = two_phase_checks(impact_gait, model_spec(impact_gait.biped))
     impact = {c.name: c for c in impact_checks}
     for name in ("model", "inverse_dynamics", "knee_loads", "impact"):
         assert impact[name].passed, impact[name].line()
     found, sim, *_ = two_phase_checks(gait, model_spec(gait.biped))
     checks = {check.name: check for check in found}
-    for name in ("model", "inverse_dynamics", "knee_loads", "impact", "feedforward"):
-        assert checks[name].passed, checks[name].line()
+    for check in found:
+        assert check.passed, check.line()
     figures = checks["feedforward"].figures
     for foot in ("rear", "front"):
         assert figures[f"{foot}_force_rms_error"] < c.FOOT_FORCE_SHARE * gait.robot.weight
     assert sim.double_support and all(sim.landed) and not checks["forward"].figures["fell"]
-    for name in ("forward", "gains"):
-        assert not checks[name].passed and "slipped" in checks[name].causes
-        assert "not run" not in checks[name].causes
     # MuJoCo's joints work per step within 10 % of the file's over both phases; against the
     # single support's work alone (what the file's costs hold) they would not
     walked = checks["forward"].figures["energy_per_step"]
     assert walked == pytest.approx(gait.double_support.energy, rel=0.1)
     assert walked > 1.1 * gait.costs.energy
     assert not any("energy_ratio not measured" in n for n in checks["forward"].notes)
-    orbit = checks["orbit"].figures
-    assert orbit["section_phase"] > o.LANDING  # where the stance foot is at rest
-    assert orbit["multipliers_real"][0] < 0 and abs(orbit["spectral_radius"] - 1) < 0.15
-    upper = orbit["spectral_radius"] + o.MARGIN_SPREADS * orbit["spectral_radius_spread"]
-    assert checks["orbit"].passed == (upper < 1)  # a marginal flip: the verdict follows ρ
+    assert checks["orbit"].figures["section_phase"] > o.LANDING  # where the foot is at rest
 
 
 def test_wrong_knee_model_fails_the_replay(gait, samples, impact_gait):
@@ -134,41 +127,41 @@ def test_another_split_fails_the_feet_forces(gait, samples):
 
 def test_biped_validate_of_a_two_phase_gait(gait, tmp_path, capsys):
     """``biped validate`` on a two-phase gait file runs its checks (the orbit's too), writes
-    the report and the recording and exits 1 (not every check passed)."""
+    the report and the recording and exits 0 (every check passed); at the servos' stiffness
+    halved the orbit, a flip, is not shown stable and the command exits 1."""
     import json
 
     from biped_cli import main
 
     path = gait.write(tmp_path / "two.json")
     rrd = tmp_path / "rec" / "two.rrd"
-    assert main(["validate", str(path), "--rrd", str(rrd)]) == 1
+    assert main(["validate", str(path), "--rrd", str(rrd)]) == 0
     printed = capsys.readouterr().out
     assert "PASS  feedforward" in printed and "PASS  impact" in printed
-    forward = next(line for line in printed.splitlines() if "FAIL  forward" in line)
-    assert "slipped" in forward and "not run" not in forward
-    assert "FAIL  orbit             [unstable orbit]" in printed and "not run" not in printed
+    assert "PASS  forward" in printed and "PASS  orbit" in printed
+    assert "FAIL" not in printed and "not run" not in printed
     report = json.loads((tmp_path / "rec" / "two.report.json").read_text())
-    assert report["passed"] is False and report["feedforward"]["passed"] is True
+    assert report["passed"] is True and report["feedforward"]["passed"] is True
     assert report["units"]["feedforward.rear_force_rms_error"] == "N"
     assert rrd.exists() and report["recording"] == str(rrd)
 
 
-def test_the_walks_slip_is_the_committed_steps(gait):
-    """The two-phase walk's stance foot creeps under the servos' damping at the committed
-    2 ms step (MuJoCo solves the contacts without the damping it then integrates
-    implicitly); the same model at 0.5 ms (``at_timestep``: contacts, stops and the knee's
-    coupling at two steps' time constant) walks the same steps without slipping, the
-    model's spec untouched."""
+def test_the_walk_slips_at_twice_the_committed_step(gait):
+    """At twice the committed 1 ms step (the models' step before; ``at_timestep``: contacts,
+    stops and the knee's coupling at two steps' time constant) the two-phase walk's stance
+    foot creeps under the servos' damping (MuJoCo solves the contacts without the damping it
+    then integrates implicitly) beyond the forward check's millimetre; at the committed step
+    it walks the same steps without slipping, the model's spec untouched."""
     from validate.scene.model import at_timestep
     from validate.walk import contact
     from validate.walk.simulate import Walker
 
     committed = model_spec(gait.biped)
-    fine = at_timestep(committed, 0.0005)
-    assert committed.option.timestep == 0.002 and fine.option.timestep == 0.0005
-    assert all(g.solref[0] == 0.001 for g in fine.geoms if g.contype or g.conaffinity)
+    coarse = at_timestep(committed, 0.002)
+    assert committed.option.timestep == 0.001 and coarse.option.timestep == 0.002
+    assert all(g.solref[0] == 0.004 for g in coarse.geoms if g.contype or g.conaffinity)
     slips = []
-    for spec in (committed, fine):
+    for spec in (coarse, committed):
         walker = Walker(gait, spec)
         sim = walker.walk(8)
         assert all(sim.landed)
@@ -177,22 +170,16 @@ def test_the_walks_slip_is_the_committed_steps(gait):
     assert slips[0] > 0.6e-3 and slips[1] < 0.3e-3, slips  # [m]
 
 
-def test_stiffer_servos_on_the_finer_model_walk_a_stable_orbit(gait):
-    """At 1 ms with the servos' stiffness doubled (``biped validate --timestep 0.001
-    --kp-scale 2``) the two-phase walk passes the forward and gains checks (the gains around
-    the doubled stiffness) and its orbit is stable; with the validation's stiffness on the
-    same model its orbit, a flip, is not."""
+def test_the_validations_servos_walk_a_stable_orbit_and_half_as_stiff_do_not(gait):
+    """With the validation's servos (kp = 2000 N·m/rad) the two-phase walk's orbit is
+    stable; with half their stiffness (the validation's before 1 ms) its slowest multiplier
+    is a flip beyond -1 and the orbit check fails."""
     from validate.checks.orbit import check_orbit
-    from validate.scene.model import at_timestep
     from validate.walk.simulate import Walker, WalkSettings
 
-    walker = Walker(gait, at_timestep(model_spec(gait.biped), 0.001))
-    stiff = WalkSettings(kp_scale=2.0)
-    energy = gait.double_support.energy
-    forward, *_ = c.check_forward(walker, 8, energy, stiff)
-    gains = c.check_gains(walker, 8, energy, forward, stiff)
-    assert forward.passed and gains.passed, (forward.line(), gains.line())
-    assert gains.figures["kp"] == 2 * c.WALK.kp
-    (stable, _), (default, found) = (check_orbit(walker, s) for s in (stiff, c.WALK))
+    walker = Walker(gait, model_spec(gait.biped))
+    (stable, _), (soft, found) = (
+        check_orbit(walker, s) for s in (c.WALK, WalkSettings(kp_scale=0.5))
+    )
     assert stable.passed, stable.line()
-    assert not default.passed and found.multipliers.values[0].real < 0, default.line()
+    assert not soft.passed and found.multipliers.values[0].real < -1.0, soft.line()

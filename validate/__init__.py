@@ -26,6 +26,9 @@ DEFAULT_STEPS = 20
 # MuJoCo's physics step of the committed models [s] (``validate.scene.mjcf.TIMESTEP``; here
 # so that the command line can say it without importing MuJoCo).
 MODEL_TIMESTEP = 0.001
+# The servos' stiffness in the walks [N·m/rad] (``validate.walk.simulate.KP``; here for the
+# command line's help).
+SERVO_KP = 2000.0
 
 if sys.platform.startswith("linux") and not (
     os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")

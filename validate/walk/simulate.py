@@ -78,7 +78,7 @@ from biped.errors import BipedError
 from biped.model.dynamics import Biped
 from biped.model.kinematics import XH, ZH
 from biped.records.gait_file import Gait
-from validate import DEFAULT_STEPS
+from validate import DEFAULT_STEPS, SERVO_KP
 from validate.scene.layout import Layout
 from validate.scene.mapping import mapping, other, rotor_torques
 from validate.scene.mjcf import SIDES
@@ -90,7 +90,7 @@ __all__ = ["JOINT_ORDER", "Push", "Simulation", "WalkSettings", "Walker", "simul
 
 # Joint-space feedback gains of the five tracked joints: stiffness [N·m/rad], damping
 # [N·m·s/rad]. The stance ankle has none (see the module docstring).
-KP = 2000.0
+KP = SERVO_KP
 KV = 40.0
 # A step waits for the swing foot at most this many periods.
 STEP_TIMEOUT = 2.0
