@@ -450,6 +450,47 @@ def add_budget(parser, sweep: bool = False):
     add_safety(parser)
 
 
+# The share of the step in double support that ``--double-support`` alone asks for: from a
+# tenth of the step (people walk with 10-20 % of a stride in double support) to 0.4.
+DOUBLE_SUPPORT = (0.1, 0.4)
+
+
+def add_double_support(parser, help: str) -> None:
+    """``--double-support [LOW:HIGH]``: alone, ``DOUBLE_SUPPORT``; ``help`` ends with what
+    the command does without it."""
+    low, high = DOUBLE_SUPPORT
+    parser.add_argument(
+        "--double-support",
+        type=double_support_share,
+        nargs="?",
+        const=DOUBLE_SUPPORT,
+        default=None,
+        metavar="LOW:HIGH",
+        help=f"{help}; the option alone: {low:g}:{high:g}",
+    )
+
+
+# How the swing foot lands with ``--double-support`` unless told: at rest. The impact
+# landing's two-phase optima touch down at about 3 m/s, and MuJoCo's walks of them fall in
+# their first steps (docs/gaits.md).
+LANDING = "zero-speed"
+
+
+def add_landing(parser) -> None:
+    """``--landing``: how the swing foot lands before a double support."""
+    from biped.model.two_phase import LANDINGS
+
+    parser.add_argument(
+        "--landing",
+        choices=LANDINGS,
+        default=LANDING,
+        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
+        "it, the paper's impact map with both feet held; its optima touch down at about "
+        "3 m/s and do not walk in MuJoCo) or zero-speed (it arrives at rest, no impact) "
+        "(default %(default)s)",
+    )
+
+
 def add_options(parser, *options) -> None:
     """Options given as rows (option, type, default, metavar, help)."""
     for option, kind, default, metavar, help in options:

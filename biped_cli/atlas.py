@@ -177,14 +177,9 @@ def add_parser(commands) -> None:
 def add_double_support(parser) -> None:
     """``--double-support LOW:HIGH`` and ``--landing``, and the rule of what they combine
     with."""
-    from biped.model.two_phase import LANDINGS
-
-    parser.add_argument(
-        "--double-support",
-        type=types.double_support_share,
-        default=None,
-        metavar="LOW:HIGH",
-        help="after the atlas, at every cell where the gait of two phases is built (sthenic "
+    types.add_double_support(
+        parser,
+        "after the atlas, at every cell where the gait of two phases is built (sthenic "
         "criterion, the paper's spline and constraints: --paper-constraints), each knee's "
         "optimum of single then double support, its double support a share of the step from "
         "LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share), started from the "
@@ -192,13 +187,7 @@ def add_double_support(parser) -> None:
         "OUT/double-support/ (docs/atlas.md); the other cells listed as not built, with why "
         "(default: the atlas alone)",
     )
-    parser.add_argument(
-        "--landing",
-        choices=LANDINGS,
-        default="impact",
-        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
-        "it) or zero-speed (it arrives at rest, no impact) (default %(default)s)",
-    )
+    types.add_landing(parser)
     options = ("--double-support", "--criteria", "--paper-constraints", "--actuator-limits",
                "--knots", "--family")  # fmt: skip
     checks.declare_rule(parser, options, _check_double_support)

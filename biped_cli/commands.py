@@ -15,7 +15,6 @@ from biped.errors import BipedError, UnreachableError
 from biped.model.dynamics import JOINTS, Biped
 from biped.model.kinematics import KNEES
 from biped.model.robot import Robot
-from biped.model.two_phase import LANDINGS
 from biped_cli import args as types
 from biped_cli import checks
 from biped_cli.args import budget, robot_of, safety
@@ -208,23 +207,15 @@ def add_optimize(commands) -> None:
     types.add_knots(opt)
     types.add_bezier(opt)
     types.add_robot(opt)
-    types.add_options(
+    types.add_double_support(
         opt,
-        ("--double-support", types.double_support_share, None, "LOW:HIGH",
-         "also optimize the gait of two phases, single then double support (both feet flat), "
-         "started from the single-support optimum, its double support a share of the step "
-         "from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share): sthenic "
-         "criterion, IPOPT with --method ipopt only; --out then receives the two-phase "
-         "gait file (both phases, see docs/gaits.md); default: single support only"),
-    )  # fmt: skip
-    opt.add_argument(
-        "--landing",
-        choices=LANDINGS,
-        default="impact",
-        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
-        "it, the paper's impact map with both feet held) or zero-speed (it arrives at rest, no "
-        "impact) (default %(default)s)",
+        "also optimize the gait of two phases, single then double support (both feet flat), "
+        "started from the single-support optimum, its double support a share of the step "
+        "from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share): sthenic "
+        "criterion, IPOPT with --method ipopt only; --out then receives the two-phase "
+        "gait file (both phases, see docs/gaits.md); default: single support only",
     )
+    types.add_landing(opt)
     checks.declare_rule(opt, ("--double-support", "--method"), _check_double_support)
 
 
@@ -363,21 +354,17 @@ def add_sweep(commands) -> None:
         ("--paper-seeds", types.bounded(0, 100), 5, "N", "also run the paper's Nelder-Mead "
          "from N seeds at the speed nearest 0.3 m/s, for every knee and criterion, for "
          "comparison.md (default 5; 0: none)"),
-        ("--double-support", types.double_support_share, None, "LOW:HIGH",
-         "also optimize at each speed and knee the gait of two phases, single then double "
-         "support, its double support a share of the step from LOW to HIGH (0 <= LOW <= HIGH "
-         "< 0.5; one number: that share), started from the sweep's single-support optimum of "
-         "the same point: sthenic criterion only (--criteria sthenic, the default with this "
-         "option), written with a summary and a figure in OUT/double-support/ "
-         "(docs/gaits.md); default: single support only"),
     )  # fmt: skip
-    sweep.add_argument(
-        "--landing",
-        choices=LANDINGS,
-        default="impact",
-        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
-        "it) or zero-speed (it arrives at rest, no impact) (default %(default)s)",
+    types.add_double_support(
+        sweep,
+        "also optimize at each speed and knee the gait of two phases, single then double "
+        "support, its double support a share of the step from LOW to HIGH (0 <= LOW <= HIGH "
+        "< 0.5; one number: that share), started from the sweep's single-support optimum of "
+        "the same point: sthenic criterion only (--criteria sthenic, the default with this "
+        "option), written with a summary and a figure in OUT/double-support/ "
+        "(docs/gaits.md); default: single support only",
     )
+    types.add_landing(sweep)
     checks.declare_rule(sweep, ("--double-support", "--criteria"), _check_sweep_double_support)
 
 
@@ -823,23 +810,16 @@ def add_pipeline(commands) -> None:
     types.add_bezier(pipe)
     checks.declare_rule(pipe, ("--design", "--family", "--knots"), _check_design_family)
     types.add_robot(pipe)
-    types.add_options(
+    types.add_double_support(
         pipe,
-        ("--double-support", types.double_support_share, None, "LOW:HIGH",
-         "also optimize each knee's gait of two phases, single then double support (both feet "
-         "flat), started from its single-support optimum, its double support a share of the "
-         "step from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share), and write, "
-         "validate and record it as <knee>-sthenic-<speed>-double-support: sthenic criterion, "
-         "IPOPT, the paper's spline (--knots 1), no --design (docs/gaits.md); default: single "
-         "support only"),
-    )  # fmt: skip
-    pipe.add_argument(
-        "--landing",
-        choices=LANDINGS,
-        default="impact",
-        help="with --double-support, how the swing foot lands: impact (both feet stopped by "
-        "it) or zero-speed (it arrives at rest, no impact) (default %(default)s)",
+        "also optimize each knee's gait of two phases, single then double support (both feet "
+        "flat), started from its single-support optimum, its double support a share of the "
+        "step from LOW to HIGH (0 <= LOW <= HIGH < 0.5; one number: that share), and write, "
+        "validate and record it as <knee>-sthenic-<speed>-double-support: sthenic criterion, "
+        "IPOPT, the paper's spline (--knots 1), no --design (docs/gaits.md); default: single "
+        "support only",
     )
+    types.add_landing(pipe)
     checks.declare_rule(
         pipe,
         ("--double-support", "--method", "--criterion", "--knots", "--family", "--design"),

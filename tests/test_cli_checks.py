@@ -182,3 +182,19 @@ def test_an_output_option_must_say_its_folders_are_created():
     """add_out refuses a help that does not say that missing folders are created."""
     with pytest.raises(ValueError, match="--out does not say"):
         checks.add_out(argparse.ArgumentParser(), "--out", checks.FILE, "a gait file")
+
+
+@pytest.mark.parametrize("command", ["optimize", "sweep", "atlas", "pipeline"])
+def test_double_support_alone_is_a_tenth_to_0_4_of_the_step_landing_at_rest(command):
+    """``--double-support`` alone asks for a share of 0.1 to 0.4 of the step, and the swing
+    foot lands at rest unless ``--landing impact`` is given (the impact landing's optima do
+    not walk in MuJoCo); without the option, single support."""
+    parser = build_parser().command_parsers[command]
+    knee = (
+        ["--knee", "rolling", "--speed", "0.3", "--out", "g.json"] if command == "optimize" else []
+    )
+    alone = parser.parse_args([*knee, "--double-support"])
+    assert alone.double_support == (0.1, 0.4) and alone.landing == "zero-speed"
+    given = parser.parse_args([*knee, "--double-support", "0.2:0.3", "--landing", "impact"])
+    assert given.double_support == (0.2, 0.3) and given.landing == "impact"
+    assert parser.parse_args(knee).double_support is None
