@@ -16,11 +16,12 @@ right after a rigid impact, exists in MuJoCo once the landing has settled. The s
 where the hip's advance over the stance ankle reaches the gait's at ``LANDING`` of the period
 (``section_advance``: x_H(0.1 T), 6 cm behind the ankle at 0.3 m/s), the state interpolated
 between the two physics steps around the crossing, so that the section does not move with
-MuJoCo's 2 ms grid. The section must find the stance foot at rest (below): the first of
-``SECTION_PHASES`` where it is (``settled_section``). A gait of single support's is at
-``LANDING``; a two-phase gait's stance foot still rocks there from its double support (its
-normal force swinging between 0 and 2100 N, its tilt rate spreading by 0.06-0.21 rad/s from
-step to step), and its section is later in the swing (0.7 T for the optima at 0.3 m/s).
+MuJoCo's grid of 1 ms physics steps. The section must find the stance foot at rest (below):
+the first of ``SECTION_PHASES`` where it is (``settled_section``). A gait of single support's
+is at ``LANDING``; a two-phase gait's stance foot still rocks there from its double support
+(its tilt rate spreading by 0.0085 rad/s from step to step for the rolling knee's optimum of
+zero-speed landing at 0.3 m/s), and its section is later in the swing (0.3 T for that gait,
+its tilt rate spreading by 2e-5 rad/s there).
 
 The coordinates: with the stance foot flat on the floor the hip follows from the stance leg
 (``Chain.stance_state``), and a state on the section has 12 coordinates, the free angles
@@ -31,14 +32,15 @@ the reference state's (``ReturnMap.lift``: the walk's mean state on the section)
 perturbation never lifts the stance foot or pushes it into the floor. That holds the walk's
 state only where the foot is at rest: where its tilt rate spreads over the walk's steps by
 more than a tenth of the map's rate step (``HELD_RATE_SPREAD``), the map restarted from the
-walk's own states misses the walk's next ones (by 2-4 spreads, root mean square, at 0.1 T of
-a two-phase walk) and is not the walk's; the orbit is then not measured (``UnsettledSection``,
-verdict undecided). The section fixes one
+walk's own states misses the walk's next ones (``restart_miss``: 1.25 central-difference
+steps, root mean square, at 0.1 T of a two-phase walk, against 0.33 at its section at rest
+and 0.03-0.07 at a single support's, beside ``RESTART_MISS``) and is not the walk's; the
+orbit is then not measured (``UnsettledSection``, verdict undecided). The section fixes one
 more direction, the flow along the orbit: a state moved along it reaches the same next state
-(J f = 0, a structural multiplier 0, measured as ``Multipliers.flow_gain``: within about
-its noise, ``Multipliers.flow_noise``, for the optimal gaits). The dynamic multipliers are
-those of J on the 11 directions across the flow (``section_basis``), along which the map
-is perturbed.
+(J f = 0, a structural multiplier 0, measured as ``Multipliers.flow_gain``: within about its
+noise, ``Multipliers.flow_noise``, for the optimal gaits). The dynamic multipliers are those
+of J on the 11 directions across the flow (``section_basis``), along which the map is
+perturbed.
 
 The closed loop carries nothing else across steps: the controller reads the phase from the
 state at each reading (``RESYNC``), its speed loop is proportional (no memory), the gains
@@ -48,42 +50,49 @@ the clock of its readings of the phase (the section's instead of the touchdown's
 
 MuJoCo's grid makes the map noisy. Which of the landing foot's two spheres touches first,
 and on which physics step, is decided by micrometres (the optimal gaits land flat, heel and
-toe within 10 µm, coming down 0.1 mm per physics step), and each choice sends the next step
-off with rates a few hundredths of a rad/s apart: the map is piecewise smooth, in pieces
-about 1e-3 rad/s wide in the rates, and within one piece its derivative is that of a landing
-pinned to one physics step, not the walk's. So the map is averaged over ``PHASES`` positions
-of the grid (the start moved back along the flow by (j + 1/2) / PHASES of a physics step),
-and the Jacobian is taken by central differences of ``STEP`` [rad] and ``RATE_STEP``
-[rad/s] over the coordinates (a unit step along each of the 12 directions of
-``section_basis`` in the coordinates over those steps, both ways, at each grid position:
-2 x 12 x PHASES one-step walks). The steps span many pieces and are about the walk's own
-spread on the section (0.02-0.03 rad/s in the rates at the default gains): the map is
-linearised over the states the walk visits. Its response is not linear far below or above
-them (the slowest multiplier of the default gains grows in modulus at smaller steps, the map
-being kinked where the landing changes from heel-first to toe-first), so ``tests/test_orbit``
-holds the multipliers of two step sizes together and the decay of walked perturbations to
-the multipliers. The spread of the central differences over the grid positions gives ρ's
+toe within 10 µm, coming down 0.05 mm per 1 ms physics step), and each choice sends the next
+step off with rates about a hundredth of a rad/s apart (the map's images over the grid
+spread by 0.010-0.015 rad/s in the fastest rates): the map is piecewise smooth, and within
+one piece its derivative is that of a landing pinned to one physics step, not the walk's. So
+the map is averaged over ``PHASES`` positions of the grid (the start moved back along the
+flow by (j + 1/2) / PHASES of a physics step), and the Jacobian is taken by central
+differences of ``STEP`` [rad] and ``RATE_STEP`` [rad/s] over the coordinates (a unit step
+along each of the 12 directions of ``section_basis`` in the coordinates over those steps,
+both ways, at each grid position: 2 x 12 x PHASES one-step walks). The steps span many
+pieces and are about the walk's own spread on the section, so that the map is linearised
+over the states the walk visits: the rates' standard deviation over the walk's steps is at
+most 0.011 rad/s for the optimal gaits at 0.3 m/s under the validation's controller (kp 2000
+N·m/rad, 1 ms physics steps; it was 0.022-0.025 rad/s at kp 1000 and 2 ms, with steps of
+3e-3 rad and 3e-2 rad/s, both halved since). The angles spread far less on the section (0.07
+mrad: the section fixes the hip's advance); the angle step stays a tenth of the rate step,
+the multipliers agreeing within their spreads for angle steps of 0.5 to 1.5 mrad. The map's
+response is not linear far below or above the walk's spread: at twice the steps the slowest
+multiplier of the default gains is a real 0.34 instead of a complex pair of modulus
+0.23-0.25, and within one piece (1e-5 rad, one grid position) it is -1.84, the map being
+kinked where the landing changes from heel-first to toe-first; so ``tests/test_orbit`` holds
+the multipliers of two step sizes together and the decay of walked perturbations to the
+multipliers. The spread of the central differences over the grid positions gives ρ's
 uncertainty (``Multipliers.spread``: the standard deviation of a bootstrap over them).
 
 The fixed point: the walk does not converge to one state, the landing's noise kicks it at
-every step (the default gains' slowest mode is a flip, near -0.8: the alternating step
-durations of the walk, 301 and 305 physics steps). Its states on the section over
+every step (the walk's steps last 598 or 599 physics steps, its rates on the section spread
+as above, while its slowest modes, a complex pair of modulus 0.23-0.25 for the optimal gaits
+at 0.3 m/s, turn by about 100° and shrink fourfold a step). Its states on the section over
 ``MEAN_STEPS`` steps after ``SETTLE_STEPS`` have a mean x̄, from which chord-Newton steps on
 the averaged map, x <- x - (J - I)⁻¹ (F̄(x) - x) (``CHORD_STEPS`` at most, while the residual
 falls), give the fixed point x*. It is reported with its residual |F̄(x*) - x*|, the noise of
 F̄ (its standard error over the grid) and its distance from the gait file's state on the
-section (the file's motion at ``LANDING`` of the period). The residual falls to the noise for
-the rolling knee's optimal gait at 0.3 m/s and stays at about 4 times it, a third of a
-central-difference step, for the revolute knee's: the averaged map, kinked, has no fixed
-point closer than that.
+section (the file's motion at ``LANDING`` of the period). For the optimal gaits at 0.3 m/s
+the residual is 0.12 of a central-difference step (rolling knee) and 0.01 (revolute knee).
 
 The verdict (``Orbit.verdict``): stable when ρ + ``MARGIN_SPREADS`` spreads < 1 (the orbit
-is inside the unit circle by more than the landing's noise moves its estimate; the
-estimate moves by about one spread from one machine to another, with the gait's last bits)
-and the walk's steps last the gait's period within ``PERIOD_TOLERANCE`` (else it walks
-another orbit: without the speed loop, a stable one at 1.3 T); unstable when ρ - as many
-spreads >= 1, or when a walk falls or misses the section (``OrbitFailure``: an orbit that
-cannot be found is unstable, said loudly); undecided between.
+is inside the unit circle by more than the landing's noise moves its estimate; the estimate
+moves by about one spread from one machine to another, with the gait's last bits) and the
+walk's steps last the gait's period within ``PERIOD_TOLERANCE`` (else it walks another
+orbit: without the speed loop and with the servos at 0.75 of their stiffness, one at
+1.13-1.14 T); unstable when ρ - as many spreads >= 1, or when a walk falls or misses the
+section (``OrbitFailure``: an orbit that cannot be found is unstable, said loudly);
+undecided between.
 """
 
 from __future__ import annotations
@@ -113,9 +122,10 @@ ANGLES = ("qp2", "q1", "q2", "q3", "q4", "q5")
 COORDINATES = ANGLES + tuple(f"{name}_rate" for name in ANGLES)
 FREE = slice(1, 7)  # the free angles' columns in the paper's q
 HELD = [QP1, XH, ZH]  # what the stance foot's contact holds: not coordinates
-# Central-difference steps: angles [rad] and rates [rad/s] (see the module docstring).
-STEP = 3e-3
-RATE_STEP = 3e-2
+# Central-difference steps: angles [rad] and rates [rad/s], about the walk's own spread on
+# the section in the rates (see the module docstring).
+STEP = 1.5e-3
+RATE_STEP = 1.5e-2
 # Positions of MuJoCo's physics-step grid the map is averaged over.
 PHASES = 12
 # Steps walked before the walk's states on the section are averaged, and how many are.
@@ -129,8 +139,8 @@ NOMINAL = WalkSettings()
 BOOTSTRAP = 200
 # The orbit check's margin: ρ plus this many spreads below 1 (see ``Orbit.verdict``): an
 # error shrinks from step to step by more than the landing's noise moves the estimate of
-# the factor (ρ + 2 spreads = 0.95 for the rolling knee's optimal gait at 0.3 m/s: an
-# error halved within 12 steps, 7 s).
+# the factor (ρ + 2 spreads = 0.30 for the rolling knee's optimal gait at 0.3 m/s: an
+# error halved within one step).
 MARGIN_SPREADS = 2.0
 # Where the section may lie, as fractions of the swing's time T after the step's start,
 # tried in turn: the orbit's is the first where the stance foot is at rest on the floor
@@ -140,13 +150,21 @@ SECTION_PHASES = (LANDING, 0.3, 0.5, 0.7)
 # [rad/s] The largest spread, over the walk's steps, of the stance foot's tilt rate on the
 # section: the return map holds the stance foot's pose and rates at the walk's mean
 # (``ReturnMap.lift``), so what they vary by must be small beside the map's rate step (a
-# tenth of it). The optimal gaits of single support: below 1e-3 rad/s at 0.1 T; the
-# two-phase gaits at 0.3 m/s: 0.06-0.21 rad/s at 0.1 and 0.3 T, their stance foot's
-# normal force swinging between 0 and 2100 N there.
+# tenth of it). The optimal gaits of single support: 2.6e-5 rad/s at 0.1 T; the rolling
+# knee's two-phase gait of zero-speed landing at 0.3 m/s: 0.0085 rad/s at 0.1 T, 2e-5 rad/s
+# at 0.3 T.
 HELD_RATE_SPREAD = 0.1 * RATE_STEP
+# The largest miss of the return map restarted from the walk's own states on the section
+# (``restart_miss``: from the walk's next state to the nearest of the map's images over the
+# grid, root mean square over the states tried) [central-difference steps]: half a step, as
+# the fixed point's residual. Measured: 0.07 on the optimal gaits' section at 0.1 T; 0.33 on
+# the rolling knee's two-phase gait at 0.3 T, where its stance foot is at rest, and 1.25 at
+# 0.1 T, where it still rocks and the 12 coordinates do not hold the walk's state.
+RESTART_MISS = 0.5
 # Largest relative difference of the orbit's step duration from the gait's period (30 ms of
-# the 0.59 s step at 0.3 m/s): the default walks' steps last 1.01-1.03 T; a walk that
-# settles at another period walks another orbit (the speed loop off: 1.3 T).
+# the 0.59 s step at 0.3 m/s): the default walks' steps last 1.007 T; a walk that settles at
+# another period walks another orbit (the speed loop off with the servos at 0.75 of their
+# stiffness: 1.13-1.14 T).
 PERIOD_TOLERANCE = 0.05
 
 
@@ -730,3 +748,23 @@ def walked_decay(result: Orbit, direction, steps: int, phases: int) -> np.ndarra
             walked[side, j] = returns.sections(sim, range(1, steps + 1))
     start = np.broadcast_to(direction, (phases, 1, 12))
     return np.concatenate([start, 0.5 * (walked[0] - walked[1])], axis=1)
+
+
+def restart_miss(returns: ReturnMap, states, rows, steps: Steps = Steps()) -> float:
+    """[central-difference steps] How far the return map restarted from the walk's own states
+    on the section misses the walk: for each row k of ``rows``, the distance from the walk's
+    next state ``states[k + 1]`` to the nearest of F(``states[k]``) over ``steps.phases``
+    grid positions, in the coordinates over ``steps`` (``Steps.vector``); the root mean square
+    over the rows. The walk's next state is one of the map's images, the one at the walk's own
+    position on MuJoCo's grid (up to the grid's spacing), when the map is the walk: the
+    distance to the images' mean would be the grid's spread, not a miss. A map that does not
+    hold the walk's state (a stance foot still rocking, ``HELD_RATE_SPREAD``) misses by its
+    bias, beyond ``RESTART_MISS``."""
+    states, scale = np.asarray(states, float), steps.vector()
+    nearest = [
+        np.linalg.norm(
+            (returns.at_phases(states[k], steps.phases) - states[k + 1]) / scale, axis=1
+        ).min()
+        for k in rows
+    ]
+    return float(np.sqrt(np.mean(np.square(nearest))))

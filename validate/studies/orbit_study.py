@@ -35,7 +35,7 @@ KNOBS = {
     "kv": ("kv_scale", "the servos' damping KV"),
     "speed": ("speed_scale", "the speed loop's gain SPEED_GAIN"),
 }
-# Largest scale of a gain (a walk's physics at 2 ms resolves stiffer servos poorly).
+# Largest scale of a gain (a walk's physics at 1 ms resolves stiffer servos poorly).
 MAX_SCALE = 100.0
 
 
