@@ -87,8 +87,8 @@ EXACT = 1e-6
 # or with 2-3 cm of clearance, need 0.0064 at most (that swing ankle, with servos of
 # 1000 N·m/rad); the optimal gaits at 0.3 m/s 0.0034 with the servos of 2000 N·m/rad (0.0021
 # at 1000: the stiffer servos pull harder on MuJoCo's integration error); the Table 1 gaits
-# on a model 10 % off need 0.026 (r1; 0.017 at 1000) to 0.67 (the trunk's centre of mass),
-# 0.05 (a thigh's inertia), 0.47 (the trunk's mass), these three at 1000 N·m/rad.
+# on a model 10 % off need 0.026 (r1; 0.017 at 1000) to 1.1 (the trunk's centre of mass;
+# 0.67), 0.058 (a thigh's inertia; 0.05), 0.69 (the trunk's mass; 0.47).
 SERVO_SHARE = 0.01
 # The same in a two-phase gait's double support replayed, both feet on the floor: the two
 # stiff soft contacts of a closed chain chatter (each foot's force swings by hundreds of
