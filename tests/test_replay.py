@@ -16,6 +16,12 @@ from validate.walk.replay import replay_model, replay_step
 from validate.walk.samples import GaitSamples
 
 KNEES = ("revolute", "rolling")
+# The exact torques' servos, RMS over the step against the torque scale: what MuJoCo's
+# integration error at the replay's step leaves, pulled on by the servos' stiffness (0.32 %
+# for the revolute knee's optimum, 0.34 % for the rolling knee's at kp = 2000 N·m/rad; 0.19
+# and 0.21 % at 1000). Allowed: a third of the 1.2 % that a joint's torque a fifth off takes
+# from them at least (test_one_joint_off_by_a_fifth), the smallest wrong input caught.
+EXACT_SHARE = 1.2 * SERVO_SHARE / 3
 
 
 @pytest.fixture(scope="module", params=KNEES)
@@ -39,12 +45,12 @@ def mutated(gait: Gait, change) -> Gait:
 
 
 def test_exact_torques_pass(optimum):
-    """The file's own torques leave every servo under a fifth of 1 % of the robot's torque
-    scale, both legs in stance; the scale is the largest joint's RMS torque."""
+    """The file's own torques leave every servo under ``EXACT_SHARE`` (0.4 %) of the robot's
+    torque scale, both legs in stance; the scale is the largest joint's RMS torque."""
     gait, biped, spec, _ = optimum
     check = check_feedforward(spec, biped, GaitSamples.from_gait(gait))
     assert check.passed and check.causes == [], check.line()
-    assert check.figures["max_feedback_ratio"] < SERVO_SHARE / 4
+    assert check.figures["max_feedback_ratio"] < EXACT_SHARE
     torques = [check.figures[f"torque_rms_{joint}"] for joint in JOINTS]
     assert min(torques) > 0.0 and check.figures["torque_scale"] == max(torques)
 

@@ -98,11 +98,14 @@ def test_fall_ends_the_simulation():
 
 
 def test_flipped_torques_roll_the_stance_foot():
-    """With every torque of the file's sign flipped, the stance foot rolls onto its heel
-    within the first step, the hip still up (its toe lifts by centimetres): the foot check
-    fails before any fall."""
+    """With every torque of the file's sign flipped and tripled, the stance foot rolls onto
+    its heel within the first step, the hip still up (its toe lifts by 12 cm): the foot check
+    fails before any fall. A servo's tracking error is the torque it lacks over its stiffness:
+    Γ x -3 lacks 4 Γ, which servos of 2000 N·m/rad track as closely as those of 1000 tracked
+    Γ x -1 (2 Γ), which rolled the foot then (0.27 rad); with 2000 N·m/rad, Γ x -1 walks two
+    steps (the replay fails it: tests/test_replay.py), Γ x -2 scuffs, Γ x -3 rolls 0.48 rad."""
     gait = gait_of(optimal_gait("revolute"))
-    gait = with_torques(gait, -gait.samples.torques)
+    gait = with_torques(gait, -3.0 * gait.samples.torques)
     walker = Walker(gait)
     sim = walker.walk(2)
     first = contact.foot_tilt(sim, walker.period)
@@ -236,15 +239,17 @@ def test_a_failed_forward_check_says_why_in_words():
     """Zero torques, the servos alone holding the joints: the forward check fails, its causes
     first on its line and its first note saying why in words (the steps walked, then each
     cause on its physical scale), so a line that gives only the notes (the atlas's) names the
-    reason: the stance foot slides (mm, a share of the step) and rolls onto its edge (mm off
-    the floor), the swing foot drags (ms, mm deep), no step lands, the hip stays up; the optimal gait's check passes with no such
-    note and no cause."""
+    reason: in the first step the stance foot slides (46 mm, a share of the step) and rolls
+    onto its edge (0.24 rad, mm off the floor), the swing foot drags (ms, mm deep), the hip
+    stays up; the servos of 2000 N·m/rad alone land the steps (advancing the hip 0.80-1.09
+    of the step; those of 1000 N·m/rad did not: "did not advance"). The optimal gait's check
+    passes with no such note and no cause."""
     from validate.checks.checks import check_forward
 
     gait = gait_of(small_optimum("revolute"))
     limp = Walker(with_torques(gait, np.zeros_like(gait.samples.torques)))
     check, _, _ = check_forward(limp, 3, energy=1.0)
-    causes = ["scuffed", "slipped", "tilted", "did not advance"]
+    causes = ["scuffed", "slipped", "tilted"]
     assert not check.passed and check.causes == causes
     assert check.line().startswith(f"FAIL  forward           [{', '.join(causes)}] ")
     first = check.notes[0]

@@ -127,16 +127,22 @@ def test_a_wrong_model_fails_naming_its_cause(knee, name):
     elif old_failed:
         assert not replay.passed, replay.line()
     if name == "ankle_height":  # the soles sink or float: the walk tells how
+        # the stance foot rolls onto an edge of its sole in the first step (0.70 rad), the
+        # robot still up (the servos of 2000 N·m/rad land the swing foot, which those of
+        # 1000 did not: "did not advance" then)
         walk = found["forward"]
-        assert {"tilted", "did not advance"} <= set(walk.causes), walk.line()
-        assert walk.figures["steps"] < STEPS
+        assert "tilted" in walk.causes and not walk.figures["fell"], walk.line()
+        assert walk.figures["steps"] == 0 and walk.figures["max_foot_tilt"] > 0.1
 
 
 def test_the_torque_scale_catches_what_the_share_missed():
-    """The rolling knee's r1 5 mm longer (r2 / r1 off: the shank's rolling) needs 0.029 N·m of
-    servo torque at the stance hip: 3.5 % of a joint's own torque at most (passed before),
-    1.7 % of the robot's torque scale (fails now)."""
-    found = checks_on(_gait("rolling"), dataclasses.replace(PAPER, r1=0.055))
+    """The rolling knee's r1 3 mm longer (r2 / r1 off: the shank's rolling) needs 0.027 N·m of
+    servo torque at the stance hip: 3.4 % of a joint's own torque at most (passed before),
+    1.6 % of the robot's torque scale (fails now). The servos strain against the wrong
+    geometry in proportion to their stiffness: at 2000 N·m/rad r1 5 mm longer needs 0.044
+    N·m at the stance hip and 5.2 % of the stance knee's own torque, which the share fails
+    too (at 1000 N·m/rad it needed 0.029 N·m and 3.5 %)."""
+    found = checks_on(_gait("rolling"), dataclasses.replace(PAPER, r1=0.053))
     figures = found["feedforward"].figures
     assert figures["max_feedback_share"] < OLD_SHARE
     assert figures["max_feedback_ratio"] >= SERVO_SHARE and not found["feedforward"].passed
@@ -174,7 +180,8 @@ def test_a_swing_ankles_small_servo_torque_passes_a_correct_gait():
 def test_the_table_1_model_passes_every_check(knee, walkable):
     """The optimal gait at 0.3 m/s (and the walkable one, ``--walkable``) of each knee on the
     Table 1 model: every check passes, no cause; the replay's servos stay below a third of
-    the tolerance."""
+    the 1.2 % that a joint's torque a fifth off takes from them (tests/test_replay.py: 0.34 %
+    at most with servos of 2000 N·m/rad, 0.21 % at 1000)."""
     from biped.model.criteria import WALKABLE
     from biped.optimization.optimize import optimize
     from biped.optimization.problem import GaitProblem
@@ -189,4 +196,4 @@ def test_the_table_1_model_passes_every_check(knee, walkable):
     assert result.passed, lines
     report = validation_report(result.checks)
     assert all(check.causes == () for check in report.checks)
-    assert report.check("feedforward").figures["max_feedback_ratio"] < SERVO_SHARE / 3
+    assert report.check("feedforward").figures["max_feedback_ratio"] < 1.2 * SERVO_SHARE / 3

@@ -84,9 +84,11 @@ EXACT = 1e-6
 # carrying 0.12 N·m needs 0.015 N·m of servo torque for the millisecond after its torque
 # jumps at the mid-step knot, 12 % of its own torque but 0.6 % of the scale. Measured
 # (``tests/test_wrong_models.py``): the correct gaits of both knees at 0.2-0.6 m/s, walkable
-# or with 2-3 cm of clearance, need 0.0064 at most (that swing ankle; 0.0021 the optimal
-# gaits at 0.3 m/s); the Table 1 gaits on a model 10 % off need 0.017 (r1) to 0.67 (the
-# trunk's centre of mass), 0.05 (a thigh's inertia), 0.47 (the trunk's mass).
+# or with 2-3 cm of clearance, need 0.0064 at most (that swing ankle, at 0.2 m/s with 3 cm,
+# with servos of 1000 or 2000 N·m/rad alike); the optimal gaits at 0.3 m/s 0.0034 (0.0021
+# at 1000: the stiffer servos pull harder on MuJoCo's integration error); the Table 1 gaits
+# on a model 10 % off need 0.026 (r1; 0.017 at 1000) to 1.1 (the trunk's centre of mass;
+# 0.67), 0.058 (a thigh's inertia; 0.05), 0.69 (the trunk's mass; 0.47).
 SERVO_SHARE = 0.01
 # The same in a two-phase gait's double support replayed, both feet on the floor: the two
 # stiff soft contacts of a closed chain chatter (each foot's force swings by hundreds of

@@ -19,7 +19,9 @@ but not against the whole robot leaning on its stance foot (gravity's 600 N·m/r
 ankle), and the soles are stiff springs, not a rigid floor. What they add falls with the
 physics step (halving it halves every servo's torque: MuJoCo's integration error), so the
 replay runs at ``TIMESTEP`` (62.5 µs) with the contact as stiff as that step allows
-(``SOLREF``): shares of 0.006 at most for the optimal gaits at 0.3 m/s and below 0.025 for
+(``SOLREF``): shares of 0.007 at most for the optimal gaits at 0.3 m/s (servos of
+2000 N·m/rad, which pull harder on the same integration error than 1000 N·m/rad's 0.005;
+their RMS torque 0.34 % of the torque scale at most, 0.21 % at 1000) and below 0.025 for
 the designed gaits with a 2 cm clearance (whose swing ankle carries 0.08 N·m RMS), against
 0.1 or more for any one joint 20 % off. At 0.25 ms the same exact torques reached 0.077 at
 that swing ankle.
