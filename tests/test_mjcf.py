@@ -260,7 +260,7 @@ def fine_spec(gait, factor: int = 2) -> mujoco.MjSpec:
     """The committed scene of ``gait``'s knee at 1/``factor`` of its time step, each sole a box
     on the floor (four contact points) instead of its heel and toe points, the contacts and
     the knee equality as stiff as that step allows, friction harder than the normal force
-    (``IMPRATIO_HARD``): the physics the committed model's cheaper settings (2 ms, two points
+    (``IMPRATIO_HARD``): the physics the committed model's cheaper settings (1 ms, two points
     a sole, friction as soft as the normal force) stand for."""
     from validate.scene import mjcf
     from validate.scene.model import model_spec
@@ -343,7 +343,7 @@ def settings_differences(knee: str, spec_of) -> list[str]:
 
 @pytest.mark.parametrize("knee", biped.KNEES)
 def test_cheaper_settings_leave_the_physics(knee):
-    """The committed model's 2 ms step, two contact points a sole and soft friction against
+    """The committed model's 1 ms step, two contact points a sole and soft friction against
     the same robot at 0.5 ms with box soles and hard friction: nothing tells them apart
     (``settings_differences``: the same inverse dynamics, the rigid bodies being one robot,
     and the same 10-step walk within stated bounds), and the finer model walks without

@@ -20,16 +20,18 @@ between, so MuJoCo runs each stretch on its own (``mujoco.rollout``, no Python i
 with the feedback closed at every physics step by its servos (``validate.scene.model.with_servos``).
 
 The stance ankle has no servo: its torque places the centre of pressure under the foot, and a
-servo there (kp = 1000 N·m/rad against a pendulum of m g l ≈ 600 N·m/rad) would move the
+servo there (kp = 2000 N·m/rad against a pendulum of m g l ≈ 600 N·m/rad) would move the
 centre of pressure by centimetres for a few hundredths of a radian, roll the foot and trip the
 robot. It carries the file's Γ1 and the ankle strategy of a walker, a torque on the speed:
 
     u_ankle = Γ1(τ) + J_r θ̈1 ṡ²  +  K (ẋ_H - ẋ_H,ref(τ))        K = ``SPEED_GAIN``
 
 (a robot a little fast moves its centre of pressure forward by K Δẋ / F_z, 3 mm for 1 cm/s,
-and slows down). The gait's orbit is not stable on its own: played with the phase alone, the
-optimal gaits lose speed step after step in MuJoCo (1.3 T a step after 10 steps) and their
-swing foot, clearing the ground by a millimetre, ends up scuffing it. The five other joints
+and slows down). Without it the gait's speed is held by the servos alone: with the
+validation's stiffness the optimal gaits at 0.3 m/s still walk their period (0.98-0.99 T a
+step), with three quarters of it they settle on another orbit, 1.13-1.14 T a step, and with
+half of it they lose speed step after step (1.3 T a step after 10 steps) until their swing
+foot, clearing the ground by a millimetre, scuffs it. The five other joints
 track their reference with ``KP``, ``KV`` (times ``WalkSettings.kp_scale``, ``kv_scale``; K
 times ``WalkSettings.speed_scale``).
 
@@ -413,7 +415,7 @@ class Simulation:
         """Torques (N, 6) of the position and velocity servos and of the stance ankle on the
         speed, in the paper's sign, in ``JOINT_ORDER``. The damping acts on the velocity at
         the end of each physics step (MuJoCo integrates it implicitly): reading it at the
-        start would add h kv θ̈, an apparent inertia of 0.08 kg·m² at 2 ms and
+        start would add h kv θ̈, an apparent inertia of 0.04 kg·m² at 1 ms and
         kv = 40 N·m·s/rad."""
         layout = self.layout
         stiffness = np.full((len(self.time), 6), self.settings.kp)
