@@ -78,7 +78,7 @@ def add_parser(commands) -> None:
 
 
 def _add_arguments(parser) -> None:
-    from validate.checks.orbit import PHASES, RATE_STEP, STEP
+    from validate.checks.orbit import PHASES, RATE_STEP, STEP, TWO_PHASE_PHASES
     from validate.studies.orbit_files import KNEES_FIGURE
     from validate.studies.orbit_study import KNOBS
 
@@ -96,9 +96,10 @@ def _add_arguments(parser) -> None:
     rates = RATE_STEP / STEP
     types.add_options(
         parser,
-        ("--phases", types.bounded(1, MAX_PHASES), PHASES, "N", "positions of MuJoCo's "
+        ("--phases", types.bounded(1, MAX_PHASES), None, "N", "positions of MuJoCo's "
          f"physics-step grid the return map is averaged over, 1 to {MAX_PHASES} (default "
-         f"{PHASES}; 2 x 12 x N one-step walks a Jacobian)"),
+         f"{PHASES}, {TWO_PHASE_PHASES} for a two-phase gait; 2 x 12 x N one-step walks a "
+         "Jacobian)"),
         ("--step", step, STEP, "RAD", "[rad] central-difference step on the angles, the "
          f"rates' {rates:g} times it in rad/s, {STEP_RANGE[0]:g} to {STEP_RANGE[1]:g} "
          f"(default {STEP:g})"),

@@ -126,8 +126,14 @@ HELD = [QP1, XH, ZH]  # what the stance foot's contact holds: not coordinates
 # the section in the rates (see the module docstring).
 STEP = 1.5e-3
 RATE_STEP = 1.5e-2
-# Positions of MuJoCo's physics-step grid the map is averaged over.
+# Positions of MuJoCo's physics-step grid the map is averaged over: for a walk of single
+# support, and for a two-phase walk, whose landed foot bounces through the double support
+# and whose map is noisier. Over 12 positions the zero-speed two-phase optima at 0.3 m/s
+# read ρ = 0.863 ± 0.107 (rolling) and 0.872 ± 0.203 (revolute), undecided; over 24,
+# 0.806 ± 0.045 and 0.814 ± 0.080; over 36, 0.819 ± 0.040 and 0.833 ± 0.075: the estimate
+# stays, its spread falls as the square root of the positions' count.
 PHASES = 12
+TWO_PHASE_PHASES = 24
 # Steps walked before the walk's states on the section are averaged, and how many are.
 SETTLE_STEPS = 6
 MEAN_STEPS = 24
@@ -184,16 +190,29 @@ class Steps:
     Attributes:
         angle: [rad] on each free angle.
         rate: [rad/s] on each rate.
-        phases: positions of the physics-step grid averaged over.
+        phases: positions of the physics-step grid averaged over (None: the walk's own,
+            ``walk_phases``).
     """
 
     angle: float = STEP
     rate: float = RATE_STEP
-    phases: int = PHASES
+    phases: int | None = None
+
+    def of_walk(self, walker: Walker) -> Steps:
+        """These steps, their grid positions the walk's own where not given."""
+        if self.phases is not None:
+            return self
+        return Steps(self.angle, self.rate, walk_phases(walker))
 
     def vector(self) -> np.ndarray:
         """(12,) the step on each coordinate."""
         return np.array([self.angle] * 6 + [self.rate] * 6)
+
+
+def walk_phases(walker: Walker) -> int:
+    """The grid positions a walk's map is averaged over: ``TWO_PHASE_PHASES`` for a two-phase
+    gait's, else ``PHASES``."""
+    return TWO_PHASE_PHASES if walker.samples.two_phase else PHASES
 
 
 class ReturnMap:
@@ -577,6 +596,7 @@ def orbit(
     rest, ``settled_section``), chord-Newton steps to the fixed point, the multipliers. An
     ``Orbit`` whose ``failure`` says why when a walk falls or misses the section, or when the
     stance foot is at rest on no section (``unsettled``)."""
+    steps = steps.of_walk(walker)
     advance = section_advance(walker, tau)
     phase = LANDING if tau is None else float(tau) / walker.samples.landing_time
     try:
@@ -761,6 +781,7 @@ def restart_miss(returns: ReturnMap, states, rows, steps: Steps = Steps()) -> fl
     hold the walk's state (a stance foot still rocking, ``HELD_RATE_SPREAD``) misses by its
     bias, beyond ``RESTART_MISS``."""
     states, scale = np.asarray(states, float), steps.vector()
+    steps = steps.of_walk(returns.walker)
     nearest = [
         np.linalg.norm(
             (returns.at_phases(states[k], steps.phases) - states[k + 1]) / scale, axis=1
