@@ -209,3 +209,43 @@ def assert_graph_is_the_model(problem, safety, family, seed: int) -> None:
     ):
         scale = np.max(np.abs(expected))
         np.testing.assert_allclose(found, expected, rtol=1e-12, atol=1e-12 * scale)
+
+
+def _orbit_key(walker, args, kwargs) -> str:
+    """What an orbit is a function of: the walker's compiled model (every number of it, the
+    servos included), the gait's samples as the walk reads them, and the arguments."""
+    import hashlib
+
+    import mujoco
+
+    model = np.empty(mujoco.mj_sizeModel(walker.model), dtype=np.uint8)
+    mujoco.mj_saveModel(walker.model, None, model)
+    digest = hashlib.sha256(model.tobytes())
+    for name in ("t", "q", "qd", "torques", "wrench", "swing_wrench"):
+        digest.update(np.ascontiguousarray(getattr(walker.samples, name)).tobytes())
+    digest.update(repr((walker.samples.period, walker.samples.landing, args, kwargs)).encode())
+    return digest.hexdigest()
+
+
+_ORBITS: dict = {}
+
+
+def pytest_runtest_setup(item):
+    """Once MuJoCo's orbit module is loaded, each orbit is computed once per test process:
+    MuJoCo's walks are deterministic, so the same walker and arguments give the same orbit,
+    and the validations of one gait in several tests share it."""
+    import sys
+
+    module = sys.modules.get("validate.checks.orbit")
+    if module is None or getattr(module.orbit, "once", False):
+        return
+    computed = module.orbit
+
+    def orbit(walker, *args, **kwargs):
+        key = _orbit_key(walker, args, kwargs)
+        if key not in _ORBITS:
+            _ORBITS[key] = computed(walker, *args, **kwargs)
+        return _ORBITS[key]
+
+    orbit.once = True
+    module.orbit = orbit
