@@ -249,3 +249,34 @@ def pytest_runtest_setup(item):
 
     orbit.once = True
     module.orbit = orbit
+
+
+# Test files whose tests share one process's two-phase optima (``two_phase_gait``,
+# ``two_phase_result``; 10-45 s each to solve): run as one unit of ``--dist loadfile``, so
+# that each optimum is solved once in the whole run instead of once in each worker that
+# runs one of them.
+TWO_PHASE_FILES = {
+    "test_anchor.py",
+    "test_two_phase_gait.py",
+    "test_two_phase_nlp.py",
+    "test_two_phase_orbit.py",
+    "test_two_phase_page.py",
+    "test_two_phase_record.py",
+    "test_two_phase_validate.py",
+    "test_two_phase_video.py",
+    "test_two_phase_walk.py",
+}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile`` with ``TWO_PHASE_FILES`` one unit of work."""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class SharedOptima(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            path = super()._split_scope(nodeid)
+            return "two-phase optima" if Path(path).name in TWO_PHASE_FILES else path
+
+    return SharedOptima(config, log)
