@@ -128,8 +128,9 @@ STEP = 1.5e-3
 RATE_STEP = 1.5e-2
 # Positions of MuJoCo's physics-step grid the map is averaged over: for a walk of single
 # support, and for a two-phase walk, whose landed foot bounces through the double support
-# and whose map is noisier. Over 12 positions the zero-speed two-phase optima at 0.3 m/s
-# read ρ = 0.863 ± 0.107 (rolling) and 0.872 ± 0.203 (revolute), undecided; over 24,
+# and whose map is noisier. Over 12 positions the zero-speed two-phase optima at 0.3 m/s (a
+# tenth to a fifth of the step in double support, one start: ``tests.conftest``) read
+# ρ = 0.863 ± 0.107 (rolling) and 0.872 ± 0.203 (revolute), undecided; over 24,
 # 0.806 ± 0.045 and 0.814 ± 0.080; over 36, 0.819 ± 0.040 and 0.833 ± 0.075: the estimate
 # stays, its spread falls as the square root of the positions' count.
 PHASES = 12
