@@ -62,7 +62,7 @@ def main() -> None:
             f"{continuous:.3f} s: x {jacobian / continuous:.2f}"
         )
         print(
-            f"{'':9} the orbit ({result.walks} walks, {steps.phases} grid positions) "
+            f"{'':9} the orbit ({result.walks} walks, {result.steps.phases} grid positions) "
             f"{whole:.2f} s, {result.walks} steps as one walk {walked:.2f} s: "
             f"x {whole / walked:.2f}; ρ {m.radius:.3f} ± {m.spread:.3f}"
         )
