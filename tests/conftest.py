@@ -177,12 +177,44 @@ _SLOW = {
 }
 
 
+# The test files that take longest in the full tier (tens of seconds each, the two-phase
+# optima's unit the longest), run first: a long unit of work started last would leave the
+# other worker idle at the end of the run.
+LONGEST_FIRST = (
+    "test_two_phase_gait.py",
+    "test_atlas.py",
+    "test_sweep.py",
+    "test_atlas_two_phase.py",
+    "test_outputs.py",
+    "test_actuators.py",
+    "test_optimize.py",
+    "test_validate.py",
+    "test_converge.py",
+    "test_wrong_models.py",
+    "test_two_phase_sweep.py",
+    "test_compiled.py",
+    "test_pipeline_two_phase.py",
+    "test_robustness.py",
+    "test_design.py",
+    "test_profile_design.py",
+)
+
+
+def _rank(item) -> int:
+    """Where ``item``'s file runs: ``LONGEST_FIRST``'s order, the two-phase optima's files
+    as their unit, then the others in their own order."""
+    name = Path(str(item.fspath)).name
+    name = "test_two_phase_gait.py" if name in TWO_PHASE_FILES else name
+    return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
+
+
 def pytest_collection_modifyitems(config, items):
     """Mark ``slow`` each test of a function, or of a test file, listed in
-    ``tests/slow.txt``."""
+    ``tests/slow.txt``; put the longest files first (``LONGEST_FIRST``)."""
     for item in items:
         if {item.nodeid.split("[")[0], item.nodeid.split("::")[0]} & _SLOW:
             item.add_marker(pytest.mark.slow)
+    items.sort(key=_rank)
 
 
 def assert_graph_is_the_model(problem, safety, family, seed: int) -> None:
@@ -279,4 +311,5 @@ def pytest_xdist_make_scheduler(config, log):
             path = super()._split_scope(nodeid)
             return "two-phase optima" if Path(path).name in TWO_PHASE_FILES else path
 
+    config.option.loadscopereorder = False  # the collection's order: ``LONGEST_FIRST``
     return SharedOptima(config, log)
