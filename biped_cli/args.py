@@ -590,17 +590,27 @@ TIMESTEP_HELP = (
 )
 
 
-def timestep(text: str) -> float:
-    """``--timestep S`` [s], from ``MIN_TIMESTEP`` to ``MAX_TIMESTEP``."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"timestep = {text!r} is not a number") from None
-    if not (np.isfinite(value) and MIN_TIMESTEP <= value <= MAX_TIMESTEP):
-        raise argparse.ArgumentTypeError(
-            f"timestep = {text!r} s: allowed {MIN_TIMESTEP:g} to {MAX_TIMESTEP:g} s"
-        )
-    return value
+def ranged(name: str, low: float, high: float, unit: str = ""):
+    """A finite number from ``low`` to ``high`` inclusive, named ``name`` [``unit``] in the
+    message of a value refused."""
+    unit = f" {unit}" if unit else ""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} = {text!r} is not a number") from None
+        if not (np.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(
+                f"{name} = {text!r}{unit}: allowed {low:g} to {high:g}{unit}"
+            )
+        return value
+
+    return parse
+
+
+# ``--timestep S`` [s], from ``MIN_TIMESTEP`` to ``MAX_TIMESTEP``.
+timestep = ranged("timestep", MIN_TIMESTEP, MAX_TIMESTEP, "s")
 
 
 def add_timestep(parser) -> None:
@@ -617,17 +627,8 @@ KP_SCALE_HELP = (
 )
 
 
-def kp_scale(text: str) -> float:
-    """``--kp-scale X``, within ``KP_SCALES``."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"kp scale = {text!r} is not a number") from None
-    if not (np.isfinite(value) and KP_SCALES[0] <= value <= KP_SCALES[1]):
-        raise argparse.ArgumentTypeError(
-            f"kp scale = {text!r}: allowed {KP_SCALES[0]:g} to {KP_SCALES[1]:g}"
-        )
-    return value
+# ``--kp-scale X``, within ``KP_SCALES``.
+kp_scale = ranged("kp scale", *KP_SCALES)
 
 
 def add_kp_scale(parser) -> None:
