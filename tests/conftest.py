@@ -177,9 +177,10 @@ _SLOW = {
 }
 
 
-# The test files that take longest in the full tier (tens of seconds each, the two-phase
-# optima's unit the longest), run first: a long unit of work started last would leave the
-# other worker idle at the end of the run.
+# The test files that take longest in the full tier (6 s to tens of seconds each, the
+# two-phase optima's unit the longest), longest first, then the others (a few seconds
+# each): a long unit of work started last would leave the other worker idle at the end of
+# the run.
 LONGEST_FIRST = (
     "test_two_phase_gait.py",
     "test_atlas.py",
@@ -197,6 +198,23 @@ LONGEST_FIRST = (
     "test_robustness.py",
     "test_design.py",
     "test_profile_design.py",
+    "test_orbit.py",
+    "test_walkable.py",
+    "test_bezier.py",
+    "test_runner.py",
+    "test_cli_help.py",
+    "test_video.py",
+    "test_design_map.py",
+    "test_interrupts.py",
+    "test_criteria_matrix.py",
+    "test_profile_graph.py",
+    "test_replay.py",
+    "test_profile_orbit.py",
+    "test_cli.py",
+    "test_paper_method.py",
+    "test_page.py",
+    "test_families.py",
+    "test_record.py",
 )
 
 
