@@ -49,12 +49,12 @@ def validate_and_record(
     with their units, the recording's and video's paths).
     """
     from biped.records.provenance import provenance
-    from validate.checks import validation
+    from validate.checks import checks, validation
     from validate.outputs.outputs import claim
     from validate.outputs.record import record
 
-    walk = {} if settings is None else {"settings": settings}  # None: the validation's gains
-    result = validation.validate(gait, steps=steps, model=model, **walk)
+    walk = checks.WALK if settings is None else settings
+    result = validation.validate(gait, steps=steps, model=model, settings=walk)
     written = record(rrd, result, spawn=spawn, connect=connect)
     if source is not None:
         claim(written, source)
